@@ -1,0 +1,68 @@
+"""The `twin` command line: builds the Typer app from the command modules; the error boundary."""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from twin_cli import commands
+
+app = typer.Typer(
+    name="twin",
+    help="A MuJoCo digital twin for robots described for Gazebo: convert, spawn, run, validate.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+commands.register_all(app)
+
+
+@app.command()
+def version() -> None:
+    """Print twin's version."""
+    from importlib.metadata import version as _version
+
+    print(f"twin {_version('twin')}")
+
+
+def main() -> None:
+    """Console entry point: known errors become one message on stderr and exit code 2.
+
+    `--debug` anywhere on the command line re-raises with the traceback instead.
+    """
+    debug = "--debug" in sys.argv
+    if debug:
+        sys.argv = [a for a in sys.argv if a != "--debug"]
+    from converters.errors import ConversionError
+    from twin_cli.errors import TwinError
+    from twin_cli.output import error
+
+    try:
+        rc = app(standalone_mode=False)
+    except (ConversionError, TwinError) as exc:
+        if debug:
+            raise
+        error(str(exc))
+        sys.exit(getattr(exc, "exit_code", 2))
+    except typer.Abort:
+        sys.exit(130)
+    except KeyboardInterrupt:
+        sys.exit(130)
+    except SystemExit:
+        raise
+    except Exception as exc:  # click usage errors and the like
+        import click
+
+        if isinstance(exc, click.exceptions.ClickException):
+            exc.show()
+            sys.exit(2)
+        if isinstance(exc, click.exceptions.Exit):
+            sys.exit(exc.exit_code)
+        raise
+    if isinstance(rc, int) and rc:
+        sys.exit(rc)
+
+
+if __name__ == "__main__":
+    main()

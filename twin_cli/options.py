@@ -1,0 +1,38 @@
+"""Options shared by several commands, defined once (Gazebo's names where Gazebo has them)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
+WorldOpt = Annotated[
+    str,
+    typer.Option("--world", envvar="TWIN_WORLD", help="Name of the world to talk to."),
+]
+ArgOpt = Annotated[
+    list[str] | None,
+    typer.Option("--arg", help="xacro argument NAME:=VALUE (repeatable)."),
+]
+PackageOpt = Annotated[
+    list[str] | None,
+    typer.Option("--package", help="Package location NAME=PATH (repeatable)."),
+]
+XOpt = Annotated[float, typer.Option("-x", help="Spawn x [m].")]
+YOpt = Annotated[float, typer.Option("-y", help="Spawn y [m].")]
+ZOpt = Annotated[float, typer.Option("-z", help="Spawn z [m].")]
+RollOpt = Annotated[float, typer.Option("-R", help="Spawn roll [rad].")]
+PitchOpt = Annotated[float, typer.Option("-P", help="Spawn pitch [rad].")]
+YawOpt = Annotated[float, typer.Option("-Y", help="Spawn yaw [rad].")]
+
+
+def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:
+    """Parse repeated `NAME<sep>VALUE` options into a dict, with a clear error for bad items."""
+    out: dict[str, str] = {}
+    for item in items or []:
+        if sep not in item:
+            raise typer.BadParameter(f"{what} {item!r} must look like NAME{sep}VALUE")
+        name, value = item.split(sep, 1)
+        out[name.strip()] = value.strip()
+    return out
