@@ -39,30 +39,12 @@ def main() -> None:
     from twin_cli.output import error
 
     try:
-        rc = app(standalone_mode=False)
+        app()  # standalone: typer itself turns usage errors into exit code 2
     except (ConversionError, TwinError) as exc:
         if debug:
             raise
         error(str(exc))
         sys.exit(getattr(exc, "exit_code", 2))
-    except typer.Abort:
-        sys.exit(130)
-    except KeyboardInterrupt:
-        sys.exit(130)
-    except SystemExit:
-        raise
-    except Exception as exc:  # click usage errors and the like
-        import click
-
-        if isinstance(exc, click.exceptions.ClickException):
-            exc.show()
-            sys.exit(2)
-        if isinstance(exc, click.exceptions.Exit):
-            sys.exit(exc.exit_code)
-        raise
-    if isinstance(rc, int) and rc:
-        sys.exit(rc)
-
 
 if __name__ == "__main__":
     main()
