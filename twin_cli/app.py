@@ -18,6 +18,11 @@ app = typer.Typer(
 commands.register_all(app)
 
 
+@app.callback()
+def _root() -> None:
+    """twin: convert, spawn, run and validate robots described for Gazebo, on MuJoCo."""
+
+
 @app.command()
 def version() -> None:
     """Print twin's version."""
@@ -45,6 +50,7 @@ def main() -> None:
             raise
         error(str(exc))
         sys.exit(getattr(exc, "exit_code", 2))
+
 
 if __name__ == "__main__":
     main()

@@ -28,5 +28,7 @@ class EntityExistsError(TwinError):
     """Spawn with a name that is taken (Gazebo's wording)."""
 
     def __init__(self, name: str) -> None:
-        super().__init__(f"Entity [{name}] already exists; choose another --name or delete it first")
+        super().__init__(
+            f"Entity [{name}] already exists; choose another --name or delete it first"
+        )
         self.name = name
