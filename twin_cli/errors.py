@@ -32,3 +32,34 @@ class EntityExistsError(TwinError):
             f"Entity [{name}] already exists; choose another --name or delete it first"
         )
         self.name = name
+
+
+class WorldRunningError(TwinError):
+    """`twin serve` for a world whose server already runs (one server per world name)."""
+
+    def __init__(self, world: str, pid: int | None) -> None:
+        who = f" (pid {pid})" if pid else ""
+        super().__init__(
+            f"world [{world}] is already served{who}; use it, stop it with "
+            f"`twin stop --world {world}`, or serve another --world"
+        )
+        self.world = world
+
+
+class ServerStartError(TwinError):
+    """A background world server did not come up."""
+
+    def __init__(self, world: str, log: object, problem: str) -> None:
+        super().__init__(
+            f"world server [{world}] failed to start: {problem}; see its log {log} "
+            f"(`twin logs --world {world}`)"
+        )
+        self.world = world
+
+
+class RequestError(TwinError):
+    """The server refused a request as malformed, or failed on it with an unexpected error."""
+
+    def __init__(self, what: str, problem: str, fix: str) -> None:
+        super().__init__(f"{what}: {problem}; {fix}")
+        self.what = what
