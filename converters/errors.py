@@ -17,3 +17,115 @@ class InputFileError(ConversionError):
     def __init__(self, path: str, problem: str, fix: str) -> None:
         super().__init__(f"{path}: {problem}; {fix}")
         self.path = path
+
+
+class GazeboTagError(ConversionError):
+    """A `<gazebo>` tag (or inline `<surface>` value) that cannot be read."""
+
+    def __init__(self, source: str, reference: str, tag: str, value: str, expected: str) -> None:
+        where = f"<gazebo reference='{reference}'>" if reference else "<gazebo> (model)"
+        super().__init__(
+            f"{source}: {where} <{tag}>: value {value!r} is not {expected}; "
+            f"write {expected} (e.g. <{tag}>{_gazebo_example(expected)}</{tag}>)"
+        )
+        self.source = source
+        self.reference = reference
+        self.tag = tag
+        self.value = value
+
+
+def _gazebo_example(expected: str) -> str:
+    return {"a number": "0.5", "an integer": "10", "three numbers": "1 0 0"}.get(expected, "true")
+
+
+# --- Converter core: packages, xacro, URDF structure, inertia, meshes -----------------------
+
+
+class PackageNotFoundError(ConversionError):
+    """A `$(find pkg)`, `package://` or `model://` names a package found nowhere."""
+
+    def __init__(self, package: str, uri: str, element: str, tried: list[str]) -> None:
+        places = "\n  ".join(tried) or "(no search paths)"
+        super().__init__(
+            f"package '{package}' not found for {uri!r} used by {element}; tried:\n  {places}\n"
+            f"fix: pass --package {package}=PATH or add its parent directory to ROS_PACKAGE_PATH"
+        )
+        self.package = package
+        self.uri = uri
+
+
+class ResourceNotFoundError(ConversionError):
+    """A mesh or included file resolves to a path that does not exist."""
+
+    def __init__(self, uri: str, element: str, path: str) -> None:
+        super().__init__(
+            f"{uri!r} used by {element} resolves to {path}, which does not exist; "
+            "fix the filename or the package location (--package NAME=PATH)"
+        )
+        self.uri = uri
+        self.path = path
+
+
+class XacroError(ConversionError):
+    """xacro failed on the input; carries xacro's own message."""
+
+    def __init__(self, path: str, message: str) -> None:
+        super().__init__(
+            f"{path}: xacro failed: {message}; fix the xacro file or pass the missing "
+            "argument with --arg NAME:=VALUE"
+        )
+        self.path = path
+
+
+class MalformedXMLError(ConversionError):
+    """The description is not well-formed XML."""
+
+    def __init__(self, path: str, line: int, column: int, message: str) -> None:
+        super().__init__(f"{path}:{line}:{column}: malformed XML: {message}; fix the XML there")
+        self.path = path
+        self.line = line
+        self.column = column
+
+
+class URDFStructureError(ConversionError):
+    """The link/joint graph is not a tree: unknown links, cycles, several roots, duplicates."""
+
+    def __init__(self, path: str, subject: str, problem: str, fix: str) -> None:
+        super().__init__(f"{path}: {subject}: {problem}; {fix}")
+        self.path = path
+        self.subject = subject
+
+
+class BadNumberError(ConversionError):
+    """An attribute that must hold numbers does not."""
+
+    def __init__(self, path: str, element: str, attribute: str, value: str, expected: str) -> None:
+        super().__init__(
+            f"{path}: {element}: attribute {attribute}={value!r} is not {expected}; "
+            "write plain decimal numbers (xacro expressions must be expanded)"
+        )
+        self.path = path
+        self.element = element
+
+
+class InertiaError(ConversionError):
+    """A moving link has no, or a non-physical, mass/inertia."""
+
+    def __init__(self, path: str, link: str, problem: str, values: str) -> None:
+        super().__init__(
+            f"{path}: link '{link}': {problem} ({values}); give it a physical <inertial> "
+            "(mass > 0, positive-definite tensor, ixx+iyy >= izz etc.) or pass --repair-inertia"
+        )
+        self.path = path
+        self.link = link
+
+
+class MeshError(ConversionError):
+    """A mesh file exists but cannot be loaded or is unusable."""
+
+    def __init__(self, path: str, link: str, problem: str) -> None:
+        super().__init__(
+            f"mesh {path} of link '{link}': {problem}; export it again as STL/OBJ/DAE"
+        )
+        self.path = path
+        self.link = link
