@@ -63,3 +63,23 @@ class RequestError(TwinError):
     def __init__(self, what: str, problem: str, fix: str) -> None:
         super().__init__(f"{what}: {problem}; {fix}")
         self.what = what
+
+
+class ScenarioError(TwinError):
+    """A scenario file (TOML) is malformed or names something that does not exist."""
+
+    def __init__(self, path: object, key: str, problem: str, fix: str) -> None:
+        where = f"{path}: {key}" if key else f"{path}"
+        super().__init__(f"{where}: {problem}; {fix}")
+        self.path = path
+        self.key = key
+
+
+class UnknownCheckError(TwinError):
+    """--only/--skip or a scenario named a validation check that does not exist."""
+
+    def __init__(self, name: str, known: list[str]) -> None:
+        super().__init__(
+            f"unknown validation check [{name}]; valid checks: {', '.join(sorted(known))}"
+        )
+        self.name = name
