@@ -124,8 +124,6 @@ class MeshError(ConversionError):
     """A mesh file exists but cannot be loaded or is unusable."""
 
     def __init__(self, path: str, link: str, problem: str) -> None:
-        super().__init__(
-            f"mesh {path} of link '{link}': {problem}; export it again as STL/OBJ/DAE"
-        )
+        super().__init__(f"mesh {path} of link '{link}': {problem}; export it again as STL/OBJ/DAE")
         self.path = path
         self.link = link

@@ -1,0 +1,472 @@
+"""Read `<gazebo>` blocks and inline `<collision><surface>` of an expanded URDF into typed values.
+
+Follows sdformat's URDF reader (`parser_urdf.cc`, `ParseSDFExtension`): a block without
+`reference` applies to the model, `reference="X"` to the link or joint named X; a value is the
+element text or its `value="..."` attribute; a tag written twice keeps the later value. Known tags
+become typed fields (`mu1: float | None`, never flag pairs); unknown children are kept as blobs.
+Nothing here touches MuJoCo: `converters.gazebo_apply` turns these values into spec settings.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from converters.errors import GazeboTagError
+
+TRUE_WORDS = frozenset({"true", "yes", "1"})
+FALSE_WORDS = frozenset({"false", "no", "0"})
+
+
+@dataclass(frozen=True)
+class TagSource:
+    """Where one value came from: `reference` ("" for the model), the tag and its raw text."""
+
+    reference: str
+    tag: str
+    value: str
+
+
+@dataclass(frozen=True)
+class Blob:
+    """An element kept verbatim (`<plugin>`, `<sensor>`, unknown tags).
+
+    `name` is its name attribute, `kind` its `type` (sensors) or `filename` (plugins).
+    """
+
+    tag: str
+    name: str | None
+    kind: str | None
+    xml: str
+
+
+@dataclass(frozen=True)
+class Surface:
+    """Collision-level values of one link or one `<collision>` (SDF `surface`), None when unset.
+
+    Units: kp [N/m], kd [N s/m], max_vel [m/s], min_depth [m]; mu1, mu2, torsional, restitution
+    are unitless; fdir1 is a direction in the collision frame.
+    """
+
+    mu1: float | None = None
+    mu2: float | None = None
+    fdir1: tuple[float, float, float] | None = None
+    kp: float | None = None
+    kd: float | None = None
+    max_vel: float | None = None
+    min_depth: float | None = None
+    max_contacts: int | None = None
+    laser_retro: float | None = None
+    torsional: float | None = None
+    restitution: float | None = None
+    category_bitmask: int | None = None
+    collide_bitmask: int | None = None
+
+    def overridden_by(self, other: Surface) -> Surface:
+        """Return this surface with every value that `other` sets replaced by other's."""
+        changes = {
+            f.name: getattr(other, f.name)
+            for f in dataclasses.fields(other)
+            if getattr(other, f.name) is not None
+        }
+        return dataclasses.replace(self, **changes)
+
+    def is_empty(self) -> bool:
+        return all(getattr(self, f.name) is None for f in dataclasses.fields(self))
+
+
+@dataclass(frozen=True)
+class LinkExtension:
+    """Link-level Gazebo values of one link (`<gazebo reference="link">`).
+
+    `turn_gravity_off` keeps the tag's own sense (True = no gravity); `gravity` is the SDF
+    `<gravity>` blob (False = no gravity). `damping_factor` is the fraction of velocity lost per
+    Gazebo step. `visual_rgba` comes from a `<visual><material><diffuse>` block.
+    """
+
+    link: str
+    surface: Surface = Surface()
+    self_collide: bool | None = None
+    turn_gravity_off: bool | None = None
+    gravity: bool | None = None
+    damping_factor: float | None = None
+    material: str | None = None
+    visual_rgba: tuple[float, float, float, float] | None = None
+    sensors: tuple[Blob, ...] = ()
+    blobs: tuple[Blob, ...] = ()
+    sources: tuple[TagSource, ...] = ()
+
+    @property
+    def feels_gravity(self) -> bool:
+        """False when `turnGravityOff` is true or `<gravity>` is false."""
+        return not (self.turn_gravity_off is True or self.gravity is False)
+
+
+@dataclass(frozen=True)
+class JointExtension:
+    """Joint-level Gazebo values (`<gazebo reference="joint">`); units as in SDF.
+
+    spring_stiffness [N/m or N m/rad], spring_reference [m or rad], stop_erp and stop_cfm as ODE.
+    """
+
+    joint: str
+    stop_erp: float | None = None
+    stop_cfm: float | None = None
+    spring_stiffness: float | None = None
+    spring_reference: float | None = None
+    fudge_factor: float | None = None
+    provide_feedback: bool | None = None
+    implicit_spring_damper: bool | None = None
+    preserve_fixed_joint: bool | None = None
+    disable_fixed_joint_lumping: bool | None = None
+    blobs: tuple[Blob, ...] = ()
+    sources: tuple[TagSource, ...] = ()
+
+
+@dataclass(frozen=True)
+class InlineSurface:
+    """A `<surface>` written inside a URDF `<collision>`: `index` counts the link's collisions."""
+
+    link: str
+    index: int
+    surface: Surface
+
+
+@dataclass(frozen=True)
+class GazeboExtensions:
+    """Everything the `<gazebo>` tags of one robot say, typed.
+
+    `preserved_joints` are fixed joints that must not be lumped (preserveFixedJoint or
+    disableFixedJointLumping). `unresolved` lists references naming no link and no joint.
+    """
+
+    source: str
+    static: bool = False
+    self_collide: bool = False
+    preserved_joints: frozenset[str] = frozenset()
+    links: Mapping[str, LinkExtension] = field(default_factory=lambda: MappingProxyType({}))
+    joints: Mapping[str, JointExtension] = field(default_factory=lambda: MappingProxyType({}))
+    inline_surfaces: tuple[InlineSurface, ...] = ()
+    plugins: tuple[Blob, ...] = ()
+    model_blobs: tuple[Blob, ...] = ()
+    unresolved: tuple[str, ...] = ()
+    sources: tuple[TagSource, ...] = ()
+
+    def link(self, name: str) -> LinkExtension:
+        """The extension of link `name` (an empty one when it has no tags)."""
+        return self.links.get(name) or LinkExtension(name)
+
+    def surface_of(self, link: str, index: int) -> Surface:
+        """Surface of collision `index` of `link`: inline `<surface>`, then `<gazebo>` tags win."""
+        base = Surface()
+        for inline in self.inline_surfaces:
+            if inline.link == link and inline.index == index:
+                base = inline.surface
+        return base.overridden_by(self.link(link).surface)
+
+
+# ---------------------------------------------------------------- value readers
+
+
+class _Ctx:
+    """Facts for error messages while reading one block."""
+
+    def __init__(self, source: str, reference: str) -> None:
+        self.source = source
+        self.reference = reference
+
+    def fail(self, tag: str, value: str, expected: str) -> GazeboTagError:
+        return GazeboTagError(self.source, self.reference, tag, value, expected)
+
+
+def _text(el: ET.Element) -> str:
+    value = el.get("value")
+    return (value if value is not None else (el.text or "")).strip()
+
+
+def _float(ctx: _Ctx, tag: str, raw: str) -> float:
+    try:
+        value = float(raw)
+    except ValueError as exc:
+        raise ctx.fail(tag, raw, "a number") from exc
+    if value != value:
+        raise ctx.fail(tag, raw, "a number")
+    return value
+
+
+def _int(ctx: _Ctx, tag: str, raw: str) -> int:
+    try:
+        return int(raw, 0) if raw.lower().startswith("0x") else int(float(raw))
+    except ValueError as exc:
+        raise ctx.fail(tag, raw, "an integer") from exc
+
+
+def _bool(ctx: _Ctx, tag: str, raw: str) -> bool:
+    word = raw.lower()
+    if word in TRUE_WORDS:
+        return True
+    if word in FALSE_WORDS:
+        return False
+    raise ctx.fail(tag, raw, "a boolean (true/false/1/0)")
+
+
+def _vec3(ctx: _Ctx, tag: str, raw: str) -> tuple[float, float, float]:
+    parts = raw.split()
+    if len(parts) != 3:
+        raise ctx.fail(tag, raw, "three numbers")
+    x, y, z = (_float(ctx, tag, p) for p in parts)
+    return (x, y, z)
+
+
+def _str(ctx: _Ctx, tag: str, raw: str) -> str:
+    return raw
+
+
+Reader = Callable[[_Ctx, str, str], Any]
+
+# tag -> (group, field, reader). group "surface" = collision level, "link" = link level.
+LINK_TAGS: dict[str, tuple[str, str, Reader]] = {
+    "mu1": ("surface", "mu1", _float),
+    "mu2": ("surface", "mu2", _float),
+    "fdir1": ("surface", "fdir1", _vec3),
+    "kp": ("surface", "kp", _float),
+    "kd": ("surface", "kd", _float),
+    "maxVel": ("surface", "max_vel", _float),
+    "minDepth": ("surface", "min_depth", _float),
+    "maxContacts": ("surface", "max_contacts", _int),
+    "laserRetro": ("surface", "laser_retro", _float),
+    "selfCollide": ("link", "self_collide", _bool),
+    "self_collide": ("link", "self_collide", _bool),
+    "turnGravityOff": ("link", "turn_gravity_off", _bool),
+    "gravity": ("link", "gravity", _bool),
+    "dampingFactor": ("link", "damping_factor", _float),
+    "material": ("link", "material", _str),
+}
+
+JOINT_TAGS: dict[str, tuple[str, Reader]] = {
+    "stopErp": ("stop_erp", _float),
+    "stopCfm": ("stop_cfm", _float),
+    "springStiffness": ("spring_stiffness", _float),
+    "springReference": ("spring_reference", _float),
+    "fudgeFactor": ("fudge_factor", _float),
+    "provideFeedback": ("provide_feedback", _bool),
+    "implicitSpringDamper": ("implicit_spring_damper", _bool),
+    "cfmDamping": ("implicit_spring_damper", _bool),
+    "preserveFixedJoint": ("preserve_fixed_joint", _bool),
+    "disableFixedJointLumping": ("disable_fixed_joint_lumping", _bool),
+}
+
+# Paths inside an SDF <surface> (or a <collision> block) -> (Surface field, reader).
+SURFACE_PATHS: dict[str, tuple[str, Reader]] = {
+    "surface/friction/ode/mu": ("mu1", _float),
+    "surface/friction/ode/mu1": ("mu1", _float),
+    "surface/friction/ode/mu2": ("mu2", _float),
+    "surface/friction/ode/fdir1": ("fdir1", _vec3),
+    "surface/friction/torsional/coefficient": ("torsional", _float),
+    "surface/contact/ode/kp": ("kp", _float),
+    "surface/contact/ode/kd": ("kd", _float),
+    "surface/contact/ode/max_vel": ("max_vel", _float),
+    "surface/contact/ode/min_depth": ("min_depth", _float),
+    "surface/contact/category_bitmask": ("category_bitmask", _int),
+    "surface/contact/collide_bitmask": ("collide_bitmask", _int),
+    "surface/bounce/restitution_coefficient": ("restitution", _float),
+    "max_contacts": ("max_contacts", _int),
+    "laser_retro": ("laser_retro", _float),
+}
+
+
+def _blob(el: ET.Element) -> Blob:
+    kind = el.get("type") if el.tag == "sensor" else el.get("filename")
+    return Blob(str(el.tag), el.get("name"), kind, _to_xml(el))
+
+
+def _to_xml(el: Any) -> str:
+    if isinstance(el, ET.Element):
+        return ET.tostring(el, encoding="unicode").strip()
+    from lxml import etree  # an lxml element: serialise with its own library
+
+    return etree.tostring(el, encoding="unicode").strip()
+
+
+def _children(el: ET.Element) -> list[ET.Element]:
+    """Element children only (lxml also yields comments and processing instructions)."""
+    return [c for c in el if isinstance(c.tag, str)]
+
+
+def read_surface(el: ET.Element, ctx: _Ctx) -> tuple[Surface, list[TagSource]]:
+    """Read an SDF `<collision>`-like element (children `surface`, `max_contacts`, ...).
+
+    Args:
+        el: the element that holds `<surface>` (a URDF `<collision>` or a `<gazebo><collision>`).
+        ctx: source and reference for error messages.
+
+    Returns:
+        The surface and the source of each value found.
+    """
+    values: dict[str, Any] = {}
+    sources: list[TagSource] = []
+    for path, (name, reader) in SURFACE_PATHS.items():
+        found = el.find(path)
+        if found is not None:
+            raw = _text(found)
+            values[name] = reader(ctx, path, raw)
+            sources.append(TagSource(ctx.reference, path, raw))
+    return Surface(**values), sources
+
+
+class _Acc:
+    """Values gathered for one reference across all its `<gazebo>` blocks (later ones win)."""
+
+    def __init__(self) -> None:
+        self.surface: dict[str, Any] = {}
+        self.link: dict[str, Any] = {}
+        self.joint: dict[str, Any] = {}
+        self.block_surface = Surface()
+        self.sensors: list[Blob] = []
+        self.blobs: list[Blob] = []
+        self.sources: list[TagSource] = []
+
+
+def _read_reference_child(
+    child: ET.Element, acc: _Acc, ctx: _Ctx, is_link: bool, is_joint: bool
+) -> None:
+    tag = str(child.tag)
+    raw = _text(child)
+    if tag in LINK_TAGS and (is_link or not is_joint):
+        group, name, reader = LINK_TAGS[tag]
+        (acc.surface if group == "surface" else acc.link)[name] = reader(ctx, tag, raw)
+    elif tag in JOINT_TAGS and (is_joint or not is_link):
+        name, reader = JOINT_TAGS[tag]
+        acc.joint[name] = reader(ctx, tag, raw)
+    elif tag == "collision":
+        surface, sources = read_surface(child, ctx)
+        acc.block_surface = acc.block_surface.overridden_by(surface)
+        acc.sources.extend(sources)
+        return
+    elif tag == "visual":
+        acc.link["visual_rgba"] = _read_visual_rgba(child, ctx)
+    elif tag == "sensor":
+        acc.sensors.append(_blob(child))
+    else:
+        acc.blobs.append(_blob(child))
+        raw = "<blob>"
+    acc.sources.append(TagSource(ctx.reference, tag, raw))
+
+
+def _read_visual_rgba(el: ET.Element, ctx: _Ctx) -> tuple[float, float, float, float] | None:
+    diffuse = el.find("material/diffuse")
+    if diffuse is None:
+        return None
+    parts = [_float(ctx, "visual/material/diffuse", p) for p in _text(diffuse).split()]
+    if len(parts) not in (3, 4):
+        raise ctx.fail("visual/material/diffuse", _text(diffuse), "three numbers")
+    return (parts[0], parts[1], parts[2], parts[3] if len(parts) == 4 else 1.0)
+
+
+def _read_model_block(block: ET.Element, ctx: _Ctx, model: dict[str, Any]) -> None:
+    for child in _children(block):
+        tag, raw = str(child.tag), _text(child)
+        if tag == "static":
+            model["static"] = _bool(ctx, tag, raw)
+        elif tag in ("self_collide", "selfCollide"):
+            model["self_collide"] = _bool(ctx, tag, raw)
+        elif tag == "plugin":
+            model["plugins"].append(_blob(child))
+        else:
+            model["blobs"].append(_blob(child))
+        model["sources"].append(TagSource("", tag, raw if len(child) == 0 else "<blob>"))
+
+
+def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
+    """Read every `<gazebo>` block and inline `<collision><surface>` of an expanded URDF.
+
+    Args:
+        root: the `<robot>` element after xacro expansion.
+        source: the file name used in error messages.
+
+    Returns:
+        The typed extensions of the model, its links and its joints.
+
+    Raises:
+        GazeboTagError: a value is not a number/boolean/vector where the tag needs one; the
+            message names the file, the reference, the tag and the value.
+    """
+    link_names = {el.get("name", "") for el in root.findall("link")}
+    joint_types = {el.get("name", ""): el.get("type", "") for el in root.findall("joint")}
+    model: dict[str, Any] = {"plugins": [], "blobs": [], "sources": []}
+    accs: dict[str, _Acc] = {}
+    unresolved: list[str] = []
+    for block in root.findall("gazebo"):
+        reference = block.get("reference")
+        ctx = _Ctx(source, reference or "")
+        if not reference:
+            _read_model_block(block, ctx, model)
+            continue
+        is_link, is_joint = reference in link_names, reference in joint_types
+        if not (is_link or is_joint) and reference not in unresolved:
+            unresolved.append(reference)
+        acc = accs.setdefault(reference, _Acc())
+        for child in _children(block):
+            _read_reference_child(child, acc, ctx, is_link, is_joint)
+    links = {
+        ref: _link_extension(ref, acc)
+        for ref, acc in accs.items()
+        if ref in link_names or ref not in joint_types
+    }
+    joints = {ref: _joint_extension(ref, acc) for ref, acc in accs.items() if ref in joint_types}
+    return GazeboExtensions(
+        source=source,
+        static=model.get("static", False),
+        self_collide=model.get("self_collide", False),
+        preserved_joints=_preserved(joints, joint_types),
+        links=MappingProxyType(links),
+        joints=MappingProxyType(joints),
+        inline_surfaces=_inline_surfaces(root, source),
+        plugins=tuple(model["plugins"]),
+        model_blobs=tuple(model["blobs"]),
+        unresolved=tuple(unresolved),
+        sources=tuple(model["sources"]),
+    )
+
+
+def _link_extension(link: str, acc: _Acc) -> LinkExtension:
+    surface = acc.block_surface.overridden_by(Surface(**acc.surface))
+    return LinkExtension(
+        link=link,
+        surface=surface,
+        sensors=tuple(acc.sensors),
+        blobs=tuple(acc.blobs),
+        sources=tuple(acc.sources),
+        **acc.link,
+    )
+
+
+def _joint_extension(joint: str, acc: _Acc) -> JointExtension:
+    return JointExtension(
+        joint=joint, blobs=tuple(acc.blobs), sources=tuple(acc.sources), **acc.joint
+    )
+
+
+def _preserved(joints: dict[str, JointExtension], joint_types: dict[str, str]) -> frozenset[str]:
+    return frozenset(
+        name
+        for name, ext in joints.items()
+        if joint_types.get(name) == "fixed"
+        and (ext.preserve_fixed_joint or ext.disable_fixed_joint_lumping)
+    )
+
+
+def _inline_surfaces(root: ET.Element, source: str) -> tuple[InlineSurface, ...]:
+    found: list[InlineSurface] = []
+    for link in root.findall("link"):
+        name = link.get("name", "")
+        for index, collision in enumerate(link.findall("collision")):
+            if collision.find("surface") is None:
+                continue
+            surface, _ = read_surface(collision, _Ctx(source, name))
+            found.append(InlineSurface(name, index, surface))
+    return tuple(found)
