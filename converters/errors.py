@@ -127,3 +127,14 @@ class MeshError(ConversionError):
         super().__init__(f"mesh {path} of link '{link}': {problem}; export it again as STL/OBJ/DAE")
         self.path = path
         self.link = link
+
+
+class CollisionSettingsError(ConversionError):
+    """A collision option names an unknown mode or preset, or contradicts another option."""
+
+    def __init__(self, option: str, value: str, valid: list[str]) -> None:
+        super().__init__(
+            f"collision option {option}: {value!r} is not valid; use one of: {', '.join(valid)}"
+        )
+        self.option = option
+        self.value = value
