@@ -83,3 +83,38 @@ class UnknownCheckError(TwinError):
             f"unknown validation check [{name}]; valid checks: {', '.join(sorted(known))}"
         )
         self.name = name
+
+
+class SpawnError(TwinError):
+    """A spawn failed (unreadable source, compile error); the world is left as it was."""
+
+    def __init__(self, entity: str, source: str, problem: str, fix: str) -> None:
+        super().__init__(f"spawn of [{entity}] from {source}: {problem}; {fix}")
+        self.entity = entity
+        self.source = source
+
+
+class InvalidRequestError(TwinError):
+    """A world request carries a bad value (non-finite gravity, unknown solver, bad mode...)."""
+
+    def __init__(self, what: str, problem: str, fix: str) -> None:
+        super().__init__(f"{what}: {problem}; {fix}")
+        self.what = what
+
+
+class PartNotFoundError(TwinError):
+    """A request named a joint or link that the entity does not have."""
+
+    def __init__(self, entity: str, kind: str, name: str, known: list[str]) -> None:
+        names = ", ".join(sorted(known)) or "none"
+        super().__init__(f"entity [{entity}] has no {kind} [{name}]; its {kind}s: {names}")
+        self.entity = entity
+        self.name = name
+
+
+class WorldFileError(TwinError):
+    """A saved world file cannot be read, or no longer matches its sources."""
+
+    def __init__(self, path: object, problem: str, fix: str) -> None:
+        super().__init__(f"{path}: {problem}; {fix}")
+        self.path = path
