@@ -1,0 +1,165 @@
+"""Gazebo's contact rules as MuJoCo settings: min-μ priorities, kp/kd → direct solref, ground.
+
+Friction. Gazebo (ODE) combines two surfaces by min(μa, μb). MuJoCo takes the larger friction of
+the two geoms when their priorities are equal, and the friction (and condim, solref, solimp) of
+the geom with the higher priority otherwise. `friction_priority` makes priority a strictly
+decreasing function of μ, quantised on log10 μ, so the lower-μ geom always wins: the pair's
+friction is min(μ) for robot–ground, robot–robot and robot–obstacle pairs alike, provided every
+geom of the world takes its priority from this one function.
+
+Stiffness. MuJoCo's soft contact with constant impedance d (solimp d0 = d1 = d) and direct
+solref (-S, -B) obeys, along the normal (MuJoCo "Solver parameters"; checked numerically):
+    a = (1 - d)·a0 - B·v - S·r,    rest penetration r = (1 - d)·a0 / S
+where a0 is the unconstrained acceleration. Gazebo's contact is a spring-damper per contact
+point: rest penetration m·g/kp, damping ratio ζ = kd / (2·sqrt(kp·m)). Matching the rest
+penetration gives S = (1 - d)·kp / m and keeping ζ gives B = 2·ζ·sqrt(S). m is the mass of the
+body that carries the geom (after lumping); the force a contact row delivers scales with the
+effective mass MuJoCo sees at that point (1/A_ii), so a contact through the centre of mass (a
+ball) reproduces kp exactly, while a cube resting on a face has m/4 at each corner (kp/4 each).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+GROUND_MU = 100.0
+"""μ of Gazebo's stock ground plane (`ground_plane` model, `surface/friction/ode/mu`)."""
+GROUND_MU2 = 50.0
+"""Coefficient μ2 of Gazebo's stock ground plane."""
+DEFAULT_MU = 1.0
+"""SDF default for `surface/friction/ode/mu` when a link sets none (`sdf/1.11/surface.sdf`)."""
+DEFAULT_KP = 1e12
+"""SDF default contact stiffness [N/m] (`surface.sdf`); only used when kd is set without kp."""
+DEFAULT_KD = 1.0
+"""SDF default contact damping [N s/m] (`surface.sdf`); only used when kp is set without kd."""
+GAZEBO_STEP = 0.001
+"""SDF default `max_step_size` [s]; the step the kp/kd mapping is checked for."""
+
+MU_MIN = 1e-6
+MU_MAX = 1e9
+PRIORITY_PER_DECADE = 1000
+"""Priority steps per decade of μ: two μ closer than 0.23 % may share a priority (then max)."""
+
+IMPEDANCE = 0.95
+"""Constant solimp impedance d for kp/kd contacts: rest penetration is exact for any d; a larger d
+lets stiffer springs be resolved (S = (1-d)·kp/m) and makes static friction creep less."""
+SOLIMP_WIDTH = 0.001
+"""solimp width [m]; irrelevant when d0 = d1, kept at MuJoCo's default."""
+MIN_DAMPING_RATIO = 0.5
+"""Floor on the contact damping ratio. MuJoCo's friction rows share the contact's damping B, and a
+nearly undamped contact lets a body creep at (1-d)·g·sinθ/B down a slope it should stick to.
+Gazebo's own per-body correction cap (`max_vel` 0.01 m/s) also keeps such contacts from bouncing."""
+
+
+@dataclass(frozen=True)
+class ContactSoftness:
+    """MuJoCo settings for one Gazebo kp/kd pair on a body of a given mass.
+
+    `solref` is direct (-S [1/s²], -B [1/s]); `clamped` is True when kp/m was stiffer than the
+    timestep resolves (then S is the stiffest stable value); `damping_ratio_gazebo` is
+    kd/(2·sqrt(kp·m)) and `damping_ratio` the one used (floored at MIN_DAMPING_RATIO).
+    """
+
+    solref: tuple[float, float]
+    solimp: tuple[float, float, float, float, float]
+    clamped: bool
+    damping_ratio_gazebo: float
+    damping_ratio: float
+    sinkage_gazebo: float
+    sinkage: float
+
+
+def friction_priority(mu: float) -> int:
+    """Geom priority for a sliding coefficient μ: lower μ, higher priority.
+
+    Args:
+        mu: Coulomb coefficient (unitless); clamped to [MU_MIN, MU_MAX].
+
+    Returns:
+        A non-negative integer, strictly decreasing in μ at PRIORITY_PER_DECADE steps per decade.
+    """
+    clamped = min(max(mu, MU_MIN), MU_MAX)
+    return round((math.log10(MU_MAX) - math.log10(clamped)) * PRIORITY_PER_DECADE)
+
+
+def max_contact_stiffness(timestep: float = GAZEBO_STEP) -> float:
+    """Stiffest stable S [1/s²]: natural period 2·timestep·2π, MuJoCo's refsafe bound τ ≥ 2·h."""
+    return 1.0 / (2.0 * timestep) ** 2
+
+
+def contact_softness(
+    kp: float | None, kd: float | None, mass: float, timestep: float = GAZEBO_STEP
+) -> ContactSoftness:
+    """Map Gazebo's per-contact spring-damper onto MuJoCo's direct solref and solimp.
+
+    Args:
+        kp: contact stiffness [N/m] (SDF default 1e12 when None).
+        kd: contact damping [N s/m] (SDF default 1 when None).
+        mass: mass carried by the contact [kg] (twin uses the mass of the geom's body).
+        timestep: simulation step [s] the result must be stable at.
+
+    Returns:
+        The settings, with the rest sinkage under 9.8 m/s² in Gazebo and in MuJoCo [m].
+    """
+    kp = DEFAULT_KP if kp is None else kp
+    kd = DEFAULT_KD if kd is None else kd
+    mass = max(mass, 1e-9)
+    stiffness = (1.0 - IMPEDANCE) * kp / mass
+    limit = max_contact_stiffness(timestep)
+    clamped = stiffness > limit
+    stiffness = min(stiffness, limit)
+    zeta_gazebo = kd / (2.0 * math.sqrt(kp * mass)) if kp > 0 else math.inf
+    zeta = max(zeta_gazebo, MIN_DAMPING_RATIO)
+    damping = min(2.0 * zeta * math.sqrt(stiffness), 1.0 / timestep)
+    d = IMPEDANCE
+    return ContactSoftness(
+        solref=(-stiffness, -damping),
+        solimp=(d, d, SOLIMP_WIDTH, 0.5, 2.0),
+        clamped=clamped,
+        damping_ratio_gazebo=zeta_gazebo,
+        damping_ratio=damping / (2.0 * math.sqrt(stiffness)),
+        sinkage_gazebo=mass * 9.8 / kp if kp > 0 else math.inf,
+        sinkage=(1.0 - d) * 9.8 / stiffness,
+    )
+
+
+def limit_solref(erp: float | None, timestep: float = GAZEBO_STEP) -> tuple[float, float]:
+    """Joint-limit softness from ODE's stopErp, as a standard solreflimit (timeconst, dampratio).
+
+    ODE removes a fraction erp of a limit violation per step, so the violation decays with time
+    constant h/erp; a critically damped MuJoCo limit with that time constant (kept ≥ 2·h, MuJoCo's
+    refsafe bound) recovers alike. stopCfm's extra compliance is not mapped (see gazebo_apply).
+
+    Args:
+        erp: ODE error-reduction parameter in (0, 1]; SDF default 0.2 when None or ≤ 0.
+        timestep: simulation step [s].
+
+    Returns:
+        (timeconst [s], dampratio).
+    """
+    erp = 0.2 if erp is None or erp <= 0 else min(erp, 1.0)
+    return (max(timestep / erp, 2.0 * timestep), 1.0)
+
+
+def add_gazebo_ground(spec: Any) -> None:
+    """Add Gazebo's stock ground plane: an infinite plane geom "ground", μ=100 (μ2=50).
+
+    MuJoCo geoms are isotropic, so the plane carries μ=GROUND_MU; its priority comes from
+    `friction_priority`, so any robot geom with a lower μ decides the pair's friction (min rule).
+
+    Args:
+        spec: a `mujoco.MjSpec`; the geom is added to its world body.
+    """
+    import mujoco
+
+    geom = spec.worldbody.add_geom(
+        name="ground",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[0.0, 0.0, 1.0],
+        rgba=[0.8, 0.8, 0.8, 1.0],
+    )
+    geom.friction = [GROUND_MU, 0.005, 0.0001]
+    geom.priority = friction_priority(GROUND_MU)
+    geom.condim = 3
