@@ -1,0 +1,95 @@
+"""Runtime files of world servers: private directory, liveness by flock, stale-file cleanup."""
+
+from __future__ import annotations
+
+import os
+import signal
+import stat
+import subprocess
+import sys
+import time
+
+import pytest
+
+from twin_cli import runtime
+from twin_cli.errors import WorldRunningError
+
+HOLDER = """
+import sys, time
+from twin_cli import runtime
+paths = runtime.world_paths(sys.argv[1])
+with runtime.hold_pid_file(paths):
+    paths.socket.write_text("")
+    print("held", flush=True)
+    time.sleep(60)
+"""
+
+
+@pytest.fixture
+def rtdir(tmp_path, monkeypatch):
+    path = tmp_path / "rt"
+    monkeypatch.setenv(runtime.RUNTIME_ENV, str(path))
+    return path
+
+
+def _hold(world: str) -> subprocess.Popen:
+    proc = subprocess.Popen(
+        [sys.executable, "-c", HOLDER, world], stdout=subprocess.PIPE, text=True
+    )
+    assert proc.stdout.readline().strip() == "held", "holder process did not take the pid lock"
+    return proc
+
+
+def test_runtime_dir_is_created_private(rtdir):
+    path = runtime.runtime_dir()
+    assert path == rtdir
+    mode = stat.S_IMODE(path.stat().st_mode)
+    assert mode == 0o700, f"runtime dir mode {oct(mode)}"
+
+
+def test_world_name_must_be_a_safe_file_name(rtdir):
+    with pytest.raises(runtime.WorldNameError, match="letters, digits"):
+        runtime.world_paths("../etc")
+
+
+def test_too_long_socket_path_is_refused_with_fix(tmp_path, monkeypatch):
+    monkeypatch.setenv(runtime.RUNTIME_ENV, str(tmp_path / ("d" * 120)))
+    with pytest.raises(runtime.RuntimeDirError, match="TWIN_RUNTIME_DIR"):
+        runtime.world_paths("w")
+
+
+def test_live_holder_is_alive_and_owns_the_world(rtdir):
+    proc = _hold("w")
+    try:
+        paths = runtime.world_paths("w")
+        assert runtime.server_alive(paths)
+        assert runtime.read_pid(paths) == proc.pid
+        assert runtime.clean_stale(paths) == [], "clean_stale removed files of a live server"
+        with pytest.raises(WorldRunningError, match=f"pid {proc.pid}"):
+            with runtime.hold_pid_file(paths):
+                pass
+    finally:
+        proc.terminate()
+        proc.wait()
+
+
+def test_sigkilled_holder_leaves_stale_files_that_are_cleaned(rtdir):
+    proc = _hold("w")
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    paths = runtime.world_paths("w")
+    assert paths.pid.exists() and paths.socket.exists(), "SIGKILL should leave the files behind"
+    assert not runtime.server_alive(paths), "a dead holder must not count as alive"
+    removed = set(runtime.clean_stale(paths))
+    assert {paths.pid, paths.socket} <= removed, f"removed: {removed}"
+    assert not paths.pid.exists() and not paths.socket.exists()
+
+
+def test_start_lock_serialises_starters(rtdir):
+    paths = runtime.world_paths("w")
+    with runtime.start_lock(paths):
+        t0 = time.monotonic()
+        with pytest.raises(Exception, match="another start is stuck"):
+            with runtime.start_lock(paths, timeout=0.2):
+                pass
+        assert time.monotonic() - t0 >= 0.2
