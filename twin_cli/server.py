@@ -20,7 +20,13 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from converters.errors import ConversionError
-from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError, TwinError
+from twin_cli.errors import (
+    EntityExistsError,
+    EntityNotFoundError,
+    PartNotFoundError,
+    RequestError,
+    TwinError,
+)
 
 log = logging.getLogger("twin.server")
 API_VERSION = "1"
@@ -283,7 +289,11 @@ def shutdown(request: Request) -> dict:
 
 
 # Status of each error class; other TwinError and ConversionError subclasses are 400.
-ERROR_STATUS: dict[type[Exception], int] = {EntityNotFoundError: 404, EntityExistsError: 409}
+ERROR_STATUS: dict[type[Exception], int] = {
+    EntityNotFoundError: 404,
+    PartNotFoundError: 404,
+    EntityExistsError: 409,
+}
 
 
 def _error(status: int, name: str, message: str) -> JSONResponse:
