@@ -1,0 +1,71 @@
+"""Actuated joints (transmissions / ros2_control, else all) → motors; mimic → joint equalities."""
+
+from __future__ import annotations
+
+from converters.report import Report
+
+ACTUATABLE = ("revolute", "continuous", "prismatic")
+
+
+def actuated_joints(parsed: object, report: Report) -> list[object]:
+    """The URDF joints that get a motor, and a report line saying how they were chosen.
+
+    Joints named by `<transmission>` or `<ros2_control>` when the file has any; otherwise every
+    revolute, continuous or prismatic joint that is not a mimic follower.
+    """
+    joints = {j.name: j for j in parsed.model.joints}
+    named = [n for n in (*parsed.transmission_joints, *parsed.ros2_control_joints) if n in joints]
+    named = list(dict.fromkeys(named))
+    if named:
+        source = "<transmission>/<ros2_control>"
+        chosen = [joints[n] for n in named]
+    else:
+        source = "all movable non-mimic joints (no <transmission> or <ros2_control>)"
+        chosen = list(joints.values())
+    chosen = [j for j in chosen if j.type in ACTUATABLE and j.mimic is None]
+    report.mapped("actuators", f"{len(chosen)} motor(s) from {source}")
+    return chosen
+
+
+def add_motors(spec: object, joints: list[object], report: Report) -> None:
+    """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m]."""
+    import mujoco
+
+    for joint in joints:
+        effort = float(joint.limit.effort) if joint.limit and joint.limit.effort else 0.0
+        if effort <= 0:
+            report.warn(f"joint '{joint.name}'", "no positive effort limit; no motor added")
+            continue
+        actuator = spec.add_actuator(name=joint.name, target=joint.name)
+        actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
+        actuator.set_to_motor()
+        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.ctrlrange = [-effort, effort]
+        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.forcerange = [-effort, effort]
+
+
+def add_mimics(spec: object, parsed: object, report: Report) -> None:
+    """Each `<mimic>`: follower = offset + multiplier · leader, as a joint equality.
+
+    MuJoCo's joint equality constrains `joint1 = polycoef[0] + polycoef[1]·joint2 + …`
+    (positions relative to qpos0, which is 0 for hinges and slides), so the follower is joint1.
+    """
+    import mujoco
+
+    for joint in parsed.model.joints:
+        mimic = joint.mimic
+        if mimic is None:
+            continue
+        multiplier = 1.0 if mimic.multiplier is None else float(mimic.multiplier)
+        offset = 0.0 if mimic.offset is None else float(mimic.offset)
+        equality = spec.add_equality(name=f"mimic_{joint.name}")
+        equality.type = mujoco.mjtEq.mjEQ_JOINT
+        equality.objtype = mujoco.mjtObj.mjOBJ_JOINT
+        equality.name1 = joint.name
+        equality.name2 = mimic.joint
+        equality.data[:5] = [offset, multiplier, 0.0, 0.0, 0.0]
+        report.mapped(
+            f"joint '{joint.name}' <mimic>",
+            f"= {offset:g} + {multiplier:g} · {mimic.joint} (joint equality)",
+        )

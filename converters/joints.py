@@ -1,0 +1,153 @@
+"""URDF joints → MuJoCo joints (hinge, slide, free, planar as slides + hinge), with limits."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from converters.report import Report
+
+# Name of the free joint of a floating base (prefixed by the entity name after attach).
+FREE_JOINT = "floating_base"
+
+
+@dataclass(frozen=True)
+class MjJointPlan:
+    """One MuJoCo joint made for a URDF joint: its name, kind, qpos width, home value, range."""
+
+    name: str
+    urdf_joint: str | None
+    kind: str
+    range: tuple[float, float] | None
+    home: tuple[float, ...]
+
+
+def add_joints(body: object, joint: object | None, report: Report) -> list[MjJointPlan]:
+    """Add the MuJoCo joint(s) for `joint` to `body`; returns them in qpos order."""
+    if joint is None:
+        return []
+    adder = _ADDERS.get(joint.type)
+    if adder is None:
+        report.ignored(
+            f"joint '{joint.name}'",
+            f"type {joint.type!r} is not a URDF joint type; the child is welded",
+        )
+        return []
+    return adder(body, joint, report)
+
+
+def _axis(joint: object) -> np.ndarray:
+    axis = np.asarray(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+    norm = np.linalg.norm(axis)
+    return axis / norm if norm > 0 else np.array([1.0, 0.0, 0.0])
+
+
+def _limited(body: object, joint: object, kind: int, report: Report) -> list[MjJointPlan]:
+    """revolute (hinge) or prismatic (slide) with range, damping and friction."""
+    import mujoco
+
+    mj = body.add_joint(name=joint.name, type=kind, axis=_axis(joint))
+    _dynamics(mj, joint)
+    lower, upper = _bounds(joint)
+    if lower is not None and upper is not None and lower < upper:
+        mj.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        mj.range = [lower, upper]
+        home = min(max(0.0, lower), upper)
+        return [MjJointPlan(joint.name, joint.name, joint.type, (lower, upper), (home,))]
+    mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    report.warn(
+        f"joint '{joint.name}'",
+        f"{joint.type} joint without a usable <limit> "
+        f"(lower={lower}, upper={upper}); left unlimited",
+    )
+    return [MjJointPlan(joint.name, joint.name, joint.type, None, (0.0,))]
+
+
+def _bounds(joint: object) -> tuple[float | None, float | None]:
+    limit = joint.limit
+    if limit is None:
+        return None, None
+    lower = None if limit.lower is None else float(limit.lower)
+    upper = None if limit.upper is None else float(limit.upper)
+    return lower, upper
+
+
+def _dynamics(mj: object, joint: object) -> None:
+    if joint.dynamics is not None:
+        mj.damping = [float(joint.dynamics.damping or 0.0), 0.0, 0.0]
+        mj.frictionloss = float(joint.dynamics.friction or 0.0)
+
+
+def _revolute(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    import mujoco
+
+    return _limited(body, joint, mujoco.mjtJoint.mjJNT_HINGE, report)
+
+
+def _prismatic(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    import mujoco
+
+    return _limited(body, joint, mujoco.mjtJoint.mjJNT_SLIDE, report)
+
+
+def _continuous(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    import mujoco
+
+    mj = body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=_axis(joint))
+    mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    _dynamics(mj, joint)
+    return [MjJointPlan(joint.name, joint.name, "continuous", None, (0.0,))]
+
+
+def _planar(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    """Motion in the plane normal to the axis: two slides in the plane and a hinge about it."""
+    import mujoco
+
+    normal = _axis(joint)
+    helper = np.array([1.0, 0, 0]) if abs(normal[0]) < 0.9 else np.array([0, 1.0, 0])
+    u = np.cross(normal, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    out = []
+    for suffix, kind, axis in (
+        ("x", mujoco.mjtJoint.mjJNT_SLIDE, u),
+        ("y", mujoco.mjtJoint.mjJNT_SLIDE, v),
+        ("yaw", mujoco.mjtJoint.mjJNT_HINGE, normal),
+    ):
+        mj = body.add_joint(name=f"{joint.name}_{suffix}", type=kind, axis=axis)
+        _dynamics(mj, joint)
+        out.append(MjJointPlan(mj.name, joint.name, "planar", None, (0.0,)))
+    report.mapped(f"joint '{joint.name}'", "planar → two slides and a hinge about the normal")
+    return out
+
+
+def _floating(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    """A nested floating joint: three slides and a ball (MuJoCo free joints must be top-level)."""
+    import mujoco
+
+    out = []
+    for suffix, axis in (("x", (1, 0, 0)), ("y", (0, 1, 0)), ("z", (0, 0, 1))):
+        mj = body.add_joint(
+            name=f"{joint.name}_{suffix}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis
+        )
+        out.append(MjJointPlan(mj.name, joint.name, "floating", None, (0.0,)))
+    body.add_joint(name=f"{joint.name}_rot", type=mujoco.mjtJoint.mjJNT_BALL)
+    out.append(MjJointPlan(f"{joint.name}_rot", joint.name, "floating", None, (1.0, 0, 0, 0)))
+    report.mapped(f"joint '{joint.name}'", "floating → three slides and a ball joint")
+    return out
+
+
+def add_free_joint(body: object, pos: np.ndarray) -> MjJointPlan:
+    """The named free joint of a floating base; home = the body's pose."""
+    body.add_freejoint(name=FREE_JOINT)
+    return MjJointPlan(FREE_JOINT, None, "free", None, (*map(float, pos), 1.0, 0.0, 0.0, 0.0))
+
+
+_ADDERS = {
+    "revolute": _revolute,
+    "continuous": _continuous,
+    "prismatic": _prismatic,
+    "planar": _planar,
+    "floating": _floating,
+}

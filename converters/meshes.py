@@ -1,0 +1,106 @@
+"""Mesh files (STL, OBJ, DAE, PLY, GLB…) → scaled vertex/face arrays, with degeneracy checks."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from converters.errors import MeshError
+
+# Relative size below which a mesh counts as flat: smallest/largest principal extent.
+FLAT_RATIO = 1e-6
+# Smallest enclosed volume [m³] MuJoCo accepts for a mesh inertia (mjMINVAL-scale, padded).
+MIN_VOLUME = 1e-12
+
+
+@dataclass(frozen=True)
+class MeshData:
+    """A triangle mesh in metres: vertices (N, 3) float64, faces (M, 3) int32."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    @property
+    def triangles(self) -> int:
+        return len(self.faces)
+
+
+@dataclass
+class MeshCache:
+    """Meshes loaded during one conversion, keyed by (file, scale); files are read once."""
+
+    loaded: dict[tuple[str, tuple[float, float, float]], MeshData] = field(default_factory=dict)
+
+    def get(self, path: Path, scale: tuple[float, float, float], link: str) -> MeshData:
+        key = (str(path), scale)
+        if key not in self.loaded:
+            raw = self.loaded.get((str(path), (1.0, 1.0, 1.0))) or load_mesh(path, link)
+            vertices = raw.vertices * np.asarray(scale, dtype=float)
+            faces = raw.faces if np.prod(scale) > 0 else raw.faces[:, ::-1]
+            self.loaded[key] = MeshData(vertices, np.ascontiguousarray(faces))
+        return self.loaded[key]
+
+
+def load_mesh(path: Path, link: str) -> MeshData:
+    """Read any mesh format trimesh knows, flattening scenes (DAE/GLB) with their transforms.
+
+    Textures and materials are not copied (copying images dominated DAE load time: 1.7 s → 0.3 s
+    for ANYmal's 19 textured DAE files).
+
+    Raises:
+        MeshError: the file cannot be parsed or holds no triangles.
+    """
+    import trimesh
+
+    logging.getLogger("trimesh").setLevel(logging.ERROR)
+    try:
+        loaded = trimesh.load(str(path), process=False, force="scene")
+    except Exception as exc:  # trimesh raises many types for corrupt files
+        raise MeshError(str(path), link, f"cannot be read ({exc})") from exc
+    parts_v: list[np.ndarray] = []
+    parts_f: list[np.ndarray] = []
+    count = 0
+    for node in loaded.graph.nodes_geometry:
+        transform, name = loaded.graph[node]
+        geometry = loaded.geometry.get(name)
+        if geometry is None or not hasattr(geometry, "faces") or len(geometry.faces) == 0:
+            continue
+        vertices = np.asarray(geometry.vertices, dtype=float)
+        parts_v.append(vertices @ transform[:3, :3].T + transform[:3, 3])
+        parts_f.append(np.asarray(geometry.faces, dtype=np.int64) + count)
+        count += len(vertices)
+    if not parts_v:
+        raise MeshError(str(path), link, "holds no triangles")
+    vertices, faces = _merge_duplicates(np.concatenate(parts_v), np.concatenate(parts_f))
+    return MeshData(vertices, faces)
+
+
+def _merge_duplicates(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Merge bit-identical vertices (STL stores three per triangle) and drop unused ones."""
+    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
+    faces = inverse.reshape(-1)[faces]
+    keep = (
+        (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    )
+    return unique, np.ascontiguousarray(faces[keep], dtype=np.int32)
+
+
+def mesh_problem(mesh: MeshData) -> str | None:
+    """Why MuJoCo could not use this mesh for collision (None when it is fine).
+
+    Degenerate meshes: fewer than 4 vertices, all vertices in a plane or on a line (flat), or
+    a convex hull of (almost) zero volume.
+    """
+    if len(mesh.vertices) < 4 or len(mesh.faces) < 1:
+        return f"{len(mesh.vertices)} vertices, {len(mesh.faces)} faces (need ≥ 4 vertices)"
+    centred = mesh.vertices - mesh.vertices.mean(axis=0)
+    extents = np.linalg.svd(centred[:: max(1, len(centred) // 5000)], compute_uv=False)
+    if extents[0] <= 0 or extents[-1] / extents[0] < FLAT_RATIO:
+        return "flat (all vertices in one plane or on a line)"
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    if float(np.prod(hi - lo)) < MIN_VOLUME:
+        return f"zero volume (bounding box {np.round(hi - lo, 9).tolist()} m)"
+    return None

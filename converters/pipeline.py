@@ -1,0 +1,111 @@
+"""The conversion pipeline: file → xacro → URDF → MjSpec → Gazebo semantics, with a report."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from converters.build import ConvertOptions, build_spec
+from converters.errors import InputFileError
+from converters.packages import PackageResolver
+from converters.provenance import Provenance
+from converters.report import Report
+from converters.urdf import ParsedRobot, parse_urdf
+from converters.xacro_stage import expand_xacro, needs_xacro
+
+
+@dataclass(frozen=True)
+class Conversion:
+    """Everything one conversion produced: the spec, the report, provenance and the inputs."""
+
+    spec: object
+    report: Report
+    provenance: Provenance
+    parsed: ParsedRobot
+    extensions: object
+
+
+def read_description(
+    path: Path, args: Mapping[str, str], resolver: PackageResolver, report: Report
+) -> str:
+    """URDF text of `path`: xacro files are expanded, plain URDF files read as they are.
+
+    Raises:
+        InputFileError: the file is missing or unreadable.
+        XacroError, PackageNotFoundError: from xacro.
+    """
+    if not path.is_file():
+        raise InputFileError(str(path), "no such file", "give the path of a .urdf or .xacro file")
+    if not needs_xacro(path):
+        if args:
+            report.ignored("--arg", f"{path.name} is plain URDF; xacro arguments are not used")
+        try:
+            return path.read_text()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InputFileError(str(path), f"cannot be read ({exc})", "check the file") from exc
+    result = expand_xacro(path, args, resolver)
+    for call in result.unexpanded:
+        report.warn(
+            f"xacro macro call {call}",
+            "matches a macro name but has no 'xacro:' prefix, so xacro left it "
+            "unexpanded and its content is missing; write it as <xacro:NAME …/>",
+        )
+    for line in result.warnings:
+        report.warn("xacro", line)
+    return result.text
+
+
+def convert_full(
+    path: str | Path,
+    *,
+    args: Mapping[str, str] | None = None,
+    package_paths: Mapping[str, str | Path] | None = None,
+    options: ConvertOptions | None = None,
+) -> Conversion:
+    """Convert a xacro/URDF file into an MjSpec carrying Gazebo's semantics.
+
+    Args:
+        path: the `.urdf` or `.xacro` file.
+        args: xacro arguments (`NAME:=VALUE` pairs as a dict).
+        package_paths: package name → directory (`--package`), searched first.
+        options: keep_fixed, repair_inertia, collision settings.
+
+    Raises:
+        ConversionError: any subclass, with file/link/joint and the fix in its message.
+    """
+    from converters.gazebo import parse_gazebo
+    from converters.gazebo_apply import apply_gazebo
+
+    path = Path(path)
+    options = options or ConvertOptions()
+    resolver = PackageResolver.create(path, package_paths)
+    report = Report(source=str(path))
+    text = read_description(path, dict(args or {}), resolver, report)
+    parsed = parse_urdf(text, str(path), path.resolve().parent)
+    report.robot = parsed.model.name
+    extensions = parse_gazebo(parsed.root, str(path))
+    provenance = Provenance()
+    spec = build_spec(
+        parsed,
+        static=extensions.static,
+        preserved=extensions.preserved_joints,
+        options=options,
+        resolver=resolver,
+        report=report,
+        provenance=provenance,
+    )
+    apply_gazebo(spec, extensions, provenance, report)
+    return Conversion(spec, report, provenance, parsed, extensions)
+
+
+def convert(
+    path: str | Path,
+    *,
+    args: Mapping[str, str] | None = None,
+    package_paths: Mapping[str, str | Path] | None = None,
+    options: ConvertOptions | None = None,
+) -> tuple[object, Report]:
+    """`convert_full` reduced to the public contract: `(MjSpec, Report)`."""
+    done = convert_full(path, args=args, package_paths=package_paths, options=options)
+    return done.spec, done.report
