@@ -1,0 +1,119 @@
+"""The used-by flow as a new user types it: `twin spawn` with no server, stats, gravity, stop."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+
+import pytest
+
+import scenarios
+
+GZ_LINE = re.compile(
+    r"^Factor\[\d+\.\d\d\] SimTime\[\d+\.\d\d\] RealTime\[\d+\.\d\d\] Paused\[[TF]\]$"
+)
+MOON, EARTH = 1.62, 9.81  # [m/s^2], the presets
+DT, STEPS = 0.001, 300  # [s], steps of free fall measured through `twin pose`
+BOX_URDF = """<?xml version="1.0"?>
+<robot name="box">
+  <link name="base">
+    <inertial><mass value="1.0"/><inertia ixx="0.0067" iyy="0.0067" izz="0.0067"
+      ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
+  </link>
+</robot>
+"""
+
+
+class Twin:
+    """Runs `twin ...` as a user would, in a private runtime dir; stops the world at the end."""
+
+    def __init__(self, runtime_dir) -> None:
+        self.env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime_dir)}
+        self.env.pop("TWIN_WORLD", None)
+
+    def __call__(self, *args: str, check: bool = True, timeout: float = 120):
+        proc = subprocess.run(
+            [sys.executable, "-m", "twin_cli.app", *args],
+            env=self.env,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
+        if check:
+            assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
+        return proc
+
+
+@pytest.fixture
+def twin(tmp_path):
+    t = Twin(tmp_path / "rt")
+    (tmp_path / "box.urdf").write_text(BOX_URDF)
+    t.box = str(tmp_path / "box.urdf")
+    yield t
+    t("stop", check=False, timeout=60)
+
+
+def _drop(twin: Twin, name: str, z0: float) -> float:
+    return z0 - json.loads(twin("pose", name, "--json").stdout)["z"]
+
+
+def test_used_by_flow_on_the_bundled_humanoid(twin):
+    spawned = twin("spawn", str(scenarios.HUMANOID), "-z", "1.2")
+    assert spawned.stdout.strip() == "humanoid", f"spawn printed {spawned.stdout!r}"
+    started = [line for line in spawned.stderr.splitlines() if "started world" in line]
+    assert len(started) == 1, f"expected one 'started world' line, stderr: {spawned.stderr!r}"
+
+    lines = twin("stats", "-d", "2").stdout.splitlines()
+    assert 8 <= len(lines) <= 13, f"{len(lines)} stats lines in 2 s (about 5 a second)"
+    bad = [line for line in lines if not GZ_LINE.match(line)]
+    assert not bad, f"lines not in gz-stats format: {bad}"
+    factor = float(re.search(r"Factor\[([\d.]+)\]", lines[-1]).group(1))
+    assert factor == pytest.approx(1.0, abs=0.1), f"real-time factor {factor}"
+
+    # Free fall of a new box, earth then moon, measured by stepping a paused world.
+    twin("pause")
+    twin("spawn", twin.box, "--name", "earthbox", "-x", "3", "-z", "10")
+    twin("step", str(STEPS))
+    earth = _drop(twin, "earthbox", 10.0)
+    twin("gravity", "--moon")
+    assert twin("gravity").stdout.split() == ["0", "0", "-1.62"]
+    twin("spawn", twin.box, "--name", "moonbox", "-x", "-3", "-z", "10")
+    twin("step", str(STEPS))
+    moon = _drop(twin, "moonbox", 10.0)
+    fall = 0.5 * DT**2 * STEPS * (STEPS + 1)  # semi-implicit Euler: sum of k*g*dt^2 [m per g]
+    assert earth == pytest.approx(EARTH * fall, rel=0.01), f"earth drop {earth} m in 0.3 s"
+    assert moon == pytest.approx(MOON * fall, rel=0.01), f"moon drop {moon} m in 0.3 s"
+    assert moon / earth == pytest.approx(MOON / EARTH, rel=0.01), "moon/earth fall ratio"
+
+    names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
+    assert names == {"humanoid", "earthbox", "moonbox"}, f"list: {names}"
+    assert len(twin("pose", "humanoid").stdout.split()) == 6, "pose is x y z roll pitch yaw"
+    twin("delete", "humanoid")
+    names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
+    assert "humanoid" not in names, f"humanoid still listed after delete: {names}"
+
+    taken = twin("spawn", twin.box, "--name", "moonbox", check=False)
+    assert taken.returncode == 2 and "Entity [moonbox] already exists" in taken.stderr, taken
+
+    twin("stop")
+    probe = twin("stats", "-d", "0", check=False)
+    assert probe.returncode == 1, f"stats with no world: exit {probe.returncode}"
+    assert probe.stderr.strip() == "An instance of twin is not running.", probe.stderr
+
+
+def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
+    twin("spawn", twin.box, "--name", "first", "-z", "1")
+    pid_file = tmp_path / "rt" / "default.pid"
+    old_pid = int(pid_file.read_text())
+    os.kill(old_pid, signal.SIGKILL)
+    again = twin("spawn", twin.box, "--name", "second", "-z", "1")
+    assert "started world" in again.stderr, f"no restart announced: {again.stderr!r}"
+    new_pid = int(pid_file.read_text())
+    assert new_pid != old_pid, "the killed server's pid is still recorded"
+    names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
+    assert names == {"second"}, f"a fresh world should hold only the new entity: {names}"

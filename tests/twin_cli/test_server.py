@@ -1,0 +1,197 @@
+"""A real world server on a temporary socket: bad requests get clear errors, it keeps stepping."""
+
+from __future__ import annotations
+
+import os
+import socket
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+
+from converters.errors import ConversionError
+from twin_cli import runtime
+from twin_cli.client import Client
+from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError, TwinError
+
+WORLD = "srv"
+BOX_URDF = """<?xml version="1.0"?>
+<robot name="box">
+  <link name="base">
+    <inertial><mass value="1.0"/><inertia ixx="0.0067" iyy="0.0067" izz="0.0067"
+      ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
+    <visual><geometry><box size="0.2 0.2 0.2"/></geometry></visual>
+  </link>
+</robot>
+"""
+# Not well-formed XML: the converter must refuse it with its file name in the message.
+BROKEN_URDF = "<robot name='broken'><link name='a'></robot>"
+START_TIMEOUT_S = 60.0
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    """`twin serve --tcp 127.0.0.1:0` in a temporary runtime dir; SIGTERM in teardown."""
+    rt = tmp_path_factory.mktemp("rt")
+    mp = pytest.MonkeyPatch()
+    mp.setenv(runtime.RUNTIME_ENV, str(rt))
+    log = open(rt / "serve.out", "wb")  # noqa: SIM115
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "twin_cli.app", "serve", "--world", WORLD, "--tcp", "127.0.0.1:0"],
+        stdout=log,
+        stderr=log,
+        env={**os.environ, runtime.RUNTIME_ENV: str(rt)},
+    )
+    client = Client(WORLD)
+    try:
+        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
+        yield client, proc
+    finally:
+        client.close()
+        proc.terminate()
+        proc.wait(timeout=20)
+        log.close()
+        mp.undo()
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("robots")
+    (d / "box.urdf").write_text(BOX_URDF)
+    (d / "broken.urdf").write_text(BROKEN_URDF)
+    return d
+
+
+def _sim_time(client: Client) -> float:
+    return float(client.stats()["sim_time"])
+
+
+def _assert_still_stepping(client: Client, before: float) -> None:
+    deadline = time.monotonic() + 5.0
+    while _sim_time(client) <= before and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert _sim_time(client) > before, f"sim_time stuck at {before} s after bad requests"
+
+
+def test_runtime_files_are_private(server):
+    client, _ = server
+    assert stat.S_IMODE(client.paths.directory.stat().st_mode) == 0o700, "runtime dir mode"
+    assert stat.S_IMODE(client.paths.socket.stat().st_mode) == 0o600, "socket mode"
+    assert stat.S_IMODE(client.paths.token.stat().st_mode) == 0o600, "token file mode"
+
+
+def test_unknown_entity_is_404_naming_it(server):
+    client, _ = server
+    with pytest.raises(EntityNotFoundError, match=r"Entity \[ghost\] does not exist"):
+        client.pose("ghost")
+    with pytest.raises(EntityNotFoundError, match="ghost"):
+        client.delete("ghost")
+
+
+def test_malformed_pose_is_422_naming_the_field(server):
+    client, _ = server
+    before = _sim_time(client)
+    with pytest.raises(RequestError, match=r"x: .*number"):
+        client.request("PUT", "/entities/anything/pose", body={"x": "one metre"})
+    with pytest.raises(RequestError, match="yaww"):
+        client.request("PUT", "/entities/anything/pose", body={"yaww": 1.0})
+    reply = client._http.put(
+        "/entities/anything/pose",
+        content=b'{"x": NaN}',
+        headers={"content-type": "application/json"},
+    )
+    assert reply.status_code == 422 and "finite" in reply.json()["message"], reply.text
+    with pytest.raises(RequestError, match="exactly one"):
+        client.request("PUT", "/gravity", body={"preset": "moon", "vector": [0, 0, 1]})
+    _assert_still_stepping(client, before)
+
+
+def test_missing_file_is_a_clear_4xx(server, tmp_path):
+    client, _ = server
+    missing = tmp_path / "nowhere" / "robot.urdf"
+    with pytest.raises((TwinError, ConversionError), match="robot.urdf") as info:
+        client.spawn(missing)
+    assert "Traceback" not in str(info.value)
+
+
+def test_file_that_fails_to_convert_is_a_4xx_with_its_message(server, files):
+    client, _ = server
+    before = _sim_time(client)
+    names = {e["name"] for e in client.entities()}
+    reply = client._http.post("/entities", json={"source": str(files / "broken.urdf")})
+    assert 400 <= reply.status_code < 500, f"status {reply.status_code}: {reply.text}"
+    assert "broken.urdf" in reply.json()["message"], reply.text
+    assert {e["name"] for e in client.entities()} == names, "a failed spawn changed the world"
+    _assert_still_stepping(client, before)
+
+
+def test_taken_name_is_entity_exists(server, files):
+    client, _ = server
+    assert client.spawn(files / "box.urdf", name="taken", pose={"z": 2.0})["name"] == "taken"
+    with pytest.raises(EntityExistsError, match=r"Entity \[taken\] already exists"):
+        client.spawn(files / "box.urdf", name="taken")
+    client.delete("taken")
+
+
+def test_raw_garbage_on_the_socket_gets_an_error_and_server_lives(server):
+    client, _ = server
+    before = _sim_time(client)
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as raw:
+        raw.settimeout(5.0)
+        raw.connect(str(client.paths.socket))
+        raw.sendall(b"\x00\xff\xfeNOT HTTP AT ALL\r\n\r\n" + os.urandom(256))
+        try:
+            reply = raw.recv(4096)
+        except (ConnectionResetError, TimeoutError):
+            reply = b""
+    assert reply == b"" or reply.startswith(b"HTTP/1.1 4"), f"reply to garbage: {reply[:80]!r}"
+    _assert_still_stepping(client, before)
+    assert client.alive()
+
+
+def test_tcp_needs_the_bearer_token(server):
+    client, _ = server
+    host, port = client.paths.tcp.read_text().strip().rsplit(":", 1)
+    assert host == "127.0.0.1", f"default TCP host {host}"
+    url = f"http://{host}:{port}"
+    assert httpx.get(url + "/stats").status_code == 401, "TCP without token must be refused"
+    bad = httpx.get(url + "/stats", headers={"Authorization": "Bearer wrong"})
+    assert bad.status_code == 401
+    token = client.paths.token.read_text().strip()
+    with Client(WORLD, url=url, token=token) as tcp_client:
+        assert tcp_client.stats()["sim_time"] >= 0.0
+
+
+def test_openapi_schema_is_served(server):
+    client, _ = server
+    schema = client.request("GET", "/openapi.json")
+    for path in ("/entities", "/gravity", "/stats", "/entities/{name}/pose"):
+        assert path in schema["paths"], f"{path} missing from the OpenAPI schema"
+
+
+def test_sigterm_ends_cleanly_and_removes_runtime_files(tmp_path):
+    env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "twin_cli.app", "serve", "--world", "t"],
+        env=env,
+        stderr=subprocess.PIPE,
+    )
+    mp = pytest.MonkeyPatch()
+    mp.setenv(runtime.RUNTIME_ENV, str(tmp_path))
+    try:
+        client = Client("t")
+        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
+        proc.terminate()
+        assert proc.wait(timeout=20) == 0, f"exit code after SIGTERM: {proc.returncode}"
+        leftovers = [p for p in client.paths.transient() if p.exists()]
+        assert leftovers == [], f"files left after SIGTERM: {leftovers}"
+        assert "stopped" in Path(client.paths.log).read_text()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        mp.undo()
