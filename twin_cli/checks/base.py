@@ -1,0 +1,131 @@
+"""Typed values shared by every validation check: the robot under test, statuses and results."""
+
+from __future__ import annotations
+
+import enum
+import re
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from converters.report import Report
+
+
+class Status(enum.Enum):
+    """Outcome of one check; only FAIL makes `twin validate` exit 1."""
+
+    PASS = "pass"
+    WARN = "warn"
+    FAIL = "fail"
+    SKIP = "skip"
+
+
+STATUS_TEXT = {
+    Status.PASS: "passed",
+    Status.WARN: "passed with warnings",
+    Status.FAIL: "failed",
+    Status.SKIP: "skipped (not applicable to this robot)",
+}
+
+
+@dataclass(frozen=True)
+class Series:
+    """A time series for a plot: `t` [s] against `values`, with an optional oracle curve."""
+
+    label: str
+    unit: str
+    t: tuple[float, ...]
+    values: dict[str, tuple[float, ...]]
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    """One check's verdict.
+
+    `measured` and `threshold` are short human strings ("12.1 mm", "≤ 5 mm"); `value` is the
+    headline number for JSON consumers; `hints` name the link/joint and the likely fix.
+    """
+
+    check: str
+    kind: str
+    status: Status
+    measured: str
+    threshold: str
+    hints: tuple[str, ...] = ()
+    details: tuple[str, ...] = ()
+    value: float | None = None
+    scenario: str | None = None
+    seconds: float = 0.0
+    series: tuple[Series, ...] = ()
+
+    @property
+    def failed(self) -> bool:
+        return self.status is Status.FAIL
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready view (series left out; they go to plots)."""
+        return {
+            "check": self.check,
+            "kind": self.kind,
+            "scenario": self.scenario,
+            "status": self.status.value,
+            "measured": self.measured,
+            "threshold": self.threshold,
+            "value": self.value,
+            "hints": list(self.hints),
+            "details": list(self.details),
+            "seconds": round(self.seconds, 4),
+        }
+
+
+@dataclass(frozen=True)
+class RobotUnderTest:
+    """What every check receives: the converted robot and how it was converted.
+
+    `spec` is never mutated by a check (physics checks spawn copies); `model` is the robot
+    compiled alone, in its initial pose. `repair_inertia` says whether the user asked for
+    inertia repairs (then repairs are warnings, not failures).
+    """
+
+    name: str
+    source: str
+    spec: mujoco.MjSpec
+    model: mujoco.MjModel
+    report: Report
+    repair_inertia: bool = False
+    body_links: dict[str, str] = field(default_factory=dict)
+
+    def link_of_body(self, body: str) -> str:
+        """The URDF link name for a body name (bodies are named after links)."""
+        return self.body_links.get(body, body)
+
+
+def result(
+    check: str,
+    kind: str,
+    status: Status,
+    measured: str,
+    threshold: str,
+    **extra: Any,
+) -> CheckResult:
+    """Build a CheckResult, turning lists into tuples."""
+    for key in ("hints", "details", "series"):
+        if key in extra:
+            extra[key] = tuple(extra[key])
+    return CheckResult(check, kind, status, measured, threshold, **extra)
+
+
+_LINK_RE = re.compile(r"link '([^']+)'")
+
+
+def link_in_subject(subject: str) -> str | None:
+    """The link named in a report subject such as "link 'wheel' mass", or None."""
+    match = _LINK_RE.search(subject)
+    return match.group(1) if match else None
+
+
+def fmt_len(metres: float) -> str:
+    """A length for people: mm below 1 m."""
+    return f"{metres * 1000:.3g} mm" if abs(metres) < 1.0 else f"{metres:.3g} m"

@@ -1,0 +1,187 @@
+"""Runs the validation checklist on one robot, in-process, and returns typed results.
+
+A missing or non-physical inertial must still reach validation as a failed model check, so the
+robot is always converted with `ConvertOptions(repair_inertia=True)`; the converter's
+`repaired` report entries then become failures (or warnings when the user passed
+`--repair-inertia`, i.e. accepted the repairs).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from twin_cli.checks import CHECKS, MODEL_CHECKS
+from twin_cli.checks.base import CheckResult, RobotUnderTest, Status, result
+from twin_cli.errors import ScenarioError, UnknownCheckError
+from twin_cli.scenario import Scenario, load_builtin, resolve
+
+
+@dataclass(frozen=True)
+class ValidationRun:
+    """Every check's result for one robot, and the wall time of the whole run [s]."""
+
+    robot: str
+    source: str
+    results: tuple[CheckResult, ...]
+    seconds: float
+
+    @property
+    def passed(self) -> bool:
+        return not any(r.failed for r in self.results)
+
+    def counts(self) -> dict[str, int]:
+        """How many checks ended in each status."""
+        out = {s.value: 0 for s in Status}
+        for r in self.results:
+            out[r.status.value] += 1
+        return out
+
+    def to_dict(self) -> dict:
+        return {
+            "robot": self.robot,
+            "source": self.source,
+            "passed": self.passed,
+            "counts": self.counts(),
+            "seconds": round(self.seconds, 3),
+            "checks": [r.to_dict() for r in self.results],
+        }
+
+
+def load_robot(
+    path: str | Path,
+    *,
+    args: dict[str, str] | None = None,
+    package_paths: dict[str, str] | None = None,
+    repair_inertia: bool = False,
+) -> RobotUnderTest:
+    """Convert (URDF/xacro) or load (MJCF .xml) a robot and compile it alone.
+
+    Raises:
+        ConversionError: the description cannot be converted (exit 2 at the CLI).
+    """
+    import mujoco
+
+    from converters.report import Report
+
+    path = Path(path)
+    body_links: dict[str, str] = {}
+    if path.suffix.lower() == ".xml":
+        spec, report = mujoco.MjSpec.from_file(str(path)), Report(source=str(path))
+    else:
+        from converters import ConvertOptions, convert_full
+
+        done = convert_full(
+            path,
+            args=args,
+            package_paths=package_paths,
+            options=ConvertOptions(repair_inertia=True),
+        )
+        spec, report = done.spec, done.report
+        body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
+    model = spec.copy().compile()
+    name = report.robot or spec.modelname or path.stem.split(".")[0]
+    return RobotUnderTest(name, str(path), spec, model, report, repair_inertia, body_links)
+
+
+def _model_scenario(check: str) -> Scenario:
+    return Scenario(name=check, check=check, source="built-in")
+
+
+def plan(
+    scenarios: list[str] | None = None,
+    only: list[str] | None = None,
+    skip: list[str] | None = None,
+) -> list[Scenario]:
+    """The scenarios to run: every model check plus the built-in (or the given) scenarios.
+
+    Raises:
+        UnknownCheckError: --only/--skip names a check that does not exist.
+        ScenarioError: a scenario file is malformed or names an unknown check or threshold.
+    """
+    for name in (only or []) + (skip or []):
+        if name not in CHECKS:
+            raise UnknownCheckError(name, list(CHECKS))
+    chosen = [resolve(s) for s in scenarios] if scenarios else load_builtin()
+    for sc in chosen:
+        _validate_scenario(sc)
+    given = {sc.check for sc in chosen}
+    todo = [_model_scenario(c) for c in MODEL_CHECKS if c not in given] + chosen
+    return [sc for sc in todo if (not only or sc.check in only) and sc.check not in (skip or [])]
+
+
+def _validate_scenario(sc: Scenario) -> None:
+    check = CHECKS.get(sc.check)
+    if check is None:
+        raise ScenarioError(
+            sc.source, "check", f"unknown check {sc.check!r}", f"use one of {', '.join(CHECKS)}"
+        )
+    for key in sc.thresholds:
+        if key not in check.defaults:
+            valid = ", ".join(check.defaults) or "none"
+            raise ScenarioError(
+                sc.source,
+                f"thresholds.{key}",
+                f"check {sc.check!r} has no threshold {key!r}",
+                f"use one of: {valid}",
+            )
+
+
+def run_check(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> CheckResult:
+    """Run one scenario's check; an unexpected error becomes a failed result naming it."""
+    check = CHECKS[sc.check]
+    thresholds = {**check.defaults, **sc.thresholds}
+    start = time.perf_counter()
+    try:
+        outcome = check.run(robot, sc, thresholds)
+    except Exception as exc:  # noqa: BLE001 - one broken check must not hide the others
+        if debug:
+            raise
+        outcome = result(
+            sc.check,
+            check.kind,
+            Status.FAIL,
+            "error",
+            "runs",
+            hints=[f"the check could not run: {type(exc).__name__}: {exc}"],
+        )
+    return _stamp(outcome, sc, time.perf_counter() - start)
+
+
+def _stamp(outcome: CheckResult, sc: Scenario, seconds: float) -> CheckResult:
+    from dataclasses import replace
+
+    scenario = None if sc.source == "built-in" else sc.name
+    return replace(outcome, scenario=scenario, seconds=seconds)
+
+
+def validate(
+    robot_path: str | Path,
+    *,
+    args: dict[str, str] | None = None,
+    package_paths: dict[str, str] | None = None,
+    scenarios: list[str] | None = None,
+    only: list[str] | None = None,
+    skip: list[str] | None = None,
+    repair_inertia: bool = False,
+    debug: bool = False,
+) -> ValidationRun:
+    """Validate one robot: convert it, run the planned checks, return every result.
+
+    Args:
+        robot_path: URDF, xacro or MJCF file.
+        args: xacro arguments NAME → VALUE.
+        package_paths: package NAME → directory.
+        scenarios: bundled scenario names or .toml paths (default: the built-in checklist).
+        only, skip: check names to keep or leave out.
+        repair_inertia: accept the converter's inertia repairs (warnings instead of failures).
+        debug: re-raise errors inside checks instead of reporting them as failures.
+    """
+    start = time.perf_counter()
+    todo = plan(scenarios, only, skip)
+    robot = load_robot(
+        robot_path, args=args, package_paths=package_paths, repair_inertia=repair_inertia
+    )
+    results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
+    return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)
