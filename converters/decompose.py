@@ -26,8 +26,9 @@ from typing import Any
 
 import numpy as np
 
-# Test-only hook: "<fault>:<request key>" (or "<fault>:*") makes the worker for that mesh
-# misbehave (fault = crash | kill | abort | hang | error), so tests exercise real processes.
+# Test-only hook: "<fault>:<request key>" (or "<fault>:*"), comma-separated, makes the worker
+# for that mesh misbehave (fault = crash | kill | abort | hang | error), so tests exercise real
+# processes dying and hanging.
 FAULT_ENV = "TWIN_TEST_COACD_FAULT"
 FAULTS = ("crash", "kill", "abort", "hang", "error")
 # How often the parent looks at running workers [s].
@@ -73,9 +74,10 @@ def default_jobs() -> int:
 
 def fault_for(key: str) -> str | None:
     """The fault the test hook asks for on `key` ("*" matches every key), else None."""
-    fault, _, target = os.environ.get(FAULT_ENV, "").partition(":")
-    if fault in FAULTS and target in (key, "*"):
-        return fault
+    for item in os.environ.get(FAULT_ENV, "").split(","):
+        fault, _, target = item.strip().partition(":")
+        if fault in FAULTS and target in (key, "*"):
+            return fault
     return None
 
 

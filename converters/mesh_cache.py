@@ -68,7 +68,9 @@ def coacd_version() -> str:
         return "absent"
 
 
-def entry_key(vertices: np.ndarray, faces: np.ndarray, facts: dict[str, Any]) -> str:
+def entry_key(
+    vertices: np.ndarray, faces: np.ndarray, facts: dict[str, Any], *, version: str | None = None
+) -> str:
     """The key of one mesh under one set of choices.
 
     Args:
@@ -77,12 +79,13 @@ def entry_key(vertices: np.ndarray, faces: np.ndarray, facts: dict[str, Any]) ->
         faces: (M, 3) vertex indices.
         facts: everything else the result depends on (mode, parameters, scale, hull cap);
             must be JSON-serialisable.
+        version: the CoACD version to key on (default: the installed one).
 
     Returns:
         A hex SHA-256 digest.
     """
     digest = hashlib.sha256()
-    header = {"format": FORMAT_VERSION, "coacd": coacd_version(), **facts}
+    header = {"format": FORMAT_VERSION, "coacd": version or coacd_version(), **facts}
     digest.update(json.dumps(header, sort_keys=True).encode())
     digest.update(np.ascontiguousarray(vertices, dtype=np.float64).tobytes())
     digest.update(np.ascontiguousarray(faces, dtype=np.int64).tobytes())

@@ -1,0 +1,164 @@
+"""Collision planning: the auto rule, presets and knobs, hull caps, and a ball in a cup."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from collision_models import CUP_FLOOR, CUP_RIM, box_mesh, cup_mesh, request
+
+from converters import hulls
+from converters.collision import (
+    CONVEX_RATIO,
+    PRESETS,
+    TRIANGLES_ADVISED,
+    TRIANGLES_MAX,
+    CollisionMode,
+    CollisionSettings,
+    coacd_params,
+    decide,
+    prepare_collision_meshes,
+)
+from converters.errors import CollisionSettingsError
+from converters.report import Outcome, Report
+
+BALL_RADIUS = 0.012  # [m], fits the 42 mm inner radius with room to spare
+BALL_DROP_Z = 0.20  # [m] above the cup's base
+
+
+@pytest.fixture(autouse=True)
+def _private_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+
+
+# One row per branch of the auto rule: (triangles, convexity) -> mode.
+AUTO_RULE = [
+    (TRIANGLES_MAX + 1, 0.99, CollisionMode.COACD),  # too heavy, even if convex
+    (500, CONVEX_RATIO - 0.01, CollisionMode.COACD),  # concave
+    (500, CONVEX_RATIO, CollisionMode.HULL),  # nearly convex
+    (TRIANGLES_ADVISED + 1, None, CollisionMode.COACD),  # open and over 1,000
+    (TRIANGLES_ADVISED, None, CollisionMode.HULL),  # open and small
+]
+
+
+@pytest.mark.parametrize(("triangles", "convexity", "expected"), AUTO_RULE)
+def test_auto_rule_picks_mode_from_volume_ratio_and_triangles(triangles, convexity, expected):
+    decision = decide(triangles, convexity)
+    assert decision.mode is expected, f"auto mode for {triangles} tris, ratio {convexity}"
+    assert decision.reason, "the decision states its reason"
+
+
+def test_cup_is_concave_and_box_convex_by_volume_ratio():
+    cup = hulls.volumes(*cup_mesh())
+    box = hulls.volumes(*box_mesh((0.1, 0.2, 0.3)))
+    # Oracle: cup volume = pi (R^2 h - r^2 (h - floor)), hull = pi R^2 h.
+    r_out, r_in = 0.05, 0.042
+    expected = (r_out**2 * CUP_RIM - r_in**2 * (CUP_RIM - CUP_FLOOR)) / (r_out**2 * CUP_RIM)
+    assert cup.convexity == pytest.approx(expected, rel=0.03), "cup volume / hull volume"
+    assert box.convexity == pytest.approx(1.0, abs=1e-9), "box volume / hull volume"
+
+
+def test_open_mesh_has_no_volume_and_no_convexity():
+    vertices, faces = box_mesh((0.1, 0.1, 0.1))
+    open_box = hulls.volumes(vertices, faces[:-2])  # drop one side
+    assert open_box.mesh is None and open_box.convexity is None, "open mesh volume"
+    assert open_box.hull == pytest.approx(1e-3, rel=1e-9), "hull volume of a 0.1 m cube [m^3]"
+
+
+def test_threshold_in_metres_becomes_coacd_relative_threshold():
+    # Longest edge 0.1 m spans 2 units inside CoACD, so 5 mm is 2 * 0.005 / 0.1 = 0.1.
+    req = request("cup/0", cup_mesh())
+    params = coacd_params(req, CollisionSettings(threshold_m=0.005))
+    assert params.threshold == pytest.approx(0.1, rel=1e-9), "relative CoACD threshold"
+    knobs = CollisionSettings(preset="fast", max_hulls=5, resolution=777, seed=3)
+    params = coacd_params(req, knobs)
+    assert (params.max_convex_hull, params.resolution, params.seed) == (5, 777, 3)
+    assert params.mcts_iterations == PRESETS["fast"].mcts_iterations, "preset kept"
+
+
+def test_presets_trade_quality_for_time():
+    fast, balanced, fine = PRESETS["fast"], PRESETS["balanced"], PRESETS["fine"]
+    assert fast.threshold > balanced.threshold > fine.threshold, "coarser threshold is faster"
+    assert fast.mcts_iterations < balanced.mcts_iterations <= fine.mcts_iterations
+    assert fast.max_convex_hull < balanced.max_convex_hull < fine.max_convex_hull
+
+
+@pytest.mark.parametrize(
+    ("settings", "option"),
+    [
+        (CollisionSettings(mode="convex"), "--collision"),
+        (CollisionSettings(per_link={"arm": "blob"}), "--collision-link arm="),
+        (CollisionSettings(preset="turbo"), "--coacd-preset"),
+    ],
+)
+def test_unknown_setting_names_option_and_valid_values(settings, option):
+    with pytest.raises(CollisionSettingsError) as info:
+        prepare_collision_meshes([], settings, Report())
+    message = str(info.value)
+    assert option in message, f"message names the option: {message}"
+    assert any(v in message for v in ("coacd", "balanced")), f"lists valid values: {message}"
+
+
+def test_hull_cap_limits_vertices_and_stays_inside_full_hull():
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=0.1)  # 2,562 vertices
+    full = hulls.convex_hull(sphere.vertices)
+    capped = hulls.convex_hull(sphere.vertices, max_vertices=64)
+    assert len(capped[0]) <= 64, "capped hull vertex count"
+    ratio = hulls.hull_volume(capped) / hulls.hull_volume(full)
+    assert 0.85 < ratio <= 1.0 + 1e-9, f"capped/full hull volume {ratio:.3f}"
+
+
+def test_per_link_override_and_mesh_mode_keep_the_mesh_whole():
+    cup, box = cup_mesh(8), box_mesh((0.1, 0.1, 0.1))
+    settings = CollisionSettings(mode="hull", per_link={"cup": "mesh"})
+    report = Report()
+    requests = [request("cup/0", cup), request("box/0", box)]
+    parts = prepare_collision_meshes(requests, settings, report)
+    assert len(parts["cup/0"]) == 1 and np.array_equal(parts["cup/0"][0].faces, cup[1])
+    rows = {row["key"]: row for row in report.meshes}
+    assert (rows["cup/0"]["mode"], rows["box/0"]["mode"]) == ("mesh", "hull")
+    assert len(report.of(Outcome.APPROXIMATED)) == 2, "one report line per mesh"
+
+
+def _cup_world(parts, ball_radius: float):
+    """A static cup made of the given parts and a free ball above it; returns (model, data)."""
+    import mujoco
+
+    spec = mujoco.MjSpec()
+    spec.option.timestep = 0.001
+    for i, part in enumerate(parts):
+        mesh = spec.add_mesh(name=f"cup_{i}")
+        mesh.uservert = np.asarray(part.vertices, float).ravel().tolist()
+        mesh.userface = np.asarray(part.faces, int).ravel().tolist()
+        geom = spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"cup_{i}")
+        geom.name = f"cup_geom_{i}"
+    ball = spec.worldbody.add_body(name="ball", pos=[0.0, 0.0, BALL_DROP_Z])
+    ball.add_freejoint(name="ball_free")
+    ball.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[ball_radius, 0, 0], mass=0.01)
+    model = spec.compile()
+    return model, mujoco.MjData(model)
+
+
+def _rest_height(parts) -> float:
+    """Height of the ball's centre after 1.5 s of falling into / onto the cup [m]."""
+    import mujoco
+
+    model, data = _cup_world(parts, BALL_RADIUS)
+    mujoco.mj_step(model, data, nstep=1500)
+    speed = float(np.linalg.norm(data.qvel[:3]))
+    assert speed < 0.05, f"ball still moving at {speed:.3f} m/s after 1.5 s"
+    return float(data.qpos[2])
+
+
+def test_ball_rests_inside_coacd_cup_and_on_top_of_hull_cup():
+    cup = request("cup/0", cup_mesh())
+    results = {}
+    for mode in ("coacd", "hull"):
+        settings = CollisionSettings(mode=mode, preset="fast", use_cache=False)
+        results[mode] = prepare_collision_meshes([cup], settings, Report())["cup/0"]
+    inside, on_top = _rest_height(results["coacd"]), _rest_height(results["hull"])
+    # Inside: on the floor (8 mm + radius), allowing the parts to bulge by up to 15 mm.
+    assert inside < CUP_FLOOR + BALL_RADIUS + 0.015, f"coacd: ball centre at {inside:.4f} m"
+    # On the hull: the hull's top is the rim plane, the ball sits one radius above it.
+    assert on_top == pytest.approx(CUP_RIM + BALL_RADIUS, abs=0.002), f"hull: {on_top:.4f} m"

@@ -1,0 +1,97 @@
+"""CoACD in worker processes: parts come back, and dying or hanging workers fall back to hulls."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from collision_models import box_mesh, cup_mesh, request
+
+from converters import hulls
+from converters.collision import PRESETS, CollisionSettings, prepare_collision_meshes
+from converters.decompose import FAULT_ENV, DecomposeJob, decompose_all, fault_for
+from converters.report import Outcome, Report
+
+FAST = PRESETS["fast"]
+
+
+@pytest.fixture(autouse=True)
+def _private_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def test_worker_returns_convex_parts_covering_the_cup():
+    vertices, faces = cup_mesh(16)
+    job = DecomposeJob("cup", vertices, faces, FAST.kwargs())
+    outcome = decompose_all([job], workers=1, time_limit=60)["cup"]
+    assert outcome.failure is None, f"worker failure: {outcome.failure}"
+    assert 2 <= len(outcome.parts) <= FAST.max_convex_hull, f"{len(outcome.parts)} parts"
+    mesh_volume = hulls.volumes(vertices, faces).mesh
+    total = sum(hulls.hull_volume(hulls.convex_hull(v)) for v, _ in outcome.parts)
+    # Parts cover the cup (>= 95 %) without filling its cavity (hull is 2.7x the cup).
+    assert 0.95 < total / mesh_volume < 1.6, f"parts / cup volume {total / mesh_volume:.2f}"
+
+
+def test_fault_hook_matches_named_keys_only(monkeypatch):
+    monkeypatch.setenv(FAULT_ENV, "crash:a/0, hang:b/0")
+    assert (fault_for("a/0"), fault_for("b/0"), fault_for("c/0")) == ("crash", "hang", None)
+
+
+FAULTS = {
+    "crash": "exited with status 70",
+    "kill": "killed by signal SIGKILL",
+    "abort": "killed by signal SIGABRT",
+    "error": "RuntimeError: injected error",
+}
+
+
+def test_dying_workers_fall_back_to_hulls_and_conversion_succeeds(monkeypatch):
+    # Distinct meshes: identical bytes would share one CoACD run.
+    cups = {fault: cup_mesh(9 + i) for i, fault in enumerate(FAULTS)}
+    faulty = [request(f"{fault}/0", cups[fault]) for fault in FAULTS]
+    healthy = request("healthy/0", cup_mesh(8))
+    convex = request("box/0", box_mesh((0.1, 0.1, 0.1)))
+    monkeypatch.setenv(FAULT_ENV, ",".join(f"{fault}:{fault}/0" for fault in FAULTS))
+    settings = CollisionSettings(mode="coacd", preset="fast", jobs=2)
+    report = Report()
+    parts = prepare_collision_meshes([*faulty, healthy, convex], settings, report)
+    rows = {row["key"]: row for row in report.meshes}
+    warnings = {entry.subject: entry.detail for entry in report.of(Outcome.WARNING)}
+    for fault, reason in FAULTS.items():
+        row = rows[f"{fault}/0"]
+        assert row["mode"] == "hull" and reason in row["fallback"], f"{fault}: {row['fallback']}"
+        assert len(parts[f"{fault}/0"]) == 1, f"{fault}: one hull part"
+        hull_volume = hulls.hull_volume(hulls.convex_hull(cups[fault][0]))
+        got = hulls.hull_volume((parts[f"{fault}/0"][0].vertices, parts[f"{fault}/0"][0].faces))
+        assert got == pytest.approx(hull_volume, rel=1e-6), f"{fault}: fallback hull volume"
+        assert any(reason in detail for detail in warnings.values()), f"report line for {fault}"
+        assert row["cache"] == "miss", "a fallback is never stored"
+    assert rows["healthy/0"]["fallback"] is None and rows["healthy/0"]["parts"] >= 2
+    assert report.summary["collision"]["fallbacks"] == len(FAULTS), "fallback count"
+    assert rows["box/0"]["mode"] == "coacd" and rows["box/0"]["fallback"] is None
+
+
+def test_hanging_worker_is_killed_at_the_time_limit(monkeypatch):
+    monkeypatch.setenv(FAULT_ENV, "hang:cup/0")
+    settings = CollisionSettings(mode="coacd", preset="fast", time_limit=1.0)
+    report = Report()
+    parts = prepare_collision_meshes([request("cup/0", cup_mesh(8))], settings, report)
+    row = report.meshes[0]
+    assert "exceeded the 1 s time limit" in row["fallback"], f"fallback: {row['fallback']}"
+    assert len(parts["cup/0"]) == 1 and row["mode"] == "hull", "hull fallback"
+    # Killed promptly: the limit plus process start-up, far below the hang's 3,600 s.
+    assert row["seconds"] < 10.0, f"hang handled after {row['seconds']:.1f} s"
+    assert report.of(Outcome.WARNING), "report line for the hang"
+
+
+def test_fallbacks_are_not_cached_so_a_retry_decomposes(monkeypatch):
+    cup = request("cup/0", cup_mesh(8))
+    settings = CollisionSettings(mode="coacd", preset="fast")
+    monkeypatch.setenv(FAULT_ENV, "crash:cup/0")
+    first = Report()
+    prepare_collision_meshes([cup], settings, first)
+    monkeypatch.delenv(FAULT_ENV)
+    second = Report()
+    parts = prepare_collision_meshes([cup], settings, second)["cup/0"]
+    assert first.meshes[0]["fallback"] and second.meshes[0]["fallback"] is None
+    assert second.meshes[0]["cache"] == "miss" and len(parts) >= 2, "retried with CoACD"
+    assert all(np.isfinite(p.vertices).all() for p in parts), "finite part vertices"
