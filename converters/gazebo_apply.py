@@ -170,7 +170,7 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
     report.mapped(
         "collision geoms",
         f"Gazebo default μ={DEFAULT_MU} (priority {friction_priority(DEFAULT_MU)}) on "
-        f"{untagged} geoms of untagged links",
+        f"{untagged} collision geoms without μ1",
         tag="mu1",
     )
 
@@ -251,7 +251,9 @@ def _apply_body_flags(spec: Any, flags: dict[str, BodyFlags], report: Report) ->
                 tag="dampingFactor",
             )
         if flag.self_collide:
-            report.mapped(subject, "selfCollide: collides with the robot's other links")
+            report.mapped(
+                subject, "selfCollide: collides with the robot's other links", tag="selfCollide"
+            )
 
 
 def add_self_collision_excludes(

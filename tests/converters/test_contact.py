@@ -1,0 +1,160 @@
+"""Contact rules of converters.contact, proved on hand-built MjSpecs by MuJoCo's own contacts."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from converters.contact import (
+    GROUND_MU,
+    MIN_DAMPING_RATIO,
+    PRIORITY_PER_DECADE,
+    add_gazebo_ground,
+    contact_softness,
+    friction_priority,
+    limit_solref,
+    max_contact_stiffness,
+)
+
+G = 9.8
+STEP = 0.001
+
+
+def _world(gravity: tuple[float, float, float] = (0.0, 0.0, -G)) -> mujoco.MjSpec:
+    spec = mujoco.MjSpec()
+    spec.option.timestep = STEP
+    spec.option.gravity = list(gravity)
+    add_gazebo_ground(spec)
+    return spec
+
+
+def _free_geom(spec: mujoco.MjSpec, geom_type, size, z: float, mass: float, mu: float, soft=None):
+    body = spec.worldbody.add_body(name=f"b{len(spec.bodies)}", pos=[0.0, 0.0, z])
+    body.add_freejoint()
+    geom = body.add_geom(type=geom_type, size=size, mass=mass)
+    geom.friction = [mu, 0.005, 0.0001]
+    geom.priority = friction_priority(mu)
+    if soft is not None:
+        geom.solref = list(soft.solref)
+        geom.solimp = list(soft.solimp)
+    return body
+
+
+def test_friction_priority_strictly_decreases_with_mu():
+    mus = np.logspace(-4, 6, 400)
+    priorities = [friction_priority(float(mu)) for mu in mus]
+    assert all(a > b for a, b in itertools.pairwise(priorities)), "priority not decreasing in μ"
+    assert all(p >= 0 for p in priorities), "priority must be non-negative"
+    step = 10 ** (1 / PRIORITY_PER_DECADE) - 1
+    assert friction_priority(1.0) != friction_priority(1.0 * (1 + 2 * step)), "quantisation"
+
+
+@pytest.mark.parametrize("mu_a,mu_b", [(0.01, 100.0), (0.3, 1.0), (5.0, 0.7), (1e5, 100.0)])
+def test_contact_friction_is_min_of_both_geoms(mu_a, mu_b):
+    """Two overlapping spheres of any μ pair get friction min(μa, μb) in MuJoCo's contact."""
+    spec = _world()
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 1.0, 1.0, mu_a)
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 1.15, 1.0, mu_b)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    pair = [c for c in data.contact[: data.ncon] if 0 not in (c.geom1, c.geom2)]
+    assert len(pair) == 1, f"expected one sphere-sphere contact, got {len(pair)}"
+    assert pair[0].friction[0] == pytest.approx(min(mu_a, mu_b), rel=1e-12), "contact μ"
+
+
+@pytest.mark.parametrize("mu", [0.05, 1.0, 99.0, 150.0])
+def test_robot_on_gazebo_ground_gets_min_mu(mu):
+    spec = _world()
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.099, 1.0, mu)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    assert data.ncon == 1, "sphere must touch the ground"
+    assert data.contact[0].friction[0] == pytest.approx(min(mu, GROUND_MU)), "ground contact μ"
+
+
+def test_gazebo_ground_is_named_plane_with_mu_100():
+    model = _world().compile()
+    ground = model.geom("ground")
+    assert ground.type[0] == mujoco.mjtGeom.mjGEOM_PLANE, "ground type"
+    assert ground.friction[0] == pytest.approx(100.0), "ground μ"
+    assert ground.priority[0] == friction_priority(100.0), "ground priority"
+
+
+def _settle_ball(kp: float, kd: float, mass: float, seconds: float = 1.0):
+    soft = contact_softness(kp, kd, mass)
+    spec = _world()
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.1, mass, 1.0, soft)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=int(seconds / STEP))
+    return 0.1 - data.qpos[2], soft, model, data
+
+
+@pytest.mark.parametrize("kp,mass", [(1e4, 1.0), (1e5, 1.0), (2e5, 5.0)])
+def test_resting_ball_sinks_mg_over_kp(kp, mass):
+    sinkage, _, _, _ = _settle_ball(kp, 2 * math.sqrt(kp * mass), mass)
+    expected = mass * G / kp
+    assert sinkage == pytest.approx(expected, rel=0.02), f"sinkage {sinkage} m vs m·g/kp"
+
+
+def test_resting_box_sinks_a_quarter_on_four_contacts():
+    kp, mass = 1e5, 1.0
+    soft = contact_softness(kp, 2 * math.sqrt(kp * mass), mass)
+    spec = _world()
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_BOX, [0.05, 0.05, 0.05], 0.05, mass, 1.0, soft)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=1000)
+    assert data.ncon == 4, "box on plane: four contact points"
+    sinkage = 0.05 - data.qpos[2]
+    assert sinkage == pytest.approx(mass * G / kp / 4, rel=0.02), "box sinkage vs m·g/(4·kp)"
+
+
+@pytest.mark.parametrize("zeta", [0.5, 0.7])
+def test_ball_rebounds_with_gazebo_damping_ratio(zeta):
+    """Free oscillation about rest: successive opposite peaks shrink by exp(-πζ/sqrt(1-ζ²))."""
+    kp, mass = 3e4, 1.0
+    soft = contact_softness(kp, zeta * 2 * math.sqrt(kp * mass), mass)
+    spec = _world()
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.1, mass, 1.0, soft)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    data.qpos[2] = 0.1 - soft.sinkage
+    data.qvel[2] = -0.05
+    deviation = []
+    for _ in range(500):
+        mujoco.mj_step(model, data)
+        deviation.append(0.1 - data.qpos[2] - soft.sinkage)
+    deviation = np.array(deviation)
+    first = int(np.argmax(deviation))
+    ratio = -deviation[first:].min() / deviation[first]
+    decrement = -math.log(ratio)
+    measured = decrement / math.sqrt(math.pi**2 + decrement**2)
+    assert measured == pytest.approx(zeta, rel=0.05), f"damping ratio {measured} vs {zeta}"
+
+
+def test_stiffer_than_timestep_is_clamped_and_sinks_as_reported():
+    kp, mass = 1e8, 1.0
+    sinkage, soft, _, _ = _settle_ball(kp, 2 * math.sqrt(kp * mass), mass)
+    assert soft.clamped, "kp/m = 1e8 /s² must be clamped at a 1 ms step"
+    assert -soft.solref[0] == pytest.approx(max_contact_stiffness(STEP)), "clamped stiffness"
+    assert sinkage == pytest.approx(soft.sinkage, rel=0.02), "sinkage vs reported figure"
+    assert np.isfinite(sinkage) and sinkage > 0, "clamped contact must stay stable"
+
+
+def test_low_gazebo_damping_is_floored_and_says_so():
+    soft = contact_softness(1e6, 1.0, 1.0)
+    assert soft.damping_ratio_gazebo == pytest.approx(1.0 / (2 * 1e3)), "Gazebo ζ figure"
+    assert soft.damping_ratio == pytest.approx(MIN_DAMPING_RATIO), "floored ζ"
+
+
+def test_limit_solref_follows_stop_erp():
+    assert limit_solref(0.2) == pytest.approx((0.005, 1.0)), "erp 0.2 at 1 ms: τ = h/erp"
+    assert limit_solref(1.0) == pytest.approx((0.002, 1.0)), "τ never below 2·h"
+    assert limit_solref(None) == pytest.approx((0.005, 1.0)), "SDF default erp 0.2"

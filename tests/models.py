@@ -1,0 +1,142 @@
+"""Small named robot descriptions for tests: URDF text factories and a writer to a tmp dir.
+
+Each factory returns URDF text; `write_urdf(tmp_path, text)` puts it in a file. Inertias are
+those of the solid shapes, so oracles can compute masses and heights by hand.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def write_urdf(directory: Path, text: str, name: str = "robot.urdf") -> Path:
+    """Write URDF `text` to `directory/name` and return the path."""
+    path = Path(directory) / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _sphere_inertial(mass: float, radius: float) -> str:
+    i = 0.4 * mass * radius**2
+    return (
+        f'<inertial><mass value="{mass}"/>'
+        f'<inertia ixx="{i}" iyy="{i}" izz="{i}" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+
+
+def _box_inertial(mass: float, sx: float, sy: float, sz: float) -> str:
+    ixx = mass * (sy**2 + sz**2) / 12
+    iyy = mass * (sx**2 + sz**2) / 12
+    izz = mass * (sx**2 + sy**2) / 12
+    return (
+        f'<inertial><mass value="{mass}"/>'
+        f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+
+
+def _gazebo(reference: str, **tags: object) -> str:
+    body = "".join(f"<{tag}>{value}</{tag}>" for tag, value in tags.items() if value is not None)
+    return f'<gazebo reference="{reference}">{body}</gazebo>' if body else ""
+
+
+def ball_on_plane(mass: float, kp: float | None = None, kd: float | None = None) -> str:
+    """A free ball (radius 0.1 m, `mass` [kg]) with Gazebo kp [N/m] and kd [N s/m] on 'ball'."""
+    return f"""<robot name="ball">
+  <link name="ball">
+    {_sphere_inertial(mass, 0.1)}
+    <collision><geometry><sphere radius="0.1"/></geometry></collision>
+    <visual><geometry><sphere radius="0.1"/></geometry></visual>
+  </link>
+  {_gazebo("ball", kp=kp, kd=kd)}
+</robot>"""
+
+
+def block(
+    mu: float | None = None, size: float = 0.1, mass: float = 1.0, name: str = "block"
+) -> str:
+    """A free cube of edge `size` [m] and `mass` [kg]; `mu` sets Gazebo mu1 and mu2 on it."""
+    return f"""<robot name="{name}">
+  <link name="{name}">
+    {_box_inertial(mass, size, size, size)}
+    <collision><geometry><box size="{size} {size} {size}"/></geometry></collision>
+  </link>
+  {_gazebo(name, mu1=mu, mu2=mu)}
+</robot>"""
+
+
+def slab(mu: float, name: str = "slab") -> str:
+    """A static 2 m × 2 m × 0.1 m slab (top face at z = 0.05 m) with Gazebo μ on its surface."""
+    return f"""<robot name="{name}">
+  <link name="{name}">
+    {_box_inertial(100.0, 2.0, 2.0, 0.1)}
+    <collision><geometry><box size="2 2 0.1"/></geometry></collision>
+  </link>
+  {_gazebo(name, mu1=mu, mu2=mu)}
+  <gazebo><static>true</static></gazebo>
+</robot>"""
+
+
+def block_on_incline(mu: float) -> str:
+    """The cube of `block(mu)`; tests tilt gravity by θ rather than the plane (same physics)."""
+    return block(mu)
+
+
+def pendulum_pair(gravity_off_link: str | None = "left", tag: str = "turnGravityOff") -> str:
+    """Two sibling pendulums on a world-fixed base, both horizontal at rest (hinges about y).
+
+    Links 'left' and 'right' (1 kg point-like spheres 0.5 m out along ±x). `tag` is written on
+    `gravity_off_link`: "turnGravityOff" (value true) or "gravity" (value false).
+    """
+    value = "true" if tag == "turnGravityOff" else "false"
+    tags = f'<gazebo reference="{gravity_off_link}"><{tag}>{value}</{tag}></gazebo>'
+    arms = "".join(_pendulum_arm(side, sign) for side, sign in (("left", 1), ("right", -1)))
+    return f"""<robot name="pendulums">
+  <link name="world"/>
+  <link name="base">{_box_inertial(1.0, 0.1, 0.1, 0.1)}</link>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/>
+    <origin xyz="0 0 1"/></joint>
+  {arms}
+  {tags if gravity_off_link else ""}
+</robot>"""
+
+
+def _pendulum_arm(side: str, sign: int) -> str:
+    return f"""<link name="{side}">
+    <inertial><origin xyz="{0.5 * sign} 0 0"/><mass value="1"/>
+      <inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial>
+  </link>
+  <joint name="{side}_hinge" type="continuous"><parent link="base"/><child link="{side}"/>
+    <axis xyz="0 1 0"/></joint>"""
+
+
+def falling_sibling(self_collide_link: str | None, model_self_collide: bool = False) -> str:
+    """Two sibling links of a world-fixed base: a box 'dropper' falling onto a plate 'plate'.
+
+    'plate' (0.4 × 0.4 × 0.02 m, top face at z = 0.01 m) turns on a vertical hinge, so gravity
+    leaves it in place; 'dropper' (0.1 m cube, 1 kg) slides on a vertical prismatic joint from
+    z = 0.3 m (joint 0) down to the joint's lower limit −1 m. The two links are not joined by a
+    joint, so under Gazebo's rule they touch only when one of them has selfCollide: then the
+    cube rests on the plate at joint position 0.01 + 0.05 − 0.3 = −0.24 m.
+    """
+    tags = _gazebo(self_collide_link, selfCollide="true") if self_collide_link else ""
+    model = "<gazebo><self_collide>true</self_collide></gazebo>" if model_self_collide else ""
+    return f"""<robot name="siblings">
+  <link name="world"/>
+  <link name="base">{_box_inertial(1.0, 0.1, 0.1, 0.1)}</link>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <link name="plate">
+    {_box_inertial(1.0, 0.4, 0.4, 0.02)}
+    <collision><geometry><box size="0.4 0.4 0.02"/></geometry></collision>
+  </link>
+  <joint name="turn" type="continuous"><parent link="base"/><child link="plate"/>
+    <axis xyz="0 0 1"/></joint>
+  <link name="dropper">
+    {_box_inertial(1.0, 0.1, 0.1, 0.1)}
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+  <joint name="drop" type="prismatic"><parent link="base"/><child link="dropper"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="100" velocity="10"/></joint>
+  {tags}
+  {model}
+</robot>"""
