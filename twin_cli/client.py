@@ -13,11 +13,16 @@ import time
 from pathlib import Path
 from typing import Any
 
-import httpx
-
 from twin_cli import errors as twin_errors
 from twin_cli import runtime
 from twin_cli.errors import NotRunningError, RequestError
+
+# httpx imports its own command line (rich, click, pygments: ~40 ms of a ~250 ms command) only
+# to offer `httpx.main`, inside `try: ... except ImportError`; a None entry makes that import
+# fail at once and httpx falls back to a stub. Nothing in twin uses httpx's command line.
+sys.modules.setdefault("httpx._main", None)  # type: ignore[arg-type]
+
+import httpx  # noqa: E402
 
 # Seconds: most requests are a lock and a copy; spawn converts (CoACD can take minutes cold).
 DEFAULT_TIMEOUT_S = 10.0
@@ -77,7 +82,9 @@ class Client:
         self.world = world
         self.paths = runtime.world_paths(world)
         headers = {"Authorization": f"Bearer {token}"} if token else {}
-        transport = None if url else httpx.HTTPTransport(uds=str(self.paths.socket))
+        # No TLS over the socket or plain-http TCP: skip loading CA certificates (~60 ms).
+        verify = bool(url and url.startswith("https:"))
+        transport = httpx.HTTPTransport(uds=None if url else str(self.paths.socket), verify=verify)
         self._http = httpx.Client(
             transport=transport,
             base_url=url or BASE_URL,
