@@ -1,0 +1,76 @@
+"""Inertial statistics of a converted robot (what `gz sdf --inertial-stats` prints) and its tree."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class InertialStats:
+    """Whole-model mass properties at the `home` pose, in the model (root) frame.
+
+    Attributes:
+        total_mass: [kg].
+        com: centre of mass (3,) [m].
+        inertia: inertia tensor about the centre of mass (3, 3) [kg·m²].
+        link_masses: URDF link → mass [kg] as declared (lumped links included).
+        tree: (depth, link, joint, joint type) rows, depth-first from the base link.
+    """
+
+    total_mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+    link_masses: dict[str, float]
+    tree: tuple[tuple[int, str, str, str], ...]
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "total_mass_kg": self.total_mass,
+            "center_of_mass_m": self.com.tolist(),
+            "inertia_about_com_kg_m2": self.inertia.tolist(),
+            "link_masses_kg": self.link_masses,
+            "tree": [
+                {"depth": d, "link": link, "joint": joint, "type": kind}
+                for d, link, joint, kind in self.tree
+            ],
+        }
+
+
+def inertial_stats(spec: object, parsed: object) -> InertialStats:
+    """Compile `spec`, pose it at qpos0 and sum every body's mass properties (parallel axis)."""
+    import mujoco
+
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    masses = model.body_mass
+    total = float(masses.sum())
+    com = (masses[:, None] * data.xipos).sum(axis=0) / total if total > 0 else np.zeros(3)
+    tensor = np.zeros((3, 3))
+    for body in range(1, model.nbody):
+        R = data.ximat[body].reshape(3, 3)
+        d = data.xipos[body] - com
+        tensor += R @ np.diag(model.body_inertia[body]) @ R.T
+        tensor += masses[body] * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
+    links = {
+        link.name: float(link.inertial.mass or 0.0) if link.inertial is not None else 0.0
+        for link in parsed.model.links
+    }
+    return InertialStats(total, com, tensor, links, link_tree(parsed))
+
+
+def link_tree(parsed: object) -> tuple[tuple[int, str, str, str], ...]:
+    """Depth-first (depth, link, parent joint, joint type) rows from the base link."""
+    children: dict[str, list[object]] = {}
+    for joint in parsed.model.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    rows: list[tuple[int, str, str, str]] = []
+    stack: list[tuple[int, str, object | None]] = [(0, parsed.base_link, None)]
+    while stack:
+        depth, link, joint = stack.pop()
+        rows.append((depth, link, joint.name if joint else "", joint.type if joint else ""))
+        for child in reversed(children.get(link, [])):
+            stack.append((depth + 1, child.child, child))
+    return tuple(rows)
