@@ -1,0 +1,211 @@
+"""Entities of a world: what was spawned, where each lives in the compiled model, its state.
+
+An entity's elements carry the prefix "<name>/" in the world spec. Element ids change at every
+recompile (spawn, delete), so the world re-indexes all entities from the model's names after
+each one and moves state by name, never by position.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from twin_cli.pose import Pose
+
+_QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
+_DOF_WIDTH = {0: 6, 1: 3, 2: 1, 3: 1}
+_INT = np.int64
+
+
+@dataclass(frozen=True)
+class EntityIndex:
+    """Where one entity lives in one compiled model (all arrays are ids or addresses).
+
+    Attributes:
+        bodies: body ids, tree order; `root` is the first body whose parent is the world.
+        root: root body id, or -1 when the entity has no body.
+        joints: joint ids; `qpos`/`dofs`: their qpos and dof addresses, concatenated.
+        free_qpos: qpos address of the root's free joint, or -1 (fixed base).
+        actuators: actuator ids; `acts`: their activation addresses.
+        equalities, mocaps, geoms: equality ids, mocap ids, geom ids (of the entity's bodies).
+    """
+
+    bodies: np.ndarray
+    root: int
+    joints: np.ndarray
+    qpos: np.ndarray
+    dofs: np.ndarray
+    free_qpos: int
+    actuators: np.ndarray
+    acts: np.ndarray
+    equalities: np.ndarray
+    mocaps: np.ndarray
+    geoms: np.ndarray
+
+
+@dataclass(frozen=True)
+class EntityState:
+    """The integration state of one entity, in its own element order (see EntityIndex)."""
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    qacc_warmstart: np.ndarray
+    qfrc_applied: np.ndarray
+    act: np.ndarray
+    ctrl: np.ndarray
+    xfrc_applied: np.ndarray
+    eq_active: np.ndarray
+    mocap_pos: np.ndarray
+    mocap_quat: np.ndarray
+
+
+@dataclass(frozen=True)
+class Entity:
+    """What was spawned and how, so that it can be reset, listed, saved and spawned again.
+
+    Attributes:
+        name: entity name (the prefix of its elements, without the "/").
+        source: absolute path of the file it came from, or "<MjSpec>".
+        args: xacro arguments; `package_paths`: package name → directory.
+        pose: spawn pose (after `on_ground` placement).
+        on_ground: whether it was placed with its lowest point on the ground.
+        spawn_state: the state `reset` returns it to.
+        report: the converter's report as a dict (URDF/xacro sources), else None.
+        xml: MJCF text of an MjSpec source (for save/load), else None.
+    """
+
+    name: str
+    source: str
+    args: dict[str, str]
+    package_paths: dict[str, str]
+    pose: Pose
+    on_ground: bool
+    spawn_state: EntityState
+    report: dict | None = None
+    xml: str | None = field(default=None, repr=False)
+
+
+def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:
+    """Names stored at `adr` (e.g. `model.name_bodyadr`) in the model's name buffer."""
+    buffer = bytes(model.names)
+    return [buffer[a : buffer.index(b"\0", a)].decode() for a in adr]
+
+
+def _owner(names: list[str]) -> dict[str, list[int]]:
+    groups: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        head, sep, _ = name.partition("/")
+        if sep:
+            groups.setdefault(head, []).append(i)
+    return groups
+
+
+def index_entities(model: mujoco.MjModel, names: list[str]) -> dict[str, EntityIndex]:
+    """Indexes every entity in `names` from the element names of `model`."""
+    groups = {
+        kind: _owner(element_names(model, adr))
+        for kind, adr in (
+            ("body", model.name_bodyadr),
+            ("joint", model.name_jntadr),
+            ("actuator", model.name_actuatoradr),
+            ("equality", model.name_eqadr),
+        )
+    }
+    return {
+        name: _index_one(model, *(np.array(groups[k].get(name, []), _INT) for k in groups))
+        for name in names
+    }
+
+
+def _index_one(
+    model: mujoco.MjModel,
+    bodies: np.ndarray,
+    joints: np.ndarray,
+    actuators: np.ndarray,
+    equalities: np.ndarray,
+) -> EntityIndex:
+    roots = [b for b in bodies if model.body_parentid[b] == 0]
+    root = int(roots[0]) if roots else -1
+    types = model.jnt_type[joints]
+    qpos = _spans(model.jnt_qposadr[joints], [_QPOS_WIDTH[int(t)] for t in types])
+    dofs = _spans(model.jnt_dofadr[joints], [_DOF_WIDTH[int(t)] for t in types])
+    free = [j for j in joints if model.jnt_type[j] == 0 and model.jnt_bodyid[j] == root]
+    act_adr, act_num = model.actuator_actadr[actuators], model.actuator_actnum[actuators]
+    has_act = act_adr >= 0
+    acts = _spans(act_adr[has_act], list(act_num[has_act]))
+    mocaps = model.body_mocapid[bodies]
+    geoms = np.flatnonzero(np.isin(model.geom_bodyid, bodies))
+    return EntityIndex(
+        bodies=bodies,
+        root=root,
+        joints=joints,
+        qpos=qpos,
+        dofs=dofs,
+        free_qpos=int(model.jnt_qposadr[free[0]]) if free else -1,
+        actuators=actuators,
+        acts=acts,
+        equalities=equalities,
+        mocaps=mocaps[mocaps >= 0].astype(_INT),
+        geoms=geoms.astype(_INT),
+    )
+
+
+def _spans(starts: np.ndarray, widths: list[int]) -> np.ndarray:
+    if len(widths) == 0:
+        return np.zeros(0, _INT)
+    return np.concatenate(
+        [np.arange(s, s + w, dtype=_INT) for s, w in zip(starts, widths, strict=True)]
+    )
+
+
+def capture_state(data: mujoco.MjData, index: EntityIndex) -> EntityState:
+    """Copies one entity's integration state out of `data`."""
+    return EntityState(
+        qpos=data.qpos[index.qpos].copy(),
+        qvel=data.qvel[index.dofs].copy(),
+        qacc_warmstart=data.qacc_warmstart[index.dofs].copy(),
+        qfrc_applied=data.qfrc_applied[index.dofs].copy(),
+        act=data.act[index.acts].copy(),
+        ctrl=data.ctrl[index.actuators].copy(),
+        xfrc_applied=data.xfrc_applied[index.bodies].copy(),
+        eq_active=data.eq_active[index.equalities].copy(),
+        mocap_pos=data.mocap_pos[index.mocaps].copy(),
+        mocap_quat=data.mocap_quat[index.mocaps].copy(),
+    )
+
+
+def write_state(data: mujoco.MjData, index: EntityIndex, state: EntityState) -> None:
+    """Writes one entity's integration state into `data` (same entity, any compiled model)."""
+    data.qpos[index.qpos] = state.qpos
+    data.qvel[index.dofs] = state.qvel
+    data.qacc_warmstart[index.dofs] = state.qacc_warmstart
+    data.qfrc_applied[index.dofs] = state.qfrc_applied
+    data.act[index.acts] = state.act
+    data.ctrl[index.actuators] = state.ctrl
+    data.xfrc_applied[index.bodies] = state.xfrc_applied
+    data.eq_active[index.equalities] = state.eq_active
+    data.mocap_pos[index.mocaps] = state.mocap_pos
+    data.mocap_quat[index.mocaps] = state.mocap_quat
+
+
+def rest_state(model: mujoco.MjModel, index: EntityIndex, qpos: np.ndarray) -> EntityState:
+    """The state of an entity at configuration `qpos`, at rest, with nothing applied."""
+    nv, nb = len(index.dofs), len(index.bodies)
+    return EntityState(
+        qpos=np.array(qpos, dtype=float),
+        qvel=np.zeros(nv),
+        qacc_warmstart=np.zeros(nv),
+        qfrc_applied=np.zeros(nv),
+        act=np.zeros(len(index.acts)),
+        ctrl=np.zeros(len(index.actuators)),
+        xfrc_applied=np.zeros((nb, 6)),
+        eq_active=model.eq_active0[index.equalities].astype(np.uint8),
+        mocap_pos=model.body_pos[index.bodies[np.isin(index.bodies, _mocap_bodies(model))]],
+        mocap_quat=model.body_quat[index.bodies[np.isin(index.bodies, _mocap_bodies(model))]],
+    )
+
+
+def _mocap_bodies(model: mujoco.MjModel) -> np.ndarray:
+    return np.flatnonzero(model.body_mocapid >= 0)
