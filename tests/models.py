@@ -140,3 +140,59 @@ def falling_sibling(self_collide_link: str | None, model_self_collide: bool = Fa
   {tags}
   {model}
 </robot>"""
+
+
+# ---- MJCF factories for the world engine (tests/twin_cli/test_world*.py) ----
+
+
+def mjcf_ball(radius: float = 0.1, mass: float = 1.0, name: str = "ball") -> str:
+    """A free sphere (`radius` [m], `mass` [kg]) whose centre starts at the origin."""
+    return f"""<mujoco model="{name}"><worldbody><body name="ball">
+  <freejoint name="root"/><geom type="sphere" size="{radius}" mass="{mass}"/>
+</body></worldbody></mujoco>"""
+
+
+def mjcf_box(
+    half: tuple[float, float, float] = (0.1, 0.1, 0.1),
+    mass: float = 1.0,
+    free: bool = True,
+    name: str = "box",
+    mu: float = 1.0,
+) -> str:
+    """A box of half-sizes `half` [m] centred at the origin; static (no joint) unless `free`."""
+    joint = '<freejoint name="root"/>' if free else ""
+    size = " ".join(str(h) for h in half)
+    return f"""<mujoco model="{name}"><worldbody><body name="box">{joint}
+  <geom type="box" size="{size}" mass="{mass}" friction="{mu} 0.005 0.0001"/>
+</body></worldbody></mujoco>"""
+
+
+def mjcf_arm(lower: float, upper: float, effort: float, name: str = "arm") -> str:
+    """A fixed-base arm: hinge 'shoulder' about y, range [lower, upper] [rad], a 0.5 m, 1 kg
+    capsule link, and a motor actuator with ctrlrange ±effort [N m] (the converter's contract)."""
+    return f"""<mujoco model="{name}"><worldbody><body name="base" pos="0 0 1">
+  <geom type="box" size="0.05 0.05 0.05" mass="1" contype="0" conaffinity="0"/>
+  <body name="link"><joint name="shoulder" type="hinge" axis="0 1 0" range="{lower} {upper}"
+      limited="true"/>
+    <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1" contype="0" conaffinity="0"/>
+  </body></body></worldbody>
+  <actuator><motor name="shoulder" joint="shoulder" ctrlrange="{-effort} {effort}"
+      ctrllimited="true"/></actuator></mujoco>"""
+
+
+def mjcf_with_home(name: str = "homed", hinge: float = 0.7, z: float = 0.5) -> str:
+    """A free body with a hinge and a `home` key: hinge at `hinge` [rad], body at height `z`."""
+    return f"""<mujoco model="{name}"><worldbody><body name="base">
+  <freejoint name="root"/><geom type="box" size="0.1 0.1 0.1" mass="1"/>
+  <body name="tip" pos="0.2 0 0"><joint name="hinge" type="hinge" axis="0 0 1"/>
+    <geom type="sphere" size="0.05" mass="0.1"/></body></body></worldbody>
+  <keyframe><key name="home" qpos="0 0 {z} 1 0 0 0 {hinge}"/></keyframe></mujoco>"""
+
+
+def mjcf_stiff_spring(name: str = "spring") -> str:
+    """A fixed-base hinge with stiffness 1e9 N m/rad on 1e-6 kg m², started off its rest angle:
+    explicit integration blows up within a few steps (MuJoCo's bad-qacc warning)."""
+    return f"""<mujoco model="{name}"><worldbody><body name="base" pos="0 0 2">
+  <body name="bob"><joint name="spring" type="hinge" axis="0 0 1" stiffness="1e9" springref="1"/>
+    <geom type="sphere" size="0.01" mass="1e-4" contype="0" conaffinity="0"/></body>
+</body></worldbody></mujoco>"""
