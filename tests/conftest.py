@@ -1,0 +1,60 @@
+"""Shared fixtures: repository and corpus roots, and each corpus robot converted once a session."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from corpus_registry import (
+    CORPUS,
+    CORPUS_ROOT,
+    NON_PHYSICAL_INERTIA,
+    PACKAGES_ROOT,
+    REPO_ROOT,
+    package_paths,
+)
+
+
+@pytest.fixture(scope="session")
+def repo_root() -> Path:
+    return REPO_ROOT
+
+
+@pytest.fixture(scope="session")
+def corpus_root() -> Path:
+    if not CORPUS_ROOT.is_dir():
+        pytest.skip(f"corpus not found at {CORPUS_ROOT}")
+    return CORPUS_ROOT
+
+
+@pytest.fixture(scope="session")
+def converted_corpus(corpus_root: Path) -> Callable[[str], Any]:
+    """`get(robot_id)` → `converters.pipeline.Conversion`, converted once per session.
+
+    Packages come from `--package` options; inertias are repaired only for the robots listed in
+    NON_PHYSICAL_INERTIA; collision meshes use convex hulls (no CoACD, to keep tests fast).
+    """
+    from converters.build import ConvertOptions
+    from converters.collision import CollisionSettings
+    from converters.pipeline import convert_full
+
+    cache: dict[str, Any] = {}
+
+    def get(robot_id: str) -> Any:
+        if robot_id not in cache:
+            robot = CORPUS[robot_id]
+            options = ConvertOptions(
+                repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
+                collision=CollisionSettings(mode="hull"),
+            )
+            cache[robot_id] = convert_full(
+                PACKAGES_ROOT / robot["entry"],
+                args=robot["xacro_args"],
+                package_paths=package_paths(robot),
+                options=options,
+            )
+        return cache[robot_id]
+
+    return get
