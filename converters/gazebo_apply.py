@@ -24,13 +24,13 @@ from converters.report import Report
 DAMPING_FACTOR_PREFIX = "damping_factor:"
 """Custom numeric `damping_factor:<body>`: fraction of velocity lost per 0.001 s (world applies)."""
 
-IGNORED_SURFACE = {
-    "max_vel": "MuJoCo has no cap on penetration-correction speed; recovery follows solref",
-    "max_contacts": "MuJoCo has no per-geom contact cap; each collider makes its own",
-    "laser_retro": "twin simulates no ray sensors; the value is not used",
-    "restitution": "MuJoCo has no restitution coefficient; bounce follows kp/kd (solref)",
-    "category_bitmask": "twin's collision filter is Gazebo's selfCollide rule; bitmasks not mapped",
-    "collide_bitmask": "twin's collision filter is Gazebo's selfCollide rule; bitmasks not mapped",
+IGNORED_SURFACE = {  # Surface field -> (Gazebo tag, why MuJoCo does without it)
+    "max_vel": ("maxVel", "MuJoCo has no cap on penetration-correction speed; solref sets it"),
+    "max_contacts": ("maxContacts", "MuJoCo has no per-geom contact cap"),
+    "laser_retro": ("laserRetro", "twin simulates no ray sensors; the value is not used"),
+    "restitution": ("restitution_coefficient", "no restitution in MuJoCo; kp/kd set bounce"),
+    "category_bitmask": ("category_bitmask", "collision filter follows Gazebo's selfCollide rule"),
+    "collide_bitmask": ("collide_bitmask", "collision filter follows Gazebo's selfCollide rule"),
 }
 
 
@@ -176,16 +176,18 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
 
 
 def _report_ignored_surface(subject: str, surface: Surface, report: Report) -> None:
-    for name, reason in IGNORED_SURFACE.items():
+    for name, (tag, reason) in IGNORED_SURFACE.items():
         value = getattr(surface, name)
         if value is not None:
-            report.ignored(subject, f"{name}={value}: {reason}", tag=name)
+            report.ignored(subject, f"{tag}={value}: {reason}", tag=tag)
 
 
 def _apply_visuals(
     spec: Any, ext: GazeboExtensions, provenance: Provenance, report: Report
 ) -> None:
     for link, link_ext in ext.links.items():
+        if link in ext.unresolved:
+            continue
         rgba = link_ext.visual_rgba
         if link_ext.material is not None and rgba is None:
             rgba = gazebo_rgba(link_ext.material)
