@@ -55,6 +55,7 @@ def load_robot(
     args: dict[str, str] | None = None,
     package_paths: dict[str, str] | None = None,
     repair_inertia: bool = False,
+    collision: str | None = None,
 ) -> RobotUnderTest:
     """Convert (URDF/xacro) or load (MJCF .xml) a robot and compile it alone.
 
@@ -71,12 +72,14 @@ def load_robot(
         spec, report = mujoco.MjSpec.from_file(str(path)), Report(source=str(path))
     else:
         from converters import ConvertOptions, convert_full
+        from converters.collision import CollisionSettings
 
+        settings = CollisionSettings(mode=collision) if collision else CollisionSettings()
         done = convert_full(
             path,
             args=args,
             package_paths=package_paths,
-            options=ConvertOptions(repair_inertia=True),
+            options=ConvertOptions(repair_inertia=True, collision=settings),
         )
         spec, report = done.spec, done.report
         body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
@@ -165,6 +168,7 @@ def validate(
     only: list[str] | None = None,
     skip: list[str] | None = None,
     repair_inertia: bool = False,
+    collision: str | None = None,
     debug: bool = False,
 ) -> ValidationRun:
     """Validate one robot: convert it, run the planned checks, return every result.
@@ -176,12 +180,17 @@ def validate(
         scenarios: bundled scenario names or .toml paths (default: the built-in checklist).
         only, skip: check names to keep or leave out.
         repair_inertia: accept the converter's inertia repairs (warnings instead of failures).
+        collision: the converter's collision-mesh mode (auto|coacd|hull|mesh); None = auto.
         debug: re-raise errors inside checks instead of reporting them as failures.
     """
     start = time.perf_counter()
     todo = plan(scenarios, only, skip)
     robot = load_robot(
-        robot_path, args=args, package_paths=package_paths, repair_inertia=repair_inertia
+        robot_path,
+        args=args,
+        package_paths=package_paths,
+        repair_inertia=repair_inertia,
+        collision=collision,
     )
     results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
     return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)

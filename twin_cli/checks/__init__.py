@@ -89,7 +89,7 @@ CHECKS: dict[str, Check] = {
             physics_friction.check_friction_incline,
             stick_factor=0.8,
             slide_factor=1.25,
-            max_stick_slip_m=0.005,
+            max_stick_slip_m=0.01,
             min_slide_ratio=0.5,
             max_probes=2,
         ),
@@ -100,6 +100,7 @@ CHECKS: dict[str, Check] = {
             physics_dynamics.check_joint_limits,
             max_violation_rad=0.05,
             max_violation_m=0.01,
+            settle_fraction=0.7,
         ),
         _check("inertia", "physics", physics_dynamics.check_inertia, rel_tol=0.01, torque_n_m=1.0),
         _check(

@@ -133,8 +133,8 @@ def check_inertia_plausible(robot: RobotUnderTest, scenario: Scenario, th: dict[
             )
         if inertia_ratio < th["min_ratio"]:
             hints.append(
-                f"link '{name}': inertia trace {trace:.3g} kg m² is {inertia_ratio:.2%} of a "
-                f"solid of its geometry at {mass:.3g} kg ({mass * trace_per_mass:.3g} kg m²): "
+                f"link '{name}': inertia trace {trace:.3g} kg m² is {inertia_ratio * 100:.2g} % "
+                f"of a solid of its geometry at {mass:.3g} kg ({mass * trace_per_mass:.3g} kg m²): "
                 "the <inertia> is too small for this mass; compute it from CAD or the geometry"
             )
     return result(

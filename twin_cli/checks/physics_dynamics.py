@@ -20,14 +20,25 @@ from twin_cli.scenario import Scenario
 FREE = 0  # mjtJoint mjJNT_FREE
 
 
-def _violations(run: ScenarioRun) -> tuple[dict[int, float], dict[int, float]]:
-    """Run the scenario; return per joint (index into run.joints) max q above/below its range."""
+def _holding(run: ScenarioRun, settle: float) -> bool:
+    """True while a drive action is active and past its first `settle` fraction (the impact)."""
+    return any(
+        a.kind == "drive" and a.at + settle * a.duration <= run.time <= a.at + a.duration
+        for a in run.scenario.actions
+    )
+
+
+def _violations(run: ScenarioRun, settle: float) -> tuple[dict[int, float], dict[int, float]]:
+    """Run the scenario; per joint (index into run.joints), max q above/below its range while
+    a drive holds it against the limit (the impact transient before `settle` is left out)."""
     ranges = {i: limited_range(run.world.model, j.joint) for i, j in enumerate(run.joints)}
     ranges = {i: r for i, r in ranges.items() if r is not None and run.joints[i].effort}
     over = {i: 0.0 for i in ranges}
     under = {i: 0.0 for i in ranges}
 
     def sample(r: ScenarioRun) -> None:
+        if not _holding(r, settle):
+            return
         q = r.qpos()
         for i, (lo, hi) in ranges.items():
             value = float(q[r.joints[i].qpos])
@@ -41,7 +52,7 @@ def _violations(run: ScenarioRun) -> tuple[dict[int, float], dict[int, float]]:
 def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Each joint driven past its limit with its full effort stays within it."""
     run = ScenarioRun(robot, scenario)
-    over, under = _violations(run)
+    over, under = _violations(run, th["settle_fraction"])
     hints, worst = [], 0.0
     model = run.world.model
     for i in over:

@@ -78,6 +78,7 @@ class ScenarioRun:
         self._index_robot()
         for i, box in enumerate(scenario.obstacles):
             self._spawn_obstacle(box, f"obstacle{i}")
+        self.forward()
         self.time = 0.0
         self.q_hold = self.qpos()[[j.qpos for j in self.joints]].copy()
 
@@ -107,10 +108,18 @@ class ScenarioRun:
         from twin_cli.world import Pose
 
         pose = box.pose.model_dump()
+        self.forward()
         if box.ahead_gap is not None:
             pose["x"] = self.extent()[1][0] + box.ahead_gap + box.size[0] / 2.0
         self.world.spawn(obstacle_spec(box, name), name=name, pose=Pose(**pose))
         self._index_robot()  # ids may shift after a recompile
+
+    def forward(self) -> None:
+        """Recompute positions, COMs and contacts of the current state (the state is unchanged)."""
+        import mujoco
+
+        with self.world.lock:
+            mujoco.mj_forward(self.world.model, self.world.data)
 
     # ---- measurements (world ids; read under the lock) -------------------------------------
     def qpos(self) -> np.ndarray:

@@ -31,6 +31,14 @@ RepairOpt = Annotated[
     ),
 ]
 
+CollisionOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--collision",
+        help="Collision meshes as the converter makes them: auto|coacd|hull|mesh (default auto).",
+    ),
+]
+
 
 def validate(
     robot: Annotated[Path, typer.Argument(help="URDF, xacro or MJCF file of the robot.")],
@@ -44,6 +52,7 @@ def validate(
     markdown: MarkdownOpt = None,
     plots: PlotsOpt = None,
     repair_inertia: RepairOpt = False,
+    collision: CollisionOpt = None,
 ) -> None:
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
     from twin_cli import validation_report as render
@@ -58,6 +67,7 @@ def validate(
         only=only,
         skip=skip,
         repair_inertia=repair_inertia,
+        collision=collision,
     )
     out = Output(json)
     if json:
