@@ -74,6 +74,10 @@ def test_used_by_flow_on_the_bundled_humanoid(twin):
     assert not bad, f"lines not in gz-stats format: {bad}"
     factor = float(re.search(r"Factor\[([\d.]+)\]", lines[-1]).group(1))
     assert factor == pytest.approx(1.0, abs=0.1), f"real-time factor {factor}"
+    csv = twin("stats", "-d", "0.2", "-p").stdout.splitlines()
+    assert csv[0].startswith("# real-time factor") and len(csv[1].split(", ")) == 4, csv
+    sample = json.loads(twin("stats", "-d", "0", "--json").stdout)
+    assert sample["sim_time"] > 2.0 and sample["paused"] is False, sample
 
     # Free fall of a new box, earth then moon, measured by stepping a paused world.
     twin("pause")
@@ -101,6 +105,7 @@ def test_used_by_flow_on_the_bundled_humanoid(twin):
     assert taken.returncode == 2 and "Entity [moonbox] already exists" in taken.stderr, taken
 
     twin("stop")
+    assert "stopped" in twin("logs", "-n", "3").stdout, "server log should end with the stop"
     probe = twin("stats", "-d", "0", check=False)
     assert probe.returncode == 1, f"stats with no world: exit {probe.returncode}"
     assert probe.stderr.strip() == "An instance of twin is not running.", probe.stderr

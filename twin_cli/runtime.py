@@ -229,13 +229,18 @@ def hold_pid_file(paths: WorldPaths) -> Iterator[None]:
         os.close(fd)
 
 
+def open_log(paths: WorldPaths) -> int:
+    """Open the world's log for appending (created 0600: it names files and entities)."""
+    return os.open(paths.log, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
+
+
 def launch_background(paths: WorldPaths, serve_args: list[str]) -> subprocess.Popen:
     """Start `twin serve` for this world detached (new session, no terminal), logging to a file.
 
     Call with `start_lock` held; the child is told so and does not take it.
     """
     cmd = [sys.executable, "-m", "twin_cli.app", "serve", "--world", paths.world, "--background"]
-    with open(paths.log, "ab") as log:
+    with os.fdopen(open_log(paths), "ab") as log:
         return subprocess.Popen(
             cmd + serve_args,
             stdin=subprocess.DEVNULL,

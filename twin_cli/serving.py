@@ -115,6 +115,7 @@ def build_world(opts: ServeOptions) -> Any:
 
 def configure_logging(paths: runtime.WorldPaths) -> None:
     """Send the server's and uvicorn's logs to the world's log file."""
+    os.close(runtime.open_log(paths))  # create it private before logging opens it
     handler = logging.FileHandler(paths.log)
     handler.setFormatter(logging.Formatter(LOG_FORMAT))
     root = logging.getLogger()

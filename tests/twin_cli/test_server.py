@@ -195,3 +195,23 @@ def test_sigterm_ends_cleanly_and_removes_runtime_files(tmp_path):
         if proc.poll() is None:
             proc.kill()
         mp.undo()
+
+
+def test_save_then_load_restores_entities_and_pose(server, files, tmp_path):
+    client, _ = server
+    client.spawn(files / "box.urdf", name="kept", pose={"x": 1.0, "z": 0.1})
+    client.pause()
+    try:
+        pose = client.pose("kept")
+        client.save(tmp_path / "world.twin")
+        client.delete("kept")
+        loaded = client.load(tmp_path / "world.twin")
+        assert "kept" in loaded["entities"], f"loaded entities: {loaded['entities']}"
+        again = client.pose("kept")
+        for key in ("x", "y", "z"):
+            assert again[key] == pytest.approx(pose[key], abs=1e-9), f"{key} after load [m]"
+    finally:
+        client.resume()
+        client.delete("kept")
+    with pytest.raises(TwinError, match="nowhere.twin"):
+        client.load(tmp_path / "nowhere.twin")

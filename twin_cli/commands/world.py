@@ -46,7 +46,8 @@ def _not_running(world: str) -> typer.Exit:
 
 
 def _pose_text(pose: dict) -> str:
-    return " ".join(f"{float(pose[k]):.6f}" for k in POSE_KEYS)
+    """`x y z roll pitch yaw` as `gz model -p` prints it (rounding first: no `-0.000000`)."""
+    return " ".join(f"{round(float(pose[k]), 6) + 0.0:.6f}" for k in POSE_KEYS)
 
 
 def serve(
@@ -151,7 +152,10 @@ def pose(
         else:
             result = c.set_pose(name, dict(zip(POSE_KEYS, set_, strict=True)))
     out = Output(json)
-    out.data(result) if json else out.line(_pose_text(result))
+    if json:
+        out.data(result)
+    else:
+        out.line(_pose_text(result))
 
 
 def joints(name: NameArg, world: WorldOpt = "default", json: JsonOpt = False) -> None:
@@ -208,7 +212,10 @@ def gravity(
         else:
             result = c.gravity()
     out = Output(json)
-    out.data(result) if json else out.line(" ".join(f"{v:g}" for v in result["gravity"]))
+    if json:
+        out.data(result)
+    else:
+        out.line(" ".join(f"{v:g}" for v in result["gravity"]))
 
 
 def physics(
@@ -256,7 +263,10 @@ def step(
     with _connect(world) as c:
         result = c.step(n)
     out = Output(json)
-    out.data(result) if json else out.line(stats_line(result))
+    if json:
+        out.data(result)
+    else:
+        out.line(stats_line(result))
 
 
 def reset(
