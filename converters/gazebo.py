@@ -11,15 +11,22 @@ from __future__ import annotations
 
 import dataclasses
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
-from converters.errors import GazeboTagError
-
-TRUE_WORDS = frozenset({"true", "yes", "1"})
-FALSE_WORDS = frozenset({"false", "no", "0"})
+from converters.gazebo_values import (
+    JOINT_TAGS,
+    LINK_TAGS,
+    SURFACE_PATHS,
+    ValueContext,
+    children_of,
+    read_bool,
+    read_float,
+    text_of,
+    to_xml,
+)
 
 
 @dataclass(frozen=True)
@@ -169,135 +176,12 @@ class GazeboExtensions:
         return base.overridden_by(self.link(link).surface)
 
 
-# ---------------------------------------------------------------- value readers
-
-
-class _Ctx:
-    """Facts for error messages while reading one block."""
-
-    def __init__(self, source: str, reference: str) -> None:
-        self.source = source
-        self.reference = reference
-
-    def fail(self, tag: str, value: str, expected: str) -> GazeboTagError:
-        return GazeboTagError(self.source, self.reference, tag, value, expected)
-
-
-def _text(el: ET.Element) -> str:
-    value = el.get("value")
-    return (value if value is not None else (el.text or "")).strip()
-
-
-def _float(ctx: _Ctx, tag: str, raw: str) -> float:
-    try:
-        value = float(raw)
-    except ValueError as exc:
-        raise ctx.fail(tag, raw, "a number") from exc
-    if value != value:
-        raise ctx.fail(tag, raw, "a number")
-    return value
-
-
-def _int(ctx: _Ctx, tag: str, raw: str) -> int:
-    try:
-        return int(raw, 0) if raw.lower().startswith("0x") else int(float(raw))
-    except ValueError as exc:
-        raise ctx.fail(tag, raw, "an integer") from exc
-
-
-def _bool(ctx: _Ctx, tag: str, raw: str) -> bool:
-    word = raw.lower()
-    if word in TRUE_WORDS:
-        return True
-    if word in FALSE_WORDS:
-        return False
-    raise ctx.fail(tag, raw, "a boolean (true/false/1/0)")
-
-
-def _vec3(ctx: _Ctx, tag: str, raw: str) -> tuple[float, float, float]:
-    parts = raw.split()
-    if len(parts) != 3:
-        raise ctx.fail(tag, raw, "three numbers")
-    x, y, z = (_float(ctx, tag, p) for p in parts)
-    return (x, y, z)
-
-
-def _str(ctx: _Ctx, tag: str, raw: str) -> str:
-    return raw
-
-
-Reader = Callable[[_Ctx, str, str], Any]
-
-# tag -> (group, field, reader). group "surface" = collision level, "link" = link level.
-LINK_TAGS: dict[str, tuple[str, str, Reader]] = {
-    "mu1": ("surface", "mu1", _float),
-    "mu2": ("surface", "mu2", _float),
-    "fdir1": ("surface", "fdir1", _vec3),
-    "kp": ("surface", "kp", _float),
-    "kd": ("surface", "kd", _float),
-    "maxVel": ("surface", "max_vel", _float),
-    "minDepth": ("surface", "min_depth", _float),
-    "maxContacts": ("surface", "max_contacts", _int),
-    "laserRetro": ("surface", "laser_retro", _float),
-    "selfCollide": ("link", "self_collide", _bool),
-    "self_collide": ("link", "self_collide", _bool),
-    "turnGravityOff": ("link", "turn_gravity_off", _bool),
-    "gravity": ("link", "gravity", _bool),
-    "dampingFactor": ("link", "damping_factor", _float),
-    "material": ("link", "material", _str),
-}
-
-JOINT_TAGS: dict[str, tuple[str, Reader]] = {
-    "stopErp": ("stop_erp", _float),
-    "stopCfm": ("stop_cfm", _float),
-    "springStiffness": ("spring_stiffness", _float),
-    "springReference": ("spring_reference", _float),
-    "fudgeFactor": ("fudge_factor", _float),
-    "provideFeedback": ("provide_feedback", _bool),
-    "implicitSpringDamper": ("implicit_spring_damper", _bool),
-    "cfmDamping": ("implicit_spring_damper", _bool),
-    "preserveFixedJoint": ("preserve_fixed_joint", _bool),
-    "disableFixedJointLumping": ("disable_fixed_joint_lumping", _bool),
-}
-
-# Paths inside an SDF <surface> (or a <collision> block) -> (Surface field, reader).
-SURFACE_PATHS: dict[str, tuple[str, Reader]] = {
-    "surface/friction/ode/mu": ("mu1", _float),
-    "surface/friction/ode/mu1": ("mu1", _float),
-    "surface/friction/ode/mu2": ("mu2", _float),
-    "surface/friction/ode/fdir1": ("fdir1", _vec3),
-    "surface/friction/torsional/coefficient": ("torsional", _float),
-    "surface/contact/ode/kp": ("kp", _float),
-    "surface/contact/ode/kd": ("kd", _float),
-    "surface/contact/ode/max_vel": ("max_vel", _float),
-    "surface/contact/ode/min_depth": ("min_depth", _float),
-    "surface/contact/category_bitmask": ("category_bitmask", _int),
-    "surface/contact/collide_bitmask": ("collide_bitmask", _int),
-    "surface/bounce/restitution_coefficient": ("restitution", _float),
-    "max_contacts": ("max_contacts", _int),
-    "laser_retro": ("laser_retro", _float),
-}
-
-
 def _blob(el: ET.Element) -> Blob:
     kind = el.get("type") if el.tag == "sensor" else el.get("filename")
-    return Blob(str(el.tag), el.get("name"), kind, _to_xml(el))
+    return Blob(str(el.tag), el.get("name"), kind, to_xml(el))
 
 
-def _to_xml(el: Any) -> str:
-    if isinstance(el, ET.Element):
-        return ET.tostring(el, encoding="unicode").strip()
-    from lxml import etree  # an lxml element: serialise with its own library
-
-    return etree.tostring(el, encoding="unicode").strip()
-
-
-def _children(el: ET.Element) -> list[ET.Element]:
-    """Element children only (lxml also yields comments and processing instructions)."""
-    return [c for c in el if isinstance(c.tag, str)]
-
-
-def read_surface(el: ET.Element, ctx: _Ctx) -> tuple[Surface, list[TagSource]]:
+def read_surface(el: ET.Element, ctx: ValueContext) -> tuple[Surface, list[TagSource]]:
     """Read an SDF `<collision>`-like element (children `surface`, `max_contacts`, ...).
 
     Args:
@@ -312,7 +196,7 @@ def read_surface(el: ET.Element, ctx: _Ctx) -> tuple[Surface, list[TagSource]]:
     for path, (name, reader) in SURFACE_PATHS.items():
         found = el.find(path)
         if found is not None:
-            raw = _text(found)
+            raw = text_of(found)
             values[name] = reader(ctx, path, raw)
             sources.append(TagSource(ctx.reference, path, raw))
     return Surface(**values), sources
@@ -332,10 +216,10 @@ class _Acc:
 
 
 def _read_reference_child(
-    child: ET.Element, acc: _Acc, ctx: _Ctx, is_link: bool, is_joint: bool
+    child: ET.Element, acc: _Acc, ctx: ValueContext, is_link: bool, is_joint: bool
 ) -> None:
     tag = str(child.tag)
-    raw = _text(child)
+    raw = text_of(child)
     if tag in LINK_TAGS and (is_link or not is_joint):
         group, name, reader = LINK_TAGS[tag]
         (acc.surface if group == "surface" else acc.link)[name] = reader(ctx, tag, raw)
@@ -357,23 +241,25 @@ def _read_reference_child(
     acc.sources.append(TagSource(ctx.reference, tag, raw))
 
 
-def _read_visual_rgba(el: ET.Element, ctx: _Ctx) -> tuple[float, float, float, float] | None:
+def _read_visual_rgba(
+    el: ET.Element, ctx: ValueContext
+) -> tuple[float, float, float, float] | None:
     diffuse = el.find("material/diffuse")
     if diffuse is None:
         return None
-    parts = [_float(ctx, "visual/material/diffuse", p) for p in _text(diffuse).split()]
+    parts = [read_float(ctx, "visual/material/diffuse", p) for p in text_of(diffuse).split()]
     if len(parts) not in (3, 4):
-        raise ctx.fail("visual/material/diffuse", _text(diffuse), "three numbers")
+        raise ctx.fail("visual/material/diffuse", text_of(diffuse), "three numbers")
     return (parts[0], parts[1], parts[2], parts[3] if len(parts) == 4 else 1.0)
 
 
-def _read_model_block(block: ET.Element, ctx: _Ctx, model: dict[str, Any]) -> None:
-    for child in _children(block):
-        tag, raw = str(child.tag), _text(child)
+def _read_model_block(block: ET.Element, ctx: ValueContext, model: dict[str, Any]) -> None:
+    for child in children_of(block):
+        tag, raw = str(child.tag), text_of(child)
         if tag == "static":
-            model["static"] = _bool(ctx, tag, raw)
+            model["static"] = read_bool(ctx, tag, raw)
         elif tag in ("self_collide", "selfCollide"):
-            model["self_collide"] = _bool(ctx, tag, raw)
+            model["self_collide"] = read_bool(ctx, tag, raw)
         elif tag == "plugin":
             model["plugins"].append(_blob(child))
         else:
@@ -402,7 +288,7 @@ def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
     unresolved: list[str] = []
     for block in root.findall("gazebo"):
         reference = block.get("reference")
-        ctx = _Ctx(source, reference or "")
+        ctx = ValueContext(source, reference or "")
         if not reference:
             _read_model_block(block, ctx, model)
             continue
@@ -410,7 +296,7 @@ def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
         if not (is_link or is_joint) and reference not in unresolved:
             unresolved.append(reference)
         acc = accs.setdefault(reference, _Acc())
-        for child in _children(block):
+        for child in children_of(block):
             _read_reference_child(child, acc, ctx, is_link, is_joint)
     links = {
         ref: _link_extension(ref, acc)
@@ -467,6 +353,6 @@ def _inline_surfaces(root: ET.Element, source: str) -> tuple[InlineSurface, ...]
         for index, collision in enumerate(link.findall("collision")):
             if collision.find("surface") is None:
                 continue
-            surface, _ = read_surface(collision, _Ctx(source, name))
+            surface, _ = read_surface(collision, ValueContext(source, name))
             found.append(InlineSurface(name, index, surface))
     return tuple(found)
