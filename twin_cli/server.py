@@ -12,14 +12,24 @@ import logging
 import os
 import secrets
 import threading
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
-from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from converters.errors import ConversionError
+from twin_cli.api_models import (
+    CommandBody,
+    GravityBody,
+    PathBody,
+    PhysicsBody,
+    PoseBody,
+    PushBody,
+    ResetBody,
+    SpawnBody,
+    StepBody,
+)
 from twin_cli.errors import (
     EntityExistsError,
     EntityNotFoundError,
@@ -30,80 +40,6 @@ from twin_cli.errors import (
 
 log = logging.getLogger("twin.server")
 API_VERSION = "1"
-
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Vector = tuple[Finite, Finite, Finite]
-EntityName = Annotated[str, Field(min_length=1, max_length=200, pattern=r"^[^/\s][^/]*$")]
-
-
-class Body(BaseModel):
-    """Request bodies reject unknown fields, so a typo is an error rather than a no-op."""
-
-    model_config = ConfigDict(extra="forbid")
-
-
-class PoseBody(Body):
-    """A pose: position [m] and extrinsic roll-pitch-yaw [rad], as Gazebo's -x..-Y."""
-
-    x: Finite = 0.0
-    y: Finite = 0.0
-    z: Finite = 0.0
-    roll: Finite = 0.0
-    pitch: Finite = 0.0
-    yaw: Finite = 0.0
-
-
-class SpawnBody(Body):
-    source: Annotated[str, Field(min_length=1, description="absolute path on the server host")]
-    name: EntityName | None = None
-    pose: PoseBody = PoseBody()
-    args: dict[str, str] = {}
-    package_paths: dict[str, str] = {}
-    on_ground: bool = False
-
-
-class PushBody(Body):
-    force: Vector = (0.0, 0.0, 0.0)
-    torque: Vector = (0.0, 0.0, 0.0)
-    link: str | None = None
-    duration: Annotated[float, Field(gt=0.0, le=3600.0, description="[s] of sim time")] = 0.1
-
-
-class CommandBody(Body):
-    joint: str
-    mode: Literal["position", "velocity", "effort"]
-    value: Finite
-
-
-class GravityBody(Body):
-    preset: Literal["earth", "moon", "mars", "zero"] | None = None
-    vector: Vector | None = None
-
-    @model_validator(mode="after")
-    def _exactly_one(self) -> GravityBody:
-        if (self.preset is None) == (self.vector is None):
-            raise ValueError("give exactly one of 'preset' or 'vector'")
-        return self
-
-
-class PhysicsBody(Body):
-    timestep: Annotated[float, Field(gt=0.0, le=0.1, description="[s]")] | None = None
-    rate: Annotated[float, Field(ge=0.0, le=1e7, description="[Hz]; 0 = unthrottled")] | None = None
-    iterations: Annotated[int, Field(ge=1, le=100_000)] | None = None
-    solver: str | None = None
-    integrator: str | None = None
-
-
-class StepBody(Body):
-    n: Annotated[int, Field(ge=1, le=10_000_000)] = 1
-
-
-class ResetBody(Body):
-    time_only: bool = False
-
-
-class PathBody(Body):
-    path: Annotated[str, Field(min_length=1)]
 
 
 class WorldHolder:
