@@ -122,3 +122,18 @@ def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
     assert new_pid != old_pid, "the killed server's pid is still recorded"
     names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
     assert names == {"second"}, f"a fresh world should hold only the new entity: {names}"
+
+
+def test_concurrent_first_commands_start_exactly_one_server(twin):
+    cmd = [sys.executable, "-m", "twin_cli.app", "list"]
+    procs = [
+        subprocess.Popen(
+            cmd, env=twin.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        for _ in range(3)
+    ]
+    outs = [p.communicate(timeout=120) for p in procs]
+    codes = [p.returncode for p in procs]
+    assert codes == [0, 0, 0], f"exit codes {codes}: {[err for _, err in outs]}"
+    started = sum("started world" in err for _, err in outs)
+    assert started == 1, f"{started} servers announced by 3 simultaneous first commands"
