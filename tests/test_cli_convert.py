@@ -1,0 +1,182 @@
+"""`twin convert` / `twin inspect` end to end: outputs, reproducibility, and every input error."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from corpus_registry import CORPUS, PACKAGES_ROOT
+
+from scenarios import HUMANOID
+
+GOOD_LINK = (
+    '<link name="{n}"><inertial><mass value="1"/>'
+    '<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+)
+
+
+def twin(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    code = "import sys; from twin_cli.app import main; sys.argv[0] = 'twin'; main()"
+    return subprocess.run(
+        [sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd, timeout=120
+    )
+
+
+def _robot(tmp_path: Path, body: str, name: str = "bad.urdf") -> Path:
+    path = tmp_path / name
+    path.write_text(body)
+    return path
+
+
+def _joint(name: str, parent: str, child: str) -> str:
+    return (
+        f'<joint name="{name}" type="continuous"><parent link="{parent}"/>'
+        f'<child link="{child}"/></joint>'
+    )
+
+
+BAD_INPUTS = {
+    "malformed_xml": (
+        '<robot name="r">\n  <link name="a">\n</robot>',
+        ["bad.urdf:3:", "malformed"],
+    ),
+    "unknown_child": (
+        f'<robot name="r">{GOOD_LINK.format(n="a")}{_joint("j", "a", "ghost")}</robot>',
+        ["joint 'j'", "'ghost'"],
+    ),
+    "cycle": (
+        '<robot name="r">'
+        + "".join(GOOD_LINK.format(n=n) for n in "abc")
+        + _joint("j1", "a", "b")
+        + _joint("j2", "b", "c")
+        + _joint("j3", "c", "b")
+        + "</robot>",
+        ["link 'b'"],
+    ),
+    "several_roots": (
+        '<robot name="r">' + "".join(GOOD_LINK.format(n=n) for n in "ab") + "</robot>",
+        ["a, b", "2 root links"],
+    ),
+    "duplicate_link": (
+        '<robot name="r">' + GOOD_LINK.format(n="a") * 2 + "</robot>",
+        ["link 'a'", "defined twice"],
+    ),
+    "bad_number": (
+        '<robot name="r"><link name="a"><inertial><mass value="heavy"/></inertial></link></robot>',
+        ["link 'a'", "'heavy'"],
+    ),
+    "missing_mesh": (
+        '<robot name="r"><link name="a"><visual><geometry><mesh filename='
+        '"meshes/nothere.stl"/></geometry></visual></link></robot>',
+        ["nothere.stl", "link 'a'"],
+    ),
+    "unknown_package": (
+        '<robot name="r"><link name="a"><visual><geometry><mesh filename='
+        '"package://no_such_pkg/m.stl"/></geometry></visual></link></robot>',
+        ["no_such_pkg", "package://no_such_pkg/m.stl", "link 'a'", "tried"],
+    ),
+    "massless_moving_link": (
+        '<robot name="r">'
+        + GOOD_LINK.format(n="a")
+        + '<link name="b"/>'
+        + _joint("j", "a", "b")
+        + "</robot>",
+        ["link 'b'", "--repair-inertia"],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_INPUTS))
+def test_bad_input_exits_2_with_one_message_naming_the_culprit(case: str, tmp_path: Path) -> None:
+    text, needles = BAD_INPUTS[case]
+    result = twin("convert", str(_robot(tmp_path, text)), "-o", str(tmp_path / "out"))
+    assert result.returncode == 2, f"{case}: exit code {result.returncode}, stderr {result.stderr}"
+    assert "Traceback" not in result.stderr, f"{case}: traceback leaked:\n{result.stderr}"
+    assert result.stderr.startswith("Error: "), f"{case}: stderr {result.stderr!r}"
+    for needle in needles:
+        assert needle in result.stderr, f"{case}: {needle!r} missing from {result.stderr!r}"
+    assert not (tmp_path / "out").exists(), f"{case}: a failed conversion wrote output"
+
+
+def test_xacro_error_names_the_file_and_xacros_message(tmp_path: Path) -> None:
+    robot = CORPUS["aliengo"]
+    result = twin("convert", str(PACKAGES_ROOT / robot["entry"]), "-o", str(tmp_path / "o"))
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert "robot.xacro" in result.stderr and "DEBUG" in result.stderr, result.stderr
+
+
+def test_non_physical_inertia_exits_2_naming_the_link(tmp_path: Path) -> None:
+    robot = CORPUS["hyq"]
+    result = twin(
+        "convert",
+        str(PACKAGES_ROOT / robot["entry"]),
+        "--package",
+        f"example-robot-data={PACKAGES_ROOT / 'example-robot-data'}",
+        "-o",
+        str(tmp_path / "o"),
+        "--collision",
+        "hull",
+    )
+    assert result.returncode == 2, result.stderr
+    assert "link 'base_link'" in result.stderr and "positive definite" in result.stderr
+
+
+def _digest(directory: Path) -> dict[str, str]:
+    return {
+        str(p.relative_to(directory)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(directory.rglob("*"))
+        if p.is_file()
+    }
+
+
+def test_convert_writes_a_loadable_scene_byte_identical_on_repeat(tmp_path: Path) -> None:
+    import mujoco
+
+    robot = CORPUS["r2d2_macroed"]
+    args = [
+        str(PACKAGES_ROOT / robot["entry"]),
+        "--package",
+        f"urdf_tutorial={PACKAGES_ROOT / 'urdf_tutorial'}",
+        "--collision",
+        "hull",
+        "--json",
+    ]
+    first = twin("convert", *args, "-o", str(tmp_path / "a"), cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    report = json.loads(first.stdout)
+    assert report["robot"] == "macroed" and Path(report["scene"]).is_file(), report.keys()
+    assert twin("convert", *args, "-o", str(tmp_path / "b")).returncode == 0
+    assert _digest(tmp_path / "a") == _digest(tmp_path / "b"), "same input, different bytes"
+    assert any(p.suffix == ".stl" for p in (tmp_path / "a" / "assets").iterdir()), "mesh assets"
+    xml = (tmp_path / "a" / "macroed.xml").read_text()
+    assert str(tmp_path) not in xml and "package://" not in xml, "paths must be relative"
+    scene = mujoco.MjModel.from_xml_path(str(tmp_path / "a" / "scene.xml"))
+    assert scene.geom("ground").friction[0] == pytest.approx(100.0), "Gazebo ground μ"
+
+
+def test_print_writes_mjcf_to_stdout(tmp_path: Path) -> None:
+    import mujoco
+
+    result = twin("convert", str(HUMANOID), "--print", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    model = mujoco.MjModel.from_xml_string(result.stdout)
+    assert model.nu == 11, f"humanoid motors in printed MJCF: {model.nu}"
+
+
+def test_inspect_json_reports_total_mass_and_tree(tmp_path: Path) -> None:
+    from converters.pipeline import convert_full
+
+    result = twin("inspect", str(HUMANOID), "--json")
+    assert result.returncode == 0, result.stderr
+    stats = json.loads(result.stdout)
+    declared = sum(
+        float(link.inertial.mass)
+        for link in convert_full(HUMANOID).parsed.model.links
+        if link.inertial is not None
+    )
+    assert stats["total_mass_kg"] == pytest.approx(declared, rel=1e-12), "total mass [kg]"
+    assert stats["tree"][0]["depth"] == 0 and len(stats["center_of_mass_m"]) == 3
