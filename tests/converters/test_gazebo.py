@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.contact import IMPEDANCE, friction_priority
+from converters.contact import IMPEDANCE, friction_priority, max_contact_stiffness
 from converters.errors import GazeboTagError
 from converters.gazebo import parse_gazebo
 from converters.gazebo_apply import DAMPING_FACTOR_PREFIX
@@ -101,6 +101,22 @@ TAG_TABLE = [
         lambda d, m: (
             _geom(d, m, "arm").solref[0] == pytest.approx(-_stiffness(0.6, 1e4))
             and _geom(d, m, "arm").solimp[0] == pytest.approx(IMPEDANCE)
+        ),
+    ),
+    (
+        "kp stiffer than the step resolves: clamped, reported with figures",
+        _ref("arm", "<kp>1e9</kp><kd>1e5</kd>"),
+        lambda d, m: (
+            _geom(d, m, "arm").solref[0] == pytest.approx(-max_contact_stiffness())
+            and "clamped" in _entry(d, "kp").detail
+            and _entry(d, "kp").outcome is Outcome.APPROXIMATED
+        ),
+    ),
+    (
+        "kd below the damping floor: raised, reported",
+        _ref("arm", "<kp>1e4</kp><kd>1</kd>"),
+        lambda d, m: (
+            _entry(d, "kd").outcome is Outcome.APPROXIMATED and "raised" in _entry(d, "kd").detail
         ),
     ),
     (
