@@ -67,22 +67,30 @@ def load_robot(
     from converters.report import Report
 
     path = Path(path)
-    body_links: dict[str, str] = {}
     if path.suffix.lower() == ".xml":
-        spec, report = mujoco.MjSpec.from_file(str(path)), Report(source=str(path))
-    else:
-        from converters import ConvertOptions, convert_full
-        from converters.collision import CollisionSettings
+        spec = mujoco.MjSpec.from_file(str(path))
+        return _robot(spec, Report(source=str(path)), path, repair_inertia, {})
+    from converters.build import ConvertOptions
+    from converters.collision import CollisionSettings
+    from converters.pipeline import convert_full
 
-        settings = CollisionSettings(mode=collision) if collision else CollisionSettings()
-        done = convert_full(
-            path,
-            args=args,
-            package_paths=package_paths,
-            options=ConvertOptions(repair_inertia=True, collision=settings),
-        )
-        spec, report = done.spec, done.report
-        body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
+    settings = CollisionSettings(mode=collision) if collision else CollisionSettings()
+    done = convert_full(
+        path,
+        args=args,
+        package_paths=package_paths,
+        options=ConvertOptions(repair_inertia=True, collision=settings),
+    )
+    return robot_from_conversion(done, path, repair_inertia=repair_inertia)
+
+
+def robot_from_conversion(done, path: str | Path, *, repair_inertia: bool) -> RobotUnderTest:
+    """The robot under test from a `converters.Conversion` (spec, report, provenance)."""
+    body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
+    return _robot(done.spec, done.report, Path(path), repair_inertia, body_links)
+
+
+def _robot(spec, report, path: Path, repair_inertia: bool, body_links) -> RobotUnderTest:
     model = spec.copy().compile()
     name = report.robot or spec.modelname or path.stem.split(".")[0]
     return RobotUnderTest(name, str(path), spec, model, report, repair_inertia, body_links)

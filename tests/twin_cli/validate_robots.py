@@ -100,7 +100,7 @@ def unenforced_limit_mjcf(directory: Path) -> Path:
     """The crate as MJCF with the elbow's range kept but its enforcement turned off."""
     import mujoco
 
-    from converters import convert
+    from converters.pipeline import convert
 
     spec, _ = convert(write(directory, crate()))
     spec.joint("elbow").limited = mujoco.mjtLimited.mjLIMITED_FALSE
