@@ -11,8 +11,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters import convert
 from converters.contact import add_gazebo_ground
+from converters.pipeline import convert
 
 
 def _load_models():
