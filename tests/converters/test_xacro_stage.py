@@ -1,0 +1,63 @@
+"""xacro without ROS: arguments, `$(find)` through our resolver, unexpanded macro calls."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from converters.errors import PackageNotFoundError, XacroError
+from converters.packages import PackageResolver
+from converters.pipeline import convert_full
+from converters.xacro_stage import expand_xacro
+
+XACRO = """<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:arg name="size" default="1"/>
+  <xacro:macro name="part" params="n"><link name="${n}"><inertial><mass value="1"/>
+    <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link></xacro:macro>
+  <xacro:include filename="$(find helper)/inc.xacro"/>
+  <xacro:part n="base_$(arg size)"/>
+  <part n="forgotten"/>
+  <joint name="j" type="fixed"><parent link="base_$(arg size)"/><child link="from_include"/></joint>
+</robot>"""
+
+
+@pytest.fixture()
+def robot(tmp_path: Path) -> Path:
+    helper = tmp_path / "helper"
+    helper.mkdir()
+    (helper / "inc.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="from_include"/></robot>'
+    )
+    path = tmp_path / "r.urdf.xacro"
+    path.write_text(XACRO)
+    return path
+
+
+def test_find_uses_our_resolver_and_args_are_applied(robot: Path) -> None:
+    resolver = PackageResolver.create(robot, env={})
+    result = expand_xacro(robot, {"size": "7"}, resolver)
+    assert 'name="base_7"' in result.text and 'name="from_include"' in result.text
+    assert result.unexpanded == ('<part n="forgotten"/>',), "calls without xacro: are reported"
+
+
+def test_unexpanded_macro_call_is_a_report_warning(robot: Path) -> None:
+    from converters.report import Outcome
+
+    report = convert_full(
+        robot, args={"size": "2"}, package_paths={"helper": robot.parent / "helper"}
+    ).report
+    assert any("forgotten" in e.subject for e in report.of(Outcome.WARNING)), report.entries
+
+
+def test_unknown_find_package_raises_our_error(robot: Path, tmp_path: Path) -> None:
+    robot.write_text(XACRO.replace("$(find helper)", "$(find nowhere_pkg)"))
+    with pytest.raises(PackageNotFoundError, match="nowhere_pkg"):
+        expand_xacro(robot, {}, PackageResolver.create(robot, env={}))
+
+
+def test_xacro_failure_carries_file_and_message(robot: Path) -> None:
+    robot.write_text(XACRO.replace("$(arg size)", "$(arg undeclared)"))
+    with pytest.raises(XacroError, match="undeclared") as caught:
+        expand_xacro(robot, {}, PackageResolver.create(robot, env={}))
+    assert str(robot) in str(caught.value)
