@@ -259,11 +259,12 @@ TAG_TABLE = [
         lambda d, m: m.body_gravcomp[m.body("arm").id] == 1.0,
     ),
     (
-        "no tags: Gazebo defaults",
+        "no tags: Gazebo defaults (μ=1 priority, no self-collision, limit erp 0.2)",
         "",
         lambda d, m: (
             all(m.geom_priority[_geom(d, m, link).id] == 9000 for link in ("base", "arm"))
             and m.nexclude == 1
+            and np.allclose(m.jnt_solref[m.joint("hinge").id], [0.005, 1.0])
         ),
     ),
 ]
