@@ -1,0 +1,88 @@
+"""Physics checks on the bundled humanoid and on broken robots, against physical oracles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import validate_robots as robots
+
+import scenarios
+from twin_cli.checks.base import Status
+from twin_cli.scenario import resolve
+from twin_cli.validate import load_robot, run_check
+
+G = 9.81
+
+
+@pytest.fixture(scope="module")
+def humanoid():
+    return load_robot(scenarios.HUMANOID)
+
+
+PASSING = [
+    "free_fall",
+    "zero_gravity",
+    "moon_gravity",
+    "ground_contact",
+    "friction_standing",
+    "friction_incline",
+    "collision",
+    "joint_limits",
+    "inertia",
+    "stability",
+    "realtime",
+]
+
+
+@pytest.mark.parametrize("scenario", PASSING)
+def test_bundled_humanoid_passes(humanoid, scenario):
+    outcome = run_check(humanoid, resolve(scenario), debug=True)
+    assert outcome.status is Status.PASS, f"{scenario}: {outcome.measured}; {outcome.hints}"
+
+
+def test_free_fall_follows_half_g_t_squared_at_every_sample(humanoid):
+    outcome = run_check(humanoid, resolve("free_fall"), debug=True)
+    (series,) = outcome.series
+    t = np.array(series.t)
+    drop = np.array(series.values["measured drop"])
+    late = t > 0.1  # relative error of tiny early drops is dominated by the 1 ms step
+    np.testing.assert_allclose(drop[late], 0.5 * G * t[late] ** 2, rtol=0.01, err_msg="COM drop")
+
+
+def test_moon_ratio_is_measured_not_assumed(humanoid):
+    outcome = run_check(humanoid, resolve("moon_gravity"), debug=True)
+    assert math.isclose(outcome.value, 1.62 / 9.81, rel_tol=0.01), "a_moon / g_earth"
+
+
+def test_soft_contact_fails_ground_contact_with_kp_hint(tmp_path):
+    robot = load_robot(robots.write(tmp_path, robots.crate(kp=1000.0)))
+    outcome = run_check(robot, resolve("ground_contact"), debug=True)
+    assert outcome.status is Status.FAIL
+    hint = outcome.hints[0]
+    assert hint.startswith("crate sinks") and "kp 1e+03 N/m is too soft for 5 kg" in hint, hint
+    # Oracle (design.md §2.2): a box rests on 4 contact points, each a kp spring: M·g / (4 kp).
+    expected = 5.5 * G / (4 * 1000.0)
+    assert math.isclose(outcome.value, expected, rel_tol=0.15), "crate sinkage [m]"
+
+
+def test_unenforced_limit_fails_joint_limits_naming_the_joint(tmp_path):
+    robot = load_robot(robots.unenforced_limit_mjcf(tmp_path))
+    outcome = run_check(robot, resolve("joint_limits"), debug=True)
+    assert outcome.status is Status.FAIL
+    assert "joint 'elbow'" in outcome.hints[0] and "not enforced" in outcome.hints[0]
+
+
+def test_intact_crate_passes_contact_and_limits(tmp_path):
+    robot = load_robot(robots.write(tmp_path, robots.crate()))
+    for name in ("ground_contact", "collision", "stability"):
+        outcome = run_check(robot, resolve(name), debug=True)
+        assert outcome.status is Status.PASS, f"{name}: {outcome.hints}"
+
+
+def test_friction_incline_probe_slides_iff_tan_theta_exceeds_mu(humanoid):
+    outcome = run_check(humanoid, resolve("friction_incline"), debug=True)
+    assert "μ = 1" in outcome.measured, "humanoid feet μ=1 against the ground's 100: min is 1"
+    stick, slide = outcome.details[:2]
+    assert "38.7°" in stick and "51.3°" in slide, outcome.details
