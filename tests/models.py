@@ -167,13 +167,18 @@ def mjcf_box(
 </body></worldbody></mujoco>"""
 
 
-def mjcf_arm(lower: float, upper: float, effort: float, name: str = "arm") -> str:
+def mjcf_arm(
+    lower: float, upper: float, effort: float, name: str = "arm", limit_timeconst: float = 0.005
+) -> str:
     """A fixed-base arm: hinge 'shoulder' about y, range [lower, upper] [rad], a 0.5 m, 1 kg
-    capsule link, and a motor actuator with ctrlrange ±effort [N m] (the converter's contract)."""
-    return f"""<mujoco model="{name}"><worldbody><body name="base" pos="0 0 1">
+    capsule link, and a motor actuator with ctrlrange ±effort [N m] (the converter's contract).
+    The limit's time constant defaults to the converter's mapping of Gazebo's stopErp 0.2 at
+    1 ms (`converters.contact.limit_solref`: 0.005 s)."""
+    return f"""<mujoco model="{name}"><compiler angle="radian"/>
+  <worldbody><body name="base" pos="0 0 1">
   <geom type="box" size="0.05 0.05 0.05" mass="1" contype="0" conaffinity="0"/>
   <body name="link"><joint name="shoulder" type="hinge" axis="0 1 0" range="{lower} {upper}"
-      limited="true"/>
+      limited="true" solreflimit="{limit_timeconst} 1"/>
     <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1" contype="0" conaffinity="0"/>
   </body></body></worldbody>
   <actuator><motor name="shoulder" joint="shoulder" ctrlrange="{-effort} {effort}"
