@@ -84,7 +84,10 @@ class _BodyMasses:
         if mass > 0:
             return mass
         if self.model is None:
-            self.model = self.spec.compile()
+            try:
+                self.model = self.spec.copy().compile()
+            except ValueError:  # the core reports uncompilable specs; 0 kg clamps to stiffest
+                return 0.0
         return float(self.model.body(body).mass[0])
 
 
