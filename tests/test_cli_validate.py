@@ -1,0 +1,140 @@
+"""`twin validate` end to end: exit codes, JUnit/JSON/Markdown/PNG reports, user scenarios."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "twin_cli"))
+import validate_robots as robots  # noqa: E402
+
+import scenarios  # noqa: E402
+from twin_cli.checks import CHECKS, MODEL_CHECKS  # noqa: E402
+from twin_cli.scenario import builtin_names  # noqa: E402
+
+TWIN = Path(sys.executable).parent / "twin"
+
+
+def twin(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(TWIN), "validate", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=cwd,
+    )
+
+
+def test_humanoid_passes_every_check_and_writes_every_report(tmp_path):
+    junit, md, plots = tmp_path / "v.xml", tmp_path / "v.md", tmp_path / "plots"
+    done = twin(scenarios.HUMANOID, "--junit", junit, "--markdown", md, "--plots", plots, "--json")
+    assert done.returncode == 0, done.stdout + done.stderr
+    report = json.loads(done.stdout)
+    expected = len(MODEL_CHECKS) + len(builtin_names())
+    assert report["passed"] and len(report["checks"]) == expected
+    assert {c["check"] for c in report["checks"]} == set(CHECKS), "every check ran"
+    suite = ET.parse(junit).getroot().find("testsuite")
+    cases = suite.findall("testcase")
+    assert int(suite.get("tests")) == len(cases) == expected, "JUnit counts the checks that ran"
+    assert int(suite.get("failures")) == 0 and not suite.findall("testcase/failure")
+    assert "twin validate: `humanoid` passed" in md.read_text()
+    pngs = sorted(p.name for p in plots.glob("*.png"))
+    assert pngs == ["friction_standing_foot_slip.png", "gravity_free_fall.png"], pngs
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in plots.glob("*.png"))
+
+
+BROKEN = [
+    ("no_inertial", {"arm_inertial": False}, ["--only", "inertial"], "inertial", "'arm'"),
+    (
+        "tiny_inertia",
+        {"arm_mass": 5.0, "arm_inertia": 1e-9},
+        ["--only", "inertia_plausible"],
+        "inertia_plausible",
+        "too small for this mass",
+    ),
+    (
+        "overlap",
+        {"flap_overlaps_arm": True, "arm_self_collide": True},
+        ["--only", "initial_overlap"],
+        "initial_overlap",
+        "'arm' and 'flap'",
+    ),
+    (
+        "soft_kp",
+        {"kp": 1000.0},
+        ["--only", "ground_contact"],
+        "ground_contact",
+        "kp 1e+03 N/m is too soft for 5 kg",
+    ),
+]
+
+
+@pytest.mark.parametrize(("label", "flaw", "options", "check", "hint"), BROKEN, ids=lambda v: v)
+def test_broken_robot_fails_the_right_check_with_exit_1(
+    tmp_path, label, flaw, options, check, hint
+):
+    path = robots.write(tmp_path, robots.crate(**flaw), f"{label}.urdf")
+    junit = tmp_path / "junit.xml"
+    done = twin(path, *options, "--junit", junit)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert hint in done.stdout, done.stdout
+    failures = ET.parse(junit).getroot().findall("testsuite/testcase/failure/..")
+    assert [case.get("name") for case in failures] == [check]
+
+
+def test_dense_collision_mesh_fails_in_mesh_mode(tmp_path):
+    stl = robots.dense_sphere_stl(tmp_path, subdivisions=5)
+    path = robots.write(tmp_path, robots.crate(arm_mesh=str(stl)))
+    done = twin(path, "--collision", "mesh", "--only", "mesh_complexity", "--json")
+    assert done.returncode == 1, done.stderr
+    (result,) = json.loads(done.stdout)["checks"]
+    assert result["status"] == "fail" and result["value"] == 20480
+    assert "20480 triangles" in result["hints"][0]
+
+
+def test_unenforced_joint_limit_fails_joint_limits(tmp_path):
+    done = twin(robots.unenforced_limit_mjcf(tmp_path), "--only", "joint_limits")
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "joint 'elbow' goes" in done.stdout and "not enforced" in done.stdout
+
+
+def test_user_scenario_thresholds_decide_pass_or_fail(tmp_path):
+    robot = robots.write(tmp_path, robots.crate(kp=1000.0))
+    text = (Path(scenarios.SCENARIO_DIR) / "ground_contact.toml").read_text()
+    lenient = tmp_path / "lenient.toml"
+    lenient.write_text(text.replace("max_penetration_m = 0.005", "max_penetration_m = 0.03"))
+    strict = tmp_path / "strict.toml"
+    strict.write_text(text.replace("max_penetration_m = 0.005", "max_penetration_m = 0.01"))
+    ok = twin(robot, "--scenario", lenient, "--skip", "inertia_plausible", "--json")
+    assert ok.returncode == 0, ok.stdout + ok.stderr
+    ran = [c["check"] for c in json.loads(ok.stdout)["checks"]]
+    assert ran[-1] == "ground_contact" and ran.count("gravity") == 0, "only the given scenario"
+    bad = twin(robot, "--scenario", strict, "--only", "ground_contact")
+    assert bad.returncode == 1 and "limit 10 mm" in bad.stdout, bad.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["no_such_robot.urdf"], "no such file"),
+        ([str(scenarios.HUMANOID), "--only", "levitation"], "unknown validation check"),
+        ([str(scenarios.HUMANOID), "--scenario", "nope"], "no such scenario"),
+        ([str(scenarios.HUMANOID), "--arg", "foot_mu"], "NAME:=VALUE"),
+    ],
+)
+def test_malformed_input_exits_2_with_a_message(args, needle):
+    done = twin(*args)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert needle in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_malformed_scenario_file_exits_2_naming_file_and_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('check = "gravity"\n[world]\ngravty = "moon"\n')
+    done = twin(scenarios.HUMANOID, "--scenario", bad)
+    assert done.returncode == 2 and str(bad) in done.stderr and "world.gravty" in done.stderr
