@@ -174,18 +174,26 @@ def test_openapi_schema_is_served(server):
         assert path in schema["paths"], f"{path} missing from the OpenAPI schema"
 
 
-def test_sigterm_ends_cleanly_and_removes_runtime_files(tmp_path):
+def test_serve_a_saved_world_paused_then_sigterm_ends_cleanly(tmp_path, files):
+    from twin_cli.world import Pose, World
+
+    saved = World()
+    saved.spawn(str(files / "box.urdf"), name="crate", pose=Pose(z=3.0))
+    saved.save(tmp_path / "saved.twin")
     env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
+    args = ["serve", str(tmp_path / "saved.twin"), "--world", "t", "--paused", "--rate", "500"]
     proc = subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.app", "serve", "--world", "t"],
-        env=env,
-        stderr=subprocess.PIPE,
+        [sys.executable, "-m", "twin_cli.app", *args], env=env, stderr=subprocess.DEVNULL
     )
     mp = pytest.MonkeyPatch()
     mp.setenv(runtime.RUNTIME_ENV, str(tmp_path))
     try:
         client = Client("t")
         runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
+        assert [e["name"] for e in client.entities()] == ["crate"], "saved entities not served"
+        assert client.stats()["paused"] is True, "--paused not applied"
+        assert client.physics()["rate"] == pytest.approx(500.0), "--rate not applied"
+        assert client.pose("crate")["z"] == pytest.approx(3.0, abs=1e-9), "saved pose z [m]"
         proc.terminate()
         assert proc.wait(timeout=20) == 0, f"exit code after SIGTERM: {proc.returncode}"
         leftovers = [p for p in client.paths.transient() if p.exists()]
