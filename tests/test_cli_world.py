@@ -122,6 +122,13 @@ def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
     assert new_pid != old_pid, "the killed server's pid is still recorded"
     names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
     assert names == {"second"}, f"a fresh world should hold only the new entity: {names}"
+    twice = twin("serve", check=False, timeout=60)
+    assert twice.returncode == 2 and f"pid {new_pid}" in twice.stderr, twice.stderr
+    assert "already served" in twice.stderr and "twin stop" in twice.stderr, twice.stderr
+    twin("stop")
+    again = twin("stop", check=False)
+    assert again.returncode == 1, f"stop with no world: exit {again.returncode}"
+    assert again.stderr.strip() == "An instance of twin is not running.", again.stderr
 
 
 def test_concurrent_first_commands_start_exactly_one_server(twin):
