@@ -37,7 +37,14 @@ from twin_cli.errors import (
 from twin_cli.loop import SteppingLoop, WorldLock
 from twin_cli.pose import Pose
 from twin_cli.queries import JointState
-from twin_cli.scene import INTEGRATORS, ODE_ONLY_FIELDS, SOLVERS, SceneSettings, build_world_spec
+from twin_cli.scene import (
+    INTEGRATORS,
+    ODE_ONLY_FIELDS,
+    SOLVERS,
+    SceneSettings,
+    build_world_spec,
+    solver_tolerance,
+)
 
 __all__ = [
     "GRAVITY_PRESETS",
@@ -120,6 +127,7 @@ class World:
         self.lock = WorldLock()
         self._spec = build_world_spec(_scene(self.settings))
         self.model = self._spec.compile()
+        self.model.opt.tolerance = solver_tolerance(self.model)
         self.data = mujoco.MjData(self.model)
         self._entities: dict[str, Entity] = {}
         self._index: dict[str, EntityIndex] = {}
@@ -286,6 +294,7 @@ class World:
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = trial, model, data, index
+        model.opt.tolerance = solver_tolerance(model)
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
         self._snapshot = np.empty(mujoco.mj_stateSize(model, _STATE))
         control.apply_pushes(model, data, self._pushes, {p.body for p in self._pushes})

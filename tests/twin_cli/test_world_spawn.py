@@ -1,0 +1,177 @@
+"""Spawning into a live world: invariance of existing entities, rollback, placement checks."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from models import mjcf_ball, mjcf_box, mjcf_with_home
+
+from twin_cli.errors import EntityExistsError, EntityNotFoundError, InvalidRequestError, SpawnError
+from twin_cli.world import Pose, World
+
+STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+def spec_of(xml: str) -> mujoco.MjSpec:
+    return mujoco.MjSpec.from_string(xml)
+
+
+def full_state(world: World) -> np.ndarray:
+    state = np.empty(mujoco.mj_stateSize(world.model, STATE))
+    mujoco.mj_getState(world.model, world.data, state, STATE)
+    return state
+
+
+@pytest.fixture(scope="module")
+def humanoid_spec() -> mujoco.MjSpec:
+    from converters.pipeline import convert
+    from scenarios import HUMANOID
+
+    spec, _ = convert(HUMANOID)
+    return spec
+
+
+def falling_trajectory(humanoid_spec: mujoco.MjSpec, spawn_second: bool) -> np.ndarray:
+    """qpos of a humanoid dropped from 2 m, pushed, 700 steps (it lands at about 0.45 s),
+    optionally spawning a second humanoid standing on the ground at step 100."""
+    world = World()
+    world.spawn(humanoid_spec, name="first", pose=Pose(z=2.0))
+    world.push("first", force=(0.0, 30.0, 0.0), torque=(0.0, 0.0, 5.0), duration=0.2)
+    rows = []
+    for k in range(700):
+        if spawn_second and k == 100:
+            world.spawn(humanoid_spec, name="second", pose=Pose(x=3.0, z=0.96))
+        world.step(1)
+        rows.append(world.data.qpos[world._index["first"].qpos].copy())
+    return np.array(rows)
+
+
+def test_spawning_a_second_robot_leaves_the_falling_first_ones_trajectory_unchanged(humanoid_spec):
+    alone = falling_trajectory(humanoid_spec, spawn_second=False)
+    with_spawn = falling_trajectory(humanoid_spec, spawn_second=True)
+    assert np.array_equal(alone[:100], with_spawn[:100]), "identical before the spawn"
+    difference = np.max(np.abs(alone - with_spawn))
+    # Not bitwise: MuJoCo's line search scales with the whole model (see scene.solver_tolerance).
+    assert difference <= 1e-12, f"first robot's qpos changed by {difference:.3g} after the spawn"
+
+
+def test_new_entity_starts_at_rest_at_its_pose_in_its_home_configuration():
+    world = World()
+    world.spawn(spec_of(mjcf_ball()), pose=Pose(z=3.0))
+    world.step(50)
+    world.spawn(spec_of(mjcf_with_home(hinge=0.7, z=0.5)), pose=Pose(x=1.0, z=1.0, yaw=0.5))
+    pose = world.get_pose("homed")
+    assert (pose.x, pose.z) == pytest.approx((1.0, 1.5)), "home key z composed with spawn pose"
+    assert pose.yaw == pytest.approx(0.5), "spawn yaw"
+    assert world.joint_states("homed")[0].position == pytest.approx(0.7), "home key hinge"
+    assert not np.any(world.data.qvel[world._index["homed"].dofs]), "new entity at rest"
+    world.spawn(spec_of(mjcf_with_home()), name="homed_again", pose=Pose(x=-1.0, z=1.0))
+    assert world.joint_states("homed_again")[0].position == pytest.approx(0.7), "second home"
+
+
+def test_spawn_keeps_applied_forces_and_controls_of_existing_entities():
+    world = World()
+    world.set_gravity((0.0, 0.0, 0.0))
+    world.spawn(spec_of(mjcf_ball()), pose=Pose(z=1.0))
+    world.push("ball", force=(1.0, 0.0, 0.0), duration=0.1)
+    world.step(50)
+    world.spawn(spec_of(mjcf_box()), pose=Pose(x=5.0, z=1.0))
+    world.step(100)
+    vx = world.data.qvel[world._index["ball"].dofs[0]]
+    assert vx == pytest.approx(0.1, rel=1e-9), f"push impulse survived the spawn: vx = {vx}"
+
+
+@pytest.mark.parametrize(
+    "bad",
+    ["taken name", "missing file", "compile error", "bad name"],
+)
+def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
+    world = World()
+    world.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
+    world.push("ball", force=(3.0, 0.0, 0.0), duration=1.0)
+    world.step(20)
+    before, xml_before = full_state(world), world._spec.to_xml()
+    broken = tmp_path / "broken.xml"
+    broken.write_text(
+        '<mujoco><worldbody><body><geom type="mesh" mesh="nope"/></body></worldbody></mujoco>'
+    )
+    attempts = {
+        "taken name": (lambda: world.spawn(spec_of(mjcf_box()), name="ball"), EntityExistsError),
+        "missing file": (lambda: world.spawn(tmp_path / "none.urdf"), SpawnError),
+        "compile error": (lambda: world.spawn(broken), SpawnError),
+        "bad name": (lambda: world.spawn(spec_of(mjcf_box()), name="a/b"), InvalidRequestError),
+    }
+    attempt, error = attempts[bad]
+    with pytest.raises(error) as caught:
+        attempt()
+    assert np.array_equal(full_state(world), before), f"state changed by a failed spawn ({bad})"
+    assert world._spec.to_xml() == xml_before, f"world spec changed by a failed spawn ({bad})"
+    assert [e.name for e in world.entities()] == ["ball"], "entity list unchanged"
+    assert "ball" in str(caught.value) or bad != "taken name", "message names the entity"
+    reference = World()
+    reference.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
+    reference.push("ball", force=(3.0, 0.0, 0.0), duration=1.0)
+    reference.step(20)
+    world.step(100), reference.step(100)
+    assert np.array_equal(full_state(world), full_state(reference)), "continues as if untried"
+
+
+def test_spawn_inside_the_ground_warns_with_depth_and_clearing_height():
+    world = World()
+    result = world.spawn(spec_of(mjcf_box(half=(0.1, 0.1, 0.1))), pose=Pose(z=0.05))
+    assert len(result.warnings) == 1, f"one overlap warning, got {result.warnings}"
+    warning = result.warnings[0]
+    assert "0.0500 m inside the ground" in warning, f"depth in the warning: {warning}"
+    assert "z >= 0.1000 m" in warning and "--on-ground" in warning, f"the fix: {warning}"
+    clear = world.spawn(spec_of(mjcf_box()), name="clear", pose=Pose(x=2.0, z=0.5))
+    assert clear.warnings == [], "no warning when the entity starts clear"
+    overlap = world.spawn(spec_of(mjcf_ball()), pose=Pose(x=2.0, z=0.65))
+    assert any("entity [clear]" in w for w in overlap.warnings), "overlap with another entity"
+
+
+def test_on_ground_puts_the_lowest_point_on_the_ground():
+    world = World()
+    world.spawn(spec_of(mjcf_box(half=(0.1, 0.2, 0.3))), pose=Pose(z=5.0, roll=0.3), on_ground=True)
+    scratch = mujoco.MjData(world.model)
+    scratch.qpos[:] = world.data.qpos
+    mujoco.mj_kinematics(world.model, scratch)
+    corners = np.array(
+        [[sx, sy, sz] for sx in (-0.1, 0.1) for sy in (-0.2, 0.2) for sz in (-0.3, 0.3)]
+    )
+    g = world._index["box"].geoms[0]
+    z_corners = scratch.geom_xpos[g][2] + corners @ scratch.geom_xmat[g].reshape(3, 3)[2]
+    assert z_corners.min() == pytest.approx(0.0, abs=1e-12), "lowest corner on the ground"
+    fixed = world.spawn(
+        spec_of(mjcf_box(free=False)), name="post", pose=Pose(x=2, z=3), on_ground=True
+    )
+    assert world.get_pose(fixed.name).z == pytest.approx(0.1), "fixed-base entity placed too"
+
+
+def test_humanoid_on_ground_rests_its_soles_on_the_ground(humanoid_spec):
+    world = World()
+    result = world.spawn(humanoid_spec, pose=Pose(z=3.0), on_ground=True)
+    assert result.warnings == [], f"no overlap at rest: {result.warnings}"
+    assert world.get_pose("humanoid").z == pytest.approx(0.95, abs=1e-9), "soles 0.95 m below"
+
+
+def test_delete_keeps_the_others_exact_and_frees_the_name():
+    world, reference = World(), World()
+    for w in (world, reference):
+        w.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
+        w.push("ball", force=(1.0, 0.0, 0.0), duration=0.5)
+    world.spawn(spec_of(mjcf_box()), pose=Pose(x=1.0, z=1.0))
+    world.step(10), reference.step(10)
+    world.delete("box")
+    world.step(200), reference.step(200)
+    assert np.array_equal(full_state(world), full_state(reference)), "ball unaffected by delete"
+    world.spawn(spec_of(mjcf_box()), pose=Pose(x=1.0, z=1.0))
+    assert [e.name for e in world.entities()] == ["ball", "box"], "name reusable after delete"
+    with pytest.raises(EntityNotFoundError, match=r"\[ghost\].*ball, box"):
+        world.delete("ghost")
+
+
+def test_default_names_are_made_unique():
+    world = World()
+    names = [world.spawn(spec_of(mjcf_ball()), pose=Pose(x=k, z=1.0)).name for k in range(3)]
+    assert names == ["ball", "ball_1", "ball_2"], "robot name, then _1, _2"
