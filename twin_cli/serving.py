@@ -53,6 +53,7 @@ def parse_tcp(text: str) -> tuple[str, int]:
     """
     host, _, port = text.rpartition(":")
     host = host.strip("[]") or "127.0.0.1"
+    host = "127.0.0.1" if host == "localhost" else host
     try:
         number = int(port)
         ipaddress.ip_address(host)
