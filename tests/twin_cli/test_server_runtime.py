@@ -93,3 +93,27 @@ def test_start_lock_serialises_starters(rtdir):
             with runtime.start_lock(paths, timeout=0.2):
                 pass
         assert time.monotonic() - t0 >= 0.2
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("8765", ("127.0.0.1", 8765)),
+        ("localhost:1", ("127.0.0.1", 1)),
+        ("[::1]:5", ("::1", 5)),
+        ("0.0.0.0:9", ("0.0.0.0", 9)),
+    ],
+)
+def test_tcp_address_defaults_to_loopback(text, expected):
+    from twin_cli.serving import parse_tcp
+
+    assert parse_tcp(text) == expected
+
+
+@pytest.mark.parametrize("text", ["nonsense", "example.com:80", "127.0.0.1:70000"])
+def test_bad_tcp_address_is_refused_with_an_example(text):
+    from twin_cli.errors import RequestError
+    from twin_cli.serving import parse_tcp
+
+    with pytest.raises(RequestError, match="--tcp"):
+        parse_tcp(text)
