@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from twin_cli.checks import CHECKS, MODEL_CHECKS
-from twin_cli.checks.base import CheckResult, RobotUnderTest, Status, result
+from twin_cli.checks.base import CheckResult, DeclaredJoint, RobotUnderTest, Status, result
 from twin_cli.errors import ScenarioError, UnknownCheckError
 from twin_cli.scenario import Scenario, load_builtin, resolve
 
@@ -87,13 +87,34 @@ def load_robot(
 def robot_from_conversion(done, path: str | Path, *, repair_inertia: bool) -> RobotUnderTest:
     """The robot under test from a `converters.Conversion` (spec, report, provenance)."""
     body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
-    return _robot(done.spec, done.report, Path(path), repair_inertia, body_links)
+    joints = tuple(_declared(j) for j in done.parsed.model.joints)
+    return _robot(done.spec, done.report, Path(path), repair_inertia, body_links, joints)
 
 
-def _robot(spec, report, path: Path, repair_inertia: bool, body_links) -> RobotUnderTest:
+def _declared(joint) -> DeclaredJoint:
+    limit = joint.limit
+
+    def value(name: str) -> float | None:
+        raw = getattr(limit, name, None) if limit is not None else None
+        return None if raw is None else float(raw)
+
+    return DeclaredJoint(
+        joint.name,
+        joint.type,
+        value("lower"),
+        value("upper"),
+        value("effort"),
+        value("velocity"),
+        joint.mimic is not None,
+    )
+
+
+def _robot(spec, report, path: Path, repair_inertia: bool, body_links, joints=()) -> RobotUnderTest:
     model = spec.copy().compile()
     name = report.robot or spec.modelname or path.stem.split(".")[0]
-    return RobotUnderTest(name, str(path), spec, model, report, repair_inertia, body_links)
+    return RobotUnderTest(
+        name, str(path), spec, model, report, repair_inertia, body_links, tuple(joints)
+    )
 
 
 def _model_scenario(check: str) -> Scenario:

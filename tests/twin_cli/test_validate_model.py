@@ -93,6 +93,15 @@ def test_2000_triangle_collision_mesh_warns(tmp_path):
     assert model_results(path, collision="mesh")["mesh_complexity"].status is Status.WARN
 
 
+def test_reversed_limits_and_zero_velocity_fail_joint_definitions(tmp_path):
+    path = robots.write(tmp_path, robots.crate(elbow_limit=(1.0, -1.0), elbow_velocity=0.0))
+    results = model_results(path)
+    assert failing(results) == {"joint_definitions"}
+    hints = results["joint_definitions"].hints
+    assert any("'elbow'" in h and "lower=1 upper=-1" in h for h in hints), hints
+    assert any("'elbow'" in h and "velocity=0" in h for h in hints), hints
+
+
 def test_declared_but_unenforced_limit_fails_joint_definitions(tmp_path):
     results = model_results(robots.unenforced_limit_mjcf(tmp_path))
     assert failing(results) == {"joint_definitions"}
@@ -128,8 +137,9 @@ def test_geometry_solid_matches_mujoco_inertia_from_density(shape, size, volume,
 # the shared session fixture (hull collision; inertia repaired only for the robots whose upstream
 # inertias are non-physical, whose repairs then count as failures). Absent: passes every check.
 CORPUS_EXPECTED_FAILURES: dict[str, set[str]] = {
-    # No <inertial> on any link upstream: every moving link was given a mass by the repair.
-    "abb_irb2400_12_155": {"inertial"},
+    # Kinematic-only ROS-Industrial description: no <inertial> on any link (the repair gave each
+    # moving link a mass) and effort="0" on every joint's <limit>.
+    "abb_irb2400_12_155": {"inertial", "joint_definitions"},
     # depth_camera_*_camera breaks the triangle inequality and 'hatch' is singular upstream.
     "anymal_c": {"inertia_tensor"},
     # Placeholder tensors upstream: base_link and the *_foot links (all six entries equal).

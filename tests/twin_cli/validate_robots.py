@@ -37,6 +37,8 @@ def crate(
     flap_overlaps_arm: bool = False,
     arm_self_collide: bool = False,
     arm_mesh: str | None = None,
+    elbow_limit: tuple[float, float] = (-1.0, 1.0),
+    elbow_velocity: float = 5.0,
 ) -> str:
     """URDF text of the crate, broken as asked.
 
@@ -48,6 +50,8 @@ def crate(
         flap_overlaps_arm: add a sibling link 'flap' whose box overlaps the arm by 2 cm.
         arm_self_collide: Gazebo selfCollide on the arm (then arm and flap collide).
         arm_mesh: a mesh file for the arm's collision instead of its box.
+        elbow_limit: the elbow's (lower, upper) [rad].
+        elbow_velocity: the elbow's velocity limit [rad/s].
     """
     if arm_inertia is None:
         arm = box_inertial(arm_mass, 0.04, 0.04, 0.2, "0 0 0.1") if arm_inertial else ""
@@ -72,7 +76,8 @@ def crate(
   {_box_link("arm", "0.04 0.04 0.2", "0 0 0.1", arm, arm_mesh)}
   <joint name="elbow" type="revolute"><parent link="crate"/><child link="arm"/>
     <origin xyz="0 0 0.05"/><axis xyz="0 1 0"/>
-    <limit lower="-1" upper="1" effort="10" velocity="5"/>
+    <limit lower="{elbow_limit[0]}" upper="{elbow_limit[1]}" effort="10"
+           velocity="{elbow_velocity}"/>
     <dynamics damping="0.05"/></joint>
   {flap}
   {gazebo}

@@ -81,12 +81,26 @@ class CheckResult:
 
 
 @dataclass(frozen=True)
+class DeclaredJoint:
+    """A joint as the URDF declares it: limits [rad] or [m], effort [N m] or [N], velocity."""
+
+    name: str
+    type: str
+    lower: float | None
+    upper: float | None
+    effort: float | None
+    velocity: float | None
+    mimic: bool
+
+
+@dataclass(frozen=True)
 class RobotUnderTest:
     """What every check receives: the converted robot and how it was converted.
 
     `spec` is never mutated by a check (physics checks spawn copies); `model` is the robot
     compiled alone, in its initial pose. `repair_inertia` says whether the user asked for
-    inertia repairs (then repairs are warnings, not failures).
+    inertia repairs (then repairs are warnings, not failures). `declared_joints` are the
+    URDF's own joint values (empty for MJCF input).
     """
 
     name: str
@@ -96,6 +110,7 @@ class RobotUnderTest:
     report: Report
     repair_inertia: bool = False
     body_links: dict[str, str] = field(default_factory=dict)
+    declared_joints: tuple[DeclaredJoint, ...] = ()
 
     def link_of_body(self, body: str) -> str:
         """The URDF link name for a body name (bodies are named after links)."""

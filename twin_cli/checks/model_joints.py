@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from converters.report import Outcome
-from twin_cli.checks.base import RobotUnderTest, Status, result
+from twin_cli.checks.base import DeclaredJoint, RobotUnderTest, Status, result
 from twin_cli.scenario import Scenario
 
 HINGE, SLIDE = 3, 2  # mjtJoint codes
@@ -63,19 +62,30 @@ def _joint_problems(model, joint: int) -> list[str]:
     return problems
 
 
-def _velocity_problems(robot: RobotUnderTest) -> list[str]:
-    """Velocity limits are not part of an MjModel; the converter reports bad ones."""
-    out = []
-    for entry in robot.report.entries:
-        text = f"{entry.subject} {entry.detail}".lower()
-        if "velocity" in text and entry.outcome in (Outcome.WARNING, Outcome.REPAIRED):
-            if "joint" in text and ("not positive" in text or "<= 0" in text or "zero" in text):
-                out.append(f"{entry.subject}: {entry.detail}; set a positive <limit velocity>")
-    return out
+def _declared_problems(joint: DeclaredJoint) -> list[str]:
+    """What the URDF itself gets wrong: limits reversed, effort or velocity not positive."""
+    if joint.type not in ("revolute", "prismatic", "continuous"):
+        return []
+    problems = []
+    name = f"joint '{joint.name}'"
+    if joint.type != "continuous" and joint.lower is not None and joint.upper is not None:
+        if joint.lower >= joint.upper:
+            problems.append(
+                f"{name}: <limit lower={joint.lower:g} upper={joint.upper:g}> is not ordered, "
+                "so the joint is left unlimited; give lower < upper"
+            )
+    for field, unit in (("effort", "N m or N"), ("velocity", "rad/s or m/s")):
+        value = getattr(joint, field)
+        if value is not None and value <= 0.0 and not joint.mimic:
+            problems.append(
+                f"{name}: <limit {field}={value:g}> must be positive [{unit}]; "
+                + ("no motor can drive it" if field == "effort" else "set the real top speed")
+            )
+    return problems
 
 
 def check_joint_definitions(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
-    """Limits ordered and enforced, efforts (and velocities, as reported) positive."""
+    """Limits ordered and enforced, efforts and velocities positive (as the URDF declares)."""
     model = robot.model
     hints = []
     checked = 0
@@ -84,7 +94,8 @@ def check_joint_definitions(robot: RobotUnderTest, scenario: Scenario, th: dict[
             continue
         checked += 1
         hints += _joint_problems(model, j)
-    hints += _velocity_problems(robot)
+    for joint in robot.declared_joints:
+        hints += _declared_problems(joint)
     return result(
         "joint_definitions",
         "model",
