@@ -82,6 +82,8 @@ def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:
     spec.option.iterations = settings.iterations
     spec.option.solver = SOLVERS[settings.solver]
     spec.option.integrator = INTEGRATORS[settings.integrator]
+    # A diverging entity must not reset the whole world (twin resets only that entity).
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
 
 
 # [MuJoCo solver cost units] convergence threshold the solver stops at, the same in every world.

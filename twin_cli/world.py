@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections import deque
 from dataclasses import dataclass, replace
 
 import mujoco
@@ -65,6 +66,7 @@ GRAVITY_PRESETS = {
     "zero": (0.0, 0.0, 0.0),
 }
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
 
 
 @dataclass(frozen=True)
@@ -136,9 +138,10 @@ class World:
         self._damping: control.Damping | None = None
         self._iterations = 0
         self._paused = False
-        self._snapshot = np.empty(mujoco.mj_stateSize(self.model, _STATE))
         self.divergences = 0
         self.divergence_log: list[Divergence] = []
+        self.mujoco_warnings: deque[str] = deque(maxlen=WARNINGS_KEPT)
+        self._snapshot = np.empty(mujoco.mj_stateSize(self.model, _STATE))
         self._loop = SteppingLoop(self)
 
     # ----------------------------------------------------------------- spawning and deleting
@@ -295,8 +298,8 @@ class World:
     ) -> None:
         self._spec, self.model, self.data, self._index = trial, model, data, index
         model.opt.tolerance = solver_tolerance(model)
-        self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
         self._snapshot = np.empty(mujoco.mj_stateSize(model, _STATE))
+        self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
         control.apply_pushes(model, data, self._pushes, {p.body for p in self._pushes})
 
     def _reapply_commands(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
@@ -607,25 +610,45 @@ class World:
                 self._expire_pushes()
 
     def _step_chunk(self, n: int) -> None:
+        """Steps n times; on divergence, replays the batch step by step to catch its origin.
+
+        NaNs spread to other entities through collisions within a few steps, so a divergence
+        found after a batch is traced back: the batch-start state is restored and stepped one
+        step at a time, and the entity that goes bad first is reset to its spawn state.
+        """
         m, d = self.model, self.data
-        mujoco.mj_getState(m, d, self._snapshot, _STATE)
+        if n > 1:
+            mujoco.mj_getState(m, d, self._snapshot, _STATE)
         before = warning_counts(d)
-        if self._damping is None:
-            mujoco.mj_step(m, d, nstep=n)
-        else:
-            dofs, keep = self._damping.dofs, self._damping.keep
-            for _ in range(n):
-                mujoco.mj_step(m, d)
-                d.qvel[dofs] *= keep
+        # MuJoCo's default handler prints and appends to ./MUJOCO_LOG.TXT; keep its text instead.
+        previous = mujoco.get_mju_user_warning()
+        mujoco.set_mju_user_warning(self.mujoco_warnings.append)
+        try:
+            if self._damping is None:
+                mujoco.mj_step(m, d, nstep=n)
+            else:
+                dofs, keep = self._damping.dofs, self._damping.keep
+                for _ in range(n):
+                    mujoco.mj_step(m, d)
+                    d.qvel[dofs] *= keep
+        finally:
+            mujoco.set_mju_user_warning(previous)
         self._iterations += n
         bad = find_divergent(d, before, self._index)
-        if bad:
-            self._recover(bad, n)
+        if bad and n == 1:
+            self._recover(bad)
+        elif bad:
+            mujoco.mj_setState(m, d, self._snapshot, _STATE)
+            self._iterations -= n
+            for _ in range(n):
+                self._step_chunk(1)
 
-    def _recover(self, bad: dict[str, str], n: int) -> None:
-        """Restores the batch-start state and resets the offending entities to spawn state."""
-        mujoco.mj_setState(self.model, self.data, self._snapshot, _STATE)
-        self._iterations -= n
+    def _recover(self, bad: dict[str, str]) -> None:
+        """Resets the offending entities to their spawn state; the others keep their state.
+
+        MuJoCo's auto-reset (which would reset the whole world) is disabled in every world
+        spec (scene.apply_physics), so within one step a diverging entity's NaNs stay its own.
+        """
         for name, reason in bad.items():
             write_state(self.data, self._index[name], self._entities[name].spawn_state)
             self.divergences += 1
