@@ -186,13 +186,16 @@ def _from_outcome(plan: _Plan, outcome: DecomposeOutcome) -> tuple[Pairs, dict[s
         failure = "CoACD returned no usable part"
     if failure is not None:
         parts = _hull_parts(plan.request.vertices, cap)
-    return parts, _finish(plan, parts, fallback=failure)
+    return parts, _finish(plan, parts, fallback=failure, worker_seconds=outcome.seconds)
 
 
-def _finish(plan: _Plan, parts: Pairs, fallback: str | None) -> dict[str, Any]:
+def _finish(
+    plan: _Plan, parts: Pairs, fallback: str | None, worker_seconds: float | None = None
+) -> dict[str, Any]:
     """Build the row and store the result (never a fallback: a retry may do better)."""
     mode = CollisionMode.HULL if fallback else plan.decision.mode
-    seconds = time.perf_counter() - plan.started
+    # A CoACD mesh is timed by its worker (not the wait in the queue behind other meshes).
+    seconds = time.perf_counter() - plan.started if worker_seconds is None else worker_seconds
     row = _row(
         plan.request,
         plan.requested.value,
