@@ -97,6 +97,8 @@ def test_used_by_flow_on_the_bundled_humanoid(twin):
     names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
     assert names == {"humanoid", "earthbox", "moonbox"}, f"list: {names}"
     assert len(twin("pose", "humanoid").stdout.split()) == 6, "pose is x y z roll pitch yaw"
+    joints = json.loads(twin("joints", "humanoid", "--json").stdout)
+    assert len(joints) == 11, f"the bundled humanoid has 11 joints, twin joints: {len(joints)}"
     twin("delete", "humanoid")
     names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
     assert "humanoid" not in names, f"humanoid still listed after delete: {names}"

@@ -223,3 +223,24 @@ def test_save_then_load_restores_entities_and_pose(server, files, tmp_path):
         client.delete("kept")
     with pytest.raises(TwinError, match="nowhere.twin"):
         client.load(tmp_path / "nowhere.twin")
+
+
+def test_set_pose_then_push_moves_by_half_a_t_squared(server, files):
+    """A 1 kg box in zero gravity pushed with 10 N for 0.1 s moves 1/2 a t^2 = 0.05 m."""
+    client, _ = server
+    client.pause()
+    client.set_gravity(preset="zero")
+    try:
+        client.spawn(files / "box.urdf", name="puck", pose={"z": 5.0})
+        moved = client.set_pose("puck", {"x": 1.0, "y": 2.0, "z": 3.0, "yaw": 0.5})
+        assert (moved["x"], moved["y"], moved["z"]) == pytest.approx((1.0, 2.0, 3.0), abs=1e-9)
+        assert moved["yaw"] == pytest.approx(0.5, abs=1e-9), "yaw after set_pose [rad]"
+        client.push("puck", (10.0, 0.0, 0.0), (0.0, 0.0, 0.0), duration=0.1)
+        client.step(100)
+        dx = client.pose("puck")["x"] - 1.0
+        # Semi-implicit Euler over 100 steps of 1 ms: a*dt^2*n(n+1)/2 = 0.0505 m.
+        assert dx == pytest.approx(10.0 * 1e-6 * 100 * 101 / 2, rel=0.02), f"push moved {dx} m"
+    finally:
+        client.delete("puck")
+        client.set_gravity(preset="earth")
+        client.resume()
