@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import os
 from collections import deque
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import mujoco
 import numpy as np
@@ -42,9 +42,18 @@ from twin_cli.scene import (
     INTEGRATORS,
     ODE_ONLY_FIELDS,
     SOLVERS,
-    SceneSettings,
     build_world_spec,
     solver_tolerance,
+)
+from twin_cli.world_types import (
+    GRAVITY_PRESETS,
+    EntityInfo,
+    SpawnResult,
+    Stats,
+    WorldSettings,
+    check_settings,
+    finite_vector,
+    scene_settings,
 )
 
 __all__ = [
@@ -58,65 +67,8 @@ __all__ = [
     "WorldSettings",
 ]
 
-# Gravity presets [m/s²] (issue 4; `earth` is the --earth preset 9.81, not empty.world's 9.8).
-GRAVITY_PRESETS = {
-    "earth": (0.0, 0.0, -9.81),
-    "moon": (0.0, 0.0, -1.62),
-    "mars": (0.0, 0.0, -3.71),
-    "zero": (0.0, 0.0, 0.0),
-}
 _STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
-
-
-@dataclass(frozen=True)
-class WorldSettings:
-    """Physics of a new world (SDF defaults: 1 ms step at 1000 Hz, ODE quick 50 iterations).
-
-    Attributes:
-        timestep: [s]; rate: real-time update rate [Hz], 0 = as fast as possible;
-        gravity: [m/s²]; iterations: solver iterations; ground: Gazebo's ground plane;
-        solver, integrator: MuJoCo names (see twin_cli.scene).
-    """
-
-    timestep: float = 0.001
-    rate: float = 1000.0
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    iterations: int = 50
-    ground: bool = True
-    solver: str = "newton"
-    integrator: str = "implicitfast"
-
-
-@dataclass(frozen=True)
-class SpawnResult:
-    """What a spawn did: the entity's name and source, start warnings, converter report."""
-
-    name: str
-    source: str
-    warnings: list[str]
-    report: dict | None
-
-
-@dataclass(frozen=True)
-class EntityInfo:
-    """One line of the entity list: name, source file, root position [m], joints (no free)."""
-
-    name: str
-    source: str
-    position: tuple[float, float, float]
-    n_joints: int
-
-
-@dataclass(frozen=True)
-class Stats:
-    """`gz stats` figures: factor, sim and real time [s], iterations, paused."""
-
-    factor: float
-    sim_time: float
-    real_time: float
-    iterations: int
-    paused: bool
 
 
 class World:
@@ -124,10 +76,10 @@ class World:
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
         self.settings = settings or WorldSettings()
-        _check_settings(self.settings)
+        check_settings(self.settings)
         self.name = name
         self.lock = WorldLock()
-        self._spec = build_world_spec(_scene(self.settings))
+        self._spec = build_world_spec(scene_settings(self.settings))
         self.model = self._spec.compile()
         self.model.opt.tolerance = solver_tolerance(self.model)
         self.data = mujoco.MjData(self.model)
@@ -376,7 +328,7 @@ class World:
         Lasts `duration` [s] of sim time, rounded to whole steps (at least one); pushes on the
         same link add up. `link` defaults to the entity's root body.
         """
-        wrench = _finite_vector("push force and torque", [*force, *torque], 6)
+        wrench = finite_vector("push force and torque", [*force, *torque], 6)
         if not (math.isfinite(duration) and duration > 0):
             raise InvalidRequestError(
                 "push duration", f"{duration} s is not positive", "give a duration > 0 s"
@@ -451,7 +403,7 @@ class World:
 
     def set_gravity(self, vector: tuple[float, float, float]) -> None:
         """Sets gravity [m/s²]; takes effect on the next step (see GRAVITY_PRESETS)."""
-        g = _finite_vector("gravity", vector, 3)
+        g = finite_vector("gravity", vector, 3)
         with self.lock:
             self.model.opt.gravity[:] = g
             self._spec.option.gravity = g
@@ -496,7 +448,7 @@ class World:
         }
         with self.lock:
             new = replace(self.settings, **changes)
-            _check_settings(new)
+            check_settings(new)
             self.settings = new
             for target in (self.model.opt, self._spec.option):
                 target.timestep, target.iterations = new.timestep, new.iterations
@@ -658,63 +610,3 @@ class World:
         ended = {p.body for p in self._pushes if p.end_step <= self._iterations}
         self._pushes = [p for p in self._pushes if p.end_step > self._iterations]
         control.apply_pushes(self.model, self.data, self._pushes, ended)
-
-
-def _scene(settings: WorldSettings) -> SceneSettings:
-    return SceneSettings(
-        settings.timestep,
-        settings.gravity,
-        settings.iterations,
-        settings.solver,
-        settings.integrator,
-        settings.ground,
-    )
-
-
-def _finite_vector(what: str, values: object, size: int) -> list[float]:
-    try:
-        vector = [float(v) for v in values]  # type: ignore[attr-defined]
-    except (TypeError, ValueError) as exc:
-        raise InvalidRequestError(
-            what, f"{values!r} is not a list of numbers", f"give {size} numbers"
-        ) from exc
-    if len(vector) != size or not all(math.isfinite(v) for v in vector):
-        raise InvalidRequestError(
-            what, f"{values!r} is not {size} finite numbers", f"give {size} finite numbers"
-        )
-    return vector
-
-
-def _check_settings(s: WorldSettings) -> None:
-    """Raises InvalidRequestError for a setting MuJoCo cannot run with."""
-    problems = [
-        (
-            "timestep",
-            s.timestep,
-            math.isfinite(s.timestep) and s.timestep > 0,
-            "give a step > 0 s, e.g. 0.001",
-        ),
-        (
-            "rate",
-            s.rate,
-            math.isfinite(s.rate) and s.rate >= 0,
-            "give a rate >= 0 Hz (0 = as fast as possible)",
-        ),
-        (
-            "iterations",
-            s.iterations,
-            isinstance(s.iterations, int) and s.iterations >= 1,
-            "give a whole number >= 1",
-        ),
-        ("solver", s.solver, s.solver in SOLVERS, f"use one of {', '.join(SOLVERS)}"),
-        (
-            "integrator",
-            s.integrator,
-            s.integrator in INTEGRATORS,
-            f"use one of {', '.join(INTEGRATORS)}",
-        ),
-    ]
-    for field, value, ok, fix in problems:
-        if not ok:
-            raise InvalidRequestError(f"physics {field}", f"{value!r} is not valid", fix)
-    _finite_vector("gravity", s.gravity, 3)
