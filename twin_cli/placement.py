@@ -8,6 +8,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from twin_cli.entities import EntityIndex
+
 PENETRATION_TOL = 1e-4  # [m] overlap below this is resting contact, not a bad start
 _G = mujoco.mjtGeom
 
@@ -98,3 +100,30 @@ def overlap_warnings(name: str, z: float, found: list[Overlap]) -> list[str]:
         f"spawn at z >= {z + o.depth:.4f} m to clear it, or use --on-ground"
         for o in found
     ]
+
+
+def start_warnings(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    index: dict[str, EntityIndex],
+    name: str,
+    z: float,
+) -> list[str]:
+    """Warnings for entity `name` starting inside the ground or another entity.
+
+    Args:
+        model, data: the world with the new entity seeded (data is not modified).
+        index: every entity's index in `model`; name: the new entity; z: its spawn height [m].
+    """
+    scratch = positioned(model, data.qpos)
+    body_owner = {int(b): n for n, ix in index.items() for b in ix.bodies}
+
+    def party_of(geom: int) -> str:
+        owner = body_owner.get(int(model.geom_bodyid[geom]))
+        if owner:
+            return f"entity [{owner}]"
+        geom_name = model.geom(geom).name
+        return "the ground" if geom_name == "ground" else f"geom [{geom_name}]"
+
+    geoms = collision_geoms(model, index[name].geoms)
+    return overlap_warnings(name, z, overlaps(scratch, geoms, party_of))

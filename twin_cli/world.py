@@ -122,14 +122,14 @@ class World:
         loaded = spawn.load_source(source, args, package_paths)
         with self.lock:
             name = self._free_name(name, loaded.default_name)
+            trial = self._spec.copy()
             try:
                 home = spawn.prepare_child(loaded.spec, self._spec)
+                spawn.attach(trial, loaded.spec, name, pose)
             except ValueError as exc:
                 raise SpawnError(
-                    name, loaded.source, f"does not compile ({exc})", "fix the model"
+                    name, loaded.source, f"cannot be attached ({exc})", "fix the model"
                 ) from exc
-            trial = self._spec.copy()
-            spawn.attach(trial, loaded.spec, name, pose)
             model, data, index = self._rebuild(trial, name, loaded.source)
             q = spawn.initial_qpos(model, index[name], home, pose)
             if on_ground:
@@ -149,7 +149,7 @@ class World:
                 loaded.report,
                 loaded.xml,
             )
-            warnings = self._start_warnings(model, data, index, name, pose.z)
+            warnings = placement.start_warnings(model, data, index, name, pose.z)
             self._entities[name] = entity
             self._commit(trial, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report)
@@ -223,23 +223,6 @@ class World:
         spawn.move_frame(trial, name, pose)
         model, data, index = self._rebuild(trial, name, "on-ground placement")
         return pose, model.qpos0[index[name].qpos].copy(), (model, data, index)
-
-    def _start_warnings(self, model, data, index, name, z):  # noqa: ANN001, ANN202
-        scratch = placement.positioned(model, data.qpos)
-        body_owner = {int(b): n for n, ix in index.items() for b in ix.bodies}
-
-        def party_of(geom: int) -> str:
-            owner = body_owner.get(int(model.geom_bodyid[geom]))
-            if owner:
-                return f"entity [{owner}]"
-            return (
-                "the ground"
-                if model.geom(geom).name == "ground"
-                else f"geom [{model.geom(geom).name}]"
-            )
-
-        geoms = placement.collision_geoms(model, index[name].geoms)
-        return placement.overlap_warnings(name, z, placement.overlaps(scratch, geoms, party_of))
 
     def _commit(
         self,
