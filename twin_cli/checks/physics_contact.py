@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin_cli.checks.base import RobotUnderTest, Status, fmt_len, result
+from twin_cli.checks.base import CheckResult, RobotUnderTest, Status, fmt_len, result
 from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
 
@@ -46,9 +46,23 @@ def _sink_hint(run: ScenarioRun, geom: int, depth: float, limit: float) -> str:
     return f"{text}: the contact is too soft for {mass:.3g} kg; set <kp>/<kd> on the link"
 
 
+def skip_fixed(check: str) -> CheckResult:
+    """The verdict for a robot welded to the world: it cannot stand, slide or be pushed."""
+    return result(
+        check,
+        "physics",
+        Status.SKIP,
+        "fixed base",
+        "n/a",
+        details=["the robot is fixed to the world (no floating base)"],
+    )
+
+
 def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """On the ground: comes to rest, nothing falls through, penetration within tolerance."""
     run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("ground_contact")
     deepest: dict[int, float] = {}
     speeds: list[float] = []
     lowest = [np.inf]
@@ -110,6 +124,8 @@ def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
             details=["the scenario has no [[obstacles]] to push the robot into"],
         )
     run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("collision")
     model = run.world.model
     box_body = max(b for b in range(model.nbody) if model.body(b).name.startswith("obstacle0/"))
     box_geoms = {g for g in range(model.ngeom) if int(model.geom_bodyid[g]) == box_body}

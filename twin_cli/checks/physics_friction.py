@@ -15,6 +15,7 @@ import numpy as np
 
 from twin_cli.checks.base import RobotUnderTest, Series, Status, fmt_len, result
 from twin_cli.checks.model_inertia import collision_geoms
+from twin_cli.checks.physics_contact import skip_fixed
 from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
 
@@ -40,6 +41,8 @@ def foot_geoms(run: ScenarioRun, within: float = 0.01) -> list[int]:
 def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Standing (posture held), the feet do not slide: horizontal slip ≤ `max_slip_m`."""
     run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("friction_standing")
     feet = sorted({int(run.world.model.geom_bodyid[g]) for g in foot_geoms(run)})
     settle = th["settle_s"]
     run.run(settle, None, every=10)
@@ -77,14 +80,17 @@ def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[
 
 
 def probe_spec(model, geom: int):
-    """A free box with a foot geom's bounding box, mass and contact settings."""
+    """A free flat box with a foot geom's footprint, mass and contact settings."""
     import mujoco
 
     spec = mujoco.MjSpec()
     spec.modelname = "probe"
     body = spec.worldbody.add_body(name="block")
     body.add_freejoint(name="free")
-    half = [max(float(v), 0.005) for v in model.geom_aabb[geom][3:]]
+    # Lying flat and thin (height ≤ 1/10 of its footprint), the block tips only beyond
+    # tan θ = 10, so it measures sliding alone; Coulomb friction does not depend on the area.
+    a, b, c = sorted((max(float(v), 0.005) for v in model.geom_aabb[geom][3:]), reverse=True)
+    half = [a, b, min(c, 0.1 * b)]
     body.add_geom(
         type=mujoco.mjtGeom.mjGEOM_BOX,
         size=half,
@@ -143,10 +149,13 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
 def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Each foot surface sticks below tan θ = μ and slides above it, μ = min(μ_foot, μ_ground)."""
     run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("friction_incline")
     feet = foot_geoms(run)
     by_surface: dict[tuple, int] = {}
+    first = min(run.robot_geoms())
     for g in feet:
-        local = g - min(run.robot_geoms())  # world ids → ids in the robot's own model
+        local = g - first  # attach appends the robot's geoms in order: world id → robot id
         key = (
             round(float(robot.model.geom_friction[local][0]), 6),
             robot.model.geom_priority[local],

@@ -81,6 +81,7 @@ class ScenarioRun:
         self.forward()
         self.time = 0.0
         self.q_hold = self.qpos()[[j.qpos for j in self.joints]].copy()
+        self.kp, self.kd = self._hold_gains()
 
     def _index_robot(self) -> None:
         model = self.world.model
@@ -212,7 +213,7 @@ class ScenarioRun:
             qd = np.array([self.world.data.qvel[j.dof] for j in self.joints])
         tau = np.zeros(len(self.joints))
         if hold is not None:
-            tau = hold.kp * (self.q_hold - q) - hold.kd * qd
+            tau = self.kp * (self.q_hold - q) - self.kd * qd
         for action in self.scenario.actions:
             if action.kind == "drive" and action.at <= self.time < action.at + action.duration:
                 for i, joint in enumerate(self.joints):
@@ -220,6 +221,28 @@ class ScenarioRun:
                         tau[i] = _drive_value(action, joint)
         limits = np.array([j.effort if j.effort is not None else np.inf for j in self.joints])
         return np.clip(tau, -limits, limits)
+
+    def _hold_gains(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per-joint PD gains of the hold, capped so the explicit PD stays stable.
+
+        A PD applied once per step h on a joint of effective inertia I (diagonal of the mass
+        matrix) is stable only for kd·h/I < 2 and kp·h²/I < 1; the caps keep a margin of 4
+        (kd ≤ I/(2h), kp ≤ I/(4h²)), so 300 N m/rad holds a humanoid hip but not a 40 g leg.
+        """
+        hold = self.scenario.hold
+        if hold is None or not self.joints:
+            return np.zeros(len(self.joints)), np.zeros(len(self.joints))
+        import mujoco
+
+        h = float(self.world.model.opt.timestep)
+        with self.world.lock:
+            model, data = self.world.model, self.world.data
+            full = np.zeros((model.nv, model.nv))
+            mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
+        inertia = np.array([full[j.dof, j.dof] for j in self.joints])
+        kp = np.minimum(hold.kp, inertia / (4.0 * h * h))
+        kd = np.minimum(hold.kd, inertia / (2.0 * h))
+        return kp, kd
 
     def _apply_joint_forces(self) -> None:
         tau = self.joint_torques()
