@@ -138,3 +138,12 @@ def test_malformed_scenario_file_exits_2_naming_file_and_key(tmp_path):
     bad.write_text('check = "gravity"\n[world]\ngravty = "moon"\n')
     done = twin(scenarios.HUMANOID, "--scenario", bad)
     assert done.returncode == 2 and str(bad) in done.stderr and "world.gravty" in done.stderr
+
+
+def test_validate_command_module_imports_nothing_heavy():
+    code = (
+        "import sys, twin_cli.commands.validate; "
+        "print(sorted(m for m in ('mujoco', 'numpy', 'trimesh', 'matplotlib') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]", done.stdout

@@ -86,3 +86,11 @@ def test_friction_incline_probe_slides_iff_tan_theta_exceeds_mu(humanoid):
     assert "μ = 1" in outcome.measured, "humanoid feet μ=1 against the ground's 100: min is 1"
     stick, slide = outcome.details[:2]
     assert "38.7°" in stick and "51.3°" in slide, outcome.details
+
+
+def test_robot_fixed_to_the_world_skips_fall_and_contact_checks(tmp_path):
+    robot = load_robot(robots.write(tmp_path, robots.crate(fixed=True)))
+    for name in ("free_fall", "moon_gravity", "ground_contact", "collision", "friction_standing"):
+        outcome = run_check(robot, resolve(name), debug=True)
+        assert outcome.status is Status.SKIP, f"{name}: {outcome.measured} {outcome.hints}"
+    assert run_check(robot, resolve("joint_limits"), debug=True).status is Status.PASS

@@ -39,6 +39,7 @@ def crate(
     arm_mesh: str | None = None,
     elbow_limit: tuple[float, float] = (-1.0, 1.0),
     elbow_velocity: float = 5.0,
+    fixed: bool = False,
 ) -> str:
     """URDF text of the crate, broken as asked.
 
@@ -52,6 +53,7 @@ def crate(
         arm_mesh: a mesh file for the arm's collision instead of its box.
         elbow_limit: the elbow's (lower, upper) [rad].
         elbow_velocity: the elbow's velocity limit [rad/s].
+        fixed: weld the crate to the world (a fixed joint to a link named `world`).
     """
     if arm_inertia is None:
         arm = box_inertial(arm_mass, 0.04, 0.04, 0.2, "0 0 0.1") if arm_inertial else ""
@@ -71,6 +73,11 @@ def crate(
     gazebo = f'<gazebo reference="crate"><kp>{kp}</kp><kd>50</kd></gazebo>' if kp else ""
     if arm_self_collide:
         gazebo += '<gazebo reference="arm"><selfCollide>true</selfCollide></gazebo>'
+    if fixed:
+        gazebo += (
+            '<link name="world"/><joint name="weld" type="fixed">'
+            '<parent link="world"/><child link="crate"/><origin xyz="0 0 0.5"/></joint>'
+        )
     return f"""<robot name="crate">
   {_box_link("crate", "0.3 0.3 0.1", "0 0 0", box_inertial(5.0, 0.3, 0.3, 0.1))}
   {_box_link("arm", "0.04 0.04 0.2", "0 0 0.1", arm, arm_mesh)}
