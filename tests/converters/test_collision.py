@@ -252,3 +252,13 @@ def _assert_falls_onto_ground_without_warning(spec, model, robot_id: str) -> Non
     warnings = {mujoco.mjtWarning(i).name: int(w.number) for i, w in enumerate(data.warning)}
     assert not any(warnings.values()), f"{robot_id}: MuJoCo warnings {warnings}"
     assert np.isfinite(data.qpos).all(), f"{robot_id}: finite qpos after 1 s"
+
+
+def test_progress_prints_plain_lines_to_stderr_when_piped(capsys):
+    boxes = [request(f"b{i}/0", box_mesh((0.1, 0.1, 0.05 * (i + 1)))) for i in range(2)]
+    prepare_collision_meshes(boxes, CollisionSettings(mode="hull", progress=True), Report())
+    prepare_collision_meshes(boxes, CollisionSettings(mode="hull"), Report())
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert [line.split()[1] for line in lines] == ["1/2", "2/2"], f"progress lines: {lines}"
+    assert "b0/0" in lines[0] and captured.out == "", "progress names the mesh, stdout untouched"
