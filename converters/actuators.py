@@ -23,8 +23,14 @@ def actuated_joints(parsed: object, report: Report) -> list[object]:
         source = "all movable non-mimic joints (no <transmission> or <ros2_control>)"
         chosen = list(joints.values())
     chosen = [j for j in chosen if j.type in ACTUATABLE and j.mimic is None]
-    report.mapped("actuators", f"{len(chosen)} motor(s) from {source}")
+    with_effort = [j for j in chosen if _effort(j) > 0]
+    report.mapped("actuators", f"{len(with_effort)} motor(s) on joints chosen from {source}")
     return chosen
+
+
+def _effort(joint: object) -> float:
+    """The joint's `<limit effort>` [N or N·m], 0 when absent."""
+    return float(joint.limit.effort) if joint.limit and joint.limit.effort else 0.0
 
 
 def add_motors(spec: object, joints: list[object], report: Report) -> None:
@@ -32,7 +38,7 @@ def add_motors(spec: object, joints: list[object], report: Report) -> None:
     import mujoco
 
     for joint in joints:
-        effort = float(joint.limit.effort) if joint.limit and joint.limit.effort else 0.0
+        effort = _effort(joint)
         if effort <= 0:
             report.warn(f"joint '{joint.name}'", "no positive effort limit; no motor added")
             continue
