@@ -160,3 +160,44 @@ def test_mimic_with_negative_multiplier_and_offset_moves_the_follower_oppositely
         f"follower angle {follow:.4f} rad vs offset + multiplier · leader"
     )
     assert model.nu == 1, "the mimic follower gets no motor"
+
+
+@pytest.mark.parametrize("suffix", ["stl", "obj", "ply", "glb", "dae"])
+def test_mesh_formats_load_with_scale_into_the_spec(tmp_path: Path, suffix: str) -> None:
+    import trimesh
+
+    trimesh.creation.box(extents=(0.1, 0.2, 0.3)).export(tmp_path / f"box.{suffix}")
+    mesh = f'<geometry><mesh filename="box.{suffix}" scale="2 1 0.5"/></geometry>'
+    body = _link("base").replace("</link>", f"<visual>{mesh}</visual></link>")
+    body = body.replace(
+        '<box size="0.1 0.1 0.1"/>', mesh.removeprefix("<geometry>").removesuffix("</geometry>")
+    )
+    model = _convert(tmp_path, body).spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    for role in ("visual", "collision"):
+        geom = model.geom(f"base_{role}_0")
+        start, count = model.mesh_vertadr[geom.dataid[0]], model.mesh_vertnum[geom.dataid[0]]
+        vertices = model.mesh_vert[start : start + count]
+        extent = vertices.max(axis=0) - vertices.min(axis=0)
+        assert np.sort(extent) == pytest.approx(np.sort([0.2, 0.2, 0.15]), abs=1e-6), (
+            f"{suffix} {role}: scaled mesh extents [m]"
+        )
+
+
+def test_flat_mesh_is_kept_out_of_collision_and_reported(tmp_path: Path) -> None:
+    from converters.report import Outcome
+    from converters.writer import stl_bytes
+
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+    (tmp_path / "flat.stl").write_bytes(stl_bytes(square, np.array([[0, 1, 2], [0, 2, 3]])))
+    mesh = '<geometry><mesh filename="flat.stl"/></geometry>'
+    body = _link("base").replace(
+        "</link>", f"<visual>{mesh}</visual><collision>{mesh}</collision></link>"
+    )
+    done = _convert(tmp_path, body)
+    model = done.spec.compile()
+    names = {model.geom(i).name for i in range(model.ngeom)}
+    assert "base_visual_0" in names and "base_collision_1" not in names, names
+    flagged = [e for e in done.report.of(Outcome.APPROXIMATED) if "flat" in e.detail]
+    assert flagged and "collision 1" in flagged[0].subject, done.report.entries
