@@ -183,6 +183,12 @@ def _add_geoms(
                 mj.meshname = meshes.name_for(mesh, geom, flat=geom.degenerate is not None)
             if geom.colour is not None:
                 mj.rgba = list(geom.colour.rgba)
+                if geom.colour.texture and part == 0:
+                    report.approximated(
+                        f"link '{geom.link}' visual {geom.index}",
+                        f"texture {geom.colour.texture} is not carried; the material colour "
+                        "is used",
+                    )
             provenance.geoms.append(
                 GeomOrigin(name, geom.link, geom.body, geom.role, geom.index, part, geom.mesh_file)
             )

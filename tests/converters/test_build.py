@@ -201,3 +201,14 @@ def test_flat_mesh_is_kept_out_of_collision_and_reported(tmp_path: Path) -> None
     assert "base_visual_0" in names and "base_collision_1" not in names, names
     flagged = [e for e in done.report.of(Outcome.APPROXIMATED) if "flat" in e.detail]
     assert flagged and "collision 1" in flagged[0].subject, done.report.entries
+
+
+def test_gazebo_static_and_preserved_fixed_joint_shape_the_tree(tmp_path: Path) -> None:
+    links = _link("base") + _link("tool") + _joint("f", "fixed", "base", "tool")
+    gazebo = (
+        "<gazebo><static>true</static></gazebo>"
+        '<gazebo reference="f"><preserveFixedJoint>true</preserveFixedJoint></gazebo>'
+    )
+    model = _convert(tmp_path, links + gazebo).spec.compile()
+    assert model.njnt == 0, "a static model has no free joint"
+    assert model.nbody == 3, "a preserved fixed joint keeps its child as a body"
