@@ -176,7 +176,7 @@ def _add_geoms(
             pos, quat = pose(geom.T_body_geom)
             mj = bodies[geom.body].add_geom(defaults[geom.role], name=name, pos=pos, quat=quat)
             if mesh is None:
-                mj.type = _PRIMITIVES[geom.kind]
+                mj.type = _primitive(geom.kind)
                 mj.size = list(geom.size) + [0.0] * (3 - len(geom.size))
             else:
                 mj.type = mujoco.mjtGeom.mjGEOM_MESH
@@ -279,7 +279,8 @@ def _summarise(
     )
 
 
-def _primitives() -> dict[str, object]:
+def _primitive(kind: str) -> object:
+    """The MuJoCo geom type of a primitive URDF shape."""
     import mujoco
 
     return {
@@ -287,13 +288,4 @@ def _primitives() -> dict[str, object]:
         "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
         "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
         "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
-    }
-
-
-class _LazyPrimitives(dict):
-    def __missing__(self, key: str) -> object:
-        self.update(_primitives())
-        return dict.__getitem__(self, key)
-
-
-_PRIMITIVES = _LazyPrimitives()
+    }[kind]

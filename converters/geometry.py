@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -107,7 +108,16 @@ def _assemble(
     )
 
 
-def _plan_one(geometry, capsule, link, role, index, base_dir, resolver, cache):
+def _plan_one(
+    geometry: object | None,
+    capsule: bool,
+    link: str,
+    role: str,
+    index: int,
+    base_dir: Path,
+    resolver: PackageResolver,
+    cache: MeshCache,
+) -> tuple | None:
     """(kind, size, mesh, mesh_file, scale) for one URDF geometry, or None if empty."""
     if geometry is None:
         return None
