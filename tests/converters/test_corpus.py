@@ -117,3 +117,16 @@ def test_converted_robot_compiles_after_attach_with_prefix(robot_id: str, conver
     model = world.compile()
     names = [model.body(i).name for i in range(1, model.nbody)]
     assert names and all(n.startswith("r1/") for n in names), f"{robot_id}: body names {names[:3]}"
+
+
+def test_collada_unit_is_applied_like_gazebo(converted_corpus) -> None:
+    """aliengo's calf.dae declares inches (<unit meter="0.0254">): 12.508 in long → 0.3177 m."""
+    done = converted_corpus("aliengo")
+    model = done.spec.compile()
+    geom = model.geom("FR_calf_visual_0")
+    start, count = model.mesh_vertadr[geom.dataid[0]], model.mesh_vertnum[geom.dataid[0]]
+    vertices = model.mesh_vert[start : start + count]
+    longest = float((vertices.max(axis=0) - vertices.min(axis=0)).max())
+    assert longest == pytest.approx(12.50800502 * 0.0254, rel=1e-4), (
+        "calf mesh length [m] (float32)"
+    )
