@@ -97,6 +97,12 @@ def build_spec(
     add_mimics(spec, parsed, report)
     spec.add_key(name=HOME_KEY, qpos=_home(joints, parsed))
     _summarise(plan, inertias, geoms, report)
+    report.summary.update(
+        joints=len(parsed.model.joints),
+        mujoco_joints=len(joints),
+        actuators=len(spec.actuators),
+        mimic_equalities=len(spec.equalities),
+    )
     return spec
 
 
