@@ -12,6 +12,8 @@ REL_TOL = 1e-9
 # Smallest principal moment a repaired tensor keeps, relative to its largest (and absolute [kg·m²]).
 REPAIR_MIN_REL = 1e-3
 REPAIR_MIN_ABS = 1e-9
+# Off-diagonal terms below this fraction of the largest moment count as zero (rounding only).
+DIAGONAL_TOL = 1e-14
 # Density [kg/m³] used to give a massless moving link a mass from its geometry's bounding box.
 REPAIR_DENSITY = 1000.0
 # Mass [kg] and half size [m] for a repaired link that has no geometry at all.
@@ -109,7 +111,12 @@ def principal(inertia: Inertia) -> tuple[np.ndarray, np.ndarray]:
     """Principal moments (3,) and the quaternion (w, x, y, z) of the principal axes."""
     import mujoco
 
-    moments, axes = np.linalg.eigh(inertia.tensor)
+    tensor = inertia.tensor
+    off_diagonal = np.abs(tensor - np.diag(np.diag(tensor))).max()
+    if off_diagonal <= DIAGONAL_TOL * max(np.abs(np.diag(tensor)).max(), 1e-300):
+        # Already principal in the body frame: keep the URDF's axes, identity quaternion.
+        return np.maximum(np.diag(tensor), 0.0), np.array([1.0, 0.0, 0.0, 0.0])
+    moments, axes = np.linalg.eigh(tensor)
     if np.linalg.det(axes) < 0:
         axes[:, 2] *= -1
     quat = np.zeros(4)
