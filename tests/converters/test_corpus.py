@@ -130,3 +130,12 @@ def test_collada_unit_is_applied_like_gazebo(converted_corpus) -> None:
     assert longest == pytest.approx(12.50800502 * 0.0254, rel=1e-4), (
         "calf mesh length [m] (float32)"
     )
+
+
+def test_open_manipulator_unprefixed_macro_calls_are_reported(converted_corpus) -> None:
+    """Its <RefLink ref="link1"/> calls lack `xacro:`, so xacro 2.1.1 leaves them unexpanded."""
+    from converters.report import Outcome
+
+    warnings = converted_corpus("open_manipulator_x").report.of(Outcome.WARNING)
+    calls = [e.subject for e in warnings if "RefLink" in e.subject]
+    assert len(calls) >= 5 and any('ref="link1"' in c for c in calls), calls
