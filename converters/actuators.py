@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from converters.errors import URDFStructureError
 from converters.report import Report
 
 ACTUATABLE = ("revolute", "continuous", "prismatic")
@@ -59,10 +60,18 @@ def add_mimics(spec: object, parsed: object, report: Report) -> None:
     """
     import mujoco
 
+    movable = {j.name for j in parsed.model.joints if j.type in ACTUATABLE}
     for joint in parsed.model.joints:
         mimic = joint.mimic
         if mimic is None:
             continue
+        if mimic.joint not in movable or joint.type not in ACTUATABLE:
+            raise URDFStructureError(
+                parsed.source,
+                f"joint '{joint.name}' <mimic joint='{mimic.joint}'>",
+                "a mimic needs a revolute, continuous or prismatic follower and leader",
+                f"name one of: {', '.join(sorted(movable)) or 'none'}",
+            )
         multiplier = 1.0 if mimic.multiplier is None else float(mimic.multiplier)
         offset = 0.0 if mimic.offset is None else float(mimic.offset)
         equality = spec.add_equality(name=f"mimic_{joint.name}")

@@ -212,3 +212,12 @@ def test_gazebo_static_and_preserved_fixed_joint_shape_the_tree(tmp_path: Path) 
     model = _convert(tmp_path, links + gazebo).spec.compile()
     assert model.njnt == 0, "a static model has no free joint"
     assert model.nbody == 3, "a preserved fixed joint keeps its child as a body"
+
+
+def test_mimic_of_an_unknown_joint_names_follower_and_leader(tmp_path: Path) -> None:
+    from converters.errors import URDFStructureError
+
+    mimic = '<mimic joint="nosuch" multiplier="1"/>'
+    body = _link("base") + _link("a") + _joint("f", "revolute", "base", "a", LIMIT + mimic)
+    with pytest.raises(URDFStructureError, match="joint 'f' <mimic joint='nosuch'>"):
+        _convert(tmp_path, body)
