@@ -203,7 +203,7 @@ def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
         while link in parent_of:
             link = parent_of[link]
             if link in path:
-                cycle = " → ".join(path[path.index(link) :] + [link])
+                cycle = " → ".join(reversed(path[path.index(link) :] + [link]))  # parent → child
                 raise URDFStructureError(
                     source,
                     f"links {cycle}",

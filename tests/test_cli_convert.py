@@ -53,9 +53,17 @@ BAD_INPUTS = {
         + "".join(GOOD_LINK.format(n=n) for n in "abc")
         + _joint("j1", "a", "b")
         + _joint("j2", "b", "c")
-        + _joint("j3", "c", "b")
+        + _joint("j3", "c", "a")
         + "</robot>",
-        ["link 'b'"],
+        ["form a cycle", "c → a → b"],
+    ),
+    "two_parents": (
+        '<robot name="r">'
+        + "".join(GOOD_LINK.format(n=n) for n in "abc")
+        + _joint("j1", "a", "b")
+        + _joint("j2", "c", "b")
+        + "</robot>",
+        ["link 'b'", "two joints"],
     ),
     "several_roots": (
         '<robot name="r">' + "".join(GOOD_LINK.format(n=n) for n in "ab") + "</robot>",
