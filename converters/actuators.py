@@ -38,6 +38,13 @@ def add_motors(spec: object, joints: list[object], report: Report) -> None:
     """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m]."""
     import mujoco
 
+    limited = [j.name for j in joints if j.limit is not None and (j.limit.velocity or 0) > 0]
+    if limited:
+        report.ignored(
+            "joint velocity limits",
+            f"<limit velocity> on {len(limited)} actuated joint(s) is not enforced: Gazebo zeroes "
+            "a motor's effort past it, a MuJoCo motor has no velocity-dependent clamp",
+        )
     for joint in joints:
         effort = _effort(joint)
         if effort <= 0:

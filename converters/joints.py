@@ -27,6 +27,12 @@ def add_joints(body: object, joint: object | None, report: Report) -> list[MjJoi
     """Add the MuJoCo joint(s) for `joint` to `body`; returns them in qpos order."""
     if joint is None:
         return []
+    for extra in ("safety_controller", "calibration"):
+        if getattr(joint, extra, None) is not None:
+            report.ignored(
+                f"joint '{joint.name}' <{extra}>",
+                "a ROS controller setting; Gazebo's physics does not use it either",
+            )
     adder = _ADDERS.get(joint.type)
     if adder is None:
         report.ignored(
@@ -138,6 +144,15 @@ def _floating(body: object, joint: object, report: Report) -> list[MjJointPlan]:
     return out
 
 
+def _spherical(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+    """Non-standard `spherical` (accepted by several parsers): a ball joint, unlimited."""
+    import mujoco
+
+    body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_BALL)
+    report.mapped(f"joint '{joint.name}'", "spherical → ball joint (limits not mapped)")
+    return [MjJointPlan(joint.name, joint.name, "spherical", None, (1.0, 0.0, 0.0, 0.0))]
+
+
 def add_free_joint(body: object, pos: np.ndarray) -> MjJointPlan:
     """The named free joint of a floating base; home = the body's pose."""
     body.add_freejoint(name=FREE_JOINT)
@@ -150,4 +165,5 @@ _ADDERS = {
     "prismatic": _prismatic,
     "planar": _planar,
     "floating": _floating,
+    "spherical": _spherical,
 }

@@ -221,3 +221,10 @@ def test_mimic_of_an_unknown_joint_names_follower_and_leader(tmp_path: Path) -> 
     body = _link("base") + _link("a") + _joint("f", "revolute", "base", "a", LIMIT + mimic)
     with pytest.raises(URDFStructureError, match="joint 'f' <mimic joint='nosuch'>"):
         _convert(tmp_path, body)
+
+
+def test_spherical_joint_becomes_a_ball(tmp_path: Path) -> None:
+    body = _link("base") + _link("a") + _joint("s", "spherical", "base", "a")
+    model = _convert(tmp_path, body).spec.compile()
+    assert model.jnt_type[model.joint("s").id] == mujoco.mjtJoint.mjJNT_BALL, "joint type"
+    assert model.nq == 7 + 4, "free joint + ball joint qpos width"
