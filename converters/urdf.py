@@ -56,11 +56,15 @@ class ParsedRobot:
 def parse_xml(text: str, source: str) -> ET.Element:
     """Parse XML text; malformed input → `MalformedXMLError` with file:line:column."""
     try:
-        return ET.fromstring(text)
+        root = ET.fromstring(text)
     except ET.ParseError as exc:
         line, column = exc.position
         message = str(exc).split(":")[0]
         raise MalformedXMLError(source, line, column + 1, message) from exc
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith("{"):
+            element.tag = element.tag.split("}", 1)[1]  # a default xmlns on <robot>
+    return root
 
 
 def parse_urdf(text: str, source: str, base_dir: Path) -> ParsedRobot:

@@ -83,3 +83,10 @@ def test_structural_errors_name_the_culprit(text: str, error: type, needle: str)
     with pytest.raises(error, match=None) as caught:
         parse_urdf(text, "r.urdf", Path("."))
     assert needle in str(caught.value), str(caught.value)
+
+
+def test_default_xml_namespace_on_robot_is_accepted(tmp_path: Path) -> None:
+    path = tmp_path / "r.urdf"
+    link = LINK.format(n="base", geom=CAPSULE)
+    path.write_text(f'<robot name="r" xmlns="http://www.ros.org">{link}</robot>')
+    assert convert_full(path).spec.compile().nbody == 2, "world + base"
