@@ -88,8 +88,28 @@ def plan_geoms(
                 if geom is None:
                     report.ignored(f"link '{link.name}' {role} {index}", "no geometry")
                     continue
+                if colour is not None and geom[2] is not None:
+                    colour = _mesh_colour(
+                        colour, geom[2], f"link '{link.name}' visual {index}", report
+                    )
                 out.append(_assemble(link.name, placement.body, role, index, geom, T, colour))
     return out
+
+
+def _mesh_colour(
+    colour: VisualColour, mesh: MeshData, subject: str, report: Report
+) -> VisualColour:
+    """A visual mesh without a URDF material is drawn in the file's own main colour (as Gazebo
+    draws the file's materials); a texture in the file is reported, not carried."""
+    if mesh.textured:
+        report.approximated(
+            subject,
+            "the mesh file's texture is not carried; its average "
+            "colour is used when the URDF gives no material",
+        )
+    if colour.material is None and mesh.rgba is not None:
+        return VisualColour(mesh.rgba, None, None)
+    return colour
 
 
 def _assemble(

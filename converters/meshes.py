@@ -18,10 +18,16 @@ MIN_VOLUME = 1e-12
 
 @dataclass(frozen=True)
 class MeshData:
-    """A triangle mesh in metres: vertices (N, 3) float64, faces (M, 3) int32."""
+    """A triangle mesh in metres: vertices (N, 3) float64, faces (M, 3) int32.
+
+    `rgba` is the file's own main colour (COLLADA/OBJ/GLB materials; None when it has none) and
+    `textured` says whether the file's materials carry an image that twin does not carry.
+    """
 
     vertices: np.ndarray
     faces: np.ndarray
+    rgba: tuple[float, float, float, float] | None = None
+    textured: bool = False
 
     @property
     def triangles(self) -> int:
@@ -40,7 +46,9 @@ class MeshCache:
             raw = self.loaded.get((str(path), (1.0, 1.0, 1.0))) or load_mesh(path, link)
             vertices = raw.vertices * np.asarray(scale, dtype=float)
             faces = raw.faces if np.prod(scale) > 0 else raw.faces[:, ::-1]
-            self.loaded[key] = MeshData(vertices, np.ascontiguousarray(faces))
+            self.loaded[key] = MeshData(
+                vertices, np.ascontiguousarray(faces), raw.rgba, raw.textured
+            )
         return self.loaded[key]
 
 
@@ -75,7 +83,45 @@ def load_mesh(path: Path, link: str) -> MeshData:
     if not parts_v:
         raise MeshError(str(path), link, "holds no triangles")
     vertices, faces = _merge_duplicates(np.concatenate(parts_v), np.concatenate(parts_f))
-    return MeshData(vertices * _unit_to_metres(loaded, path), faces)
+    rgba, textured = _main_colour(loaded)
+    return MeshData(vertices * _unit_to_metres(loaded, path), faces, rgba, textured)
+
+
+def _main_colour(scene: object) -> tuple[tuple[float, float, float, float] | None, bool]:
+    """The colour of the geometry with most faces that defines one, and whether any is textured.
+
+    Gazebo draws a mesh in its own material colours when the URDF gives none; MuJoCo geoms
+    have one rgba, so the dominant colour stands in for the file's materials.
+    """
+    best: tuple[int, tuple[float, float, float, float]] | None = None
+    textured = False
+    for geometry in scene.geometry.values():
+        visual = getattr(geometry, "visual", None)
+        material = getattr(visual, "material", None)
+        image = getattr(material, "image", None) or getattr(material, "baseColorTexture", None)
+        textured = textured or image is not None
+        try:
+            if image is not None:
+                colour = _mean_colour(image)
+            elif material is not None:
+                colour = material.main_color
+            elif getattr(visual, "defined", False):
+                colour = visual.main_color
+            else:
+                continue
+        except (AttributeError, ValueError, IndexError):
+            continue
+        rgba = tuple(float(c) / 255.0 for c in np.asarray(colour).reshape(-1)[:4])
+        faces = len(getattr(geometry, "faces", ()))
+        if len(rgba) == 4 and (best is None or faces > best[0]):
+            best = (faces, rgba)  # type: ignore[assignment]
+    return (best[1] if best else None), textured
+
+
+def _mean_colour(image: object) -> np.ndarray:
+    """Average RGBA [0-255] of a texture image (sampled at 16×16 pixels)."""
+    small = image.convert("RGBA").resize((16, 16))
+    return np.asarray(small, dtype=float).reshape(-1, 4).mean(axis=0)
 
 
 def _unit_to_metres(scene: object, path: Path) -> float:

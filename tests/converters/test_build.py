@@ -228,3 +228,19 @@ def test_spherical_joint_becomes_a_ball(tmp_path: Path) -> None:
     model = _convert(tmp_path, body).spec.compile()
     assert model.jnt_type[model.joint("s").id] == mujoco.mjtJoint.mjJNT_BALL, "joint type"
     assert model.nq == 7 + 4, "free joint + ball joint qpos width"
+
+
+def test_visual_mesh_without_urdf_material_takes_the_files_colour(tmp_path: Path) -> None:
+    import trimesh
+
+    box = trimesh.creation.box(extents=(0.1, 0.1, 0.1))
+    box.visual.face_colors = [255, 0, 0, 255]
+    box.export(tmp_path / "red.glb")
+    mesh = '<geometry><mesh filename="red.glb"/></geometry>'
+    blue = '<material name="blue"><color rgba="0 0 1 1"/></material>'
+    body = _link("base").replace(
+        "</link>", f"<visual>{mesh}</visual><visual>{mesh}{blue}</visual></link>"
+    )
+    model = _convert(tmp_path, body).spec.compile()
+    assert model.geom("base_visual_0").rgba.tolist() == pytest.approx([1, 0, 0, 1]), "file colour"
+    assert model.geom("base_visual_1").rgba.tolist() == pytest.approx([0, 0, 1, 1]), "URDF wins"
