@@ -119,9 +119,20 @@ def _main_colour(scene: object) -> tuple[tuple[float, float, float, float] | Non
 
 
 def _mean_colour(image: object) -> np.ndarray:
-    """Average RGBA [0-255] of a texture image (sampled at 16×16 pixels)."""
-    small = image.convert("RGBA").resize((16, 16))
-    return np.asarray(small, dtype=float).reshape(-1, 4).mean(axis=0)
+    """Average RGBA [0-255] of a texture image, from about 16×16 strided pixels.
+
+    Strided sampling of the decoded pixels avoids converting and resizing whole textures
+    (ANYmal's 19 DAE files: 1.25 s → a few ms).
+    """
+    if getattr(image, "_im", True) is None and hasattr(image, "draft"):
+        image.draft("RGB", (64, 64))  # JPEG: decode at 1/8 scale when not decoded yet
+    pixels = np.asarray(image)
+    step = max(1, max(pixels.shape[:2]) // 16)
+    sample = pixels[::step, ::step].astype(float)
+    if sample.ndim == 2:  # greyscale
+        sample = np.repeat(sample[..., None], 3, axis=2)
+    rgb = sample[..., :3].reshape(-1, 3).mean(axis=0)
+    return np.append(rgb, 255.0)
 
 
 def _unit_to_metres(scene: object, path: Path) -> float:
