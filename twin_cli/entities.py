@@ -14,8 +14,8 @@ import numpy as np
 
 from twin_cli.pose import Pose
 
-_QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
-_DOF_WIDTH = {0: 6, 1: 3, 2: 1, 3: 1}
+_QPOS_WIDTH = np.array([7, 4, 1, 1])  # by mjtJoint: free, ball, slide, hinge
+_DOF_WIDTH = np.array([6, 3, 1, 1])
 _INT = np.int64
 
 
@@ -113,9 +113,14 @@ def index_entities(model: mujoco.MjModel, names: list[str]) -> dict[str, EntityI
             ("equality", model.name_eqadr),
         )
     }
+    parts = {name: [np.array(groups[k].get(name, []), _INT) for k in groups] for name in names}
+    body_owner = np.full(model.nbody, -1, _INT)
+    for k, name in enumerate(names):
+        body_owner[parts[name][0]] = k
+    geom_owner = body_owner[model.geom_bodyid]
     return {
-        name: _index_one(model, *(np.array(groups[k].get(name, []), _INT) for k in groups))
-        for name in names
+        name: _index_one(model, *parts[name], np.flatnonzero(geom_owner == k).astype(_INT))
+        for k, name in enumerate(names)
     }
 
 
@@ -125,69 +130,86 @@ def _index_one(
     joints: np.ndarray,
     actuators: np.ndarray,
     equalities: np.ndarray,
+    geoms: np.ndarray,
 ) -> EntityIndex:
-    roots = [b for b in bodies if model.body_parentid[b] == 0]
-    root = int(roots[0]) if roots else -1
+    roots = bodies[model.body_parentid[bodies] == 0]
+    root = int(roots[0]) if len(roots) else -1
     types = model.jnt_type[joints]
-    qpos = _spans(model.jnt_qposadr[joints], [_QPOS_WIDTH[int(t)] for t in types])
-    dofs = _spans(model.jnt_dofadr[joints], [_DOF_WIDTH[int(t)] for t in types])
-    free = [j for j in joints if model.jnt_type[j] == 0 and model.jnt_bodyid[j] == root]
-    act_adr, act_num = model.actuator_actadr[actuators], model.actuator_actnum[actuators]
-    has_act = act_adr >= 0
-    acts = _spans(act_adr[has_act], list(act_num[has_act]))
+    free = joints[(types == mujoco.mjtJoint.mjJNT_FREE) & (model.jnt_bodyid[joints] == root)]
+    has_act = model.actuator_actadr[actuators] >= 0
     mocaps = model.body_mocapid[bodies]
-    geoms = np.flatnonzero(np.isin(model.geom_bodyid, bodies))
     return EntityIndex(
         bodies=bodies,
         root=root,
         joints=joints,
-        qpos=qpos,
-        dofs=dofs,
-        free_qpos=int(model.jnt_qposadr[free[0]]) if free else -1,
+        qpos=_spans(model.jnt_qposadr[joints], _QPOS_WIDTH[types]),
+        dofs=_spans(model.jnt_dofadr[joints], _DOF_WIDTH[types]),
+        free_qpos=int(model.jnt_qposadr[free[0]]) if len(free) else -1,
         actuators=actuators,
-        acts=acts,
+        acts=_spans(
+            model.actuator_actadr[actuators][has_act], model.actuator_actnum[actuators][has_act]
+        ),
         equalities=equalities,
         mocaps=mocaps[mocaps >= 0].astype(_INT),
-        geoms=geoms.astype(_INT),
+        geoms=geoms,
     )
 
 
-def _spans(starts: np.ndarray, widths: list[int]) -> np.ndarray:
-    if len(widths) == 0:
+def _spans(starts: np.ndarray, widths: np.ndarray) -> np.ndarray:
+    """The addresses start, start+1, ..., start+width-1 of every span, concatenated."""
+    widths = np.asarray(widths, _INT)
+    if widths.size == 0:
         return np.zeros(0, _INT)
-    return np.concatenate(
-        [np.arange(s, s + w, dtype=_INT) for s, w in zip(starts, widths, strict=True)]
-    )
+    first = np.repeat(np.cumsum(widths) - widths, widths)
+    return np.repeat(np.asarray(starts, _INT), widths) + np.arange(int(widths.sum())) - first
+
+
+# EntityState field -> the EntityIndex addresses it is read at (data.<field>[index.<part>]).
+_STATE_PARTS = (
+    ("qpos", "qpos"),
+    ("qvel", "dofs"),
+    ("qacc_warmstart", "dofs"),
+    ("qfrc_applied", "dofs"),
+    ("act", "acts"),
+    ("ctrl", "actuators"),
+    ("xfrc_applied", "bodies"),
+    ("eq_active", "equalities"),
+    ("mocap_pos", "mocaps"),
+    ("mocap_quat", "mocaps"),
+)
 
 
 def capture_state(data: mujoco.MjData, index: EntityIndex) -> EntityState:
     """Copies one entity's integration state out of `data`."""
     return EntityState(
-        qpos=data.qpos[index.qpos].copy(),
-        qvel=data.qvel[index.dofs].copy(),
-        qacc_warmstart=data.qacc_warmstart[index.dofs].copy(),
-        qfrc_applied=data.qfrc_applied[index.dofs].copy(),
-        act=data.act[index.acts].copy(),
-        ctrl=data.ctrl[index.actuators].copy(),
-        xfrc_applied=data.xfrc_applied[index.bodies].copy(),
-        eq_active=data.eq_active[index.equalities].copy(),
-        mocap_pos=data.mocap_pos[index.mocaps].copy(),
-        mocap_quat=data.mocap_quat[index.mocaps].copy(),
+        **{attr: getattr(data, attr)[getattr(index, part)].copy() for attr, part in _STATE_PARTS}
     )
 
 
 def write_state(data: mujoco.MjData, index: EntityIndex, state: EntityState) -> None:
     """Writes one entity's integration state into `data` (same entity, any compiled model)."""
-    data.qpos[index.qpos] = state.qpos
-    data.qvel[index.dofs] = state.qvel
-    data.qacc_warmstart[index.dofs] = state.qacc_warmstart
-    data.qfrc_applied[index.dofs] = state.qfrc_applied
-    data.act[index.acts] = state.act
-    data.ctrl[index.actuators] = state.ctrl
-    data.xfrc_applied[index.bodies] = state.xfrc_applied
-    data.eq_active[index.equalities] = state.eq_active
-    data.mocap_pos[index.mocaps] = state.mocap_pos
-    data.mocap_quat[index.mocaps] = state.mocap_quat
+    for attr, part in _STATE_PARTS:
+        getattr(data, attr)[getattr(index, part)] = getattr(state, attr)
+
+
+def move_states(
+    source: mujoco.MjData,
+    source_index: dict[str, EntityIndex],
+    target: mujoco.MjData,
+    target_index: dict[str, EntityIndex],
+    names: list[str],
+) -> None:
+    """Copies the state of entities `names` from `source` into `target` (another model's data).
+
+    Equivalent to `write_state(target, ..., capture_state(source, ...))` per entity, with one
+    gather and one scatter per field for all entities (spawn latency grows with their number).
+    """
+    if not names:
+        return
+    for attr, part in _STATE_PARTS:
+        old = np.concatenate([getattr(source_index[n], part) for n in names])
+        new = np.concatenate([getattr(target_index[n], part) for n in names])
+        getattr(target, attr)[new] = getattr(source, attr)[old]
 
 
 def rest_state(model: mujoco.MjModel, index: EntityIndex, qpos: np.ndarray) -> EntityState:

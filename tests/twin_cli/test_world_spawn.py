@@ -175,3 +175,67 @@ def test_default_names_are_made_unique():
     world = World()
     names = [world.spawn(spec_of(mjcf_ball()), pose=Pose(x=k, z=1.0)).name for k in range(3)]
     assert names == ["ball", "ball_1", "ball_2"], "robot name, then _1, _2"
+
+
+def test_spawn_then_delete_restores_the_world_spec_exactly(humanoid_spec):
+    world = World()
+    world.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
+    xml_before = world._spec.to_xml()
+    world.spawn(humanoid_spec, name="h", pose=Pose(x=2.0, z=1.0))
+    assert "h/main" in world._spec.to_xml(), "the humanoid's default classes were attached"
+    world.delete("h")
+    assert world._spec.to_xml() == xml_before, "frame, elements and default classes all removed"
+
+
+@pytest.mark.parametrize("stage", ["attach", "compile"])
+def test_failed_humanoid_spawn_leaves_the_spec_as_it_was(humanoid_spec, stage):
+    """The spawn attaches to the live spec; a failure in attach or compile must undo it all."""
+    world = World()
+    world.spawn(humanoid_spec, name="h0", pose=Pose(z=1.0))
+    xml_before, state_before = world._spec.to_xml(), full_state(world)
+    broken = humanoid_spec.copy()
+    bad = broken.worldbody.add_body(name="bad")
+    if stage == "attach":  # MuJoCo resolves mesh names when attaching
+        bad.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="missing")
+    else:  # a reversed joint range is found only by the compiler (no home key to read first)
+        for key in list(broken.keys):
+            broken.delete(key)
+        bad.add_geom(size=[0.1, 0.0, 0.0])
+        bad.add_joint(range=[1.0, -1.0], limited=mujoco.mjtLimited.mjLIMITED_TRUE)
+    message = {"attach": "cannot be attached", "compile": "does not compile"}[stage]
+    with pytest.raises(SpawnError, match=rf"h1.*{message}"):
+        world.spawn(broken, name="h1", pose=Pose(x=2.0, z=1.0))
+    assert world._spec.to_xml() == xml_before, "attached elements and defaults removed again"
+    assert np.array_equal(full_state(world), state_before), "state untouched"
+    world.spawn(humanoid_spec, name="h1", pose=Pose(x=2.0, z=1.0))
+    assert [e.name for e in world.entities()] == ["h0", "h1"], "the name is free after rollback"
+
+
+def test_entity_index_matches_per_joint_addresses_after_spawns_and_deletes(humanoid_spec):
+    """Oracle: every entity's qpos/dof/geom ids, looked up element by element by name."""
+    world = World()
+    for name in ("a", "b", "c"):
+        world.spawn(humanoid_spec, name=name, pose=Pose(x=2.0 * len(name), z=1.0))
+    world.spawn(spec_of(mjcf_ball()), pose=Pose(z=3.0))
+    world.delete("b")
+    m = world.model
+    qpos_width, dof_width = {0: 7, 1: 4, 2: 1, 3: 1}, {0: 6, 1: 3, 2: 1, 3: 1}
+    assert set(world._index) == {"a", "c", "ball"}, "deleted entity not indexed"
+    for name, ix in world._index.items():
+        joints = [j for j in range(m.njnt) if m.joint(j).name.startswith(f"{name}/")]
+        kinds = [int(m.jnt_type[j]) for j in joints]
+        qpos = [
+            m.jnt_qposadr[j] + k
+            for j, t in zip(joints, kinds, strict=True)
+            for k in range(qpos_width[t])
+        ]
+        dofs = [
+            m.jnt_dofadr[j] + k
+            for j, t in zip(joints, kinds, strict=True)
+            for k in range(dof_width[t])
+        ]
+        owner = [m.body(m.geom_bodyid[g]).name.partition("/")[0] for g in range(m.ngeom)]
+        assert ix.qpos.tolist() == qpos, f"{name}: qpos addresses"
+        assert ix.dofs.tolist() == dofs, f"{name}: dof addresses"
+        assert ix.geoms.tolist() == [g for g, o in enumerate(owner) if o == name], f"{name}: geoms"
+        assert m.jnt_type[joints[0]] != 0 or ix.free_qpos == m.jnt_qposadr[joints[0]], "free"
