@@ -10,6 +10,7 @@ import subprocess
 import sys
 
 import pytest
+from models import block
 
 import scenarios
 
@@ -18,15 +19,7 @@ GZ_LINE = re.compile(
 )
 MOON, EARTH = 1.62, 9.81  # [m/s^2], the presets
 DT, STEPS = 0.001, 300  # [s], steps of free fall measured through `twin pose`
-BOX_URDF = """<?xml version="1.0"?>
-<robot name="box">
-  <link name="base">
-    <inertial><mass value="1.0"/><inertia ixx="0.0067" iyy="0.0067" izz="0.0067"
-      ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
-  </link>
-</robot>
-"""
+BOX_URDF = block(size=0.2, name="box")  # 1 kg, 0.2 m cube
 
 
 class Twin:

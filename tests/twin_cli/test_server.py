@@ -5,58 +5,28 @@ from __future__ import annotations
 import os
 import socket
 import stat
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import httpx
 import pytest
+from models import block
 
 from converters.errors import ConversionError
-from twin_cli import runtime
 from twin_cli.client import Client
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError, TwinError
 
 WORLD = "srv"
-BOX_URDF = """<?xml version="1.0"?>
-<robot name="box">
-  <link name="base">
-    <inertial><mass value="1.0"/><inertia ixx="0.0067" iyy="0.0067" izz="0.0067"
-      ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
-    <visual><geometry><box size="0.2 0.2 0.2"/></geometry></visual>
-  </link>
-</robot>
-"""
+BOX_URDF = block(size=0.2, name="box")
 # Not well-formed XML: the converter must refuse it with its file name in the message.
 BROKEN_URDF = "<robot name='broken'><link name='a'></robot>"
-START_TIMEOUT_S = 60.0
 
 
 @pytest.fixture(scope="module")
-def server(tmp_path_factory):
+def server(tmp_path_factory, serve_world):
     """`twin serve --tcp 127.0.0.1:0` in a temporary runtime dir; SIGTERM in teardown."""
-    rt = tmp_path_factory.mktemp("rt")
-    mp = pytest.MonkeyPatch()
-    mp.setenv(runtime.RUNTIME_ENV, str(rt))
-    log = open(rt / "serve.out", "wb")  # noqa: SIM115
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.app", "serve", "--world", WORLD, "--tcp", "127.0.0.1:0"],
-        stdout=log,
-        stderr=log,
-        env={**os.environ, runtime.RUNTIME_ENV: str(rt)},
-    )
-    client = Client(WORLD)
-    try:
-        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
-        yield client, proc
-    finally:
-        client.close()
-        proc.terminate()
-        proc.wait(timeout=20)
-        log.close()
-        mp.undo()
+    with serve_world(tmp_path_factory.mktemp("rt"), WORLD, "--tcp", "127.0.0.1:0") as served:
+        yield served
 
 
 @pytest.fixture(scope="module")
@@ -174,22 +144,14 @@ def test_openapi_schema_is_served(server):
         assert path in schema["paths"], f"{path} missing from the OpenAPI schema"
 
 
-def test_serve_a_saved_world_paused_then_sigterm_ends_cleanly(tmp_path, files):
+def test_serve_a_saved_world_paused_then_sigterm_ends_cleanly(tmp_path, files, serve_world):
     from twin_cli.world import Pose, World
 
     saved = World()
     saved.spawn(str(files / "box.urdf"), name="crate", pose=Pose(z=3.0))
     saved.save(tmp_path / "saved.twin")
-    env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
-    args = ["serve", str(tmp_path / "saved.twin"), "--world", "t", "--paused", "--rate", "500"]
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.app", *args], env=env, stderr=subprocess.DEVNULL
-    )
-    mp = pytest.MonkeyPatch()
-    mp.setenv(runtime.RUNTIME_ENV, str(tmp_path))
-    try:
-        client = Client("t")
-        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
+    args = (str(tmp_path / "saved.twin"), "--paused", "--rate", "500")
+    with serve_world(tmp_path, "t", *args) as (client, proc):
         assert [e["name"] for e in client.entities()] == ["crate"], "saved entities not served"
         assert client.stats()["paused"] is True, "--paused not applied"
         assert client.physics()["rate"] == pytest.approx(500.0), "--rate not applied"
@@ -199,10 +161,6 @@ def test_serve_a_saved_world_paused_then_sigterm_ends_cleanly(tmp_path, files):
         leftovers = [p for p in client.paths.transient() if p.exists()]
         assert leftovers == [], f"files left after SIGTERM: {leftovers}"
         assert "stopped" in Path(client.paths.log).read_text()
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-        mp.undo()
 
 
 def test_save_then_load_restores_entities_and_pose(server, files, tmp_path):

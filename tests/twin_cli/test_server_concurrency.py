@@ -2,50 +2,24 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 import threading
 import time
 
 import pytest
+from models import block
 
-from twin_cli import runtime
 from twin_cli.client import Client
 from twin_cli.errors import EntityNotFoundError
 
 WORLD = "busy"
 DURATION_S = 10.0
-BOX_URDF = """<?xml version="1.0"?>
-<robot name="box">
-  <link name="base">
-    <inertial><mass value="1.0"/><inertia ixx="0.0067" iyy="0.0067" izz="0.0067"
-      ixy="0" ixz="0" iyz="0"/></inertial>
-    <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>
-  </link>
-</robot>
-"""
+BOX_URDF = block(size=0.2, name="box")
 
 
 @pytest.fixture
-def server(tmp_path, monkeypatch):
-    monkeypatch.setenv(runtime.RUNTIME_ENV, str(tmp_path))
-    env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
-    with open(tmp_path / "serve.out", "wb") as out:
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "twin_cli.app", "serve", "--world", WORLD],
-            stdout=out,
-            stderr=out,
-            env=env,
-        )
-    client = Client(WORLD)
-    try:
-        runtime.wait_until(client.paths, client.alive, proc, 60.0)
+def server(tmp_path, serve_world):
+    with serve_world(tmp_path, WORLD) as (client, _):
         yield client
-    finally:
-        client.close()
-        proc.terminate()
-        proc.wait(timeout=20)
 
 
 class Worker(threading.Thread):

@@ -1,0 +1,53 @@
+"""Fixtures for the world server tests: a real `twin serve` on a temporary runtime directory."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
+from pathlib import Path
+
+import pytest
+
+from twin_cli import runtime
+from twin_cli.client import Client
+
+START_TIMEOUT_S = 60.0  # [s] a cold start imports mujoco and FastAPI on a loaded CI machine
+
+
+@contextmanager
+def served_world(
+    runtime_dir: Path, world: str, *serve_args: str
+) -> Iterator[tuple[Client, subprocess.Popen]]:
+    """Runs `twin serve --world <world> <serve_args>` with its runtime files in `runtime_dir`.
+
+    Yields a connected client and the server process; on exit closes the client, sends SIGTERM
+    and waits for the process (its output goes to `runtime_dir/serve.out`).
+    """
+    patch = pytest.MonkeyPatch()
+    patch.setenv(runtime.RUNTIME_ENV, str(runtime_dir))
+    env = {**os.environ, runtime.RUNTIME_ENV: str(runtime_dir)}
+    with open(runtime_dir / "serve.out", "wb") as log:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "twin_cli.app", "serve", "--world", world, *serve_args],
+            stdout=log,
+            stderr=log,
+            env=env,
+        )
+    client = Client(world)
+    try:
+        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
+        yield client, proc
+    finally:
+        client.close()
+        proc.terminate()
+        proc.wait(timeout=20)
+        patch.undo()
+
+
+@pytest.fixture(scope="session")
+def serve_world() -> Callable[..., AbstractContextManager[tuple[Client, subprocess.Popen]]]:
+    """`served_world` (see above), for module- and function-scoped server fixtures."""
+    return served_world
