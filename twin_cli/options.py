@@ -36,3 +36,12 @@ def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:
         name, value = item.split(sep, 1)
         out[name.strip()] = value.strip()
     return out
+
+
+def source_inputs(arg: list[str] | None, package: list[str] | None) -> dict[str, dict[str, str]]:
+    """`--arg NAME:=VALUE` and `--package NAME=PATH` as the `args` and `package_paths` keywords
+    that `convert`, `convert_full`, `validate` and `spawn` all take."""
+    return {
+        "args": parse_pairs(arg, ":=", "--arg"),
+        "package_paths": parse_pairs(package, "=", "--package"),
+    }

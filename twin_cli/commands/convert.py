@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
-from twin_cli.options import ArgOpt, JsonOpt, PackageOpt, parse_pairs
+from twin_cli.options import ArgOpt, JsonOpt, PackageOpt, parse_pairs, source_inputs
 
 RobotArg = Annotated[Path, typer.Argument(help="Robot description: .urdf or .xacro file.")]
 KeepFixedOpt = Annotated[
@@ -104,8 +104,7 @@ def convert_command(
     )
     done = convert_full(
         robot,
-        args=parse_pairs(arg, ":=", "--arg"),
-        package_paths=parse_pairs(package, "=", "--package"),
+        **source_inputs(arg, package),
         options=_options(keep_fixed, repair_inertia, settings),
     )
     if print_xml:
@@ -147,8 +146,7 @@ def inspect_command(
 
     done = convert_full(
         robot,
-        args=parse_pairs(arg, ":=", "--arg"),
-        package_paths=parse_pairs(package, "=", "--package"),
+        **source_inputs(arg, package),
         options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}),
     )
     stats = inertial_stats(done.spec, done.parsed)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from twin_cli.options import ArgOpt, JsonOpt, PackageOpt, parse_pairs
+from twin_cli.options import ArgOpt, JsonOpt, PackageOpt, source_inputs
 
 ScenarioOpt = Annotated[
     list[str] | None,
@@ -61,8 +61,7 @@ def validate(
 
     run = run_validation(
         robot,
-        args=parse_pairs(arg, ":=", "--arg"),
-        package_paths=parse_pairs(package, "=", "--package"),
+        **source_inputs(arg, package),
         scenarios=scenario,
         only=only,
         skip=skip,

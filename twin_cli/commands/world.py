@@ -24,7 +24,7 @@ from twin_cli.options import (
     YawOpt,
     YOpt,
     ZOpt,
-    parse_pairs,
+    source_inputs,
 )
 from twin_cli.output import Output
 
@@ -99,13 +99,10 @@ def spawn(
     json: JsonOpt = False,
 ) -> None:
     """Spawn a robot; prints its name once it exists in the world."""
-    args = parse_pairs(arg, ":=", "--arg")
-    packages = parse_pairs(package, "=", "--package")
+    inputs = source_inputs(arg, package)
     pose = dict(zip(POSE_KEYS, (x, y, z, roll, pitch, yaw), strict=True))
     with _connect(world) as c:
-        result = c.spawn(
-            file, name=name, pose=pose, args=args, package_paths=packages, on_ground=on_ground
-        )
+        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, **inputs)
     out = Output(json)
     if json:
         out.data(result)
