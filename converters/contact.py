@@ -47,6 +47,11 @@ IMPEDANCE = 0.95
 lets stiffer springs be resolved (S = (1-d)·kp/m) and makes static friction creep less."""
 SOLIMP_WIDTH = 0.001
 """solimp width [m]; irrelevant when d0 = d1, kept at MuJoCo's default."""
+DEFAULT_LIMIT_ERP = 0.2
+"""SDF default `joint/axis/limit` erp (ODE `stopErp`); Gazebo's default cfm there is 0 (hard)."""
+LIMIT_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+"""solimplimit of every joint: constant impedance d = 0.9999 (MuJoCo's largest, mjMAXIMP), the
+nearest MuJoCo gets to ODE's cfm 0: the limit gives way by (1 − d)/d of what it resists."""
 MIN_DAMPING_RATIO = 0.5
 """Floor on the contact damping ratio. MuJoCo's friction rows share the contact's damping B, and a
 nearly undamped contact lets a body creep at (1-d)·g·sinθ/B down a slope it should stick to.
@@ -126,21 +131,45 @@ def contact_softness(
 
 
 def limit_solref(erp: float | None, timestep: float = GAZEBO_STEP) -> tuple[float, float]:
-    """Joint-limit softness from ODE's stopErp, as a standard solreflimit (timeconst, dampratio).
+    """Joint-limit reference dynamics from ODE's stopErp: standard solreflimit (timeconst, ratio).
 
-    ODE removes a fraction erp of a limit violation per step, so the violation decays with time
-    constant h/erp; a critically damped MuJoCo limit with that time constant (kept ≥ 2·h, MuJoCo's
-    refsafe bound) recovers alike. stopCfm's extra compliance is not mapped (see gazebo_apply).
+    ODE's limit row with cfm 0 is a hard velocity constraint: each step it sets the joint's
+    velocity so that a fraction erp of the violation r is removed, v' = −erp·r/h. A MuJoCo limit
+    with impedance d → 1 (`LIMIT_SOLIMP`) follows its reference acceleration
+    aref = −b·v − k·r with b = 2/(d·τ), k = 1/(d·τ²·ζ²) (MuJoCo "Solver parameters"), and
+    semi-implicit Euler gives v' = v + h·aref. Choosing τ = 2h and ζ = 1/(2·√erp) makes
+    b = 1/h and k = erp/h², so v' = −erp·r/h: ODE's rule, step for step (the violation decays
+    by (1 − erp) per step, the impact velocity is removed in one step). τ = 2h is also MuJoCo's
+    refsafe bound, which MuJoCo re-applies at a larger world timestep, so the rule still holds
+    there (b = 1/h, k = erp/h² at that h).
 
     Args:
         erp: ODE error-reduction parameter in (0, 1]; SDF default 0.2 when None or ≤ 0.
-        timestep: simulation step [s].
+        timestep: the Gazebo step [s] the mapping is exact for.
 
     Returns:
         (timeconst [s], dampratio).
     """
-    erp = 0.2 if erp is None or erp <= 0 else min(erp, 1.0)
-    return (max(timestep / erp, 2.0 * timestep), 1.0)
+    erp = DEFAULT_LIMIT_ERP if erp is None or erp <= 0 else min(erp, 1.0)
+    return (2.0 * timestep, 1.0 / (2.0 * math.sqrt(erp)))
+
+
+def limit_violation(a0: float, erp: float | None = None, timestep: float = GAZEBO_STEP) -> float:
+    """Steady violation [rad or m] of a MuJoCo limit (`limit_solref` + `LIMIT_SOLIMP`) under a load.
+
+    At rest a = 0 = (1 − d)·a0 + d·aref with aref = −k·r, so r = (1 − d)/d · a0/k
+    = (1 − d)·a0·τ²·ζ² = (1 − d)·a0·h²/erp. Gazebo's cfm-0 limit holds exactly (r = 0); with
+    d = 0.9999 the residue is 5e-10·a0 at erp 0.2 and h = 1 ms (1000 N m on a 1e-4 kg m² link,
+    a0 = 1e7 rad/s²: 5 mrad). MuJoCo's default d = 0.95 with τ = 5 ms gave 1.25e-6·a0.
+
+    Args:
+        a0: unconstrained acceleration pushing into the limit [rad/s² or m/s²].
+        erp: ODE stopErp (SDF default 0.2 when None).
+        timestep: Gazebo step [s].
+    """
+    timeconst, ratio = limit_solref(erp, timestep)
+    d = LIMIT_SOLIMP[1]
+    return (1.0 - d) * abs(a0) * (timeconst * ratio) ** 2
 
 
 def add_gazebo_ground(spec: Any) -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from converters.contact import limit_solref
+from converters.contact import DEFAULT_LIMIT_ERP, LIMIT_SOLIMP, limit_solref
 from converters.gazebo import Blob, GazeboExtensions, JointExtension
 from converters.provenance import Provenance
 from converters.report import Report
@@ -50,9 +50,12 @@ def apply_joint_tags(
 
 
 def _apply_default_limit_softness(spec: Any, provenance: Provenance, report: Report) -> None:
-    """Gazebo's default joint-limit softness (SDF `limit/erp` 0.2, cfm 0) on every robot joint.
+    """Gazebo's default joint limit (SDF `limit/erp` 0.2, cfm 0: hard) on every robot joint.
 
-    MuJoCo's own default (solreflimit 0.02 s) is four times softer than ODE's erp 0.2 at 1 ms.
+    `converters.contact.limit_solref` gives MuJoCo the reference dynamics of ODE's limit row
+    (v' = −erp·r/h); `LIMIT_SOLIMP` (d = 0.9999) makes the row nearly as hard as cfm 0. MuJoCo's
+    own default (solref 0.02 s, d 0.9–0.95) let a 1000 N m drive push the R2-D2 gripper 0.6 rad
+    past its stop.
     """
     timeconst, ratio = limit_solref(None)
     count = 0
@@ -60,12 +63,14 @@ def _apply_default_limit_softness(spec: Any, provenance: Provenance, report: Rep
         joint = spec.joint(mj_joint)
         if joint is not None:
             joint.solref_limit = [timeconst, ratio]
+            joint.solimp_limit = list(LIMIT_SOLIMP)
             count += 1
     if count:
         report.mapped(
             "joint limits",
-            f"Gazebo default limit erp 0.2 at 1 ms: solreflimit {timeconst:g} s, damping "
-            f"ratio {ratio:g} on {count} joints",
+            f"Gazebo default limit erp {DEFAULT_LIMIT_ERP:g}, cfm 0 at 1 ms: solreflimit "
+            f"{timeconst:g} s, damping ratio {ratio:.4g} (v' = −erp·r/h, as ODE), solimplimit "
+            f"d = {LIMIT_SOLIMP[0]:g} (gives way by 1e-4 of the load) on {count} joints",
             tag="stopErp",
         )
 
@@ -87,9 +92,10 @@ def _apply_joint(joint: Any, ext: JointExtension, subject: str, report: Report) 
     if ext.stop_erp is not None or ext.stop_cfm is not None:
         timeconst, ratio = limit_solref(ext.stop_erp)
         joint.solref_limit = [timeconst, ratio]
-        report.approximated(
+        entry = report.approximated if ext.stop_cfm else report.mapped
+        entry(
             subject,
-            f"stopErp={ext.stop_erp}: limit solref {timeconst:.4g} s, damping ratio {ratio}"
+            f"stopErp={ext.stop_erp}: limit solref {timeconst:.4g} s, damping ratio {ratio:.4g}"
             + (f"; stopCfm={ext.stop_cfm} compliance not mapped" if ext.stop_cfm else ""),
             tag="stopErp",
         )

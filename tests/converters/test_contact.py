@@ -10,13 +10,16 @@ import numpy as np
 import pytest
 
 from converters.contact import (
+    DEFAULT_LIMIT_ERP,
     GROUND_MU,
+    LIMIT_SOLIMP,
     MIN_DAMPING_RATIO,
     PRIORITY_PER_DECADE,
     add_gazebo_ground,
     contact_softness,
     friction_priority,
     limit_solref,
+    limit_violation,
     max_contact_stiffness,
 )
 
@@ -155,6 +158,80 @@ def test_low_gazebo_damping_is_floored_and_says_so():
 
 
 def test_limit_solref_follows_stop_erp():
-    assert limit_solref(0.2) == pytest.approx((0.005, 1.0)), "erp 0.2 at 1 ms: τ = h/erp"
-    assert limit_solref(1.0) == pytest.approx((0.002, 1.0)), "τ never below 2·h"
-    assert limit_solref(None) == pytest.approx((0.005, 1.0)), "SDF default erp 0.2"
+    assert limit_solref(0.2) == pytest.approx((0.002, 1.0 / (2 * math.sqrt(0.2)))), "τ=2h, ζ"
+    assert limit_solref(1.0) == pytest.approx((0.002, 0.5)), "erp 1: dead-beat"
+    assert limit_solref(None) == limit_solref(DEFAULT_LIMIT_ERP), "SDF default erp 0.2"
+
+
+def _hinge(inertia: float, erp: float | None, lower: float = -1.0, upper: float = 1.0):
+    """A hinge (axis z, range [lower, upper] rad) on a body of `inertia` [kg m²], no gravity,
+    with the converter's limit settings for `erp`; returns (model, data)."""
+    spec = _world(gravity=(0.0, 0.0, 0.0))
+    spec.compiler.degree = False
+    body = spec.worldbody.add_body(name="link", mass=1.0, inertia=[inertia] * 3)
+    body.explicitinertial = True
+    joint = body.add_joint(name="hinge", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1])
+    joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+    joint.range = [lower, upper]
+    joint.solref_limit = list(limit_solref(erp))
+    joint.solimp_limit = list(LIMIT_SOLIMP)
+    body.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.01], contype=0, conaffinity=0)
+    model = spec.compile()
+    return model, mujoco.MjData(model)
+
+
+@pytest.mark.parametrize("erp", [0.2, 0.5, 0.9])
+@pytest.mark.parametrize("start", [0.001, 0.01, 0.1])
+def test_limit_sets_the_velocity_ode_sets_from_a_violation(erp, start):
+    """ODE's cfm-0 limit row sets v' = −erp·r/h in one step (±0.1 %), from rest at r past the
+    stop; a limit can only push, so afterwards the joint leaves at that speed, as in ODE."""
+    model, data = _hinge(0.01, erp)
+    data.qpos[0] = 1.0 + start
+    mujoco.mj_step(model, data)
+    assert data.qvel[0] == pytest.approx(-erp * start / STEP, rel=1e-3), "v' = −erp·r/h"
+
+
+def test_pressed_limit_violation_decays_by_one_minus_erp_per_step():
+    """Held into the stop by 1000 N m on 0.01 kg m², a 10 mrad violation shrinks by (1 − erp)
+    per step (±1 %) towards the steady residue, as ODE's row does."""
+    erp = DEFAULT_LIMIT_ERP
+    model, data = _hinge(0.01, erp)
+    data.qpos[0] = 1.01
+    data.qfrc_applied[0] = 1000.0
+    residue = limit_violation(1000.0 / 0.01)
+    excess = []
+    for _ in range(6):
+        mujoco.mj_step(model, data)
+        excess.append(data.qpos[0] - 1.0 - residue)
+    ratios = np.array(excess[1:]) / np.array(excess[:-1])
+    assert ratios == pytest.approx(1.0 - erp, rel=0.01), f"per-step ratios {ratios}"
+
+
+def test_limit_impact_is_stopped_in_one_step_without_elastic_rebound():
+    """A joint hitting its stop at 50 rad/s overshoots by at most one step of travel and leaves
+    at erp·overshoot/h (ODE's error correction, 10 rad/s here), not at 50 rad/s."""
+    model, data = _hinge(0.01, None)
+    data.qpos[0], data.qvel[0] = 0.9, 50.0
+    for _ in range(100):
+        if data.qpos[0] > 1.0:
+            break
+        mujoco.mj_step(model, data)
+    overshoot = data.qpos[0] - 1.0
+    assert 0.0 < overshoot <= 50.0 * STEP + 1e-9, f"overshoot {overshoot:.4f} rad"
+    mujoco.mj_step(model, data)
+    expected = -DEFAULT_LIMIT_ERP * overshoot / STEP
+    assert data.qvel[0] == pytest.approx(expected, rel=1e-3), "leaves at erp·r/h"
+
+
+@pytest.mark.parametrize("torque, inertia", [(1000.0, 1e-4), (28.0, 1e-3), (80.0, 0.05)])
+def test_limit_gives_way_by_the_predicted_residue_under_full_effort(torque, inertia):
+    """Held against the stop by τ on I, the steady violation is (1 − d)·a0·h²/erp (±2 %) and
+    stays within 0.05 rad for every corpus effort-to-inertia ratio up to 1e7 rad/s²."""
+    model, data = _hinge(inertia, None)
+    data.qfrc_applied[0] = torque
+    for _ in range(3000):
+        mujoco.mj_step(model, data)
+    measured = data.qpos[0] - 1.0
+    predicted = limit_violation(torque / inertia)
+    assert measured == pytest.approx(predicted, rel=0.02), f"violation {measured:.3e} rad"
+    assert measured < 0.05, "within joint_limits' 0.05 rad"

@@ -170,7 +170,7 @@ TAG_TABLE = [
     (
         "stopErp",
         _ref("hinge", "<stopErp>0.4</stopErp>"),
-        lambda d, m: np.allclose(m.jnt_solref[m.joint("hinge").id], [0.0025, 1.0]),
+        lambda d, m: np.allclose(m.jnt_solref[m.joint("hinge").id], [0.002, 0.5 / 0.4**0.5]),
     ),
     (
         "provideFeedback",
@@ -264,7 +264,8 @@ TAG_TABLE = [
         lambda d, m: (
             all(m.geom_priority[_geom(d, m, link).id] == 9000 for link in ("base", "arm"))
             and m.nexclude == 1
-            and np.allclose(m.jnt_solref[m.joint("hinge").id], [0.005, 1.0])
+            and np.allclose(m.jnt_solref[m.joint("hinge").id], [0.002, 0.5 / 0.2**0.5])
+            and np.allclose(m.jnt_solimp[m.joint("hinge").id][:2], [0.9999, 0.9999])
         ),
     ),
 ]
