@@ -18,6 +18,9 @@ from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
 
 FREE = 0  # mjtJoint mjJNT_FREE
+REACHED_RAD = 0.01
+"""A drive reached its stop when the joint came within this of it [rad or m]; a joint whose
+velocity limit keeps it from crossing its range within the drive reaches neither stop."""
 
 
 def _holding(run: ScenarioRun, settle: float) -> bool:
@@ -33,8 +36,8 @@ def _violations(run: ScenarioRun, settle: float) -> tuple[dict[int, float], dict
     a drive holds it against the limit (the impact transient before `settle` is left out)."""
     ranges = {i: limited_range(run.world.model, j.joint) for i, j in enumerate(run.joints)}
     ranges = {i: r for i, r in ranges.items() if r is not None and run.joints[i].effort}
-    over = {i: 0.0 for i in ranges}
-    under = {i: 0.0 for i in ranges}
+    over = {i: -math.inf for i in ranges}
+    under = {i: -math.inf for i in ranges}
 
     def sample(r: ScenarioRun) -> None:
         if not _holding(r, settle):
@@ -53,7 +56,7 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     """Each joint driven past its limit with its full effort stays within it."""
     run = ScenarioRun(robot, scenario)
     over, under = _violations(run, th["settle_fraction"])
-    hints, worst = [], 0.0
+    hints, worst, reached = [], 0.0, 0
     model = run.world.model
     for i in over:
         joint = run.joints[i]
@@ -62,6 +65,7 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         unit = "m" if slide else "rad"
         lo, hi = limited_range(model, joint.joint)
         for side, amount, bound in (("upper", over[i], hi), ("lower", under[i], lo)):
+            reached += amount > -REACHED_RAD
             worst = max(worst, amount / tol)
             if amount > tol:
                 enforced = "soft" if model.jnt_limited[joint.joint] else "not enforced"
@@ -74,7 +78,8 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         "joint_limits",
         "physics",
         Status.FAIL if hints else (Status.PASS if over else Status.SKIP),
-        f"{len(over)} joint(s) driven, worst {worst:.2f}× tolerance",
+        f"{len(over)} joint(s) driven, {reached}/{2 * len(over)} stops reached, "
+        f"worst {worst:.2f}× tolerance",
         f"≤ {th['max_violation_rad']:g} rad / {th['max_violation_m']:g} m past a limit",
         hints=hints,
         value=worst,

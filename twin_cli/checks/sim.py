@@ -6,6 +6,7 @@ to MuJoCo's stepping directly: the same engine as `twin serve`, without the serv
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -20,13 +21,15 @@ PLANE = 0  # mjtGeom mjGEOM_PLANE
 
 @dataclass(frozen=True)
 class RobotJoint:
-    """One 1-DoF joint of the spawned robot: world ids and its effort limit [N m] or [N]."""
+    """One 1-DoF joint of the spawned robot: world ids, its effort limit [N m] or [N] and its
+    declared velocity limit [rad/s] or [m/s] (None: not declared)."""
 
     name: str
     joint: int
     qpos: int
     dof: int
     effort: float | None
+    velocity: float | None = None
 
 
 def obstacle_spec(box: Obstacle, name: str):
@@ -75,6 +78,7 @@ class ScenarioRun:
             robot.spec.copy(), name=robot.name, pose=pose, on_ground=scenario.robot.on_ground
         )
         self.entity = spawned.name
+        self._velocity_limits = {j.name: j.velocity for j in robot.declared_joints}
         self._index_robot()
         for i, box in enumerate(scenario.obstacles):
             self._spawn_obstacle(box, f"obstacle{i}")
@@ -95,6 +99,7 @@ class ScenarioRun:
                 int(model.jnt_qposadr[j]),
                 int(model.jnt_dofadr[j]),
                 joint_effort(model, j),
+                self._velocity_limits.get(model.joint(j).name.removeprefix(prefix)),
             )
             for j in range(model.njnt)
             if int(model.jnt_bodyid[j]) in self.bodies and int(model.jnt_type[j]) in (HINGE, SLIDE)
@@ -219,30 +224,39 @@ class ScenarioRun:
                 for i, joint in enumerate(self.joints):
                     if action.joints == "*" or joint.name in action.joints:
                         tau[i] = _drive_value(action, joint)
-        limits = np.array([j.effort if j.effort is not None else np.inf for j in self.joints])
-        return np.clip(tau, -limits, limits)
+        return np.array(
+            [gazebo_effort(t, v, j) for t, v, j in zip(tau, qd, self.joints, strict=True)]
+        )
 
     def _hold_gains(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-joint PD gains of the hold, capped so the explicit PD stays stable.
 
-        A PD applied once per step h on a joint of effective inertia I (diagonal of the mass
-        matrix) is stable only for kd·h/I < 2 and kp·h²/I < 1; the caps keep a margin of 4
-        (kd ≤ I/(2h), kp ≤ I/(4h²)), so 300 N m/rad holds a humanoid hip but not a 40 g leg.
+        A PD applied once per step h on a joint of effective inertia I is stable only for
+        kd·h/I < 2 and kp·h²/I < 1; the caps keep a margin of 4 (kd ≤ I/(2h), kp ≤ I/(4h²)),
+        so 300 N m/rad holds a humanoid hip but not a 40 g leg. I is what a torque at the joint
+        accelerates, 1/(M⁻¹)ᵢᵢ: on a floating robot the torque also turns the base, so I is
+        below the mass matrix's diagonal Mᵢᵢ (solo12's knee: 2.2e-4 vs 5.4e-4 kg m²; capping
+        with Mᵢᵢ made its stance diverge within 25 ms).
         """
         hold = self.scenario.hold
         if hold is None or not self.joints:
             return np.zeros(len(self.joints)), np.zeros(len(self.joints))
+        h = float(self.world.model.opt.timestep)
+        inertia = self._effective_inertia()
+        kp = np.minimum(hold.kp, inertia / (4.0 * h * h))
+        kd = np.minimum(hold.kd, inertia / (2.0 * h))
+        return kp, kd
+
+    def _effective_inertia(self) -> np.ndarray:
+        """1/(M⁻¹)ᵢᵢ [kg m² or kg] of each joint at the current state."""
         import mujoco
 
-        h = float(self.world.model.opt.timestep)
         with self.world.lock:
             model, data = self.world.model, self.world.data
             full = np.zeros((model.nv, model.nv))
             mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
-        inertia = np.array([full[j.dof, j.dof] for j in self.joints])
-        kp = np.minimum(hold.kp, inertia / (4.0 * h * h))
-        kd = np.minimum(hold.kd, inertia / (2.0 * h))
-        return kp, kd
+        inverse = np.linalg.inv(full)
+        return np.array([1.0 / inverse[j.dof, j.dof] for j in self.joints])
 
     def _apply_joint_forces(self) -> None:
         tau = self.joint_torques()
@@ -253,6 +267,26 @@ class ScenarioRun:
     def close(self) -> None:
         """Release the world (no thread runs; nothing else to free)."""
         self.world = None  # type: ignore[assignment]
+
+
+def gazebo_effort(tau: float, qvel: float, joint: RobotJoint) -> float:
+    """The effort Gazebo applies for a commanded `tau` (gazebo-classic `Joint::SetForce` →
+    `CheckAndTruncateForce`): zero when the joint already moves faster than its velocity
+    limit in the direction of `tau`, then clipped to ±effort.
+
+    Without the velocity rule a full-effort drive spins ANYmal's ±3π rad knee to 400 rad/s
+    (velocity limit 7.5 rad/s) and whirls the whole robot.
+
+    Args:
+        tau: commanded effort [N m] or [N].
+        qvel: joint velocity [rad/s] or [m/s].
+        joint: the joint, with its effort and velocity limits.
+    """
+    limit = joint.velocity
+    if limit is not None and limit >= 0.0 and abs(qvel) > limit and tau * qvel > 0.0:
+        tau = 0.0
+    effort = joint.effort if joint.effort is not None else math.inf
+    return min(max(tau, -effort), effort)
 
 
 def _drive_value(action: Action, joint: RobotJoint) -> float:
