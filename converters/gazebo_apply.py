@@ -105,10 +105,12 @@ def _apply_surface(
         geom.condim = max(int(geom.condim), 4)
     geom.friction = friction
     geom.priority = friction_priority(mu)
+    # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
+    # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
+    softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))
+    geom.solref = list(softness.solref)
+    geom.solimp = list(softness.solimp)
     if surface.kp is not None or surface.kd is not None:
-        softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))
-        geom.solref = list(softness.solref)
-        geom.solimp = list(softness.solimp)
         _report_softness(origin, surface, softness, masses.of(origin.body), report)
 
 

@@ -259,13 +259,14 @@ TAG_TABLE = [
         lambda d, m: m.body_gravcomp[m.body("arm").id] == 1.0,
     ),
     (
-        "no tags: Gazebo defaults (μ=1 priority, no self-collision, limit erp 0.2)",
+        "no tags: Gazebo defaults (μ=1 priority, no self-collision, limit erp 0.2, kp 1e12)",
         "",
         lambda d, m: (
             all(m.geom_priority[_geom(d, m, link).id] == 9000 for link in ("base", "arm"))
             and m.nexclude == 1
             and np.allclose(m.jnt_solref[m.joint("hinge").id], [0.002, 0.5 / 0.2**0.5])
             and np.allclose(m.jnt_solimp[m.joint("hinge").id][:2], [0.9999, 0.9999])
+            and _geom(d, m, "arm").solref[0] == pytest.approx(-max_contact_stiffness())
         ),
     ),
 ]
