@@ -132,6 +132,15 @@ def result(
     return CheckResult(check, kind, status, measured, threshold, **extra)
 
 
+def judged(
+    check: str, kind: str, measured: str, threshold: str, hints: list[str], **extra: Any
+) -> CheckResult:
+    """A check's verdict by the one rule every check uses: it fails iff it has hints (each
+    hint names a measured quantity past its threshold and the fix); otherwise it passes."""
+    status = Status.FAIL if hints else Status.PASS
+    return result(check, kind, status, measured, threshold, hints=hints, **extra)
+
+
 _LINK_RE = re.compile(r"link '([^']+)'")
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from converters.report import Outcome
-from twin_cli.checks.base import RobotUnderTest, Status, link_in_subject, result
+from twin_cli.checks.base import RobotUnderTest, Status, judged, link_in_subject, result
 from twin_cli.checks.geometry import body_solid
 from twin_cli.scenario import Scenario
 
@@ -137,13 +137,12 @@ def check_inertia_plausible(robot: RobotUnderTest, scenario: Scenario, th: dict[
                 f"of a solid of its geometry at {mass:.3g} kg ({mass * trace_per_mass:.3g} kg m²): "
                 "the <inertia> is too small for this mass; compute it from CAD or the geometry"
             )
-    return result(
+    return judged(
         "inertia_plausible",
         "model",
-        Status.FAIL if hints else Status.PASS,
         f"lowest ratio {worst:.3g}",
         f"≥ {th['min_ratio']:g} of a solid of the geometry",
-        hints=hints,
+        hints,
         details=details,
         value=worst,
     )

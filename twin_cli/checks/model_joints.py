@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from twin_cli.checks.base import DeclaredJoint, RobotUnderTest, Status, result
+from twin_cli.checks.base import DeclaredJoint, RobotUnderTest, judged
 from twin_cli.scenario import Scenario
 
 HINGE, SLIDE = 3, 2  # mjtJoint codes
@@ -96,12 +96,11 @@ def check_joint_definitions(robot: RobotUnderTest, scenario: Scenario, th: dict[
         hints += _joint_problems(model, j)
     for joint in robot.declared_joints:
         hints += _declared_problems(joint)
-    return result(
+    return judged(
         "joint_definitions",
         "model",
-        Status.FAIL if hints else Status.PASS,
         f"{len(hints)} problem(s) in {checked} joint(s)",
         "0",
-        hints=hints,
+        hints,
         value=float(len(hints)),
     )

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin_cli.checks.base import CheckResult, RobotUnderTest, Status, fmt_len, result
+from twin_cli.checks.base import CheckResult, RobotUnderTest, Status, fmt_len, judged, result
 from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
 
@@ -101,13 +101,12 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         hints.append(
             "no contact with the ground after settling: the robot has no collision geometry"
         )
-    return result(
+    return judged(
         "ground_contact",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"penetration {fmt_len(depth)}, speed {final_speed:.2g} m/s",
         f"≤ {fmt_len(th['max_penetration_m'])}, ≤ {th['rest_speed_m_s']:g} m/s",
-        hints=hints,
+        hints,
         value=depth,
     )
 
@@ -152,12 +151,11 @@ def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
             f"a link's centre of mass reached {fmt_len(beyond)} past the box's near face: the "
             "robot passes through; give its links <collision> geometry (not only <visual>)"
         )
-    return result(
+    return judged(
         "collision",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"deepest link COM {fmt_len(beyond)} past the near face",
         f"< {fmt_len(scenario.obstacles[0].size[0] - th['max_intrusion_m'])}",
-        hints=hints,
+        hints,
         value=beyond,
     )

@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from twin_cli.checks.base import RobotUnderTest, Status, result
+from twin_cli.checks.base import RobotUnderTest, Status, judged, result
 from twin_cli.checks.model_joints import SLIDE, limited_range
 from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
@@ -142,13 +142,12 @@ def check_inertia(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float
             " the simulated inertia is not the declared one (armature on the free joint, or "
             "inertial frames lost in conversion)"
         )
-    return result(
+    return judged(
         "inertia",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"|α − I⁻¹τ| / |I⁻¹τ| = {error:.2e}",
         f"≤ {th['rel_tol']:g}",
-        hints=hints,
+        hints,
         value=error,
     )
 
@@ -177,13 +176,12 @@ def check_stability(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
     run.run(scenario.duration, sample, every=10)
     gain = (peak[0] - start_energy) / scale
     hints = _stability_hints(run, finite[0], gain, spin, th)
-    return result(
+    return judged(
         "stability",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"energy gain {gain:.2%} of m·g·h, max spin {max(spin.values()):.3g} rad/s",
         f"≤ {th['max_energy_gain']:.0%}, ≤ {th['max_spin_rad_s']:g} rad/s, 0 warnings",
-        hints=hints,
+        hints,
         value=gain,
     )
 
@@ -233,12 +231,11 @@ def check_realtime(robot: RobotUnderTest, scenario: Scenario, th: dict[str, floa
             f"{target:g} target at {w.rate:g} Hz: simplify collision meshes (--collision hull) "
             "or raise the timestep"
         )
-    return result(
+    return judged(
         "realtime",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"capacity {factor:.2f}× real time",
         f"≥ {th['min_factor'] * target:g}×",
-        hints=hints,
+        hints,
         value=factor,
     )

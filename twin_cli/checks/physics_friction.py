@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from twin_cli.checks.base import RobotUnderTest, Series, Status, fmt_len, result
+from twin_cli.checks.base import RobotUnderTest, Series, Status, fmt_len, judged, result
 from twin_cli.checks.model_inertia import collision_geoms
 from twin_cli.checks.physics_contact import skip_fixed
 from twin_cli.checks.sim import ScenarioRun
@@ -67,13 +67,12 @@ def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[
             "<gazebo> block, or check that the posture hold is not fighting a joint limit"
         )
     series = Series("foot slip", "m", tuple(times), {names[b]: tuple(slips[b]) for b in feet})
-    return result(
+    return judged(
         "friction_standing",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"slip {fmt_len(slip)}",
         f"≤ {fmt_len(th['max_slip_m'])}",
-        hints=hints,
+        hints,
         value=slip,
         series=[series],
     )

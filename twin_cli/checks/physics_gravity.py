@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin_cli.checks.base import RobotUnderTest, Series, Status, fmt_len, result
+from twin_cli.checks.base import RobotUnderTest, Series, Status, fmt_len, judged, result
 from twin_cli.checks.sim import ScenarioRun
 from twin_cli.scenario import Scenario
 
@@ -76,13 +76,12 @@ def check_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float
     series = Series(
         "free fall", "m", tuple(t), {"measured drop": tuple(drop), "½gt²": tuple(expected)}
     )
-    return result(
+    return judged(
         "gravity",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"drop {fmt_len(drop[-1])} ({error:.2%} off ½gt²)",
         f"≤ {th['rel_tol']:.0%} off",
-        hints=hints,
+        hints,
         value=error,
         series=[series],
     )
@@ -103,13 +102,12 @@ def check_moon_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
             f"measured acceleration {accel:.3f} m/s² is {ratio:.4f} of Earth's, expected "
             f"{target:.4f}: the world's gravity preset did not reach the robot"
         )
-    return result(
+    return judged(
         "moon_gravity",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"a/g_earth = {ratio:.4f}",
         f"{target:.4f} ± {th['rel_tol']:.0%}",
-        hints=hints,
+        hints,
         value=ratio,
     )
 
@@ -137,12 +135,11 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
             f"link '{name}' moves {fmt_len(moved[worst])} without gravity or control: check its "
             "joint springs (springStiffness/springReference) and initial overlaps"
         )
-    return result(
+    return judged(
         "zero_gravity",
         "physics",
-        Status.FAIL if hints else Status.PASS,
         f"COM drift {fmt_len(drift)}, links {fmt_len(float(moved.max()))}",
         f"≤ {fmt_len(th['max_com_drift_m'])}, ≤ {fmt_len(th['max_link_motion_m'])}",
-        hints=hints,
+        hints,
         value=drift,
     )
