@@ -6,6 +6,11 @@ volume_reference ("mesh" when the mesh is closed, else "hull"), volume_ratio (su
 volumes / reference volume), seconds (this run), compute_seconds (when first computed),
 cache ("hit" | "miss" | "off"), fallback (why CoACD was replaced by the hull, else None)`,
 and one line in `report.entries`. `report.summary["collision"]` totals them.
+
+Cache: a result is stored under its content key (mesh bytes, scale, mode, CoACD parameters).
+A fallback that would recur is cached too, so a mesh that times out costs its time limit once,
+not on every conversion: a timeout under a second key that adds the time limit (a longer limit
+retries), and "no usable part" under the content key. A crashed worker is never cached.
 """
 
 from __future__ import annotations
@@ -37,6 +42,10 @@ from converters.progress import MeshProgress
 from converters.report import Report
 
 Pairs = list[tuple[np.ndarray, np.ndarray]]
+RETRY_HINT = (
+    " (cached fallback: a longer CoACD time limit, other CoACD settings or"
+    " `twin cache clear` makes the next conversion try again)"
+)
 ROW_FIELDS = (
     "key",
     "link",
@@ -66,6 +75,7 @@ class _Plan:
     params: CoacdParams
     volume_reference: tuple[str, float]
     content_key: str
+    fallback_key: str
     use_cache: bool
     started: float
 
@@ -110,7 +120,8 @@ def _plan(
     if requested is CollisionMode.MESH:
         return None, None
     key = _cache_key(request, requested, params)
-    hit = mesh_cache.load(key) if settings.use_cache else None
+    fallback_key = _cache_key(request, requested, params, time_limit=settings.time_limit)
+    hit = _load(key, fallback_key) if settings.use_cache else None
     if hit is not None:  # the entry may come from another link with the same mesh bytes
         own = {"key": request.key, "link": request.link, "source": request.source}
         row = {**hit.meta, **own, "cache": "hit", "seconds": time.perf_counter() - started}
@@ -121,8 +132,23 @@ def _plan(
         volumes = hulls.MeshVolumes(mesh=None, hull=0.0)
     decision = _decision(request, requested, volumes)
     reference = ("mesh", volumes.mesh) if volumes.mesh is not None else ("hull", volumes.hull)
-    plan = _Plan(request, requested, decision, params, reference, key, settings.use_cache, started)
+    plan = _Plan(
+        request,
+        requested,
+        decision,
+        params,
+        reference,
+        key,
+        fallback_key,
+        settings.use_cache,
+        started,
+    )
     return plan, None
+
+
+def _load(key: str, fallback_key: str) -> mesh_cache.CachedResult | None:
+    """The stored result, else the stored timeout fallback under this time limit, else None."""
+    return mesh_cache.load(key) or mesh_cache.load(fallback_key)
 
 
 def _decision(
@@ -135,8 +161,15 @@ def _decision(
     return Decision(requested, f"--collision {requested.value}", volumes.convexity)
 
 
-def _cache_key(request: CollisionRequest, requested: CollisionMode, params: CoacdParams) -> str:
+def _cache_key(
+    request: CollisionRequest,
+    requested: CollisionMode,
+    params: CoacdParams,
+    time_limit: float | None = None,
+) -> str:
+    """Content key; with `time_limit` [s], the key of a timeout fallback under that limit."""
     facts = {
+        "time_limit": time_limit,
         "mode": requested.value,
         "scale": list(request.scale),
         "params": params.kwargs(),
@@ -166,7 +199,7 @@ def _without_coacd(request: CollisionRequest, plan: _Plan | None) -> tuple[Pairs
         row["volume_ratio"] = 1.0
         return parts, row
     parts = _hull_parts(request.vertices, plan.params.max_ch_vertex)
-    return parts, _finish(plan, parts, fallback=None)
+    return parts, _finish(plan, parts, fallback=None, store_key=plan.content_key)
 
 
 def _hull_parts(vertices: np.ndarray, cap: int) -> Pairs:
@@ -181,18 +214,28 @@ def _from_outcome(plan: _Plan, outcome: DecomposeOutcome) -> tuple[Pairs, dict[s
     """Capped CoACD parts, or the hull when the worker failed or left nothing usable."""
     cap = plan.params.max_ch_vertex
     parts = [hulls.convex_hull(v, cap) for v, f in outcome.parts if hulls.usable_part(v, f)]
-    failure = outcome.failure
+    failure, store_key = outcome.failure, plan.content_key
     if failure is None and not parts:
         failure = "CoACD returned no usable part"
+    elif outcome.timed_out:
+        store_key = plan.fallback_key
+    elif failure is not None:
+        store_key = None  # a crash may not recur (out-of-memory kill, Ctrl-C): retry next time
     if failure is not None:
         parts = _hull_parts(plan.request.vertices, cap)
-    return parts, _finish(plan, parts, fallback=failure, worker_seconds=outcome.seconds)
+    row = _finish(plan, parts, failure, store_key=store_key, worker_seconds=outcome.seconds)
+    return parts, row
 
 
 def _finish(
-    plan: _Plan, parts: Pairs, fallback: str | None, worker_seconds: float | None = None
+    plan: _Plan,
+    parts: Pairs,
+    fallback: str | None,
+    *,
+    store_key: str | None,
+    worker_seconds: float | None = None,
 ) -> dict[str, Any]:
-    """Build the row and store the result (never a fallback: a retry may do better)."""
+    """Build the row and store the result under `store_key` (None: not stored)."""
     mode = CollisionMode.HULL if fallback else plan.decision.mode
     # A CoACD mesh is timed by its worker (not the wait in the queue behind other meshes).
     seconds = time.perf_counter() - plan.started if worker_seconds is None else worker_seconds
@@ -207,10 +250,10 @@ def _finish(
     )
     row["fallback"] = fallback
     row["cache"] = "miss" if plan.use_cache else "off"
-    if plan.use_cache and fallback is None:
+    if plan.use_cache and store_key is not None:
         meta = {k: v for k, v in row.items() if k not in ("cache", "seconds")}
         try:
-            mesh_cache.store(plan.content_key, parts, meta)
+            mesh_cache.store(store_key, parts, meta)
         except OSError as exc:
             row["cache"] = f"not stored: {exc}"
     return row
@@ -262,7 +305,8 @@ def _report(
         subject = f"link '{row['link']}' collision mesh {Path(row['source']).name}"
         report.meshes.append(row)
         if row["fallback"]:
-            report.warn(subject, f"{row['fallback']}; using its convex hull instead")
+            again = RETRY_HINT if row["cache"] == "hit" else ""
+            report.warn(subject, f"{row['fallback']}; using its convex hull instead{again}")
         elif row["parts"] == 0:
             report.warn(subject, f"{row['reason']}; left out of collision")
         else:

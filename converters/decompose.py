@@ -48,12 +48,18 @@ class DecomposeJob:
 
 @dataclass(frozen=True)
 class DecomposeOutcome:
-    """What became of one job: parts as (vertices [m], faces) pairs, or a failure reason."""
+    """What became of one job: parts as (vertices [m], faces) pairs, or a failure reason.
+
+    `timed_out` marks a worker stopped at the time limit: the same mesh, parameters and limit
+    would time out again, so that fallback may be cached; a crash may come from outside
+    (out-of-memory killer, Ctrl-C), so it is retried.
+    """
 
     key: str
     parts: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
     seconds: float = 0.0
     failure: str | None = None
+    timed_out: bool = False
 
 
 @dataclass
@@ -123,14 +129,15 @@ def _kill(run: _Running, time_limit: float) -> DecomposeOutcome:
     run.process.kill()
     run.process.wait()
     reason = f"CoACD exceeded the {time_limit:g} s time limit and was stopped"
-    return DecomposeOutcome(run.job.key, seconds=time.perf_counter() - run.started, failure=reason)
+    seconds = time.perf_counter() - run.started
+    return DecomposeOutcome(run.job.key, seconds=seconds, failure=reason, timed_out=True)
 
 
 def decompose_all(
     jobs: list[DecomposeJob],
     *,
     workers: int | None = None,
-    time_limit: float = 120.0,
+    time_limit: float = 20.0,
     on_done: Callable[[DecomposeOutcome], None] | None = None,
 ) -> dict[str, DecomposeOutcome]:
     """Decompose every job, at most `workers` at a time, each in its own process.

@@ -11,6 +11,8 @@ from collision_models import CUP_FLOOR, CUP_RIM, box_mesh, cup_mesh, request
 from converters import hulls
 from converters.collision import (
     CONVEX_RATIO,
+    HEAVY_CAPS,
+    HEAVY_TRIANGLES,
     PRESETS,
     TRIANGLES_ADVISED,
     TRIANGLES_MAX,
@@ -82,6 +84,21 @@ def test_presets_trade_quality_for_time():
     assert fast.threshold > balanced.threshold > fine.threshold, "coarser threshold is faster"
     assert fast.mcts_iterations < balanced.mcts_iterations <= fine.mcts_iterations
     assert fast.max_convex_hull < balanced.max_convex_hull < fine.max_convex_hull
+
+
+def test_heavy_mesh_gets_cheaper_coacd_search_unless_the_user_sets_knobs():
+    light = request("cup/0", cup_mesh(8))  # 128 triangles
+    heavy = request("cup/0", cup_mesh(HEAVY_TRIANGLES // 8 + 1))  # 8 triangles per section
+    assert len(heavy.faces) > HEAVY_TRIANGLES >= len(light.faces), "fixture sizes"
+    balanced = PRESETS["balanced"]
+    assert coacd_params(light, CollisionSettings()) == balanced, "light mesh keeps its preset"
+    sized = coacd_params(heavy, CollisionSettings())
+    assert sized.threshold == HEAVY_CAPS["threshold"] > balanced.threshold, "coarser threshold"
+    for name in ("max_convex_hull", "mcts_iterations", "mcts_nodes", "resolution"):
+        assert getattr(sized, name) == HEAVY_CAPS[name], f"{name} capped"
+    knobs = CollisionSettings(threshold=0.04, max_hulls=20, resolution=3000)
+    chosen = coacd_params(heavy, knobs)
+    assert (chosen.threshold, chosen.max_convex_hull, chosen.resolution) == (0.04, 20, 3000)
 
 
 @pytest.mark.parametrize(

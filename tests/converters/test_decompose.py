@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from collision_models import box_mesh, cup_mesh, request
+from collision_models import CUP_OUTER_R, CUP_RIM, box_mesh, cup_mesh, request
 
 from converters import hulls
 from converters.collision import PRESETS, CollisionSettings, prepare_collision_meshes
@@ -95,3 +95,29 @@ def test_fallbacks_are_not_cached_so_a_retry_decomposes(monkeypatch):
     assert first.meshes[0]["fallback"] and second.meshes[0]["fallback"] is None
     assert second.meshes[0]["cache"] == "miss" and len(parts) >= 2, "retried with CoACD"
     assert all(np.isfinite(p.vertices).all() for p in parts), "finite part vertices"
+
+
+def test_timed_out_mesh_is_served_from_cache_without_a_worker(monkeypatch):
+    # Oracle: the cached fallback is the mesh's convex hull, volume pi R^2 h for the cup
+    # (32-gon: within 1 %), and a second conversion starts no worker: any worker now crashes,
+    # which would show as a crash fallback instead of the cached timeout.
+    cup = request("cup/0", cup_mesh(32))
+    settings = CollisionSettings(mode="coacd", preset="fast", time_limit=1.0)
+    monkeypatch.setenv(FAULT_ENV, "hang:cup/0")
+    first = Report()
+    prepare_collision_meshes([cup], settings, first)
+    monkeypatch.setenv(FAULT_ENV, "crash:*")
+    second = Report()
+    parts = prepare_collision_meshes([cup], settings, second)["cup/0"]
+    row = second.meshes[0]
+    assert first.meshes[0]["cache"] == "miss" and row["cache"] == "hit", "timeout cached"
+    assert "exceeded the 1 s time limit" in row["fallback"], f"fallback: {row['fallback']}"
+    assert second.summary["collision"]["coacd_runs"] == 0, "no CoACD worker on the second run"
+    volume = hulls.hull_volume((parts[0].vertices, parts[0].faces))
+    assert volume == pytest.approx(np.pi * CUP_OUTER_R**2 * CUP_RIM, rel=0.01), "hull volume"
+    assert any("cached fallback" in e.detail for e in second.of(Outcome.WARNING)), "retry hint"
+    # A longer time limit is another key: the mesh is decomposed again (and crashes here).
+    third = Report()
+    longer = CollisionSettings(mode="coacd", preset="fast", time_limit=2.0)
+    prepare_collision_meshes([cup], longer, third)
+    assert third.summary["collision"]["coacd_runs"] == 1, "a longer limit retries CoACD"
