@@ -36,7 +36,7 @@ from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
 from twin_cli.loop import SteppingLoop, WorldLock
 from twin_cli.pose import Pose
 from twin_cli.queries import JointState
-from twin_cli.scene import build_world_spec, solver_tolerance
+from twin_cli.scene import build_world_spec
 from twin_cli.world_control import EntityControl
 from twin_cli.world_physics import PhysicsSettings
 from twin_cli.world_run import STATE, RunControl
@@ -75,7 +75,6 @@ class World(RunControl, PhysicsSettings, EntityControl):
         self.lock = WorldLock()
         self._spec = build_world_spec(scene_settings(self.settings))
         self.model = self._spec.compile()
-        self.model.opt.tolerance = solver_tolerance(self.model)
         self.data = mujoco.MjData(self.model)
         self._entities: dict[str, Entity] = {}
         self._index: dict[str, EntityIndex] = {}
@@ -239,7 +238,6 @@ class World(RunControl, PhysicsSettings, EntityControl):
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = spec, model, data, index
-        model.opt.tolerance = solver_tolerance(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
         control.apply_pushes(model, data, self._pushes, {p.body for p in self._pushes})

@@ -52,7 +52,7 @@ def test_spawning_a_second_robot_leaves_the_falling_first_ones_trajectory_unchan
     with_spawn = falling_trajectory(humanoid_spec, spawn_second=True)
     assert np.array_equal(alone[:100], with_spawn[:100]), "identical before the spawn"
     difference = np.max(np.abs(alone - with_spawn))
-    # Not bitwise: MuJoCo's line search scales with the whole model (see scene.solver_tolerance).
+    # Not bitwise: an island's solver stopping point shifts with the model (see scene.SOLVER_TOLERANCE).
     assert difference <= 1e-12, f"first robot's qpos changed by {difference:.3g} after the spawn"
 
 
