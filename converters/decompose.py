@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from converters.mesh_cache import unpack_parts
+
 # Test-only hook: "<fault>:<request key>" (or "<fault>:*"), comma-separated, makes the worker
 # for that mesh misbehave (fault = crash | kill | abort | hang | error), so tests exercise real
 # processes dying and hanging.
@@ -115,7 +117,7 @@ def _collect(run: _Running) -> DecomposeOutcome:
     code = run.process.returncode
     if code == 0 and run.result.exists():
         with np.load(run.result, allow_pickle=False) as data:
-            parts = [(data[f"v{i}"], data[f"f{i}"]) for i in range(int(data["count"]))]
+            parts = unpack_parts(data, int(data["count"]))
         return DecomposeOutcome(run.job.key, parts=parts, seconds=elapsed)
     if code is not None and code < 0:
         failure = f"CoACD worker killed by signal {signal.Signals(-code).name}"

@@ -15,6 +15,8 @@ import time
 
 import numpy as np
 
+from converters.mesh_cache import pack_parts
+
 EXIT_ERROR = 3
 
 
@@ -44,10 +46,7 @@ def run(job_path: str, result_path: str) -> None:
 
     coacd.set_log_level("error")
     parts = coacd.run_coacd(coacd.Mesh(vertices, faces), **params)
-    arrays = {"count": np.array(len(parts))}
-    for i, (part_vertices, part_faces) in enumerate(parts):
-        arrays[f"v{i}"] = np.asarray(part_vertices, np.float64)
-        arrays[f"f{i}"] = np.asarray(part_faces, np.int32)
+    arrays = {**pack_parts(parts), "count": np.array(len(parts))}
     tmp = f"{result_path}.part"
     with open(tmp, "wb") as stream:
         np.savez(stream, **arrays)

@@ -43,6 +43,21 @@ class CachedResult:
     meta: dict[str, Any]
 
 
+def pack_parts(parts: list[tuple[np.ndarray, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Parts as .npz arrays `v0, f0, v1, f1, ...` (float64 vertices, int32 faces); the one
+    layout shared by cache entries and CoACD worker results."""
+    arrays: dict[str, np.ndarray] = {}
+    for i, (vertices, faces) in enumerate(parts):
+        arrays[f"v{i}"] = np.asarray(vertices, np.float64)
+        arrays[f"f{i}"] = np.asarray(faces, np.int32)
+    return arrays
+
+
+def unpack_parts(data: Any, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The first `count` parts of an open .npz written from `pack_parts`."""
+    return [(data[f"v{i}"], data[f"f{i}"]) for i in range(count)]
+
+
 def cache_root() -> Path:
     """twin's cache directory: `$TWIN_CACHE_DIR` if set, else the per-user cache dir."""
     override = os.environ.get(ENV_CACHE_DIR)
@@ -99,7 +114,7 @@ def load(key: str) -> CachedResult | None:
     try:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
-            parts = [(data[f"v{i}"], data[f"f{i}"]) for i in range(int(meta["n_parts"]))]
+            parts = unpack_parts(data, int(meta["n_parts"]))
     except FileNotFoundError:
         return None
     except (OSError, ValueError, KeyError, EOFError):
@@ -116,10 +131,8 @@ def store(key: str, parts: list[tuple[np.ndarray, np.ndarray]], meta: dict[str, 
     """
     directory = collision_dir()
     directory.mkdir(parents=True, exist_ok=True)
-    arrays: dict[str, np.ndarray] = {"meta": np.array(json.dumps({**meta, "n_parts": len(parts)}))}
-    for i, (vertices, faces) in enumerate(parts):
-        arrays[f"v{i}"] = np.asarray(vertices, np.float64)
-        arrays[f"f{i}"] = np.asarray(faces, np.int32)
+    arrays = pack_parts(parts)
+    arrays["meta"] = np.array(json.dumps({**meta, "n_parts": len(parts)}))
     handle, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=directory)
     try:
         with os.fdopen(handle, "wb") as stream:

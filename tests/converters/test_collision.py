@@ -202,8 +202,9 @@ CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 # Robots whose converted model must also step 1 s without a MuJoCo warning (issue 3).
 MESH_ROBOTS = {"booster_t1", "solo12", "anymal_c", "open_manipulator_x", "robotiq_2f_85"}
 # CI keeps CoACD cold runs short: fast preset, and a mesh that needs longer than this falls
-# back to its hull (reported). open_manipulator_x's 13-21k-triangle meshes need 10-120 s each
-# on a shared 2-core machine, so some of them fall back here; bench_collision measures them.
+# back to its hull (reported). With the heavy-mesh caps open_manipulator_x's 13-21k-triangle
+# meshes need 2-14 s each, one over 20 s (chain_link1) on a shared 2-core machine, so some fall
+# back here; bench_collision measures the defaults.
 CORPUS_TIME_LIMIT = 8.0  # [s]
 
 
