@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from collision_models import CUP_FLOOR, CUP_RIM, box_mesh, cup_mesh, request
+from collision_models import CUP_FLOOR, CUP_INNER_R, CUP_RIM, box_mesh, cup_mesh, request
 
 from converters import hulls
 from converters.collision import (
@@ -87,7 +87,7 @@ def test_presets_trade_quality_for_time():
 
 
 def test_heavy_mesh_gets_cheaper_coacd_search_unless_the_user_sets_knobs():
-    light = request("cup/0", cup_mesh(8))  # 128 triangles
+    light = request("cup/0", cup_mesh(8))  # 64 triangles
     heavy = request("cup/0", cup_mesh(HEAVY_TRIANGLES // 8 + 1))  # 8 triangles per section
     assert len(heavy.faces) > HEAVY_TRIANGLES >= len(light.faces), "fixture sizes"
     balanced = PRESETS["balanced"]
@@ -154,22 +154,25 @@ CUP_URDF = """<?xml version="1.0"?>
 """
 
 
-def _write_cup_robot(directory) -> str:
+def _write_cup_robot(directory, sections: int = 32) -> str:
     """A static URDF whose only link is the cup mesh (an STL written here); returns its path."""
     import trimesh
 
-    trimesh.Trimesh(*cup_mesh(), process=False).export(directory / "cup.stl")
+    trimesh.Trimesh(*cup_mesh(sections), process=False).export(directory / "cup.stl")
     (directory / "cup.urdf").write_text(CUP_URDF)
     return str(directory / "cup.urdf")
 
 
-def _rest_height(urdf: str, mode: str) -> tuple[float, dict]:
-    """Convert the cup with `mode`, drop a free ball into it for 1.5 s; (ball height [m], row)."""
+def _drop_ball(urdf: str, settings: CollisionSettings, seconds: float):
+    """Convert the cup, drop a free ball into it and step `seconds` at 1 ms.
+
+    Returns:
+        (ball centre positions (steps, 3) [m], ball speeds (steps,) [m/s], the mesh's row).
+    """
     import mujoco
 
     from converters import ConvertOptions, convert
 
-    settings = CollisionSettings(mode=mode, preset="fast", use_cache=False)
     spec, report = convert(urdf, options=ConvertOptions(collision=settings))
     spec.option.timestep = 0.001
     ball = spec.worldbody.add_body(name="ball", pos=[0.0, 0.0, BALL_DROP_Z])
@@ -181,10 +184,21 @@ def _rest_height(urdf: str, mode: str) -> tuple[float, dict]:
     ball.inertia = [0.4 * 0.01 * BALL_RADIUS**2] * 3  # solid sphere, 2/5 m r^2 [kg m^2]
     model = spec.compile()
     data = mujoco.MjData(model)
-    mujoco.mj_step(model, data, nstep=1500)
-    speed = float(np.linalg.norm(data.qvel[-6:-3]))
-    assert speed < 0.05, f"{mode}: ball still moving at {speed:.3f} m/s after 1.5 s"
-    return float(data.qpos[-5]), report.meshes[0]
+    positions, speeds = [], []
+    for _ in range(round(seconds / 0.001)):
+        mujoco.mj_step(model, data)
+        positions.append(data.qpos[-7:-4].copy())
+        speeds.append(float(np.linalg.norm(data.qvel[-6:-3])))
+    return np.array(positions), np.array(speeds), report.meshes[0]
+
+
+def _rest_height(urdf: str, mode: str) -> tuple[float, dict]:
+    """Drop a ball into the cup converted with `mode` (fast preset) for 1.5 s; it must come to
+    rest. Returns (ball height [m], the mesh's row)."""
+    settings = CollisionSettings(mode=mode, preset="fast", use_cache=False)
+    positions, speeds, row = _drop_ball(urdf, settings, 1.5)
+    assert speeds[-1] < 0.05, f"{mode}: ball still moving at {speeds[-1]:.3f} m/s after 1.5 s"
+    return float(positions[-1, 2]), row
 
 
 def test_ball_rests_inside_coacd_cup_and_on_top_of_hull_cup(tmp_path):
@@ -196,6 +210,21 @@ def test_ball_rests_inside_coacd_cup_and_on_top_of_hull_cup(tmp_path):
     assert inside < CUP_FLOOR + BALL_RADIUS + 0.015, f"coacd: ball centre at {inside:.4f} m"
     # On the hull: the hull's top is the rim plane, the ball sits one radius above it.
     assert on_top == pytest.approx(CUP_RIM + BALL_RADIUS, abs=0.002), f"hull: {on_top:.4f} m"
+
+
+def test_ball_stays_inside_heavy_cup_decomposed_by_the_default_auto_plan(tmp_path):
+    # 2,008 triangles: over HEAVY_TRIANGLES, so the cheaper CoACD search runs; the cavity must
+    # stay open. Oracle: over the last second the ball's centre stays inside the cavity (below
+    # the rim and within the inner wall), where the hull would hold it at rim + radius.
+    # (Measured: it does not come to rest; slanted part tops and seams keep it rolling and
+    # kicked at up to ~0.9 m/s, also at threshold 0.10, so rest is not asserted here.)
+    urdf = _write_cup_robot(tmp_path, sections=HEAVY_TRIANGLES // 8 + 1)
+    positions, _, row = _drop_ball(urdf, CollisionSettings(use_cache=False), 2.0)
+    assert row["triangles_before"] > HEAVY_TRIANGLES and row["mode"] == "coacd", f"row: {row}"
+    last = positions[-1000:]
+    highest, widest = last[:, 2].max(), np.linalg.norm(last[:, :2], axis=1).max()
+    assert highest < CUP_RIM, f"heavy cup: ball centre up to {highest:.4f} m (rim {CUP_RIM} m)"
+    assert widest < CUP_INNER_R, f"heavy cup: ball centre {widest:.4f} m off the axis"
 
 
 CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
