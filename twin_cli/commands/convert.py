@@ -36,8 +36,14 @@ def _collision_settings(
     seed: int,
     jobs: int | None,
     no_cache: bool,
+    time_limit: float | None = None,
+    threshold_m: float | None = None,
 ) -> dict[str, Any]:
+    extra = {"time_limit": time_limit} if time_limit is not None else {}
     return {
+        **extra,
+        "threshold_m": threshold_m,
+        "progress": True,
         "mode": mode,
         "per_link": parse_pairs(per_link, "=", "--collision-link"),
         "preset": preset,
@@ -80,6 +86,14 @@ def convert_command(
     coacd_resolution: Annotated[
         int | None, typer.Option("--coacd-resolution", help="CoACD sampling resolution.")
     ] = None,
+    coacd_threshold_m: Annotated[
+        float | None,
+        typer.Option("--coacd-threshold-m", help="CoACD concavity threshold in metres."),
+    ] = None,
+    coacd_time_limit: Annotated[
+        float | None,
+        typer.Option("--coacd-time-limit", help="Seconds per mesh before the hull fallback."),
+    ] = None,
     seed: Annotated[int, typer.Option("--seed", help="CoACD random seed.")] = 0,
     jobs: Annotated[int | None, typer.Option("--jobs", help="Parallel CoACD workers.")] = None,
     no_cache: Annotated[
@@ -101,6 +115,8 @@ def convert_command(
         seed,
         jobs,
         no_cache,
+        coacd_time_limit,
+        coacd_threshold_m,
     )
     done = convert_full(
         robot,
