@@ -9,6 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 from models import mjcf_arm, mjcf_ball, mjcf_box, mjcf_stiff_spring
+from world_helpers import full_state, spec_of
 
 import twin_cli.world as world_module
 from twin_cli.errors import (
@@ -18,18 +19,6 @@ from twin_cli.errors import (
     WorldFileError,
 )
 from twin_cli.world import Pose, World, WorldSettings
-
-STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-
-
-def spec_of(xml: str) -> mujoco.MjSpec:
-    return mujoco.MjSpec.from_string(xml)
-
-
-def full_state(world: World) -> np.ndarray:
-    state = np.empty(mujoco.mj_stateSize(world.model, STATE))
-    mujoco.mj_getState(world.model, world.data, state, STATE)
-    return state
 
 
 def test_public_names_exist():

@@ -6,21 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 from models import mjcf_ball, mjcf_box, mjcf_with_home
+from world_helpers import full_state, spec_of
 
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, InvalidRequestError, SpawnError
 from twin_cli.world import Pose, World
-
-STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-
-
-def spec_of(xml: str) -> mujoco.MjSpec:
-    return mujoco.MjSpec.from_string(xml)
-
-
-def full_state(world: World) -> np.ndarray:
-    state = np.empty(mujoco.mj_stateSize(world.model, STATE))
-    mujoco.mj_getState(world.model, world.data, state, STATE)
-    return state
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +41,7 @@ def test_spawning_a_second_robot_leaves_the_falling_first_ones_trajectory_unchan
     with_spawn = falling_trajectory(humanoid_spec, spawn_second=True)
     assert np.array_equal(alone[:100], with_spawn[:100]), "identical before the spawn"
     difference = np.max(np.abs(alone - with_spawn))
-    # Not bitwise: an island's solver stopping point shifts with the model (see scene.SOLVER_TOLERANCE).
+    # Not bitwise: island solves stop where the model decides (see scene.SOLVER_TOLERANCE).
     assert difference <= 1e-12, f"first robot's qpos changed by {difference:.3g} after the spawn"
 
 
