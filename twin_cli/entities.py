@@ -74,6 +74,7 @@ class Entity:
         spawn_state: the state `reset` returns it to.
         report: the converter's report as a dict (URDF/xacro sources), else None.
         xml: MJCF text of an MjSpec source (for save/load), else None.
+        joints: initial joint positions given at spawn (`-J`), name → [rad] or [m].
     """
 
     name: str
@@ -85,6 +86,7 @@ class Entity:
     spawn_state: EntityState
     report: dict | None = None
     xml: str | None = field(default=None, repr=False)
+    joints: dict[str, float] = field(default_factory=dict)
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:

@@ -20,7 +20,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
-from twin_cli import control, placement, queries, spawn
+from twin_cli import control, placement, posture, queries, spawn
 from twin_cli.divergence import Divergence
 from twin_cli.entities import (
     Entity,
@@ -99,15 +99,22 @@ class World(RunControl, PhysicsSettings, EntityControl):
         args: dict[str, str] | None = None,
         package_paths: dict[str, str] | None = None,
         on_ground: bool = False,
+        joints: dict[str, float] | None = None,
     ) -> SpawnResult:
         """Adds an entity at `pose`; existing entities keep their exact state.
 
         The source is read (and converted) before the lock is taken, so a slow conversion does
         not stall the loop. The new entity starts at rest in its own initial configuration
-        (its `home` key if it has one). Returns once the entity is in the world.
+        (its `home` key if it has one) with `joints` (Gazebo's `spawn_model -J`: joint name
+        without prefix → position [rad] or [m]) written over it; mimic followers follow their
+        leaders. That start is its spawn state (what `reset` returns to). Returns once the
+        entity is in the world.
 
         Raises:
             EntityExistsError: `name` is taken. SpawnError: unreadable source or compile error.
+            PartNotFoundError: a `joints` name is not a hinge/slide joint of the entity.
+            InvalidRequestError: a `joints` value is outside its joint's range (or sets a mimic
+                follower). On any error the world is unchanged.
             converters.ConversionError: the converter refused the file.
         """
         if name is not None:
@@ -117,7 +124,9 @@ class World(RunControl, PhysicsSettings, EntityControl):
             name = self._free_name(name, loaded.default_name)
             try:
                 home = self._attach(loaded, name, pose)
-                pose, state, (model, data, index) = self._seed(loaded, name, pose, home, on_ground)
+                pose, state, (model, data, index) = self._seed(
+                    loaded, name, pose, home, on_ground, joints or {}
+                )
                 warnings = placement.start_warnings(model, data, index, name, pose.z)
             except BaseException:
                 spawn.remove_entity(self._spec, name)  # the world spec as it was before
@@ -132,6 +141,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 state,
                 loaded.report,
                 loaded.xml,
+                dict(joints or {}),
             )
             self._commit(self._spec, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report)
@@ -154,10 +164,13 @@ class World(RunControl, PhysicsSettings, EntityControl):
         pose: Pose,
         home: np.ndarray | None,
         on_ground: bool,
+        joints: dict[str, float],
     ) -> tuple[Pose, EntityState, _Built]:
         """Compiles the world with the attached entity and writes its initial state at rest."""
         model, data, index = self._rebuild(self._spec, name, loaded.source)
-        q = spawn.initial_qpos(model, index[name], home, pose)
+        ix = index[name]
+        targets = posture.joint_targets(model, ix.joints, f"{name}/", joints, name)
+        q = posture.apply_targets(spawn.initial_qpos(model, ix, home, pose), ix.qpos, targets)
         if on_ground:
             pose, q, (model, data, index) = self._ground(model, data, index, name, pose, q)
         state = rest_state(model, index[name], q)
@@ -228,7 +241,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
             return pose, q, (model, data, index)
         spawn.move_frame(self._spec, name, pose)
         model, data, index = self._rebuild(self._spec, name, "on-ground placement")
-        return pose, model.qpos0[index[name].qpos].copy(), (model, data, index)
+        return pose, q, (model, data, index)  # joint values keep their layout; only the frame moved
 
     def _commit(
         self,

@@ -72,6 +72,7 @@ def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
         "pose": entity.pose.to_dict(),
         "on_ground": entity.on_ground,
         "xml": entity.xml,
+        "joints": entity.joints,
         "spawn_state": state,
     }
 
@@ -152,6 +153,7 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         pose=Pose(**item["pose"]),
         args=item["args"] or None,
         package_paths=item["package_paths"] or None,
+        joints=item.get("joints") or None,  # absent in files saved before -J existed
     )
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world._entities[item["name"]]
@@ -165,6 +167,7 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         _typed_like(entity.spawn_state, spawn_state),
         entity.report,
         entity.xml,
+        entity.joints,
     )
 
 
