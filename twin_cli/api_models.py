@@ -41,6 +41,9 @@ class SpawnBody(Body):
     args: dict[str, str] = {}
     package_paths: dict[str, str] = {}
     on_ground: bool = False
+    joints: dict[str, Finite] = Field(
+        default={}, description="initial joint positions [rad] or [m] by URDF joint name (-J)"
+    )
 
 
 class PushBody(Body):

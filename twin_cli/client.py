@@ -152,8 +152,12 @@ class Client:
         args: dict[str, str] | None = None,
         package_paths: dict[str, str] | None = None,
         on_ground: bool = False,
+        joints: dict[str, float] | None = None,
     ) -> dict:
-        """Spawn a file (paths made absolute here: the server has its own working directory)."""
+        """Spawn a file (paths made absolute here: the server has its own working directory).
+
+        `joints`: initial joint positions [rad] or [m] by joint name (Gazebo's `-J`).
+        """
         body = {
             "source": str(Path(source).expanduser().absolute()),
             "name": name,
@@ -163,6 +167,7 @@ class Client:
                 k: str(Path(v).expanduser().absolute()) for k, v in (package_paths or {}).items()
             },
             "on_ground": on_ground,
+            "joints": joints or {},
         }
         return self.request("POST", "/entities", body=body, timeout=SPAWN_TIMEOUT_S)
 

@@ -19,6 +19,14 @@ PackageOpt = Annotated[
     list[str] | None,
     typer.Option("--package", help="Package location NAME=PATH (repeatable)."),
 ]
+JointOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "-J",
+        "--joint",
+        help="Initial joint position NAME=POS [rad or m] (repeatable; Gazebo's -J NAME POS).",
+    ),
+]
 XOpt = Annotated[float, typer.Option("-x", help="Spawn x [m].")]
 YOpt = Annotated[float, typer.Option("-y", help="Spawn y [m].")]
 ZOpt = Annotated[float, typer.Option("-z", help="Spawn z [m].")]
@@ -35,6 +43,24 @@ def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:
             raise typer.BadParameter(f"{what} {item!r} must look like NAME{sep}VALUE")
         name, value = item.split(sep, 1)
         out[name.strip()] = value.strip()
+    return out
+
+
+def joint_positions(items: list[str] | None) -> dict[str, float]:
+    """Repeated `-J NAME=POS` as joint name → position [rad] or [m].
+
+    Gazebo's `spawn_model -J NAME POS` takes two values per flag; Typer cannot repeat an option
+    of two values ("List types with complex sub-types are not currently supported"), so twin
+    takes one `NAME=POS` value per flag.
+    """
+    out: dict[str, float] = {}
+    for name, value in parse_pairs(items, "=", "-J").items():
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise typer.BadParameter(
+                f"-J {name}={value}: {value!r} is not a number; give e.g. -J {name}=0.5"
+            ) from None
     return out
 
 

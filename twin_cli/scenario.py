@@ -94,10 +94,23 @@ class WorldSpec(_Strict):
 
 
 class RobotStart(_Strict):
-    """Where the robot starts; `on_ground` lowers it until its lowest geom touches z = 0."""
+    """Where the robot starts; `on_ground` lowers it until its lowest geom touches z = 0.
+
+    `joints`: start positions [rad] or [m] by URDF joint name (Gazebo's `-J`), the rest from the
+    robot's home configuration; a `[hold]` holds this posture.
+    """
 
     pose: PoseSpec = PoseSpec()
     on_ground: bool = False
+    joints: dict[str, float] = {}
+
+    @field_validator("joints")
+    @classmethod
+    def _finite(cls, value: dict[str, float]) -> dict[str, float]:
+        for name, position in value.items():
+            if not math.isfinite(position):
+                raise ValueError(f"joint {name!r}: position {position} is not finite")
+        return value
 
 
 class Hold(_Strict):
@@ -205,3 +218,11 @@ def _fix_for(error: dict) -> str:
     if error["type"] == "missing":
         return "add this key (see docs/scenarios.md)"
     return "give a value of the documented type and range (see docs/scenarios.md)"
+
+
+def with_joints(scenario: Scenario, joints: dict[str, float]) -> Scenario:
+    """`scenario` with `joints` [rad] or [m] over its `[robot] joints` (the command line wins)."""
+    if not joints:
+        return scenario
+    start = scenario.robot.model_copy(update={"joints": {**scenario.robot.joints, **joints}})
+    return scenario.model_copy(update={"robot": start})

@@ -104,6 +104,7 @@ def spawn(body: SpawnBody, world: WorldDep) -> dict:
         args=body.args,
         package_paths=body.package_paths,
         on_ground=body.on_ground,
+        joints=body.joints,
     )
     log.info("spawned %s from %s", result.name, body.source)
     return _plain(result)

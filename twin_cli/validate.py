@@ -14,8 +14,8 @@ from pathlib import Path
 
 from twin_cli.checks import CHECKS, MODEL_CHECKS
 from twin_cli.checks.base import CheckResult, DeclaredJoint, RobotUnderTest, Status, result
-from twin_cli.errors import ScenarioError, UnknownCheckError
-from twin_cli.scenario import Scenario, load_builtin, resolve
+from twin_cli.errors import ScenarioError, TwinError, UnknownCheckError
+from twin_cli.scenario import Scenario, load_builtin, resolve, with_joints
 
 
 @dataclass(frozen=True)
@@ -198,6 +198,7 @@ def validate(
     skip: list[str] | None = None,
     repair_inertia: bool = False,
     collision: str | None = None,
+    joints: dict[str, float] | None = None,
     debug: bool = False,
 ) -> ValidationRun:
     """Validate one robot: convert it, run the planned checks, return every result.
@@ -210,10 +211,12 @@ def validate(
         only, skip: check names to keep or leave out.
         repair_inertia: accept the converter's inertia repairs (warnings instead of failures).
         collision: the converter's collision-mesh mode (auto|coacd|hull|mesh); None = auto.
+        joints: start posture, joint name → [rad] or [m] (`-J`), over each scenario's
+            `[robot] joints`; what a scenario's `[hold]` holds.
         debug: re-raise errors inside checks instead of reporting them as failures.
     """
     start = time.perf_counter()
-    todo = plan(scenarios, only, skip)
+    todo = [with_joints(sc, joints or {}) for sc in plan(scenarios, only, skip)]
     robot = load_robot(
         robot_path,
         args=args,
@@ -221,5 +224,32 @@ def validate(
         repair_inertia=repair_inertia,
         collision=collision,
     )
+    check_start_postures(robot, todo, joints or {})
     results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
     return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)
+
+
+def check_start_postures(
+    robot: RobotUnderTest, todo: list[Scenario], joints: dict[str, float]
+) -> None:
+    """Checks every scenario's start joints against the robot before anything runs.
+
+    A wrong name or an out-of-range value is bad input (exit 2), not a failed check.
+
+    Raises:
+        PartNotFoundError, InvalidRequestError: a `-J` joint is unknown or out of range.
+        ScenarioError: a scenario file's `[robot] joints` is (names the file and key).
+    """
+    import numpy as np
+
+    from twin_cli.posture import joint_targets
+
+    all_joints = np.arange(robot.model.njnt)
+    joint_targets(robot.model, all_joints, "", joints, robot.name)
+    for sc in todo:
+        try:
+            joint_targets(robot.model, all_joints, "", dict(sc.robot.joints), robot.name)
+        except TwinError as exc:
+            raise ScenarioError(
+                sc.source, "robot.joints", str(exc), "fix the joint name or position"
+            ) from exc

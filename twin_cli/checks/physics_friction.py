@@ -109,7 +109,10 @@ def slide_on_slope(robot: RobotUnderTest, spec, scenario: Scenario, theta: float
     from twin_cli.checks.base import RobotUnderTest as Robot
 
     world = scenario.world.model_copy(update={"incline_deg": math.degrees(theta)})
-    probe_scenario = scenario.model_copy(update={"world": world, "actions": [], "hold": None})
+    start = scenario.robot.model_copy(update={"joints": {}})  # the probe has no joints
+    probe_scenario = scenario.model_copy(
+        update={"world": world, "robot": start, "actions": [], "hold": None}
+    )
     probe = Robot("probe", "probe", spec, robot.model, robot.report)
     run = ScenarioRun(probe, probe_scenario)
     start = run.subtree_com()

@@ -75,7 +75,11 @@ class ScenarioRun:
         self.world = World(settings, name=f"validate-{scenario.name}")
         pose = Pose(**scenario.robot.pose.model_dump())
         spawned = self.world.spawn(
-            robot.spec.copy(), name=robot.name, pose=pose, on_ground=scenario.robot.on_ground
+            robot.spec.copy(),
+            name=robot.name,
+            pose=pose,
+            on_ground=scenario.robot.on_ground,
+            joints=dict(scenario.robot.joints),
         )
         self.entity = spawned.name
         self._velocity_limits = {j.name: j.velocity for j in robot.declared_joints}

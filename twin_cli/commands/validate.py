@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from twin_cli.options import ArgOpt, JsonOpt, PackageOpt, source_inputs
+from twin_cli.options import ArgOpt, JointOpt, JsonOpt, PackageOpt, joint_positions, source_inputs
 
 ScenarioOpt = Annotated[
     list[str] | None,
@@ -53,6 +53,7 @@ def validate(
     plots: PlotsOpt = None,
     repair_inertia: RepairOpt = False,
     collision: CollisionOpt = None,
+    joint: JointOpt = None,
 ) -> None:
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
     from twin_cli import validation_report as render
@@ -67,6 +68,7 @@ def validate(
         skip=skip,
         repair_inertia=repair_inertia,
         collision=collision,
+        joints=joint_positions(joint),
     )
     out = Output(json)
     if json:

@@ -15,6 +15,7 @@ import typer
 
 from twin_cli.options import (
     ArgOpt,
+    JointOpt,
     JsonOpt,
     PackageOpt,
     PitchOpt,
@@ -24,6 +25,7 @@ from twin_cli.options import (
     YawOpt,
     YOpt,
     ZOpt,
+    joint_positions,
     source_inputs,
 )
 from twin_cli.output import Output
@@ -95,14 +97,16 @@ def spawn(
     arg: ArgOpt = None,
     package: PackageOpt = None,
     on_ground: Annotated[bool, typer.Option("--on-ground", help="Rest on the ground.")] = False,
+    joint: JointOpt = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
     """Spawn a robot; prints its name once it exists in the world."""
     inputs = source_inputs(arg, package)
+    joints = joint_positions(joint)
     pose = dict(zip(POSE_KEYS, (x, y, z, roll, pitch, yaw), strict=True))
     with _connect(world) as c:
-        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, **inputs)
+        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, joints=joints, **inputs)
     out = Output(json)
     if json:
         out.data(result)
