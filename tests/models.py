@@ -142,6 +142,32 @@ def falling_sibling(self_collide_link: str | None, model_self_collide: bool = Fa
 </robot>"""
 
 
+def mimic_pincer(offset: float = 0.2, multiplier: float = -1.0) -> str:
+    """A fixed-base pincer 1 m up: 'lead' (range ±1 rad) and 'follow' (range ±1 rad, mimic
+    `offset + multiplier · lead`), both hinges about y with a 0.5 kg, 0.2 m box finger whose
+    centre is 0.1 m along x, so gravity swings them; only 'lead' has a motor."""
+    limit = '<limit lower="-1" upper="1" effort="5" velocity="3"/>'
+    mimic = f'<mimic joint="lead" multiplier="{multiplier}" offset="{offset}"/>'
+    finger = _box_inertial(0.5, 0.2, 0.02, 0.02).replace("<mass", '<origin xyz="0.1 0 0"/><mass')
+
+    def joint(name: str, child: str, y: float, extra: str = "") -> str:
+        return (
+            f'<joint name="{name}" type="revolute"><parent link="base"/><child link="{child}"/>'
+            f'<origin xyz="0 {y} 0"/><axis xyz="0 1 0"/>{limit}{extra}</joint>'
+        )
+
+    return f"""<robot name="pincer">
+  <link name="world"/>
+  <link name="base">{_box_inertial(1.0, 0.1, 0.1, 0.1)}</link>
+  <link name="a">{finger}</link>
+  <link name="b">{finger}</link>
+  <joint name="anchor" type="fixed"><parent link="world"/><child link="base"/>
+    <origin xyz="0 0 1"/></joint>
+  {joint("lead", "a", 0.05)}
+  {joint("follow", "b", -0.05, mimic)}
+</robot>"""
+
+
 # ---- MJCF factories for the world engine (tests/twin_cli/test_world*.py) ----
 
 

@@ -10,7 +10,7 @@ import subprocess
 import sys
 
 import pytest
-from models import block
+from models import block, mimic_pincer
 
 import scenarios
 
@@ -139,3 +139,50 @@ def test_concurrent_first_commands_start_exactly_one_server(twin):
     assert codes == [0, 0, 0], f"exit codes {codes}: {[err for _, err in outs]}"
     started = sum("started world" in err for _, err in outs)
     assert started == 1, f"{started} servers announced by 3 simultaneous first commands"
+
+
+def _joints(twin: Twin, name: str) -> dict[str, tuple[float, float]]:
+    """name → (position [rad], velocity [rad/s]) as `twin joints --json` reports them."""
+    rows = json.loads(twin("joints", name, "--json").stdout)
+    return {r["name"]: (r["position"], r["velocity"]) for r in rows}
+
+
+def test_spawn_J_starts_at_rest_in_that_posture_mimic_follows_and_reset_returns_there(
+    twin, tmp_path
+):
+    # follow = 0.2 - lead (mimic); gravity swings both fingers once stepped.
+    (tmp_path / "pincer.urdf").write_text(mimic_pincer(offset=0.2, multiplier=-1.0))
+    twin("pause")
+    twin("spawn", str(tmp_path / "pincer.urdf"), "-J", "lead=0.6")
+    start = _joints(twin, "pincer")
+    assert start["lead"] == (pytest.approx(0.6, abs=1e-12), 0.0), f"lead at spawn: {start}"
+    assert start["follow"] == (pytest.approx(-0.4, abs=1e-12), 0.0), f"follow = 0.2 - lead {start}"
+    twin("step", "300")
+    moved = _joints(twin, "pincer")
+    assert abs(moved["lead"][0] - 0.6) > 0.1, f"gravity should swing the lead finger: {moved}"
+    residual = moved["follow"][0] - (0.2 - moved["lead"][0])
+    assert abs(residual) < 5e-3, f"mimic residual {residual:.2e} rad while swinging (≤ 5 mrad)"
+    twin("reset")
+    assert _joints(twin, "pincer") == start, "reset returns to the -J posture, at rest"
+
+
+def test_spawn_J_out_of_range_exits_2_naming_joint_and_range_and_world_is_unchanged(twin, tmp_path):
+    (tmp_path / "pincer.urdf").write_text(mimic_pincer(offset=0.2, multiplier=-1.0))
+    twin("pause")
+    twin("spawn", str(tmp_path / "pincer.urdf"), "-J", "lead=0.5")
+    before = _joints(twin, "pincer")
+    cases = {
+        "lead=1.5": ("[lead]", "1.5 rad", "[-1, 1] rad"),
+        "lead=-1": ("[follow]", "1.2 rad", "[lead]"),  # the follower would leave its range
+        "nope=0": ("[nope]", "follow", "lead"),  # unknown: lists the valid names
+    }
+    for value, expected in cases.items():
+        proc = twin(
+            "spawn", str(tmp_path / "pincer.urdf"), "--name", "p2", "-J", value, check=False
+        )
+        assert proc.returncode == 2, f"-J {value}: exit {proc.returncode}, {proc.stderr}"
+        missing = [text for text in expected if text not in proc.stderr]
+        assert not missing, f"-J {value}: message lacks {missing}: {proc.stderr}"
+    names = [e["name"] for e in json.loads(twin("list", "--json").stdout)]
+    assert names == ["pincer"], f"entities after failed spawns: {names}"
+    assert _joints(twin, "pincer") == before, "the existing entity is untouched"
