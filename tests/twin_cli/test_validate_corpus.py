@@ -14,7 +14,7 @@ import pytest
 from corpus_registry import CORPUS
 
 from twin_cli.checks.base import Status
-from twin_cli.scenario import load_builtin
+from twin_cli.scenario import load_builtin, with_joints
 from twin_cli.validate import robot_from_conversion, run_check
 
 CHECKS = ("stability", "ground_contact", "joint_limits")
@@ -29,8 +29,19 @@ UPSTREAM = {
     ("aliengo", "ground_contact"): (
         "home posture = zeros clamped into the ranges: every knee sits on its -0.646 rad stop, "
         "80 % of the weight lands on the rear feet and the front feet (μ 0.6) slide at the "
-        "friction-cone edge, so the robot drifts backwards (~0.9 m/s) instead of coming to rest"
+        "friction-cone edge, so the robot drifts backwards (~0.9 m/s) instead of coming to rest; "
+        "in a standing posture (-J, STANDING below) it passes"
     ),
+}
+
+# Start postures (`twin validate -J`, scenario `[robot] joints`) [rad] for robots whose home
+# posture cannot stand. aliengo: hips 0, thighs 0.8, calves -1.5 (knees off their stops).
+STANDING = {
+    "aliengo": {
+        f"{leg}_{part}_joint": value
+        for leg in ("FR", "FL", "RR", "RL")
+        for part, value in (("hip", 0.0), ("thigh", 0.8), ("calf", -1.5))
+    },
 }
 
 
@@ -65,3 +76,13 @@ def test_corpus_robot_passes_stability_contact_and_limit_checks(
     assert outcome.status in (Status.PASS, Status.SKIP), (
         f"{robot_id} {check}: {outcome.measured}; {hints}"
     )
+
+
+@pytest.mark.parametrize("check", ["ground_contact", "friction_standing"])
+def test_aliengo_stands_still_in_a_standing_start_posture(check, converted_corpus):
+    # Measured in its home posture: friction_standing slip 1.56 m, ground_contact 0.91 m/s.
+    done = converted_corpus("aliengo")
+    robot = robot_from_conversion(done, CORPUS["aliengo"]["entry"], repair_inertia=True)
+    scenario = with_joints(next(s for s in load_builtin() if s.check == check), STANDING["aliengo"])
+    outcome = run_check(robot, scenario, debug=True)
+    assert outcome.status is Status.PASS, f"aliengo {check}: {outcome.measured}; {outcome.hints}"
