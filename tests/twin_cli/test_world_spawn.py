@@ -5,10 +5,16 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from models import mjcf_ball, mjcf_box, mjcf_with_home
+from models import mimic_pincer, mjcf_arm, mjcf_ball, mjcf_box, mjcf_with_home, write_urdf
 from world_helpers import full_state, spec_of
 
-from twin_cli.errors import EntityExistsError, EntityNotFoundError, InvalidRequestError, SpawnError
+from twin_cli.errors import (
+    EntityExistsError,
+    EntityNotFoundError,
+    InvalidRequestError,
+    PartNotFoundError,
+    SpawnError,
+)
 from twin_cli.world import Pose, World
 
 
@@ -73,7 +79,7 @@ def test_spawn_keeps_applied_forces_and_controls_of_existing_entities():
 
 @pytest.mark.parametrize(
     "bad",
-    ["taken name", "missing file", "compile error", "bad name"],
+    ["taken name", "missing file", "compile error", "bad name", "joint out of range", "joint name"],
 )
 def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
     world = World()
@@ -90,6 +96,14 @@ def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
         "missing file": (lambda: world.spawn(tmp_path / "none.urdf"), SpawnError),
         "compile error": (lambda: world.spawn(broken), SpawnError),
         "bad name": (lambda: world.spawn(spec_of(mjcf_box()), name="a/b"), InvalidRequestError),
+        "joint out of range": (
+            lambda: world.spawn(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"shoulder": 1.2}),
+            InvalidRequestError,
+        ),
+        "joint name": (
+            lambda: world.spawn(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"elbow": 0.0}),
+            PartNotFoundError,
+        ),
     }
     attempt, error = attempts[bad]
     with pytest.raises(error) as caught:
@@ -228,3 +242,18 @@ def test_entity_index_matches_per_joint_addresses_after_spawns_and_deletes(human
         assert ix.dofs.tolist() == dofs, f"{name}: dof addresses"
         assert ix.geoms.tolist() == [g for g, o in enumerate(owner) if o == name], f"{name}: geoms"
         assert m.jnt_type[joints[0]] != 0 or ix.free_qpos == m.jnt_qposadr[joints[0]], "free"
+
+
+def test_spawn_joints_posture_survives_save_and_load_and_on_ground_placement(tmp_path):
+    urdf = write_urdf(tmp_path, mimic_pincer(offset=0.2, multiplier=-1.0))
+    world = World()
+    world.spawn(urdf, joints={"lead": -0.5}, on_ground=True)  # fixed base: the frame moves
+    start = {j.name: j.position for j in world.joint_states("pincer")}
+    assert start == pytest.approx({"lead": -0.5, "follow": 0.7}, abs=1e-12), "posture on ground"
+    world.step(200)
+    world.save(tmp_path / "w.json")
+    loaded = World.load(tmp_path / "w.json")
+    assert np.array_equal(full_state(loaded), full_state(world)), "loaded state bit for bit"
+    loaded.reset()
+    after = {j.name: j.position for j in loaded.joint_states("pincer")}
+    assert after == pytest.approx(start, abs=1e-12), "a loaded world resets to the -J posture"
