@@ -109,3 +109,46 @@ def test_parsing_scenarios_does_not_import_mujoco():
 
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False", "scenario parsing must stay light"
+
+
+PINCER_HOLD = """
+name = "pincer_hold"
+check = "ground_contact"
+duration = 0.5
+[robot]
+joints = {{ lead = {lead} }}
+[hold]
+kp = 300.0
+kd = 10.0
+"""
+
+
+def test_robot_joints_set_the_start_posture_that_the_hold_holds(tmp_path):
+    from models import mimic_pincer, write_urdf
+
+    from twin_cli.checks.sim import ScenarioRun
+    from twin_cli.validate import load_robot
+
+    robot = load_robot(write_urdf(tmp_path, mimic_pincer(offset=0.2, multiplier=-1.0)))
+    run = ScenarioRun(robot, load_scenario(write(tmp_path, PINCER_HOLD.format(lead=0.6))))
+    held = dict(zip([j.name for j in run.joints], run.q_hold, strict=True))
+    assert held == pytest.approx({"lead": 0.6, "follow": -0.4}, abs=1e-12), "start posture"
+    run.run(0.5)
+    lead = float(run.qpos()[next(j.qpos for j in run.joints if j.name == "lead")])
+    # Gravity on the 0.5 kg finger (centre 0.1 m out) vs the PD: steady error ≈ m·g·r·cos q/kp.
+    sag = 0.5 * 9.81 * 0.1 * math.cos(0.6) / 300.0
+    assert abs(lead - 0.6) < 3 * sag, f"held lead {lead:.4f} rad; PD sag ≈ {sag:.4f} rad"
+
+
+def test_unknown_or_out_of_range_robot_joints_is_a_scenario_error_before_any_check(tmp_path):
+    from models import mimic_pincer, write_urdf
+
+    from twin_cli.validate import validate
+
+    urdf = write_urdf(tmp_path, mimic_pincer())
+    path = write(tmp_path, PINCER_HOLD.format(lead=2.0))
+    with pytest.raises(ScenarioError) as caught:
+        validate(urdf, scenarios=[str(path)])
+    message = str(caught.value)
+    for part in (str(path), "robot.joints", "[lead]", "[-1, 1] rad"):
+        assert part in message, f"message lacks {part!r}: {message}"
