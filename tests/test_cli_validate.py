@@ -147,3 +147,32 @@ def test_validate_command_module_imports_nothing_heavy():
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]", done.stdout
+
+
+def test_start_posture_out_of_range_or_unknown_exits_2_naming_the_joint():
+    bad_range = twin(scenarios.HUMANOID, "-J", "left_knee=3.0", "--only", "friction_standing")
+    assert bad_range.returncode == 2, bad_range.stdout + bad_range.stderr
+    assert "left_knee" in bad_range.stderr and "2.2" in bad_range.stderr, bad_range.stderr
+    unknown = twin(scenarios.HUMANOID, "-J", "left_tail=0.1", "--only", "friction_standing")
+    assert unknown.returncode == 2, unknown.stdout + unknown.stderr
+    assert "left_tail" in unknown.stderr and "left_knee" in unknown.stderr, unknown.stderr
+    assert "Traceback" not in bad_range.stderr + unknown.stderr
+
+
+def test_start_posture_reaches_the_standing_check():
+    """A crouch is held and passes; a 0.7 rad ankle lean puts the COM outside the feet and
+    fails, which it can only do if -J reached the robot (upright, it passes)."""
+
+    def standing(*postures: str) -> subprocess.CompletedProcess:
+        flags = [arg for item in postures for arg in ("-J", item)]
+        return twin(scenarios.HUMANOID, *flags, "--only", "friction_standing", "--json")
+
+    crouch = standing(
+        "left_hip=-0.3", "right_hip=-0.3", "left_knee=0.6", "right_knee=0.6",
+        "left_ankle=-0.3", "right_ankle=-0.3",
+    )  # fmt: skip
+    assert crouch.returncode == 0, crouch.stdout + crouch.stderr
+    lean = standing("left_ankle=0.7", "right_ankle=0.7")
+    assert lean.returncode == 1, lean.stdout + lean.stderr
+    (check,) = json.loads(lean.stdout)["checks"]
+    assert check["value"] > 0.05, f"leaning robot slipped only {check['value']} m"
