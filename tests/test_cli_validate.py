@@ -176,3 +176,4 @@ def test_start_posture_reaches_the_standing_check():
     assert lean.returncode == 1, lean.stdout + lean.stderr
     (check,) = json.loads(lean.stdout)["checks"]
     assert check["value"] > 0.05, f"leaning robot slipped only {check['value']} m"
+    assert "tips over" in " ".join(check["hints"]), check["hints"]

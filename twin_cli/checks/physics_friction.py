@@ -21,6 +21,8 @@ from twin_cli.scenario import Scenario
 
 GROUND_MU = 100.0  # Gazebo's stock ground plane (converters.contact.GROUND_MU)
 MAX_SLIDE_ANGLE = math.radians(80.0)  # steeper slopes are not tested for sliding
+# [rad] a foot turned this far from level has rolled over its edge: the robot tipped, not slid.
+TIPPED_OVER_RAD = 0.3
 
 
 def foot_geoms(run: ScenarioRun, within: float = 0.01) -> list[int]:
@@ -61,7 +63,14 @@ def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[
     worst = max(feet, key=lambda b: max(slips[b]), default=None)
     slip = max(slips[worst]) if worst is not None else 0.0
     hints = []
-    if slip > th["max_slip_m"]:
+    tilt, tilted = _largest_foot_tilt(run, feet)
+    if slip > th["max_slip_m"] and tilt > TIPPED_OVER_RAD:
+        hints.append(
+            f"the robot tips over ({names[tilted]} tilts {np.degrees(tilt):.0f}°): its centre "
+            "of mass is outside its feet in this posture; start it balanced (-J JOINT=POS or "
+            "[robot] joints in the scenario)"
+        )
+    elif slip > th["max_slip_m"]:
         hints.append(
             f"{names[worst]} slides {fmt_len(slip)} while standing: raise mu1/mu2 in its "
             "<gazebo> block, or check that the posture hold is not fighting a joint limit"
@@ -76,6 +85,14 @@ def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[
         value=slip,
         series=[series],
     )
+
+
+def _largest_foot_tilt(run: ScenarioRun, feet: list[int]) -> tuple[float, int | None]:
+    """Largest angle [rad] between a foot's z axis and the world's z axis, and that foot."""
+    with run.world.lock:
+        tilts = {b: float(np.arccos(np.clip(run.world.data.xmat[b][8], -1, 1))) for b in feet}
+    foot = max(tilts, key=tilts.get, default=None)
+    return (tilts[foot] if foot is not None else 0.0), foot
 
 
 def probe_spec(model, geom: int):
