@@ -82,10 +82,22 @@ def test_intact_crate_passes_contact_and_limits(tmp_path):
 
 
 def test_friction_incline_probe_slides_iff_tan_theta_exceeds_mu(humanoid):
-    outcome = run_check(humanoid, resolve("friction_incline"), debug=True)
+    """A foot-surface probe on slopes at tan θ = 0.8 μ and 1.25 μ (μ = min(1, 100) = 1):
+    Coulomb says it sticks on the first and slides ½·g·(sin θ − μ cos θ)·t² on the second."""
+    from twin_cli.checks.physics_friction import foot_geoms, probe_spec, slide_on_slope
+    from twin_cli.checks.sim import ScenarioRun
+
+    scenario = resolve("friction_incline")
+    outcome = run_check(humanoid, scenario, debug=True)
     assert "μ = 1" in outcome.measured, "humanoid feet μ=1 against the ground's 100: min is 1"
-    stick, slide = outcome.details[:2]
-    assert "38.7°" in stick and "51.3°" in slide, outcome.details
+    spec = probe_spec(humanoid.model, foot_geoms(ScenarioRun(humanoid, scenario))[0])
+    t = scenario.duration
+    stuck = slide_on_slope(humanoid, spec, scenario, math.atan(0.8))
+    assert stuck < 0.01, f"probe crept {stuck:.4f} m at tan θ = 0.8 μ (soft-friction creep < 1 cm)"
+    theta = math.atan(1.25)
+    coulomb = 0.5 * G * (math.sin(theta) - math.cos(theta)) * t * t
+    slid = slide_on_slope(humanoid, spec, scenario, theta)
+    assert math.isclose(slid, coulomb, rel_tol=0.15), f"slid {slid:.4f} m, Coulomb {coulomb:.4f} m"
 
 
 def test_robot_fixed_to_the_world_skips_fall_and_contact_checks(tmp_path):
