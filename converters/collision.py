@@ -42,14 +42,6 @@ class CollisionMode(enum.Enum):
     MESH = "mesh"
 
 
-MODE_HELP = {
-    CollisionMode.AUTO: "hull for nearly convex meshes, CoACD for concave or heavy ones",
-    CollisionMode.COACD: "convex decomposition with CoACD, one geom per part",
-    CollisionMode.HULL: "one convex hull, vertex count capped",
-    CollisionMode.MESH: "the mesh as given (MuJoCo collides it as its convex hull)",
-}
-
-
 @dataclass(frozen=True)
 class CoacdParams:
     """`coacd.run_coacd` keyword arguments (names as CoACD spells them) plus twin's hull cap."""

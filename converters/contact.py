@@ -26,8 +26,6 @@ from typing import Any
 
 GROUND_MU = 100.0
 """μ of Gazebo's stock ground plane (`ground_plane` model, `surface/friction/ode/mu`)."""
-GROUND_MU2 = 50.0
-"""Coefficient μ2 of Gazebo's stock ground plane."""
 DEFAULT_MU = 1.0
 """SDF default for `surface/friction/ode/mu` when a link sets none (`sdf/1.11/surface.sdf`)."""
 DEFAULT_KP = 1e12
@@ -152,24 +150,6 @@ def limit_solref(erp: float | None, timestep: float = GAZEBO_STEP) -> tuple[floa
     """
     erp = DEFAULT_LIMIT_ERP if erp is None or erp <= 0 else min(erp, 1.0)
     return (2.0 * timestep, 1.0 / (2.0 * math.sqrt(erp)))
-
-
-def limit_violation(a0: float, erp: float | None = None, timestep: float = GAZEBO_STEP) -> float:
-    """Steady violation [rad or m] of a MuJoCo limit (`limit_solref` + `LIMIT_SOLIMP`) under a load.
-
-    At rest a = 0 = (1 − d)·a0 + d·aref with aref = −k·r, so r = (1 − d)/d · a0/k
-    = (1 − d)·a0·τ²·ζ² = (1 − d)·a0·h²/erp. Gazebo's cfm-0 limit holds exactly (r = 0); with
-    d = 0.9999 the residue is 5e-10·a0 at erp 0.2 and h = 1 ms (1000 N m on a 1e-4 kg m² link,
-    a0 = 1e7 rad/s²: 5 mrad). MuJoCo's default d = 0.95 with τ = 5 ms gave 1.25e-6·a0.
-
-    Args:
-        a0: unconstrained acceleration pushing into the limit [rad/s² or m/s²].
-        erp: ODE stopErp (SDF default 0.2 when None).
-        timestep: Gazebo step [s].
-    """
-    timeconst, ratio = limit_solref(erp, timestep)
-    d = LIMIT_SOLIMP[1]
-    return (1.0 - d) * abs(a0) * (timeconst * ratio) ** 2
 
 
 def add_gazebo_ground(spec: Any) -> None:

@@ -38,6 +38,3 @@ class Provenance:
 
     def geoms_of_link(self, link: str, role: str = "collision") -> list[GeomOrigin]:
         return [g for g in self.geoms if g.link == link and g.role == role]
-
-    def geoms_of_body(self, body: str, role: str = "collision") -> list[GeomOrigin]:
-        return [g for g in self.geoms if g.body == body and g.role == role]

@@ -87,8 +87,6 @@ def _load_mjcf(path: Path) -> LoadedSource:
 def _load_urdf(
     path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
 ) -> LoadedSource:
-    # converters.pipeline, not the package's lazy `converters.convert`: under pytest, tests/ on
-    # sys.path makes `converters` a namespace package whose __getattr__ is missing.
     from converters.pipeline import convert
 
     spec, report = convert(path, args=args, package_paths=package_paths)

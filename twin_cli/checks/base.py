@@ -22,14 +22,6 @@ class Status(enum.Enum):
     SKIP = "skip"
 
 
-STATUS_TEXT = {
-    Status.PASS: "passed",
-    Status.WARN: "passed with warnings",
-    Status.FAIL: "failed",
-    Status.SKIP: "skipped (not applicable to this robot)",
-}
-
-
 @dataclass(frozen=True)
 class Series:
     """A time series for a plot: `t` [s] against `values`, with an optional oracle curve."""
