@@ -31,7 +31,7 @@ def _robots() -> dict[str, dict]:
 def _convert(robot: dict, cache: str, **settings) -> tuple[float, dict]:
     """Convert and compile once with the given collision settings; (wall [s], summary)."""
     from converters import ConvertOptions, convert
-    from converters.collision import CollisionSettings
+    from converters.collision.plan import CollisionSettings
 
     os.environ["TWIN_CACHE_DIR"] = cache
     packages = {p.name: p for p in PACKAGES.iterdir()}
@@ -61,7 +61,7 @@ def _cold_warm(robot: dict, **settings) -> dict:
 
 
 def run() -> dict:
-    from converters.decompose import default_jobs
+    from converters.collision.decompose import default_jobs
 
     previous = os.environ.get("TWIN_CACHE_DIR")
     cores = default_jobs()

@@ -26,8 +26,8 @@ def _time(fn: object) -> float:
 def run() -> dict[str, object]:
     """Per robot: convert [s] with hull collisions, convert with the default `auto` plan (cached
     CoACD after the first run) [s], compile [s], and mesh triangles carried in the spec."""
-    from converters.build import ConvertOptions
-    from converters.collision import CollisionSettings
+    from converters.collision.plan import CollisionSettings
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert
     from scenarios import HUMANOID
 

@@ -15,9 +15,9 @@ from pathlib import Path
 import mujoco
 import tomllib
 
-from converters.contact import add_gazebo_ground
-from converters.gazebo import parse_gazebo
-from converters.gazebo_apply import DAMPING_FACTOR_PREFIX, apply_gazebo
+from converters.gazebo.apply import DAMPING_FACTOR_PREFIX, apply_gazebo
+from converters.gazebo.blocks import parse_gazebo
+from converters.gazebo.contact import add_gazebo_ground
 from converters.pipeline import convert, convert_full
 from converters.report import Report
 
@@ -28,8 +28,8 @@ G = 9.8
 
 
 def _stage_timing(robot: dict) -> dict[str, float]:
-    from converters.build import ConvertOptions
-    from converters.collision import CollisionSettings
+    from converters.collision.plan import CollisionSettings
+    from converters.mjcf.builder import ConvertOptions
 
     options = ConvertOptions(repair_inertia=True, collision=CollisionSettings(mode="hull"))
     paths = {name: PACKAGES / name for name in robot["packages"]}

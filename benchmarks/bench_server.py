@@ -22,8 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import scenarios
-from twin_cli import runtime
-from twin_cli.client import Client
+from twin_cli.server import runtime
+from twin_cli.server.client import Client
 
 WORLD = "bench"
 COMMAND_RUNS = 15
@@ -53,7 +53,7 @@ class Rate:
 
 def _twin(args: list[str], env: dict[str, str], **kwargs) -> subprocess.Popen:
     return subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.app", *args, "--world", WORLD], env=env, **kwargs
+        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", WORLD], env=env, **kwargs
     )
 
 

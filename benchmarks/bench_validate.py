@@ -31,7 +31,7 @@ def _cli_seconds() -> tuple[float, int]:
 def run() -> dict:
     """Figures: CLI wall time, conversion time, and each check's own time [s]."""
     import scenarios
-    from twin_cli.validate import load_robot, plan, run_check
+    from twin_cli.validate.runner import load_robot, plan, run_check
 
     cli, code = _cli_seconds()
     start = time.perf_counter()

@@ -8,9 +8,9 @@ from converters.errors import ConversionError
 from converters.report import Outcome, Report
 
 if TYPE_CHECKING:
-    from converters.build import ConvertOptions
+    from converters.mjcf.builder import ConvertOptions
+    from converters.mjcf.writer import write_model
     from converters.pipeline import Conversion, convert, convert_full
-    from converters.writer import write_model
 
 __all__ = [
     "Conversion",
@@ -25,11 +25,11 @@ __all__ = [
 
 # Heavy modules (numpy, mujoco via build) load on first use, so `import converters` stays cheap.
 _LAZY = {
-    "ConvertOptions": "converters.build",
+    "ConvertOptions": "converters.mjcf.builder",
     "Conversion": "converters.pipeline",
     "convert": "converters.pipeline",
     "convert_full": "converters.pipeline",
-    "write_model": "converters.writer",
+    "write_model": "converters.mjcf.writer",
 }
 
 

@@ -6,13 +6,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from converters.build import ConvertOptions, build_spec
 from converters.errors import InputFileError
-from converters.packages import PackageResolver
+from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
 from converters.report import Report
-from converters.urdf import ParsedRobot, parse_urdf
-from converters.xacro_stage import expand_xacro, needs_xacro
+from converters.resources.packages import PackageResolver
+from converters.urdf.reader import ParsedRobot, parse_urdf
+from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
 
 @dataclass(frozen=True)
@@ -74,8 +74,8 @@ def convert_full(
     Raises:
         ConversionError: any subclass, with file/link/joint and the fix in its message.
     """
-    from converters.gazebo import parse_gazebo
-    from converters.gazebo_apply import apply_gazebo
+    from converters.gazebo.apply import apply_gazebo
+    from converters.gazebo.blocks import parse_gazebo
 
     path = Path(path)
     options = options or ConvertOptions()

@@ -36,8 +36,8 @@ def converted_corpus(corpus_root: Path) -> Callable[[str], Any]:
     Packages come from `--package` options; inertias are repaired only for the robots listed in
     NON_PHYSICAL_INERTIA; collision meshes use convex hulls (no CoACD, to keep tests fast).
     """
-    from converters.build import ConvertOptions
-    from converters.collision import CollisionSettings
+    from converters.collision.plan import CollisionSettings
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
 
     cache: dict[str, Any] = {}

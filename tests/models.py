@@ -199,7 +199,7 @@ def mjcf_arm(
     """A fixed-base arm: hinge 'shoulder' about y, range [lower, upper] [rad], a 0.5 m, 1 kg
     capsule link, and a motor actuator with ctrlrange ±effort [N m] (the converter's contract).
     The limit's time constant defaults to the converter's mapping of Gazebo's stopErp 0.2 at
-    1 ms (`converters.contact.limit_solref`: 0.005 s)."""
+    1 ms (`converters.gazebo.contact.limit_solref`: 0.005 s)."""
     return f"""<mujoco model="{name}"><compiler angle="radian"/>
   <worldbody><body name="base" pos="0 0 1">
   <geom type="box" size="0.05 0.05 0.05" mass="1" contype="0" conaffinity="0"/>

@@ -20,7 +20,7 @@ GOOD_LINK = (
 
 
 def twin(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    code = "import sys; from twin_cli.app import main; sys.argv[0] = 'twin'; main()"
+    code = "import sys; from twin_cli.cli.app import main; sys.argv[0] = 'twin'; main()"
     return subprocess.run(
         [sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd, timeout=120
     )

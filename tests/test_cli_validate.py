@@ -14,8 +14,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "twin_cli"))
 import validate_robots as robots  # noqa: E402
 
 import scenarios  # noqa: E402
-from twin_cli.checks import CHECKS, MODEL_CHECKS  # noqa: E402
-from twin_cli.scenario import builtin_names  # noqa: E402
+from twin_cli.validate.checks import CHECKS, MODEL_CHECKS  # noqa: E402
+from twin_cli.validate.scenario import builtin_names  # noqa: E402
 
 TWIN = Path(sys.executable).parent / "twin"
 
@@ -142,7 +142,7 @@ def test_malformed_scenario_file_exits_2_naming_file_and_key(tmp_path):
 
 def test_validate_command_module_imports_nothing_heavy():
     code = (
-        "import sys, twin_cli.commands.validate; "
+        "import sys, twin_cli.cli.commands.validate; "
         "print(sorted(m for m in ('mujoco', 'numpy', 'trimesh', 'matplotlib') if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

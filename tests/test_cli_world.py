@@ -31,7 +31,7 @@ class Twin:
 
     def __call__(self, *args: str, check: bool = True, timeout: float = 120):
         proc = subprocess.run(
-            [sys.executable, "-m", "twin_cli.app", *args],
+            [sys.executable, "-m", "twin_cli.cli.app", *args],
             env=self.env,
             capture_output=True,
             text=True,
@@ -127,7 +127,7 @@ def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
 
 
 def test_concurrent_first_commands_start_exactly_one_server(twin):
-    cmd = [sys.executable, "-m", "twin_cli.app", "list"]
+    cmd = [sys.executable, "-m", "twin_cli.cli.app", "list"]
     procs = [
         subprocess.Popen(
             cmd, env=twin.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True

@@ -9,8 +9,8 @@ import sys
 
 import pytest
 
-from twin_cli import runtime
-from twin_cli.client import Client
+from twin_cli.server import runtime
+from twin_cli.server.client import Client
 
 HEAVY = ("mujoco", "numpy", "trimesh", "coacd", "fastapi", "uvicorn", "scipy")
 
@@ -18,7 +18,7 @@ HEAVY = ("mujoco", "numpy", "trimesh", "coacd", "fastapi", "uvicorn", "scipy")
 def _imported(args: list[str], env: dict[str, str]) -> tuple[subprocess.CompletedProcess, set]:
     """Run `twin ARGS` with -X importtime; return the process and its top-level imports."""
     proc = subprocess.run(
-        [sys.executable, "-X", "importtime", "-m", "twin_cli.app", *args],
+        [sys.executable, "-X", "importtime", "-m", "twin_cli.cli.app", *args],
         env=env,
         capture_output=True,
         text=True,
@@ -40,7 +40,7 @@ def test_client_commands_against_a_running_world_import_nothing_heavy(tmp_path, 
     monkeypatch.setenv(runtime.RUNTIME_ENV, str(tmp_path))
     env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
     server = subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.app", "serve", "--world", "lazy"],
+        [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", "lazy"],
         env=env,
         stderr=subprocess.DEVNULL,
     )

@@ -1,4 +1,8 @@
-"""twin's world engine, server, client and command line.
+"""twin's runtime: the world engine, its server and client, validation, and the command line.
+
+Packages, by concern (imports point down this list only; `make lint` enforces it):
+`cli` (Typer commands, output) → `server` (HTTP API, runtime files, client) and `validate`
+(scenarios, checks, reports) → `world` (the engine: spec, model, data, entities, the loop).
 
 Importing this package imports nothing heavy: the public names below load their modules on first
 use, so `import twin_cli` (and every client command) stays free of mujoco and numpy.
@@ -6,14 +10,14 @@ use, so `import twin_cli` (and every client command) stays free of mujoco and nu
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from twin_cli.errors import TwinError
+from twin_cli.lazy import lazy_getattr
 
 if TYPE_CHECKING:
-    from twin_cli.client import Client, connect
-    from twin_cli.scenario import Scenario, load_scenario
-    from twin_cli.validate import validate
+    from twin_cli.server import Client, connect
+    from twin_cli.validate import Scenario, load_scenario, validate
     from twin_cli.world import (
         GRAVITY_PRESETS,
         EntityInfo,
@@ -42,23 +46,26 @@ __all__ = [
     "validate",
 ]
 
-_LAZY = {
-    **dict.fromkeys(
-        ("GRAVITY_PRESETS", "EntityInfo", "JointState", "Pose", "SpawnResult", "Stats", "World"),
-        "twin_cli.world",
-    ),
-    "WorldSettings": "twin_cli.world",
-    "Client": "twin_cli.client",
-    "connect": "twin_cli.client",
-    "Scenario": "twin_cli.scenario",
-    "load_scenario": "twin_cli.scenario",
-    "validate": "twin_cli.validate",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        import importlib
-
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'twin_cli' has no attribute {name!r}")
+__getattr__ = lazy_getattr(
+    "twin_cli",
+    {
+        **dict.fromkeys(
+            (
+                "GRAVITY_PRESETS",
+                "EntityInfo",
+                "JointState",
+                "Pose",
+                "SpawnResult",
+                "Stats",
+                "World",
+                "WorldSettings",
+            ),
+            "twin_cli.world",
+        ),
+        "Client": "twin_cli.server.client",
+        "connect": "twin_cli.server.client",
+        "Scenario": "twin_cli.validate.scenario",
+        "load_scenario": "twin_cli.validate.scenario",
+        "validate": "twin_cli.validate.runner",
+    },
+)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from converters.collision import CollisionRequest
+from converters.collision.plan import CollisionRequest
 
 # Cup: outer radius 50 mm, wall 8 mm, floor 8 mm, rim at 80 mm [m].
 CUP_OUTER_R = 0.05

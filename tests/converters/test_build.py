@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.build import ConvertOptions
+from converters.mjcf.builder import ConvertOptions
 from converters.pipeline import convert_full
 
 INERTIAL = (
@@ -186,8 +186,8 @@ def test_mesh_formats_load_with_scale_into_the_spec(tmp_path: Path, suffix: str)
 
 
 def test_flat_mesh_is_kept_out_of_collision_and_reported(tmp_path: Path) -> None:
+    from converters.mjcf.writer import stl_bytes
     from converters.report import Outcome
-    from converters.writer import stl_bytes
 
     square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
     (tmp_path / "flat.stl").write_bytes(stl_bytes(square, np.array([[0, 1, 2], [0, 2, 3]])))

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from collision_models import CUP_FLOOR, CUP_INNER_R, CUP_RIM, box_mesh, cup_mesh, request
 
-from converters import hulls
-from converters.collision import (
+from converters.collision import hulls
+from converters.collision.plan import (
     CONVEX_RATIO,
     HEAVY_CAPS,
     HEAVY_TRIANGLES,
@@ -20,8 +20,8 @@ from converters.collision import (
     CollisionSettings,
     coacd_params,
     decide,
-    prepare_collision_meshes,
 )
+from converters.collision.prepare import prepare_collision_meshes
 from converters.errors import CollisionSettingsError
 from converters.report import Outcome, Report
 

@@ -1,4 +1,4 @@
-"""Contact rules of converters.contact, proved on hand-built MjSpecs by MuJoCo's own contacts."""
+"""Gazebo contact rules (`converters.gazebo.contact`) proved on hand-built MjSpecs by MuJoCo."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.contact import (
+from converters.gazebo.contact import (
     DEFAULT_LIMIT_ERP,
     GROUND_MU,
     LIMIT_SOLIMP,

@@ -41,8 +41,8 @@ def test_corpus_robot_steps_one_second_with_random_control_without_warnings(
 def test_corpus_robot_converts_through_ros_package_path(
     robot_id: str, converted_corpus, monkeypatch
 ) -> None:
-    from converters.build import ConvertOptions
-    from converters.collision import CollisionSettings
+    from converters.collision.plan import CollisionSettings
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
 
     robot = CORPUS[robot_id]

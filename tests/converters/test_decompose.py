@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 from collision_models import CUP_OUTER_R, CUP_RIM, box_mesh, cup_mesh, request
 
-from converters import hulls
-from converters.collision import PRESETS, CollisionSettings, prepare_collision_meshes
-from converters.decompose import FAULT_ENV, DecomposeJob, decompose_all, fault_for
+from converters.collision import hulls
+from converters.collision.decompose import FAULT_ENV, DecomposeJob, decompose_all, fault_for
+from converters.collision.plan import PRESETS, CollisionSettings
+from converters.collision.prepare import prepare_collision_meshes
 from converters.report import Outcome, Report
 
 FAST = PRESETS["fast"]

@@ -9,10 +9,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.contact import IMPEDANCE, friction_priority, max_contact_stiffness
 from converters.errors import GazeboTagError
-from converters.gazebo import parse_gazebo
-from converters.gazebo_apply import DAMPING_FACTOR_PREFIX
+from converters.gazebo.apply import DAMPING_FACTOR_PREFIX
+from converters.gazebo.blocks import parse_gazebo
+from converters.gazebo.contact import IMPEDANCE, friction_priority, max_contact_stiffness
 from converters.pipeline import convert_full
 from converters.report import Outcome
 

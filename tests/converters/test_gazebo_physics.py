@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.contact import add_gazebo_ground
+from converters.gazebo.contact import add_gazebo_ground
 from converters.pipeline import convert
 
 

@@ -12,9 +12,10 @@ import pytest
 from collision_models import box_mesh, cup_mesh, request
 from typer.testing import CliRunner
 
-from converters import mesh_cache
-from converters.collision import CollisionSettings, prepare_collision_meshes
-from converters.decompose import FAULT_ENV
+from converters.collision import cache as mesh_cache
+from converters.collision.decompose import FAULT_ENV
+from converters.collision.plan import CollisionSettings
+from converters.collision.prepare import prepare_collision_meshes
 from converters.report import Report
 
 
@@ -64,7 +65,7 @@ def test_damaged_entry_is_a_miss_and_is_removed(cache_dir):
 WRITER = textwrap.dedent(
     """
     import sys, numpy as np
-    from converters import mesh_cache
+    from converters.collision import cache as mesh_cache
     rng = np.random.default_rng(0)
     parts = [(rng.random((5000, 3)), rng.integers(0, 5000, (10000, 3))) for _ in range(4)]
     for _ in range(int(sys.argv[1])):
@@ -113,7 +114,7 @@ def test_no_cache_setting_neither_reads_nor_writes(cache_dir):
 
 
 def test_cli_cache_info_and_clear(cache_dir):
-    from twin_cli.app import app
+    from twin_cli.cli.app import app
 
     mesh_cache.store("a", _parts(1), {})
     mesh_cache.store("b", _parts(2), {})

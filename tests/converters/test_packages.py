@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from converters.errors import PackageNotFoundError, ResourceNotFoundError
-from converters.packages import PackageResolver
+from converters.resources.packages import PackageResolver
 
 
 def _package(root: Path, directory: str, name: str | None = None) -> Path:

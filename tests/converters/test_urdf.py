@@ -10,7 +10,7 @@ import pytest
 import converters
 from converters.errors import BadNumberError, MalformedXMLError, URDFStructureError
 from converters.pipeline import convert_full
-from converters.urdf import parse_urdf
+from converters.urdf.reader import parse_urdf
 
 LINK = (
     '<link name="{n}"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" '

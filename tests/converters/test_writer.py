@@ -7,7 +7,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from converters.writer import stl_bytes, write_model
+from converters.mjcf.writer import stl_bytes, write_model
 
 
 def _vertices(model: object, mesh: int) -> np.ndarray:

@@ -7,9 +7,9 @@ from pathlib import Path
 import pytest
 
 from converters.errors import PackageNotFoundError, XacroError
-from converters.packages import PackageResolver
 from converters.pipeline import convert_full
-from converters.xacro_stage import expand_xacro
+from converters.resources.packages import PackageResolver
+from converters.urdf.xacro_expand import expand_xacro
 
 XACRO = """<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">
   <xacro:arg name="size" default="1"/>

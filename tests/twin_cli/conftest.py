@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from twin_cli import runtime
-from twin_cli.client import Client
+from twin_cli.server import runtime
+from twin_cli.server.client import Client
 
 START_TIMEOUT_S = 60.0  # [s] a cold start imports mujoco and FastAPI on a loaded CI machine
 
@@ -31,7 +31,7 @@ def served_world(
     env = {**os.environ, runtime.RUNTIME_ENV: str(runtime_dir)}
     with open(runtime_dir / "serve.out", "wb") as log:
         proc = subprocess.Popen(
-            [sys.executable, "-m", "twin_cli.app", "serve", "--world", world, *serve_args],
+            [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", world, *serve_args],
             stdout=log,
             stderr=log,
             env=env,

@@ -6,9 +6,9 @@ import re
 
 import pytest
 
-from twin_cli.client import rebuild_error
+from twin_cli.cli.stats_format import CSV_HEADER, sample_times, stats_csv_row, stats_line
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError
-from twin_cli.stats_format import CSV_HEADER, sample_times, stats_csv_row, stats_line
+from twin_cli.server.client import rebuild_error
 
 # The line format scripts rely on (issue 5, gz-cli.md §2).
 GZ_LINE = re.compile(

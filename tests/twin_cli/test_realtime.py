@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from twin_cli import realtime as rt
+from twin_cli.world import realtime as rt
 
 RATE = 1000.0  # [Hz] SDF default real_time_update_rate
 PERIOD = 1.0 / RATE

@@ -7,10 +7,10 @@ import sys
 
 import pytest
 
-from twin_cli.checks import CHECKS, MODEL_CHECKS
 from twin_cli.errors import ScenarioError, UnknownCheckError
-from twin_cli.scenario import builtin_names, load_builtin, load_scenario, resolve
-from twin_cli.validate import plan
+from twin_cli.validate.checks import CHECKS, MODEL_CHECKS
+from twin_cli.validate.runner import plan
+from twin_cli.validate.scenario import builtin_names, load_builtin, load_scenario, resolve
 
 
 def write(tmp_path, text: str, name: str = "mine.toml"):
@@ -103,8 +103,11 @@ def test_plan_keeps_model_checks_and_filters_with_only_and_skip(tmp_path):
 
 
 def test_parsing_scenarios_does_not_import_mujoco():
-    assert "twin_cli.scenario" in sys.modules
-    code = "import sys, twin_cli.scenario, twin_cli.checks; print('mujoco' in sys.modules)"
+    assert "twin_cli.validate.scenario" in sys.modules
+    code = (
+        "import sys, twin_cli.validate.scenario, twin_cli.validate.checks; "
+        "print('mujoco' in sys.modules)"
+    )
     import subprocess
 
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -126,8 +129,8 @@ kd = 10.0
 def test_robot_joints_set_the_start_posture_that_the_hold_holds(tmp_path):
     from models import mimic_pincer, write_urdf
 
-    from twin_cli.checks.sim import ScenarioRun
-    from twin_cli.validate import load_robot
+    from twin_cli.validate.checks.sim import ScenarioRun
+    from twin_cli.validate.runner import load_robot
 
     robot = load_robot(write_urdf(tmp_path, mimic_pincer(offset=0.2, multiplier=-1.0)))
     run = ScenarioRun(robot, load_scenario(write(tmp_path, PINCER_HOLD.format(lead=0.6))))
@@ -143,7 +146,7 @@ def test_robot_joints_set_the_start_posture_that_the_hold_holds(tmp_path):
 def test_unknown_or_out_of_range_robot_joints_is_a_scenario_error_before_any_check(tmp_path):
     from models import mimic_pincer, write_urdf
 
-    from twin_cli.validate import validate
+    from twin_cli.validate.runner import validate
 
     urdf = write_urdf(tmp_path, mimic_pincer())
     path = write(tmp_path, PINCER_HOLD.format(lead=2.0))

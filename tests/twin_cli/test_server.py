@@ -13,8 +13,8 @@ import pytest
 from models import block
 
 from converters.errors import ConversionError
-from twin_cli.client import Client
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError, TwinError
+from twin_cli.server.client import Client
 
 WORLD = "srv"
 BOX_URDF = block(size=0.2, name="box")

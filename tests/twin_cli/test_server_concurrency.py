@@ -8,8 +8,8 @@ import time
 import pytest
 from models import block
 
-from twin_cli.client import Client
 from twin_cli.errors import EntityNotFoundError
+from twin_cli.server.client import Client
 
 WORLD = "busy"
 DURATION_S = 10.0

@@ -11,12 +11,12 @@ import time
 
 import pytest
 
-from twin_cli import runtime
 from twin_cli.errors import WorldRunningError
+from twin_cli.server import runtime
 
 HOLDER = """
 import sys, time
-from twin_cli import runtime
+from twin_cli.server import runtime
 paths = runtime.world_paths(sys.argv[1])
 with runtime.hold_pid_file(paths):
     paths.socket.write_text("")
@@ -105,7 +105,7 @@ def test_start_lock_serialises_starters(rtdir):
     ],
 )
 def test_tcp_address_defaults_to_loopback(text, expected):
-    from twin_cli.serving import parse_tcp
+    from twin_cli.server.process import parse_tcp
 
     assert parse_tcp(text) == expected
 
@@ -113,7 +113,7 @@ def test_tcp_address_defaults_to_loopback(text, expected):
 @pytest.mark.parametrize("text", ["nonsense", "example.com:80", "127.0.0.1:70000"])
 def test_bad_tcp_address_is_refused_with_an_example(text):
     from twin_cli.errors import RequestError
-    from twin_cli.serving import parse_tcp
+    from twin_cli.server.process import parse_tcp
 
     with pytest.raises(RequestError, match="--tcp"):
         parse_tcp(text)

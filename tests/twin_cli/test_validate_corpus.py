@@ -13,9 +13,9 @@ import math
 import pytest
 from corpus_registry import CORPUS
 
-from twin_cli.checks.base import Status
-from twin_cli.scenario import load_builtin, with_joints
-from twin_cli.validate import robot_from_conversion, run_check
+from twin_cli.validate.checks.base import Status
+from twin_cli.validate.runner import robot_from_conversion, run_check
+from twin_cli.validate.scenario import load_builtin, with_joints
 
 CHECKS = ("stability", "ground_contact", "joint_limits")
 

@@ -12,9 +12,9 @@ import pytest
 import validate_robots as robots
 from corpus_registry import CORPUS
 
-from twin_cli.checks import MODEL_CHECKS
-from twin_cli.checks.base import Status
-from twin_cli.validate import _model_scenario, load_robot, robot_from_conversion, run_check
+from twin_cli.validate.checks import MODEL_CHECKS
+from twin_cli.validate.checks.base import Status
+from twin_cli.validate.runner import _model_scenario, load_robot, robot_from_conversion, run_check
 
 
 def model_results(path, **kwargs) -> dict:
@@ -120,7 +120,7 @@ def test_geometry_solid_matches_mujoco_inertia_from_density(shape, size, volume,
     import mujoco
     import numpy as np
 
-    from twin_cli.checks.geometry import geom_solid
+    from twin_cli.validate.checks.geometry import geom_solid
 
     xml = f"""<mujoco><worldbody><body><freejoint/>
       <geom type="{shape}" size="{size}" density="1000"/></body></worldbody></mujoco>"""

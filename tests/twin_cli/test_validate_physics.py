@@ -9,9 +9,9 @@ import pytest
 import validate_robots as robots
 
 import scenarios
-from twin_cli.checks.base import Status
-from twin_cli.scenario import resolve
-from twin_cli.validate import load_robot, run_check
+from twin_cli.validate.checks.base import Status
+from twin_cli.validate.runner import load_robot, run_check
+from twin_cli.validate.scenario import resolve
 
 G = 9.81
 
@@ -84,8 +84,8 @@ def test_intact_crate_passes_contact_and_limits(tmp_path):
 def test_friction_incline_probe_slides_iff_tan_theta_exceeds_mu(humanoid):
     """A foot-surface probe on slopes at tan θ = 0.8 μ and 1.25 μ (μ = min(1, 100) = 1):
     Coulomb says it sticks on the first and slides ½·g·(sin θ − μ cos θ)·t² on the second."""
-    from twin_cli.checks.physics_friction import foot_geoms, probe_spec, slide_on_slope
-    from twin_cli.checks.sim import ScenarioRun
+    from twin_cli.validate.checks.physics_friction import foot_geoms, probe_spec, slide_on_slope
+    from twin_cli.validate.checks.sim import ScenarioRun
 
     scenario = resolve("friction_incline")
     outcome = run_check(humanoid, scenario, debug=True)

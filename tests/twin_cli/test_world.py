@@ -11,7 +11,7 @@ import pytest
 from models import mjcf_arm, mjcf_ball, mjcf_box, mjcf_stiff_spring
 from world_helpers import full_state, spec_of
 
-import twin_cli.world as world_module
+import twin_cli.world.engine as world_module
 from twin_cli.errors import (
     EntityNotFoundError,
     InvalidRequestError,
@@ -23,7 +23,7 @@ from twin_cli.world import Pose, World, WorldSettings
 
 def test_public_names_exist():
     for name in world_module.__all__:
-        assert hasattr(world_module, name), f"twin_cli.world.__all__ names missing {name}"
+        assert hasattr(world_module, name), f"twin_cli.world.engine.__all__ names missing {name}"
 
 
 def test_default_world_is_gazebos_empty_world():

@@ -1,0 +1,354 @@
+"""Carrying out the collision plan: cache look-ups, hulls, CoACD jobs, fallbacks, report rows.
+
+Each mesh gets one row in `report.meshes`:
+`key, link, source, requested, mode, reason, triangles_before, triangles_after, parts,
+volume_reference ("mesh" when the mesh is closed, else "hull"), volume_ratio (sum of part
+volumes / reference volume), seconds (this run), compute_seconds (when first computed),
+cache ("hit" | "miss" | "off"), fallback (why CoACD was replaced by the hull, else None)`,
+and one line in `report.entries`. `report.summary["collision"]` totals them.
+
+Cache: a result is stored under its content key (mesh bytes, scale, mode, CoACD parameters).
+A fallback that would recur is cached too, so a mesh that times out costs its time limit once,
+not on every conversion: a timeout under a second key that adds the time limit (a longer limit
+retries), and "no usable part" under the content key. A crashed worker is never cached.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from converters.collision import cache as mesh_cache
+from converters.collision import hulls
+from converters.collision.decompose import DecomposeJob, DecomposeOutcome, decompose_all, fault_for
+from converters.collision.plan import (
+    CONVEX_RATIO,
+    TRIANGLES_ADVISED,
+    TRIANGLES_MAX,
+    CoacdParams,
+    CollisionMode,
+    CollisionRequest,
+    CollisionSettings,
+    Decision,
+    MeshPart,
+    check_settings,
+    coacd_params,
+    decide,
+    requested_mode,
+)
+from converters.collision.progress import MeshProgress
+from converters.report import Report
+
+Pairs = list[tuple[np.ndarray, np.ndarray]]
+RETRY_HINT = (
+    " (cached fallback: a longer CoACD time limit, other CoACD settings or"
+    " `twin cache clear` makes the next conversion try again)"
+)
+ROW_FIELDS = (
+    "key",
+    "link",
+    "source",
+    "requested",
+    "mode",
+    "reason",
+    "triangles_before",
+    "triangles_after",
+    "parts",
+    "volume_reference",
+    "volume_ratio",
+    "seconds",
+    "compute_seconds",
+    "cache",
+    "fallback",
+)
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """One mesh on its way: what was asked, what was decided, and the facts for its row."""
+
+    request: CollisionRequest
+    requested: CollisionMode
+    decision: Decision
+    params: CoacdParams
+    volume_reference: tuple[str, float]
+    content_key: str
+    fallback_key: str
+    use_cache: bool
+    started: float
+
+
+def prepare(
+    requests: list[CollisionRequest], settings: CollisionSettings, report: Report
+) -> dict[str, list[MeshPart]]:
+    """See `converters.collision.plan.prepare_collision_meshes` (settings already checked)."""
+    started = time.perf_counter()
+    results: dict[str, Pairs] = {}
+    rows: dict[str, dict[str, Any]] = {}
+    waiting: dict[str, list[_Plan]] = {}  # content key -> meshes with those bytes
+    with MeshProgress(len(requests), enabled=settings.progress) as progress:
+        for request in requests:
+            plan, cached = _plan(request, settings)
+            if plan is not None and plan.decision.mode is CollisionMode.COACD and cached is None:
+                waiting.setdefault(plan.content_key, []).append(plan)
+                continue
+            results[request.key], rows[request.key] = cached or _without_coacd(request, plan)
+            progress.advance(_label(rows[request.key]))
+
+        def finished(outcome: DecomposeOutcome) -> None:
+            for plan in waiting[outcome.key]:
+                key = plan.request.key
+                results[key], rows[key] = _from_outcome(plan, outcome)
+                progress.advance(_label(rows[key]))
+
+        jobs = [_job(plans) for plans in waiting.values()]
+        decompose_all(jobs, workers=settings.jobs, time_limit=settings.time_limit, on_done=finished)
+    ordered = [rows[r.key] for r in requests]
+    _report(ordered, settings, report, len(jobs), time.perf_counter() - started)
+    return {r.key: [MeshPart(v, f) for v, f in results[r.key]] for r in requests}
+
+
+def _plan(
+    request: CollisionRequest, settings: CollisionSettings
+) -> tuple[_Plan | None, tuple[Pairs, dict[str, Any]] | None]:
+    """Decide one mesh's mode; return (plan, None) to compute or (None|plan, cached result)."""
+    started = time.perf_counter()
+    requested = requested_mode(request, settings)
+    params = coacd_params(request, settings)
+    if requested is CollisionMode.MESH:
+        return None, None
+    key = _cache_key(request, requested, params)
+    fallback_key = _cache_key(request, requested, params, time_limit=settings.time_limit)
+    hit = _load(key, fallback_key) if settings.use_cache else None
+    if hit is not None:  # the entry may come from another link with the same mesh bytes
+        own = {"key": request.key, "link": request.link, "source": request.source}
+        row = {**hit.meta, **own, "cache": "hit", "seconds": time.perf_counter() - started}
+        return None, (hit.parts, {name: row.get(name) for name in ROW_FIELDS})
+    try:
+        volumes = hulls.volumes(request.vertices, request.faces)
+    except Exception:  # qhull rejects flat or tiny point sets; the builder gets no parts
+        volumes = hulls.MeshVolumes(mesh=None, hull=0.0)
+    decision = _decision(request, requested, volumes)
+    reference = ("mesh", volumes.mesh) if volumes.mesh is not None else ("hull", volumes.hull)
+    plan = _Plan(
+        request,
+        requested,
+        decision,
+        params,
+        reference,
+        key,
+        fallback_key,
+        settings.use_cache,
+        started,
+    )
+    return plan, None
+
+
+def _load(key: str, fallback_key: str) -> mesh_cache.CachedResult | None:
+    """The stored result, else the stored timeout fallback under this time limit, else None."""
+    return mesh_cache.load(key) or mesh_cache.load(fallback_key)
+
+
+def _decision(
+    request: CollisionRequest, requested: CollisionMode, volumes: hulls.MeshVolumes
+) -> Decision:
+    if volumes.hull <= hulls.MIN_PART_VOLUME:
+        return Decision(CollisionMode.HULL, "flat or degenerate mesh: no volume to collide with")
+    if requested is CollisionMode.AUTO:
+        return decide(len(request.faces), volumes.convexity)
+    return Decision(requested, f"--collision {requested.value}", volumes.convexity)
+
+
+def _cache_key(
+    request: CollisionRequest,
+    requested: CollisionMode,
+    params: CoacdParams,
+    time_limit: float | None = None,
+) -> str:
+    """Content key; with `time_limit` [s], the key of a timeout fallback under that limit."""
+    facts = {
+        "time_limit": time_limit,
+        "mode": requested.value,
+        "scale": list(request.scale),
+        "params": params.kwargs(),
+        "rule": [CONVEX_RATIO, TRIANGLES_ADVISED, TRIANGLES_MAX, hulls.MIN_PART_VOLUME],
+    }
+    return mesh_cache.entry_key(request.vertices, request.faces, facts)
+
+
+def _job(plans: list[_Plan]) -> DecomposeJob:
+    """One CoACD run for every mesh with the same bytes and parameters."""
+    first = plans[0]
+    faults = [fault_for(plan.request.key) for plan in plans]
+    return DecomposeJob(
+        key=first.content_key,
+        vertices=first.request.vertices,
+        faces=first.request.faces,
+        params=first.params.kwargs(),
+        fault=next((f for f in faults if f), None),
+    )
+
+
+def _without_coacd(request: CollisionRequest, plan: _Plan | None) -> tuple[Pairs, dict[str, Any]]:
+    """Whole mesh (mode `mesh`) or its capped hull; hull results are cached like CoACD's."""
+    if plan is None:
+        parts = [(np.asarray(request.vertices, float), np.asarray(request.faces))]
+        row = _row(request, "mesh", "mesh", "--collision mesh", parts, ("mesh", 0.0), 0.0)
+        row["volume_ratio"] = 1.0
+        return parts, row
+    parts = _hull_parts(request.vertices, plan.params.max_ch_vertex)
+    return parts, _finish(plan, parts, fallback=None, store_key=plan.content_key)
+
+
+def _hull_parts(vertices: np.ndarray, cap: int) -> Pairs:
+    try:
+        hull = hulls.convex_hull(vertices, cap)
+    except Exception:  # flat: qhull has nothing to wrap
+        return []
+    return [hull] if hulls.usable_part(*hull) else []
+
+
+def _from_outcome(plan: _Plan, outcome: DecomposeOutcome) -> tuple[Pairs, dict[str, Any]]:
+    """Capped CoACD parts, or the hull when the worker failed or left nothing usable."""
+    cap = plan.params.max_ch_vertex
+    parts = [hulls.convex_hull(v, cap) for v, f in outcome.parts if hulls.usable_part(v, f)]
+    failure, store_key = outcome.failure, plan.content_key
+    if failure is None and not parts:
+        failure = "CoACD returned no usable part"
+    elif outcome.timed_out:
+        store_key = plan.fallback_key
+    elif failure is not None:
+        store_key = None  # a crash may not recur (out-of-memory kill, Ctrl-C): retry next time
+    if failure is not None:
+        parts = _hull_parts(plan.request.vertices, cap)
+    row = _finish(plan, parts, failure, store_key=store_key, worker_seconds=outcome.seconds)
+    return parts, row
+
+
+def _finish(
+    plan: _Plan,
+    parts: Pairs,
+    fallback: str | None,
+    *,
+    store_key: str | None,
+    worker_seconds: float | None = None,
+) -> dict[str, Any]:
+    """Build the row and store the result under `store_key` (None: not stored)."""
+    mode = CollisionMode.HULL if fallback else plan.decision.mode
+    # A CoACD mesh is timed by its worker (not the wait in the queue behind other meshes).
+    seconds = time.perf_counter() - plan.started if worker_seconds is None else worker_seconds
+    row = _row(
+        plan.request,
+        plan.requested.value,
+        mode.value,
+        plan.decision.reason,
+        parts,
+        plan.volume_reference,
+        seconds,
+    )
+    row["fallback"] = fallback
+    row["cache"] = "miss" if plan.use_cache else "off"
+    if plan.use_cache and store_key is not None:
+        meta = {k: v for k, v in row.items() if k not in ("cache", "seconds")}
+        try:
+            mesh_cache.store(store_key, parts, meta)
+        except OSError as exc:
+            row["cache"] = f"not stored: {exc}"
+    return row
+
+
+def _row(
+    request: CollisionRequest,
+    requested: str,
+    mode: str,
+    reason: str,
+    parts: Pairs,
+    reference: tuple[str, float],
+    seconds: float,
+) -> dict[str, Any]:
+    total = sum(hulls.hull_volume((np.asarray(v), np.asarray(f))) for v, f in parts)
+    ratio = total / reference[1] if reference[1] > 0 else None
+    return {
+        "key": request.key,
+        "link": request.link,
+        "source": request.source,
+        "requested": requested,
+        "mode": mode,
+        "reason": reason,
+        "triangles_before": int(len(request.faces)),
+        "triangles_after": int(sum(len(f) for _, f in parts)),
+        "parts": len(parts),
+        "volume_reference": reference[0],
+        "volume_ratio": ratio,
+        "seconds": seconds,
+        "compute_seconds": seconds,
+        "cache": "off",
+        "fallback": None,
+    }
+
+
+def _label(row: dict[str, Any]) -> str:
+    return f"{row['key']} {row['mode']} {row['parts']} parts ({row['cache']})"
+
+
+def _report(
+    rows: list[dict[str, Any]],
+    settings: CollisionSettings,
+    report: Report,
+    runs: int,
+    seconds: float,
+) -> None:
+    """One report line per mesh, the rows, and the totals."""
+    for row in rows:
+        subject = f"link '{row['link']}' collision mesh {Path(row['source']).name}"
+        report.meshes.append(row)
+        if row["fallback"]:
+            again = RETRY_HINT if row["cache"] == "hit" else ""
+            report.warn(subject, f"{row['fallback']}; using its convex hull instead{again}")
+        elif row["parts"] == 0:
+            report.warn(subject, f"{row['reason']}; left out of collision")
+        else:
+            report.approximated(subject, _describe(row, settings.preset))
+    report.summary["collision"] = {
+        "meshes": len(rows),
+        "coacd_runs": runs,
+        "cache_hits": sum(row["cache"] == "hit" for row in rows),
+        "fallbacks": sum(bool(row["fallback"]) for row in rows),
+        "parts": sum(row["parts"] for row in rows),
+        "seconds": seconds,
+    }
+
+
+def _describe(row: dict[str, Any], preset: str) -> str:
+    ratio = row["volume_ratio"]
+    volume = "" if ratio is None else f"; {ratio:.2f}x the {row['volume_reference']} volume"
+    if row["mode"] == "mesh":
+        return "kept whole; MuJoCo collides it as its convex hull"
+    if row["mode"] == "hull":
+        return f"convex hull, {row['triangles_after']} triangles ({row['reason']}){volume}"
+    return f"CoACD ({preset}): {row['parts']} convex parts ({row['reason']}){volume}"
+
+
+def prepare_collision_meshes(
+    requests: list[CollisionRequest], settings: CollisionSettings, report: Report
+) -> dict[str, list[MeshPart]]:
+    """Return the convex parts for each request key, decomposing in parallel, cached on disk.
+
+    Args:
+        requests: every collision mesh of the robot, scaled to metres.
+        settings: the user's choices.
+        report: receives one line per mesh and `report.meshes` rows (see this module).
+
+    Returns:
+        `{request.key: [MeshPart, ...]}`, one MuJoCo geom per part.
+
+    Raises:
+        CollisionSettingsError: an unknown mode or preset. A mesh that fails to decompose
+            never raises: it falls back to its convex hull and the report says why.
+    """
+    check_settings(settings)
+    return prepare(requests, settings, report)

@@ -1,0 +1,57 @@
+"""The neutral robot description: what format readers produce and every later stage consumes.
+
+`robot` holds links, joints, shapes and inertials; `gazebo` holds Gazebo's typed values
+(surfaces, link and joint flags, plugins and sensors). Nothing here knows a file format.
+"""
+
+from __future__ import annotations
+
+from converters.description.gazebo import (
+    Blob,
+    GazeboExtensions,
+    InlineSurface,
+    JointExtension,
+    LinkExtension,
+    Surface,
+    TagSource,
+)
+from converters.description.robot import (
+    JOINT_TYPES,
+    SHAPES,
+    WORLD_LINK,
+    Collision,
+    Dynamics,
+    Geometry,
+    Inertial,
+    Joint,
+    Limit,
+    Link,
+    Material,
+    Mimic,
+    RobotDescription,
+    Visual,
+)
+
+__all__ = [
+    "JOINT_TYPES",
+    "SHAPES",
+    "WORLD_LINK",
+    "Blob",
+    "Collision",
+    "Dynamics",
+    "GazeboExtensions",
+    "Geometry",
+    "Inertial",
+    "InlineSurface",
+    "Joint",
+    "JointExtension",
+    "Limit",
+    "Link",
+    "LinkExtension",
+    "Material",
+    "Mimic",
+    "RobotDescription",
+    "Surface",
+    "TagSource",
+    "Visual",
+]

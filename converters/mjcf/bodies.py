@@ -1,0 +1,98 @@
+"""Per-body mass properties after lumping: validation against physics, optional repair."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from converters.errors import InertiaError
+from converters.mjcf import inertia as inr
+from converters.mjcf.geometry import GeomPlan
+from converters.mjcf.lumping import WORLDBODY, BodyPlan
+from converters.report import Report
+
+
+def link_inertias(parsed: object, repair: bool, report: Report) -> dict[str, inr.Inertia]:
+    """Each link's inertia in its own frame, checked; links without `<inertial>` are absent.
+
+    Raises:
+        InertiaError: a link with mass > 0 and a non-physical tensor, or a negative mass
+            (unless `repair`, which bounds the tensor and reports the link).
+    """
+    out: dict[str, inr.Inertia] = {}
+    for link in parsed.model.links:
+        value = inr.from_urdf(link.inertial)
+        if value is None:
+            continue
+        if value.mass == 0 and not np.any(value.tensor):
+            out[link.name] = value
+            continue
+        trouble = inr.problem(value)
+        if trouble is not None and value.mass > 0 and repair:
+            fixed = inr.repair_tensor(value)
+            report.repaired(
+                f"link '{link.name}' <inertial>",
+                f"{trouble}: {inr.describe(value)} → {inr.describe(fixed)}",
+            )
+            value = fixed
+        elif trouble is not None and (value.mass != 0 or not repair):
+            raise InertiaError(parsed.source, link.name, trouble, inr.describe(value))
+        out[link.name] = value
+    return out
+
+
+def body_inertias(
+    parsed: object, plan: BodyPlan, geoms: list[GeomPlan], repair: bool, report: Report
+) -> dict[str, inr.Inertia]:
+    """Merged inertia of every body (its link plus the links lumped into it), in body frame.
+
+    A moving body (one with a joint, or the floating base) needs mass; without it conversion
+    fails, or with `repair` it gets a solid box of 1000 kg/m³ spanning its collision geometry.
+    """
+    links = link_inertias(parsed, repair, report)
+    parts: dict[str, list[inr.Inertia]] = {}
+    for name, value in links.items():
+        placement = plan.placements[name]
+        parts.setdefault(placement.body, []).append(value.transformed(placement.T_body_link))
+    moving = {b.name for b in plan.bodies if b.joint is not None}
+    if plan.floating:
+        moving.add(plan.root_body)
+    out: dict[str, inr.Inertia] = {}
+    for body in plan.bodies:
+        merged = inr.combine(parts.get(body.name, [])) if body.name in parts else inr.Inertia.zero()
+        if body.name in moving and merged.mass <= 0:
+            merged = _massless(parsed, body.name, links, geoms, repair, report)
+        out[body.name] = merged
+    out.pop(WORLDBODY, None)
+    return out
+
+
+def _massless(
+    parsed: object,
+    body: str,
+    links: dict[str, inr.Inertia],
+    geoms: list[GeomPlan],
+    repair: bool,
+    report: Report,
+) -> inr.Inertia:
+    if not repair:
+        problem = "moving link has no <inertial>" if body not in links else "moving link"
+        value = links.get(body, inr.Inertia.zero())
+        raise InertiaError(
+            parsed.source, body, f"{problem} with mass {value.mass:g} kg", inr.describe(value)
+        )
+    own = [g for g in geoms if g.body == body and g.role == "collision"] or [
+        g for g in geoms if g.body == body
+    ]
+    if own:
+        bounds = [g.aabb() for g in own]
+        lo = np.min([b[0] for b in bounds], axis=0)
+        hi = np.max([b[1] for b in bounds], axis=0)
+    else:
+        lo = hi = np.zeros(3)
+    value = inr.from_box(lo, hi)
+    report.repaired(
+        f"link '{body}' <inertial>",
+        f"moving link without mass: given {value.mass:.4g} kg, a solid box of "
+        f"{inr.REPAIR_DENSITY:g} kg/m³ over its geometry ({inr.describe(value)})",
+    )
+    return value

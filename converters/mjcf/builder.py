@@ -1,0 +1,298 @@
+"""Typed robot → MjSpec: bodies, joints, inertials, sites, geoms, meshes, actuators, keyframe."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from converters.collision.plan import CollisionRequest, CollisionSettings
+from converters.collision.prepare import prepare_collision_meshes
+from converters.mjcf import inertia as inr
+from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
+from converters.mjcf.bodies import body_inertias
+from converters.mjcf.geometry import GeomPlan, plan_geoms
+from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joints
+from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
+from converters.provenance import GeomOrigin, Provenance
+from converters.report import Report
+from converters.resources.meshes import MeshData
+from converters.resources.packages import PackageResolver
+
+# Menagerie conventions and Gazebo's default world step (SDF physics max_step_size 0.001 s).
+TIMESTEP = 0.001
+VISUAL_CLASS = "visual"
+COLLISION_CLASS = "collision"
+VISUAL_GROUP = 2
+COLLISION_GROUP = 3
+HOME_KEY = "home"
+
+
+@dataclass(frozen=True)
+class ConvertOptions:
+    """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan."""
+
+    keep_fixed: bool = False
+    repair_inertia: bool = False
+    collision: CollisionSettings = field(default_factory=CollisionSettings)
+
+
+def pose(T: np.ndarray) -> tuple[list[float], list[float]]:
+    """(pos, quat w-x-y-z) of a 4×4 transform."""
+    import mujoco
+
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).reshape(-1))
+    return T[:3, 3].tolist(), quat.tolist()
+
+
+def new_spec(name: str) -> object:
+    """An empty spec with twin's compiler settings, option and default classes."""
+    import mujoco
+
+    spec = mujoco.MjSpec()
+    spec.modelname = name
+    spec.compiler.degree = False
+    spec.compiler.autolimits = True
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    spec.option.timestep = TIMESTEP
+    visual = spec.add_default(VISUAL_CLASS, spec.default)
+    visual.geom.group = VISUAL_GROUP
+    visual.geom.contype = 0
+    visual.geom.conaffinity = 0
+    visual.geom.density = 0
+    collision = spec.add_default(COLLISION_CLASS, spec.default)
+    collision.geom.group = COLLISION_GROUP
+    return spec
+
+
+def build_spec(
+    parsed: object,
+    *,
+    static: bool,
+    preserved: frozenset[str],
+    options: ConvertOptions,
+    resolver: PackageResolver,
+    report: Report,
+    provenance: Provenance,
+) -> object:
+    """Build the robot's MjSpec (Gazebo tags are applied afterwards by the caller).
+
+    Raises:
+        InertiaError, PackageNotFoundError, ResourceNotFoundError, MeshError.
+    """
+    plan = plan_bodies(
+        parsed.model,
+        parsed.base_link,
+        preserved=preserved,
+        keep_fixed=options.keep_fixed,
+        static=static,
+    )
+    geoms = plan_geoms(parsed, plan, resolver, report)
+    inertias = body_inertias(parsed, plan, geoms, options.repair_inertia, report)
+    spec = new_spec(parsed.model.name)
+    bodies, joints = _add_bodies(spec, plan, inertias, report, provenance)
+    _add_sites(bodies, plan, provenance)
+    _add_geoms(spec, bodies, geoms, options.collision, report, provenance)
+    add_motors(spec, actuated_joints(parsed, report), report)
+    add_mimics(spec, parsed, report)
+    spec.add_key(name=HOME_KEY, qpos=_home(joints, parsed))
+    _summarise(plan, inertias, geoms, report)
+    report.summary.update(
+        joints=len(parsed.model.joints),
+        mujoco_joints=len(joints),
+        actuators=len(spec.actuators),
+        mimic_equalities=len(spec.equalities),
+    )
+    return spec
+
+
+def _add_bodies(
+    spec: object,
+    plan: BodyPlan,
+    inertias: dict[str, inr.Inertia],
+    report: Report,
+    provenance: Provenance,
+) -> tuple[dict[str, object], list[MjJointPlan]]:
+    bodies: dict[str, object] = {WORLDBODY: spec.worldbody}
+    joints: list[MjJointPlan] = []
+    for node in plan.bodies:
+        pos, quat = pose(node.T_parent_body)
+        body = bodies[node.parent].add_body(name=node.name, pos=pos, quat=quat)
+        bodies[node.name] = body
+        _set_inertial(body, inertias[node.name])
+        if node.name == plan.root_body and plan.floating:
+            joints.append(add_free_joint(body, np.asarray(pos)))
+        joints += add_joints(body, node.joint, report)
+    for made in joints:
+        if made.urdf_joint is not None:
+            provenance.joints[made.name] = made.urdf_joint
+    for link, placement in plan.placements.items():
+        provenance.body_of_link[link] = placement.body
+    provenance.lumped.extend(plan.lumped)
+    return bodies, joints
+
+
+def _set_inertial(body: object, value: inr.Inertia) -> None:
+    """Principal moments + axes quaternion: keeps the full tensor, off-diagonals included."""
+    moments, quat = inr.principal(value)
+    body.explicitinertial = True
+    body.mass = value.mass
+    body.ipos = value.com.tolist()
+    body.iquat = quat.tolist()
+    body.inertia = moments.tolist()
+
+
+def _add_sites(bodies: dict[str, object], plan: BodyPlan, provenance: Provenance) -> None:
+    """Every lumped link stays addressable as a site named after it, at its frame."""
+    for link in plan.lumped:
+        placement = plan.placements[link]
+        pos, quat = pose(placement.T_body_link)
+        bodies[placement.body].add_site(name=link, pos=pos, quat=quat, group=VISUAL_GROUP + 3)
+
+
+def _add_geoms(
+    spec: object,
+    bodies: dict[str, object],
+    geoms: list[GeomPlan],
+    settings: CollisionSettings,
+    report: Report,
+    provenance: Provenance,
+) -> None:
+    import mujoco
+
+    parts = _collision_parts(geoms, settings, report)
+    meshes = _MeshAssets(spec)
+    defaults = {r: spec.find_default(r) for r in (VISUAL_CLASS, COLLISION_CLASS)}
+    for geom in geoms:
+        pieces = parts.get(_key(geom), [geom.mesh]) if geom.role == "collision" else [geom.mesh]
+        if geom.role == "collision" and geom.degenerate is not None:
+            report.approximated(
+                f"link '{geom.link}' collision {geom.index}",
+                f"mesh {geom.mesh_file} is degenerate ({geom.degenerate}); kept out of collision",
+            )
+            continue
+        if geom.mesh is not None and len(geom.mesh.vertices) < 4:
+            report.ignored(
+                f"link '{geom.link}' {geom.role} {geom.index}",
+                f"mesh {geom.mesh_file} has {len(geom.mesh.vertices)} vertices",
+            )
+            continue
+        for part, mesh in enumerate(pieces):
+            name = f"{geom.link}_{geom.role}_{geom.index}" + (f"_{part}" if len(pieces) > 1 else "")
+            pos, quat = pose(geom.T_body_geom)
+            mj = bodies[geom.body].add_geom(defaults[geom.role], name=name, pos=pos, quat=quat)
+            if mesh is None:
+                mj.type = _primitive(geom.kind)
+                mj.size = list(geom.size) + [0.0] * (3 - len(geom.size))
+            else:
+                mj.type = mujoco.mjtGeom.mjGEOM_MESH
+                mj.meshname = meshes.name_for(mesh, geom, flat=geom.degenerate is not None)
+            if geom.colour is not None:
+                mj.rgba = list(geom.colour.rgba)
+                if geom.colour.texture and part == 0:
+                    report.approximated(
+                        f"link '{geom.link}' visual {geom.index}",
+                        f"texture {geom.colour.texture} is not carried; the material colour "
+                        "is used",
+                    )
+            provenance.geoms.append(
+                GeomOrigin(name, geom.link, geom.body, geom.role, geom.index, part, geom.mesh_file)
+            )
+
+
+def _key(geom: GeomPlan) -> str:
+    return f"{geom.link}/collision_{geom.index}"
+
+
+def _collision_parts(
+    geoms: list[GeomPlan], settings: CollisionSettings, report: Report
+) -> dict[str, list[MeshData]]:
+    """All collision meshes through `prepare_collision_meshes` in one call."""
+    requests = [
+        CollisionRequest(_key(g), g.link, g.mesh_file or "", g.scale, g.mesh.vertices, g.mesh.faces)
+        for g in geoms
+        if g.role == "collision" and g.mesh is not None and g.degenerate is None
+    ]
+    if not requests:
+        return {}
+    prepared = prepare_collision_meshes(requests, settings, report)
+    by_key = {r.key: r for r in requests}
+    out: dict[str, list[MeshData]] = {}
+    for key, parts in prepared.items():
+        whole = by_key[key]
+        out[key] = [
+            next(g.mesh for g in geoms if g.role == "collision" and _key(g) == key)
+            if p.vertices is whole.vertices
+            else MeshData(np.asarray(p.vertices, float), np.asarray(p.faces, np.int32))
+            for p in parts
+        ]
+    return out
+
+
+class _MeshAssets:
+    """Mesh assets carried inside the spec (vertex and face data, no files); one per mesh."""
+
+    def __init__(self, spec: object) -> None:
+        self.spec = spec
+        self.names: dict[int, str] = {}
+        self.used: set[str] = set()
+
+    def name_for(self, mesh: MeshData, geom: GeomPlan, flat: bool) -> str:
+        import mujoco
+
+        if id(mesh) in self.names:
+            return self.names[id(mesh)]
+        stem = (geom.mesh_file or geom.link).replace("\\", "/").rsplit("/", 1)[-1]
+        base = stem.rsplit(".", 1)[0] if geom.mesh is mesh else f"{geom.link}_c{geom.index}"
+        name, n = base, 1
+        while name in self.used:
+            n += 1
+            name = f"{base}_{n}"
+        asset = self.spec.add_mesh(
+            name=name, uservert=mesh.vertices.reshape(-1), userface=mesh.faces.reshape(-1)
+        )
+        if flat:
+            asset.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+        self.names[id(mesh)] = name
+        self.used.add(name)
+        return name
+
+
+def _home(joints: list[MjJointPlan], parsed: object) -> list[float]:
+    """The `home` keyframe: zero (clamped into range), mimic followers consistent."""
+    values = {j.name: j.home for j in joints}
+    for joint in parsed.model.joints:
+        mimic = joint.mimic
+        if mimic is not None and joint.name in values and mimic.joint in values:
+            leader = values[mimic.joint][0]
+            multiplier = 1.0 if mimic.multiplier is None else float(mimic.multiplier)
+            offset = 0.0 if mimic.offset is None else float(mimic.offset)
+            values[joint.name] = (offset + multiplier * leader,)
+    return [v for j in joints for v in values[j.name]]
+
+
+def _summarise(
+    plan: BodyPlan, inertias: dict[str, inr.Inertia], geoms: list[GeomPlan], report: Report
+) -> None:
+    report.summary.update(
+        links=len(plan.placements),
+        bodies=len(plan.bodies),
+        lumped_links=len(plan.lumped),
+        floating_base=plan.floating,
+        total_mass_kg=float(sum(v.mass for v in inertias.values())),
+        visual_geoms=sum(g.role == "visual" for g in geoms),
+        collision_geoms=sum(g.role == "collision" for g in geoms),
+    )
+
+
+def _primitive(kind: str) -> object:
+    """The MuJoCo geom type of a primitive URDF shape."""
+    import mujoco
+
+    return {
+        "box": mujoco.mjtGeom.mjGEOM_BOX,
+        "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+        "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+        "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+    }[kind]

@@ -1,0 +1,167 @@
+"""URDF `<visual>`/`<collision>` geometry → planned geoms in body frames (meshes loaded)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from converters.mjcf.lumping import BodyPlan
+from converters.mjcf.materials import VisualColour, robot_materials, visual_colour
+from converters.report import Report
+from converters.resources.meshes import MeshCache, MeshData, mesh_problem
+from converters.resources.packages import PackageResolver
+
+ROLES = ("visual", "collision")
+
+
+@dataclass(frozen=True)
+class GeomPlan:
+    """One geom to create.
+
+    Attributes:
+        link, body, role, index: provenance (URDF link, MuJoCo body, visual|collision, n-th).
+        kind: box | cylinder | sphere | capsule | mesh.
+        size: MuJoCo size (half extents, radius, half length) [m]; empty for meshes.
+        T_body_geom: pose in the body (4×4).
+        colour: visual colour (visuals only).
+        mesh: the scaled mesh (meshes only); mesh_file: its resolved file; scale: its scale.
+        degenerate: why the mesh cannot collide (None if it can).
+    """
+
+    link: str
+    body: str
+    role: str
+    index: int
+    kind: str
+    size: tuple[float, ...]
+    T_body_geom: np.ndarray
+    colour: VisualColour | None = None
+    mesh: MeshData | None = None
+    mesh_file: str | None = None
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    degenerate: str | None = None
+
+    def aabb(self) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned bounds [m] of this geom in its body frame."""
+        if self.mesh is not None:
+            points = self.mesh.vertices
+        else:
+            half = _half_extents(self.kind, self.size)
+            points = (
+                np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+                * half
+            )
+        world = points @ self.T_body_geom[:3, :3].T + self.T_body_geom[:3, 3]
+        return world.min(axis=0), world.max(axis=0)
+
+
+def _half_extents(kind: str, size: tuple[float, ...]) -> np.ndarray:
+    if kind == "box":
+        return np.asarray(size)
+    if kind == "sphere":
+        return np.full(3, size[0])
+    if kind == "capsule":
+        return np.array([size[0], size[0], size[1] + size[0]])
+    return np.array([size[0], size[0], size[1]])
+
+
+def plan_geoms(
+    parsed: object, plan: BodyPlan, resolver: PackageResolver, report: Report
+) -> list[GeomPlan]:
+    """Every visual and collision geom of every link, placed in its body, meshes loaded."""
+    cache = MeshCache()
+    named = robot_materials(parsed.model)
+    out: list[GeomPlan] = []
+    for link in parsed.model.links:
+        placement = plan.placements[link.name]
+        for role in ROLES:
+            for index, item in enumerate(getattr(link, f"{role}s")):
+                origin = item.origin if item.origin is not None else np.eye(4)
+                T = placement.T_body_link @ np.asarray(origin, dtype=float)
+                colour = visual_colour(item.material, named) if role == "visual" else None
+                capsule = (link.name, role, index) in parsed.capsules
+                geom = _plan_one(
+                    item.geometry, capsule, link.name, role, index, parsed.base_dir, resolver, cache
+                )
+                if geom is None:
+                    report.ignored(f"link '{link.name}' {role} {index}", "no geometry")
+                    continue
+                if colour is not None and geom[2] is not None:
+                    colour = _mesh_colour(
+                        colour, geom[2], f"link '{link.name}' visual {index}", report
+                    )
+                out.append(_assemble(link.name, placement.body, role, index, geom, T, colour))
+    return out
+
+
+def _mesh_colour(
+    colour: VisualColour, mesh: MeshData, subject: str, report: Report
+) -> VisualColour:
+    """A visual mesh without a URDF material is drawn in the file's own main colour (as Gazebo
+    draws the file's materials); a texture in the file is reported, not carried."""
+    if mesh.textured:
+        report.approximated(
+            subject,
+            "the mesh file's texture is not carried; its average "
+            "colour is used when the URDF gives no material",
+        )
+    if colour.material is None and mesh.rgba is not None:
+        return VisualColour(mesh.rgba, None, None)
+    return colour
+
+
+def _assemble(
+    link: str,
+    body: str,
+    role: str,
+    index: int,
+    geom: tuple,
+    T: np.ndarray,
+    colour: VisualColour | None,
+) -> GeomPlan:
+    kind, size, mesh, mesh_file, scale = geom
+    degenerate = mesh_problem(mesh) if mesh is not None else None
+    return GeomPlan(
+        link, body, role, index, kind, size, T, colour, mesh, mesh_file, scale, degenerate
+    )
+
+
+def _plan_one(
+    geometry: object | None,
+    capsule: bool,
+    link: str,
+    role: str,
+    index: int,
+    base_dir: Path,
+    resolver: PackageResolver,
+    cache: MeshCache,
+) -> tuple | None:
+    """(kind, size, mesh, mesh_file, scale) for one URDF geometry, or None if empty."""
+    if geometry is None:
+        return None
+    unit = (1.0, 1.0, 1.0)
+    if geometry.box is not None:
+        return "box", tuple(float(v) / 2 for v in geometry.box.size), None, None, unit
+    if geometry.cylinder is not None:
+        kind = "capsule" if capsule else "cylinder"
+        size = (float(geometry.cylinder.radius), float(geometry.cylinder.length) / 2)
+        return kind, size, None, None, unit
+    if geometry.sphere is not None:
+        return "sphere", (float(geometry.sphere.radius),), None, None, unit
+    if geometry.mesh is not None:
+        element = f"link '{link}' <{role}> {index} <mesh>"
+        path = resolver.resolve(geometry.mesh.filename, base_dir=base_dir, element=element)
+        scale = _scale(geometry.mesh.scale)
+        return "mesh", (), cache.get(path, scale, link), str(path), scale
+    return None
+
+
+def _scale(value: object) -> tuple[float, float, float]:
+    if value is None:
+        return (1.0, 1.0, 1.0)
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.size == 1:
+        arr = np.repeat(arr, 3)
+    return (float(arr[0]), float(arr[1]), float(arr[2]))

@@ -1,0 +1,107 @@
+"""MjSpec → an MJCF directory: `<robot>.xml`, `scene.xml`, `assets/*.stl`; atomic, reproducible."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from converters.report import Report
+
+ASSETS = "assets"
+SCENE = "scene.xml"
+# Binary STL: 80-byte header, uint32 count, then per triangle normal + 3 vertices + attribute.
+_STL_HEADER = b"twin binary STL".ljust(80, b" ")
+_STL_DTYPE = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+
+
+def safe_name(name: str) -> str:
+    """A file-name-safe version of a robot or mesh name."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("._") or "robot"
+
+
+def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    """A binary STL of a triangle mesh (float32, as the format stores it)."""
+    triangles = np.asarray(vertices, dtype=float)[np.asarray(faces, dtype=np.int64)]
+    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
+    records = np.zeros(len(triangles), dtype=_STL_DTYPE)
+    records["normal"] = normals
+    records["v"] = triangles
+    count = np.array([len(triangles)], dtype="<u4").tobytes()
+    return _STL_HEADER + count + records.tobytes()
+
+
+def robot_xml(spec: object, assets_dir: Path) -> str:
+    """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
+    copy = spec.copy()
+    copy.modelfiledir = str(assets_dir.parent)  # to_xml compiles: let it find the new files
+    for mesh in copy.meshes:
+        if len(mesh.uservert) == 0:
+            continue
+        vertices = np.asarray(mesh.uservert, dtype=float).reshape(-1, 3)
+        faces = np.asarray(mesh.userface, dtype=np.int64).reshape(-1, 3)
+        filename = f"{safe_name(mesh.name)}.stl"
+        (assets_dir / filename).write_bytes(stl_bytes(vertices, faces))
+        mesh.file = f"{ASSETS}/{filename}"
+        mesh.uservert = []
+        mesh.userface = []
+    return copy.to_xml()
+
+
+def scene_xml(robot_file: str, model_name: str) -> str:
+    """A scene with Gazebo's ground plane (via `add_gazebo_ground`), a light, the robot included."""
+    import mujoco
+
+    from converters.gazebo.contact import add_gazebo_ground
+
+    scene = mujoco.MjSpec()
+    scene.modelname = f"{model_name} scene"
+    add_gazebo_ground(scene)
+    scene.worldbody.add_light(name="sun", pos=[0, 0, 5], dir=[0, 0, -1])
+    text = scene.to_xml()
+    head, sep, rest = text.partition(">\n")
+    return f'{head}{sep}  <include file="{robot_file}"/>\n{rest}'
+
+
+def write_model(spec: object, report: Report, out_dir: str | Path) -> Path:
+    """Write the converted robot as an MJCF directory, replacing `out_dir` atomically.
+
+    Layout: `OUT/<robot>.xml`, `OUT/scene.xml` (ground + light + robot), `OUT/assets/*.stl`;
+    only relative paths. The same spec gives byte-identical files.
+
+    Returns:
+        The path of `<robot>.xml`.
+    """
+    out = Path(out_dir).resolve()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    name = safe_name(spec.modelname or report.robot)
+    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        (staging / ASSETS).mkdir()
+        robot_file = f"{name}.xml"
+        (staging / robot_file).write_text(robot_xml(spec, staging / ASSETS))
+        (staging / SCENE).write_text(scene_xml(robot_file, name))
+        os.chmod(staging, 0o755)
+        _replace(staging, out)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return out / robot_file
+
+
+def _replace(staging: Path, out: Path) -> None:
+    """Swap `staging` into `out` with renames, so readers never see a half-written model."""
+    if not out.exists():
+        staging.rename(out)
+        return
+    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+    old.rmdir()
+    out.rename(old)
+    staging.rename(out)
+    shutil.rmtree(old, ignore_errors=True)

@@ -1,0 +1,114 @@
+"""xacro → URDF text without ROS: `--arg` mappings, `$(find pkg)` through our resolver."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import threading
+import xml.dom.minidom
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from converters.errors import ConversionError, XacroError
+from converters.resources.packages import PackageResolver
+
+# xacro keeps its substitution context and our patched `find` in module globals.
+_LOCK = threading.Lock()
+
+XACRO_SUFFIXES = (".xacro",)
+
+
+@dataclass(frozen=True)
+class XacroResult:
+    """Expanded URDF text plus what xacro left behind.
+
+    Attributes:
+        text: the URDF XML.
+        unexpanded: tags that match a macro name but lacked the `xacro:` prefix (never expanded).
+        warnings: lines xacro printed to stderr while processing.
+    """
+
+    text: str
+    unexpanded: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def needs_xacro(path: Path) -> bool:
+    """True for `.xacro` files (incl. `.urdf.xacro`); plain `.urdf` files skip xacro."""
+    return path.suffix.lower() in XACRO_SUFFIXES
+
+
+@contextlib.contextmanager
+def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
+    """Make xacro's `$(find pkg)` and `find()` use `resolver`; records the macro names seen."""
+    import xacro
+    from xacro import substitution_args as subst
+
+    def find(pkg: str) -> str:
+        return str(resolver.find_package(pkg, uri=f"$(find {pkg})", element="xacro $(find)"))
+
+    macro_names: list[str] = []
+    original_grab = xacro.grab_macro
+
+    def grab_macro(elt: xml.dom.minidom.Element, macros: object) -> None:
+        name = elt.getAttribute("name")
+        macro_names.append(name[6:] if name.startswith("xacro:") else name)
+        original_grab(elt, macros)
+
+    saved = (subst._eval_find, subst._eval_dict["find"])
+    subst._eval_find = find
+    subst._eval_dict["find"] = find
+    xacro.grab_macro = grab_macro
+    try:
+        yield macro_names
+    finally:
+        subst._eval_find, subst._eval_dict["find"] = saved
+        xacro.grab_macro = original_grab
+
+
+def _conversion_cause(exc: BaseException) -> ConversionError | None:
+    """Our own error if xacro wrapped one (e.g. an unknown package inside `$(find)`)."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        if isinstance(seen, ConversionError):
+            return seen
+        inner = getattr(seen, "exc", None)
+        seen = inner if isinstance(inner, BaseException) else (seen.__cause__ or seen.__context__)
+    return None
+
+
+def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver) -> XacroResult:
+    """Run xacro on `path` with `args` (the `NAME:=VALUE` mappings).
+
+    Raises:
+        XacroError: xacro failed; the message is xacro's own, with the file.
+        PackageNotFoundError: a `$(find pkg)` names an unknown package.
+    """
+    import xacro
+
+    stderr = io.StringIO()
+    with _LOCK, _patched_find(resolver) as macro_names, contextlib.redirect_stderr(stderr):
+        try:
+            doc = xacro.process_file(str(path), mappings=dict(args))
+        except Exception as exc:  # xacro raises many types (XacroException, NameError, …)
+            ours = _conversion_cause(exc)
+            if ours is not None:
+                raise ours from exc
+            raise XacroError(str(path), str(exc) or type(exc).__name__) from exc
+        finally:
+            xacro.init_stacks(None)
+    unexpanded = _unexpanded_calls(doc, set(macro_names))
+    warnings = tuple(line for line in stderr.getvalue().splitlines() if line.strip())
+    return XacroResult(doc.toxml(), unexpanded, warnings)
+
+
+def _unexpanded_calls(doc: xml.dom.minidom.Document, macro_names: set[str]) -> tuple[str, ...]:
+    """Tags left in the output whose name is a macro's: calls written without `xacro:`."""
+    found: list[str] = []
+    for node in doc.documentElement.getElementsByTagName("*"):
+        tag = node.tagName.split(":")[-1]
+        if tag in macro_names:
+            attrs = " ".join(f'{k}="{v}"' for k, v in node.attributes.items())
+            found.append(f"<{node.tagName}{' ' + attrs if attrs else ''}/>")
+    return tuple(found)

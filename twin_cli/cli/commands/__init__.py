@@ -1,0 +1,22 @@
+"""Command modules, one per group; each has `register(app)` and imports nothing heavy at top."""
+
+from __future__ import annotations
+
+import importlib
+
+import typer
+
+# Each module registers its commands on the app. Keep this list in the order of `twin --help`.
+MODULES = ("convert", "cache", "serve", "world", "validate")
+
+
+def register_all(app: typer.Typer) -> None:
+    """Register every command module that exists (modules are added as features land)."""
+    for name in MODULES:
+        try:
+            module = importlib.import_module(f"twin_cli.cli.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"twin_cli.cli.commands.{name}":
+                continue
+            raise
+        module.register(app)

@@ -1,0 +1,39 @@
+"""`twin serve`: run a world server in the foreground, like gzserver (the one server-side command).
+
+Kept apart from the client commands in `world.py` so that those never reach mujoco or fastapi.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from twin_cli.cli.options import WorldOpt
+
+
+def serve(
+    world_file: Annotated[Path | None, typer.Argument(help="World saved by `twin save`.")] = None,
+    world: WorldOpt = "default",
+    rate: Annotated[float | None, typer.Option(help="Real-time update rate (Hz); 0 = max.")] = None,
+    step: Annotated[float | None, typer.Option(help="Physics step (s) (default 0.001).")] = None,
+    paused: Annotated[bool, typer.Option("--paused", help="Start paused.")] = False,
+    tcp: Annotated[
+        str | None, typer.Option(help="Also listen on HOST:PORT (loopback if only PORT), token.")
+    ] = None,
+    background: Annotated[bool, typer.Option("--background", hidden=True)] = False,
+) -> None:
+    """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
+    from twin_cli.server.process import ServeOptions
+    from twin_cli.server.process import serve as run_server
+
+    opts = ServeOptions(
+        world, str(world_file) if world_file else None, rate, step, paused, tcp, background
+    )
+    run_server(opts)
+
+
+def register(app: typer.Typer) -> None:
+    """Add `twin serve` to the `twin` app."""
+    app.command("serve")(serve)

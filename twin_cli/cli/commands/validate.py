@@ -1,0 +1,114 @@
+"""`twin validate`: run the physics validation checklist on a robot, in-process (no server)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from twin_cli.cli.options import (
+    ArgOpt,
+    JointOpt,
+    JsonOpt,
+    PackageOpt,
+    joint_positions,
+    source_inputs,
+)
+
+ScenarioOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--scenario",
+        help="Bundled scenario name or scenario .toml file (repeatable; default: the checklist).",
+    ),
+]
+OnlyOpt = Annotated[list[str] | None, typer.Option("--only", help="Run only this check.")]
+SkipOpt = Annotated[list[str] | None, typer.Option("--skip", help="Leave this check out.")]
+JunitOpt = Annotated[Path | None, typer.Option("--junit", help="Write JUnit XML to FILE.")]
+MarkdownOpt = Annotated[
+    Path | None, typer.Option("--markdown", help="Write a Markdown summary to FILE.")
+]
+PlotsOpt = Annotated[Path | None, typer.Option("--plots", help="Write PNG plots into DIR.")]
+RepairOpt = Annotated[
+    bool,
+    typer.Option(
+        "--repair-inertia",
+        help="Accept the converter's inertia repairs (report them as warnings, not failures).",
+    ),
+]
+
+CollisionOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--collision",
+        help="Collision meshes as the converter makes them: auto|coacd|hull|mesh (default auto).",
+    ),
+]
+
+
+def validate(
+    robot: Annotated[Path, typer.Argument(help="URDF, xacro or MJCF file of the robot.")],
+    arg: ArgOpt = None,
+    package: PackageOpt = None,
+    scenario: ScenarioOpt = None,
+    only: OnlyOpt = None,
+    skip: SkipOpt = None,
+    junit: JunitOpt = None,
+    json: JsonOpt = False,
+    markdown: MarkdownOpt = None,
+    plots: PlotsOpt = None,
+    repair_inertia: RepairOpt = False,
+    collision: CollisionOpt = None,
+    joint: JointOpt = None,
+) -> None:
+    """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
+    from twin_cli.cli.output import Output
+    from twin_cli.validate import report as render
+    from twin_cli.validate.runner import validate as run_validation
+
+    run = run_validation(
+        robot,
+        **source_inputs(arg, package),
+        scenarios=scenario,
+        only=only,
+        skip=skip,
+        repair_inertia=repair_inertia,
+        collision=collision,
+        joints=joint_positions(joint),
+    )
+    out = Output(json)
+    if json:
+        out.data(run.to_dict())
+    else:
+        print_table(run, out)
+    if junit:
+        junit.write_text(render.junit_xml(run), encoding="utf-8")
+    if markdown:
+        markdown.write_text(render.markdown(run), encoding="utf-8")
+    if plots:
+        for path in render.write_plots(run, plots):
+            out.line(f"plot: {path}")
+    raise typer.Exit(0 if run.passed else 1)
+
+
+def register(app: typer.Typer) -> None:
+    """Add `twin validate` to the app."""
+    app.command("validate")(validate)
+
+
+def print_table(run: Any, out: Any) -> None:
+    """The human view: one row per check, then the hints of every failed or warned check."""
+    from twin_cli.validate import report as render
+
+    rows = [(render.label(r), r.measured, r.threshold, render.MARK[r.status]) for r in run.results]
+    out.table(f"twin validate {run.robot}", ["check", "measured", "threshold", "result"], rows)
+    for r in run.results:
+        if r.status in (render.Status.FAIL, render.Status.WARN):
+            for hint in r.hints or r.details:
+                out.line(f"{render.MARK[r.status]} {r.check}: {hint}")
+    counts = run.counts()
+    out.line(
+        f"{run.robot}: {counts['pass']} passed, {counts['warn']} warned, {counts['fail']} failed,"
+        f" {counts['skip']} skipped in {run.seconds:.1f} s"
+    )

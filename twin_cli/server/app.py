@@ -1,0 +1,356 @@
+"""HTTP API over one World (FastAPI): validated requests, twin's errors as 4xx JSON bodies.
+
+Endpoints are plain `def` functions, so FastAPI runs them in its thread pool and the event
+loop keeps answering while one waits for the world's lock (a spawn may convert for seconds).
+The world steps in its own thread; nothing here does physics. `twin_cli.server.process` runs it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import os
+import secrets
+import threading
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Depends, FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+
+from converters.errors import ConversionError
+from twin_cli.errors import (
+    EntityExistsError,
+    EntityNotFoundError,
+    PartNotFoundError,
+    RequestError,
+    TwinError,
+)
+from twin_cli.server.models import (
+    CommandBody,
+    GravityBody,
+    PathBody,
+    PhysicsBody,
+    PoseBody,
+    PushBody,
+    ResetBody,
+    SpawnBody,
+    StepBody,
+)
+
+log = logging.getLogger("twin.server")
+API_VERSION = "1"
+
+
+class WorldHolder:
+    """The served world; `load` replaces it under a lock while requests keep arriving."""
+
+    def __init__(self, world: Any) -> None:
+        self.world = world
+        self.swap_lock = threading.Lock()
+
+    def replace(self, new_world: Any) -> None:
+        """Stop the old world's loop and start the new one's."""
+        with self.swap_lock:
+            old, self.world = self.world, new_world
+            old.stop()
+            new_world.start()
+
+
+def current_world(request: Request) -> Any:
+    return request.app.state.holder.world
+
+
+WorldDep = Annotated[Any, Depends(current_world)]
+router = APIRouter()
+
+
+def _plain(value: Any) -> Any:
+    """Dataclasses (and lists of them) as JSON-ready dicts."""
+    if dataclasses.is_dataclass(value):
+        return dataclasses.asdict(value)
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+@router.get("/health")
+def health(request: Request) -> dict:
+    """Liveness probe: the world's name and the server's pid."""
+    state = request.app.state
+    return {"world": state.world_name, "pid": os.getpid(), "api": API_VERSION}
+
+
+@router.get("/stats")
+def stats(world: WorldDep) -> dict:
+    """gz-stats figures: factor (last 20 samples of 0.2 s), sim_time [s], real_time [s]."""
+    return _plain(world.stats())
+
+
+@router.get("/entities")
+def entities(world: WorldDep) -> list[dict]:
+    return _plain(world.entities())
+
+
+@router.post("/entities", status_code=201)
+def spawn(body: SpawnBody, world: WorldDep) -> dict:
+    """Spawn a URDF/xacro/MJCF file; replies once the entity exists (gazebo_ros semantics)."""
+    from twin_cli.world import Pose
+
+    result = world.spawn(
+        body.source,
+        name=body.name,
+        pose=Pose(**body.pose.model_dump()),
+        args=body.args,
+        package_paths=body.package_paths,
+        on_ground=body.on_ground,
+        joints=body.joints,
+    )
+    log.info("spawned %s from %s", result.name, body.source)
+    return _plain(result)
+
+
+@router.delete("/entities/{name}")
+def delete(name: str, world: WorldDep) -> dict:
+    world.delete(name)
+    log.info("deleted %s", name)
+    return {"deleted": name}
+
+
+@router.get("/entities/{name}/pose")
+def get_pose(name: str, world: WorldDep) -> dict:
+    return world.get_pose(name).to_dict()
+
+
+@router.put("/entities/{name}/pose")
+def set_pose(name: str, body: PoseBody, world: WorldDep) -> dict:
+    from twin_cli.world import Pose
+
+    world.set_pose(name, Pose(**body.model_dump()))
+    return world.get_pose(name).to_dict()
+
+
+@router.get("/entities/{name}/joints")
+def joints(name: str, world: WorldDep) -> list[dict]:
+    return _plain(world.joint_states(name))
+
+
+@router.get("/entities/{name}/links")
+def links(name: str, world: WorldDep) -> dict:
+    return {link: pose.to_dict() for link, pose in world.link_poses(name).items()}
+
+
+@router.post("/entities/{name}/push")
+def push(name: str, body: PushBody, world: WorldDep) -> dict:
+    world.push(name, body.force, body.torque, link=body.link, duration=body.duration)
+    return {"pushed": name}
+
+
+@router.post("/entities/{name}/command")
+def command(name: str, body: CommandBody, world: WorldDep) -> dict:
+    world.command(name, body.joint, mode=body.mode, value=body.value)
+    return {"commanded": name, "joint": body.joint}
+
+
+@router.get("/gravity")
+def get_gravity(world: WorldDep) -> dict:
+    return {"gravity": list(world.gravity())}
+
+
+@router.put("/gravity")
+def set_gravity(body: GravityBody, world: WorldDep) -> dict:
+    from twin_cli.world import GRAVITY_PRESETS
+
+    vector = GRAVITY_PRESETS[body.preset] if body.preset else body.vector
+    world.set_gravity(tuple(float(v) for v in vector))
+    log.info("gravity set to %s", vector)
+    return {"gravity": list(world.gravity())}
+
+
+@router.get("/physics")
+def get_physics(world: WorldDep) -> dict:
+    return world.physics()
+
+
+@router.put("/physics")
+def set_physics(body: PhysicsBody, world: WorldDep) -> dict:
+    return world.set_physics(**body.model_dump())
+
+
+@router.post("/pause")
+def pause(world: WorldDep) -> dict:
+    world.pause()
+    return {"paused": True}
+
+
+@router.post("/resume")
+def resume(world: WorldDep) -> dict:
+    world.resume()
+    return {"paused": False}
+
+
+@router.post("/step")
+def step(body: StepBody, world: WorldDep) -> dict:
+    world.step(body.n)
+    return _plain(world.stats())
+
+
+@router.post("/reset")
+def reset(body: ResetBody, world: WorldDep) -> dict:
+    world.reset(time_only=body.time_only)
+    return _plain(world.stats())
+
+
+@router.post("/save")
+def save(body: PathBody, world: WorldDep) -> dict:
+    world.save(body.path)
+    return {"saved": body.path}
+
+
+@router.post("/load")
+def load(body: PathBody, request: Request) -> dict:
+    """Replace the served world by one read from a file written by `save`."""
+    from twin_cli.world import World
+
+    new_world = World.load(body.path)
+    request.app.state.holder.replace(new_world)
+    log.info("loaded world from %s", body.path)
+    return {"loaded": body.path, "entities": [e.name for e in new_world.entities()]}
+
+
+@router.post("/shutdown")
+def shutdown(request: Request) -> dict:
+    """End the server after this reply (what `twin stop` asks)."""
+    request.app.state.request_exit()
+    return {"stopping": request.app.state.world_name}
+
+
+# Status of each error class; other TwinError and ConversionError subclasses are 400.
+ERROR_STATUS: dict[type[Exception], int] = {
+    EntityNotFoundError: 404,
+    PartNotFoundError: 404,
+    EntityExistsError: 409,
+}
+
+
+def _error(status: int, name: str, message: str) -> JSONResponse:
+    return JSONResponse(status_code=status, content={"error": name, "message": message})
+
+
+def _known_error(request: Request, exc: Exception) -> JSONResponse:
+    """TwinError/ConversionError: the class name and its message (what, where, fix)."""
+    status = next((s for cls, s in ERROR_STATUS.items() if isinstance(exc, cls)), 400)
+    log.info(
+        "%s %s -> %d %s: %s", request.method, request.url.path, status, type(exc).__name__, exc
+    )
+    return _error(status, type(exc).__name__, str(exc))
+
+
+def _validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
+    """pydantic's findings as one line naming each bad field."""
+    problems = "; ".join(
+        f"{'.'.join(str(p) for p in err['loc'] if p != 'body') or 'body'}: {err['msg']}"
+        for err in exc.errors()
+    )
+    message = str(
+        RequestError(
+            f"{request.method} {request.url.path}",
+            problems,
+            "see docs/api.md or /openapi.json for the request schema",
+        )
+    )
+    return _error(422, "RequestError", message)
+
+
+def _os_error(request: Request, exc: OSError) -> JSONResponse:
+    """A file the request named cannot be read or written on the server's host."""
+    where = exc.filename or request.url.path
+    message = str(
+        RequestError(
+            str(where),
+            exc.strerror or str(exc),
+            "give a path that exists and is readable on the server's host",
+        )
+    )
+    return _error(400, "RequestError", message)
+
+
+def _value_error(request: Request, exc: ValueError) -> JSONResponse:
+    message = str(
+        RequestError(
+            f"{request.method} {request.url.path}",
+            str(exc),
+            "check the values against `twin physics`/docs/api.md",
+        )
+    )
+    return _error(400, "RequestError", message)
+
+
+def _unexpected(request: Request, exc: Exception) -> JSONResponse:
+    """Any other failure: logged with its traceback; the server and the world keep running."""
+    log.exception("%s %s failed", request.method, request.url.path)
+    message = str(
+        RequestError(
+            f"{request.method} {request.url.path}",
+            f"internal error {type(exc).__name__}: {exc}",
+            "see `twin logs`; the world is still running",
+        )
+    )
+    return _error(500, "RequestError", message)
+
+
+class TokenGuard:
+    """ASGI middleware: requests that arrive over TCP must carry `Authorization: Bearer TOKEN`.
+
+    Unix-socket requests pass (the 0700 directory and 0600 socket already restrict them to
+    the user). uvicorn reports a Unix socket's scope["server"] as (path, None).
+    """
+
+    def __init__(self, app: Any, token: str | None) -> None:
+        self.app = app
+        self.expected = f"Bearer {token}".encode() if token else None
+
+    async def __call__(self, scope: dict, receive: Any, send: Any) -> None:
+        server = scope.get("server") or (None, None)
+        if scope["type"] == "http" and server[1] is not None:
+            given = dict(scope.get("headers") or []).get(b"authorization", b"")
+            if self.expected is None or not secrets.compare_digest(given, self.expected):
+                reply = _error(
+                    401,
+                    "RequestError",
+                    "missing or wrong bearer token; send "
+                    "`Authorization: Bearer <contents of the world's .token file>`",
+                )
+                await reply(scope, receive, send)
+                return
+        await self.app(scope, receive, send)
+
+
+def create_app(
+    world: Any, *, world_name: str = "default", token: str | None = None, request_exit: Any = None
+) -> FastAPI:
+    """The HTTP API over `world` (a started or unstarted `twin_cli.world.engine.World`).
+
+    Args:
+        world: the world to serve.
+        world_name: reported by `/health`; clients check it.
+        token: bearer token required on TCP connections (None: TCP refused).
+        request_exit: called by `POST /shutdown` to end the server.
+    """
+    app = FastAPI(
+        title="twin world server",
+        version=API_VERSION,
+        description="One running MuJoCo world; see docs/api.md.",
+    )
+    app.state.holder = WorldHolder(world)
+    app.state.world_name = world_name
+    app.state.request_exit = request_exit or (lambda: None)
+    app.include_router(router)
+    app.add_exception_handler(TwinError, _known_error)
+    app.add_exception_handler(ConversionError, _known_error)
+    app.add_exception_handler(RequestValidationError, _validation_error)
+    app.add_exception_handler(OSError, _os_error)
+    app.add_exception_handler(ValueError, _value_error)
+    app.add_exception_handler(Exception, _unexpected)
+    app.add_middleware(TokenGuard, token=token)
+    return app

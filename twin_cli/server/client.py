@@ -1,0 +1,318 @@
+"""HTTP client of a world server over its Unix socket; server errors come back as the same class.
+
+Imports httpx and the standard library only: never mujoco, numpy, trimesh, coacd, fastapi or
+uvicorn: a client command costs Python, typer and httpx start-up only (~0.25 s).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from twin_cli import errors as twin_errors
+from twin_cli.errors import NotRunningError, RequestError
+from twin_cli.server import runtime
+
+# httpx imports its own command line (rich, click, pygments: ~40 ms of a ~250 ms command) only
+# to offer `httpx.main`, inside `try: ... except ImportError`; a None entry makes that import
+# fail at once and httpx falls back to a stub. Nothing in twin uses httpx's command line.
+sys.modules.setdefault("httpx._main", None)  # type: ignore[arg-type]
+
+import httpx  # noqa: E402
+
+# Seconds: most requests are a lock and a copy; spawn converts (CoACD can take minutes cold).
+DEFAULT_TIMEOUT_S = 10.0
+SPAWN_TIMEOUT_S = 600.0
+STOP_TIMEOUT_S = 15.0
+BASE_URL = "http://twin"
+
+
+def _error_class(name: str) -> type[Exception] | None:
+    """The TwinError/ConversionError subclass called `name`, from the two errors modules.
+
+    `converters` is imported only on this error path, so a client command that succeeds
+    never loads the converter package.
+    """
+    cls = getattr(twin_errors, name, None)
+    if isinstance(cls, type) and issubclass(cls, twin_errors.TwinError):
+        return cls
+    from converters import errors as conversion_errors
+
+    cls = getattr(conversion_errors, name, None)
+    if isinstance(cls, type) and issubclass(cls, conversion_errors.ConversionError):
+        return cls
+    return None
+
+
+def rebuild_error(status: int, body: Any) -> Exception:
+    """Turn a server's error body `{"error": class, "message": text}` into that exception.
+
+    The class's constructor takes facts, not a message, so the instance is made without it
+    and given the server's message, which already names the subject and the fix.
+    """
+    if not isinstance(body, dict) or "message" not in body:
+        return RequestError(f"HTTP {status}", str(body)[:500], "see `twin logs`")
+    cls = _error_class(str(body.get("error", "")))
+    if cls is None:
+        return RequestError(str(body.get("error", "request")), body["message"], "see `twin logs`")
+    exc = cls.__new__(cls)
+    Exception.__init__(exc, body["message"])
+    return exc
+
+
+class Client:
+    """One world server, reached through its Unix socket (or TCP with a bearer token)."""
+
+    def __init__(
+        self,
+        world: str = runtime.DEFAULT_WORLD,
+        *,
+        url: str | None = None,
+        token: str | None = None,
+    ) -> None:
+        """Args:
+        world: world name; selects the socket in the runtime directory.
+        url: `http://host:port` to use TCP instead of the socket (needs `token`).
+        token: bearer token for TCP (the server's `<world>.token` file).
+        """
+        self.world = world
+        self.paths = runtime.world_paths(world)
+        headers = {"Authorization": f"Bearer {token}"} if token else {}
+        # No TLS over the socket or plain-http TCP: skip loading CA certificates (~60 ms).
+        verify = bool(url and url.startswith("https:"))
+        transport = httpx.HTTPTransport(uds=None if url else str(self.paths.socket), verify=verify)
+        self._http = httpx.Client(
+            transport=transport,
+            base_url=url or BASE_URL,
+            headers=headers,
+            timeout=DEFAULT_TIMEOUT_S,
+        )
+
+    def close(self) -> None:
+        """Close the connection pool."""
+        self._http.close()
+
+    def __enter__(self) -> Client:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def request(
+        self, method: str, path: str, *, body: Any = None, timeout: float = DEFAULT_TIMEOUT_S
+    ) -> Any:
+        """Send one request and return the decoded JSON reply.
+
+        Raises:
+            NotRunningError: no server listens for this world.
+            TwinError | ConversionError: the server's error, as the same class.
+        """
+        try:
+            reply = self._http.request(method, path, json=body, timeout=timeout)
+        except (httpx.ConnectError, httpx.RemoteProtocolError, FileNotFoundError) as exc:
+            raise NotRunningError(self.world) from exc
+        except httpx.TimeoutException as exc:
+            raise RequestError(
+                f"{method} {path}",
+                f"no answer from world [{self.world}] in {timeout:.0f} s",
+                "the server may be busy; see `twin logs`",
+            ) from exc
+        try:
+            payload = reply.json()
+        except ValueError:
+            payload = reply.text
+        if reply.is_error:
+            raise rebuild_error(reply.status_code, payload)
+        return payload
+
+    def alive(self) -> bool:
+        """True when the server answers `/health` for this world."""
+        try:
+            return self.request("GET", "/health", timeout=2.0).get("world") == self.world
+        except (NotRunningError, RequestError):
+            return False
+
+    # World commands, one per endpoint (see docs/api.md).
+    def stats(self) -> dict:
+        return self.request("GET", "/stats")
+
+    def entities(self) -> list[dict]:
+        return self.request("GET", "/entities")
+
+    def spawn(
+        self,
+        source: str | os.PathLike,
+        *,
+        name: str | None = None,
+        pose: dict[str, float] | None = None,
+        args: dict[str, str] | None = None,
+        package_paths: dict[str, str] | None = None,
+        on_ground: bool = False,
+        joints: dict[str, float] | None = None,
+    ) -> dict:
+        """Spawn a file (paths made absolute here: the server has its own working directory).
+
+        `joints`: initial joint positions [rad] or [m] by joint name (Gazebo's `-J`).
+        """
+        body = {
+            "source": str(Path(source).expanduser().absolute()),
+            "name": name,
+            "pose": pose or {},
+            "args": args or {},
+            "package_paths": {
+                k: str(Path(v).expanduser().absolute()) for k, v in (package_paths or {}).items()
+            },
+            "on_ground": on_ground,
+            "joints": joints or {},
+        }
+        return self.request("POST", "/entities", body=body, timeout=SPAWN_TIMEOUT_S)
+
+    def delete(self, name: str) -> dict:
+        return self.request("DELETE", f"/entities/{_seg(name)}")
+
+    def pose(self, name: str) -> dict:
+        return self.request("GET", f"/entities/{_seg(name)}/pose")
+
+    def set_pose(self, name: str, pose: dict[str, float]) -> dict:
+        return self.request("PUT", f"/entities/{_seg(name)}/pose", body=pose)
+
+    def joints(self, name: str) -> list[dict]:
+        return self.request("GET", f"/entities/{_seg(name)}/joints")
+
+    def links(self, name: str) -> dict:
+        return self.request("GET", f"/entities/{_seg(name)}/links")
+
+    def push(
+        self,
+        name: str,
+        force: tuple,
+        torque: tuple,
+        *,
+        link: str | None = None,
+        duration: float = 0.1,
+    ) -> dict:
+        body = {"force": list(force), "torque": list(torque), "link": link, "duration": duration}
+        return self.request("POST", f"/entities/{_seg(name)}/push", body=body)
+
+    def command(self, name: str, joint: str, *, mode: str, value: float) -> dict:
+        body = {"joint": joint, "mode": mode, "value": value}
+        return self.request("POST", f"/entities/{_seg(name)}/command", body=body)
+
+    def gravity(self) -> dict:
+        return self.request("GET", "/gravity")
+
+    def set_gravity(self, *, preset: str | None = None, vector: tuple | None = None) -> dict:
+        body = {"preset": preset, "vector": list(vector) if vector is not None else None}
+        return self.request("PUT", "/gravity", body=body)
+
+    def physics(self) -> dict:
+        return self.request("GET", "/physics")
+
+    def set_physics(self, **changes: Any) -> dict:
+        return self.request("PUT", "/physics", body=changes)
+
+    def pause(self) -> dict:
+        return self.request("POST", "/pause")
+
+    def resume(self) -> dict:
+        return self.request("POST", "/resume")
+
+    def step(self, n: int = 1) -> dict:
+        return self.request("POST", "/step", body={"n": n}, timeout=SPAWN_TIMEOUT_S)
+
+    def reset(self, *, time_only: bool = False) -> dict:
+        return self.request("POST", "/reset", body={"time_only": time_only})
+
+    def save(self, path: str | os.PathLike) -> dict:
+        return self.request("POST", "/save", body={"path": str(Path(path).absolute())})
+
+    def load(self, path: str | os.PathLike) -> dict:
+        body = {"path": str(Path(path).absolute())}
+        return self.request("POST", "/load", body=body, timeout=SPAWN_TIMEOUT_S)
+
+
+def _seg(name: str) -> str:
+    """An entity name as one URL path segment."""
+    return httpx.URL("/" + name.replace("/", "%2F")).raw_path.decode()[1:]
+
+
+def connect(
+    world: str = runtime.DEFAULT_WORLD, *, start: bool = True, announce: Any = None
+) -> Client:
+    """A client of `world`'s server, starting it in the background when none runs.
+
+    Args:
+        world: world name.
+        start: start the server when none answers (False: raise NotRunningError).
+        announce: callable given one line to tell the user a server was started
+            (default: write it to stderr).
+
+    Raises:
+        NotRunningError: none runs and `start` is False.
+        ServerStartError: the background server did not come up.
+    """
+    client = Client(world)
+    if client.alive():
+        return client
+    if not start:
+        client.close()
+        raise NotRunningError(world)
+    paths = client.paths
+    with runtime.start_lock(paths):
+        if not runtime.server_alive(paths):
+            runtime.clean_stale(paths)
+            proc = runtime.launch_background(paths, [])
+            runtime.wait_until(paths, client.alive, proc, runtime.START_TIMEOUT_S)
+            (announce or _stderr)(
+                f"twin: started world [{world}] in the background (pid {proc.pid}); "
+                f"`twin stop` ends it"
+            )
+    runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
+    return client
+
+
+def _stderr(line: str) -> None:
+    sys.stderr.write(line + "\n")
+    sys.stderr.flush()
+
+
+def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) -> int | None:
+    """Ask `world`'s server to shut down and wait until its process is gone.
+
+    Escalates to SIGTERM, then SIGKILL, if it does not end within `timeout` seconds.
+
+    Returns:
+        The pid of the stopped server.
+
+    Raises:
+        NotRunningError: no server runs for this world.
+    """
+    paths = runtime.world_paths(world)
+    pid = runtime.read_pid(paths)
+    if not runtime.server_alive(paths):
+        with runtime.start_lock(paths):
+            runtime.clean_stale(paths)
+        raise NotRunningError(world)
+    with Client(world) as client:
+        try:
+            client.request("POST", "/shutdown")
+        except NotRunningError:
+            pass  # socket gone but process alive: fall through to signals
+    for sig in (None, signal.SIGTERM, signal.SIGKILL):
+        if sig is not None and pid:
+            try:
+                os.kill(pid, sig)
+            except ProcessLookupError:
+                break
+        deadline = time.monotonic() + timeout
+        while runtime.server_alive(paths) and time.monotonic() < deadline:
+            time.sleep(runtime.START_POLL_S)
+        if not runtime.server_alive(paths):
+            break
+    with runtime.start_lock(paths):
+        runtime.clean_stale(paths)
+    return pid

@@ -1,0 +1,198 @@
+"""Runs one world server process: owns its runtime files, binds sockets, serves until stopped."""
+
+from __future__ import annotations
+
+import contextlib
+import ipaddress
+import logging
+import os
+import secrets
+import signal
+import socket
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from twin_cli.errors import RequestError
+from twin_cli.server import runtime
+
+log = logging.getLogger("twin.server")
+LOG_FORMAT = "%(asctime)s %(levelname)s %(name)s: %(message)s"
+
+
+@dataclass(frozen=True)
+class ServeOptions:
+    """What `twin serve` was asked for.
+
+    Attributes:
+        world: world name (one server per name).
+        world_file: a world saved by `twin save`, or None for an empty world.
+        rate: real-time update rate [Hz]; 0 = unthrottled; None = the world's default.
+        step: physics timestep [s]; None = the world's default.
+        paused: start paused.
+        tcp: `HOST:PORT` or `PORT` for an extra TCP listener with a bearer token.
+        background: started by a client that holds the world's start lock.
+    """
+
+    world: str = runtime.DEFAULT_WORLD
+    world_file: str | None = None
+    rate: float | None = None
+    step: float | None = None
+    paused: bool = False
+    tcp: str | None = None
+    background: bool = False
+
+
+def parse_tcp(text: str) -> tuple[str, int]:
+    """`HOST:PORT` or `PORT` (loopback) as (host, port).
+
+    Raises:
+        RequestError: not a host and port.
+    """
+    host, _, port = text.rpartition(":")
+    host = host.strip("[]") or "127.0.0.1"
+    host = "127.0.0.1" if host == "localhost" else host
+    try:
+        number = int(port)
+        ipaddress.ip_address(host)
+    except ValueError as exc:
+        raise RequestError(
+            f"--tcp {text}",
+            "is not HOST:PORT with an IP address",
+            "use e.g. --tcp 127.0.0.1:8765 or --tcp 8765",
+        ) from exc
+    if not 0 <= number <= 65535:
+        raise RequestError(f"--tcp {text}", f"port {number} is out of range", "use 0-65535")
+    return host, number
+
+
+def bind_unix(path: Path) -> socket.socket:
+    """A listening Unix socket at `path`, created with mode 0600 (no window where it is wider)."""
+    with contextlib.suppress(FileNotFoundError):
+        path.unlink()  # a stale socket of a dead server; we own the pid lock here
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    old_umask = os.umask(0o177)
+    try:
+        sock.bind(str(path))
+    finally:
+        os.umask(old_umask)
+    path.chmod(0o600)
+    return sock
+
+
+def bind_tcp(host: str, port: int) -> socket.socket:
+    """A TCP socket bound to (host, port); port 0 picks a free one."""
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    return sock
+
+
+def write_private(path: Path, text: str) -> None:
+    """Write `text` to a file created with mode 0600."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as handle:
+        handle.write(text)
+
+
+def build_world(opts: ServeOptions) -> Any:
+    """The world to serve, loaded or empty, with the requested rate, step and pause state."""
+    from twin_cli.world import World, WorldSettings
+
+    changes = {k: v for k, v in (("timestep", opts.step), ("rate", opts.rate)) if v is not None}
+    if opts.world_file:
+        world = World.load(opts.world_file)
+        if changes:
+            world.set_physics(**changes)
+    else:
+        world = World(WorldSettings(**changes), name=opts.world)
+    if opts.paused:
+        world.pause()
+    return world
+
+
+def configure_logging(paths: runtime.WorldPaths) -> None:
+    """Send the server's and uvicorn's logs to the world's log file."""
+    os.close(runtime.open_log(paths))  # create it private before logging opens it
+    handler = logging.FileHandler(paths.log)
+    handler.setFormatter(logging.Formatter(LOG_FORMAT))
+    root = logging.getLogger()
+    root.addHandler(handler)
+    root.setLevel(logging.INFO)
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    """SIGTERM: unwind through every `finally`, so files are removed and the world stopped."""
+    raise SystemExit(0)
+
+
+@contextlib.contextmanager
+def owned_world(paths: runtime.WorldPaths, background: bool) -> Iterator[None]:
+    """Hold the world's pid lock; a foreground server also takes the start lock to get it."""
+    with contextlib.ExitStack() as stack:
+        if background:  # our starter holds the start lock until we answer
+            stack.enter_context(runtime.hold_pid_file(paths))
+        else:
+            with runtime.start_lock(paths):
+                stack.enter_context(runtime.hold_pid_file(paths))
+        yield
+
+
+def serve(opts: ServeOptions) -> None:
+    """Serve one world until `twin stop`, SIGTERM or SIGINT; always clean up runtime files.
+
+    Raises:
+        WorldRunningError: a server for this world already runs.
+    """
+    import uvicorn
+
+    from twin_cli.server.app import create_app
+
+    paths = runtime.world_paths(opts.world)
+    signal.signal(signal.SIGTERM, _terminate)
+    configure_logging(paths)
+    tcp = parse_tcp(opts.tcp) if opts.tcp else None
+    token = secrets.token_urlsafe(32) if tcp else None
+    with owned_world(paths, opts.background):
+        world = build_world(opts)
+        app = create_app(
+            world,
+            world_name=opts.world,
+            token=token,
+            request_exit=lambda: setattr(server, "should_exit", True),
+        )
+        config = uvicorn.Config(
+            app, log_config=None, access_log=False, lifespan="off", timeout_graceful_shutdown=5
+        )
+        server = uvicorn.Server(config)
+        try:
+            world.start()
+            sockets = _listen(paths, tcp, token)
+            log.info("serving world [%s] on %s (pid %d)", opts.world, paths.socket, os.getpid())
+            if not opts.background:
+                sys.stderr.write(
+                    f"twin: serving world [{opts.world}] on {paths.socket}; log {paths.log}\n"
+                )
+            with contextlib.suppress(KeyboardInterrupt):
+                server.run(sockets=sockets)
+        finally:
+            app.state.holder.world.stop()
+            log.info("world [%s] stopped", opts.world)
+
+
+def _listen(paths: runtime.WorldPaths, tcp: tuple[str, int] | None, token: str | None) -> list:
+    """The Unix socket, plus a TCP listener whose address and token go to 0600 files."""
+    sockets = [bind_unix(paths.socket)]
+    if tcp is None or token is None:
+        return sockets
+    sock = bind_tcp(*tcp)
+    sockets.append(sock)
+    host, port = sock.getsockname()[:2]
+    write_private(paths.token, token + "\n")
+    write_private(paths.tcp, f"{host}:{port}\n")
+    if not ipaddress.ip_address(host).is_loopback:
+        log.warning("TCP listener on non-loopback %s:%d; every request needs the token", host, port)
+    return sockets

@@ -1,0 +1,168 @@
+"""Physics checks on contact: resting on the ground, and pushed into a box without passing through.
+
+Penetration oracle: Gazebo's contact is a spring per contact point, so a link of mass m resting
+on kp sinks about m·g/kp (design.md §2.2). twin maps kp to MuJoCo's direct solref
+S = (1 − d)·kp/m (converters.gazebo.contact), so kp is recovered from a compiled geom as S·m/(1 − d)
+and named in the hint when a link sinks too deep.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from twin_cli.validate.checks.base import (
+    CheckResult,
+    RobotUnderTest,
+    Status,
+    fmt_len,
+    judged,
+    result,
+)
+from twin_cli.validate.checks.sim import ScenarioRun
+from twin_cli.validate.scenario import Scenario
+
+G = 9.81  # [m/s²]
+
+
+def _link(run: ScenarioRun, body: int) -> str:
+    return run.world.model.body(body).name.removeprefix(f"{run.entity}/")
+
+
+def geom_kp(run: ScenarioRun, geom: int) -> float | None:
+    """The Gazebo kp [N/m] a geom's direct solref encodes, or None for a standard solref."""
+    model = run.world.model
+    s = float(model.geom_solref[geom][0])
+    if s >= 0:
+        return None
+    d = float(model.geom_solimp[geom][0])
+    mass = float(model.body_mass[int(model.geom_bodyid[geom])])
+    return -s * mass / max(1.0 - d, 1e-9)
+
+
+def _sink_hint(run: ScenarioRun, geom: int, depth: float, limit: float) -> str:
+    body = int(run.world.model.geom_bodyid[geom])
+    mass = float(run.world.model.body_mass[body])
+    kp = geom_kp(run, geom)
+    text = f"{_link(run, body)} sinks {fmt_len(depth)} (limit {fmt_len(limit)})"
+    if kp is not None:
+        needed = mass * G / limit
+        return (
+            f"{text}: kp {kp:.3g} N/m is too soft for {mass:.3g} kg; raise <kp> in its "
+            f"<gazebo> block to ≥ {needed:.2g} N/m (m·g/kp ≤ {fmt_len(limit)})"
+        )
+    return f"{text}: the contact is too soft for {mass:.3g} kg; set <kp>/<kd> on the link"
+
+
+def skip_fixed(check: str) -> CheckResult:
+    """The verdict for a robot welded to the world: it cannot stand, slide or be pushed."""
+    return result(
+        check,
+        "physics",
+        Status.SKIP,
+        "fixed base",
+        "n/a",
+        details=["the robot is fixed to the world (no floating base)"],
+    )
+
+
+def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
+    """On the ground: comes to rest, nothing falls through, penetration within tolerance."""
+    run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("ground_contact")
+    deepest: dict[int, float] = {}
+    speeds: list[float] = []
+    lowest = [np.inf]
+    previous = [run.subtree_com()]
+    settle = scenario.duration * 0.5
+
+    def sample(r: ScenarioRun) -> None:
+        com = r.subtree_com()
+        speeds.append(float(np.linalg.norm(com - previous[0]) / (10 * r.world.model.opt.timestep)))
+        previous[0] = com
+        with r.world.lock:
+            lowest[0] = min(lowest[0], min(float(r.world.data.xipos[b][2]) for b in r.bodies))
+        if r.time >= settle:
+            for geom, dist in r.ground_contacts():
+                deepest[geom] = max(deepest.get(geom, 0.0), -dist)
+
+    run.run(scenario.duration, sample, every=10)
+    final_speed = float(np.mean(speeds[-20:]))
+    depth = max(deepest.values(), default=0.0)
+    hints = [
+        _sink_hint(run, g, d, th["max_penetration_m"])
+        for g, d in sorted(deepest.items(), key=lambda kv: -kv[1])
+        if d > th["max_penetration_m"]
+    ]
+    if lowest[0] < -th["max_penetration_m"]:
+        hints.append(
+            f"a link's centre of mass went {fmt_len(-lowest[0])} below the ground: it fell "
+            "through; give the link a <collision> or stiffen its contact"
+        )
+    if final_speed > th["rest_speed_m_s"]:
+        hints.append(
+            f"still moving at {final_speed:.3g} m/s after {scenario.duration:g} s: the contact "
+            "bounces or the robot drifts; raise <kd> or check for overlapping collisions"
+        )
+    if not deepest:
+        hints.append(
+            "no contact with the ground after settling: the robot has no collision geometry"
+        )
+    return judged(
+        "ground_contact",
+        "physics",
+        f"penetration {fmt_len(depth)}, speed {final_speed:.2g} m/s",
+        f"≤ {fmt_len(th['max_penetration_m'])}, ≤ {th['rest_speed_m_s']:g} m/s",
+        hints,
+        value=depth,
+    )
+
+
+def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
+    """Pushed towards a box, the robot touches it and does not pass through."""
+    if not scenario.obstacles:
+        return result(
+            "collision",
+            "physics",
+            Status.SKIP,
+            "no obstacle",
+            "n/a",
+            details=["the scenario has no [[obstacles]] to push the robot into"],
+        )
+    run = ScenarioRun(robot, scenario)
+    if not run.floating:
+        return skip_fixed("collision")
+    model = run.world.model
+    box_body = max(b for b in range(model.nbody) if model.body(b).name.startswith("obstacle0/"))
+    box_geoms = {g for g in range(model.ngeom) if int(model.geom_bodyid[g]) == box_body}
+    with run.world.lock:
+        far_face = float(run.world.data.xpos[box_body][0]) + scenario.obstacles[0].size[0] / 2
+        near_face = far_face - scenario.obstacles[0].size[0]
+    touched, furthest = [False], [-np.inf]
+
+    def sample(r: ScenarioRun) -> None:
+        with r.world.lock:
+            data = r.world.data
+            furthest[0] = max(furthest[0], max(float(data.xipos[b][0]) for b in r.bodies))
+            for i in range(data.ncon):
+                if {int(data.contact[i].geom1), int(data.contact[i].geom2)} & box_geoms:
+                    touched[0] = True
+
+    run.run(scenario.duration, sample, every=5)
+    beyond = furthest[0] - near_face
+    hints = []
+    if not touched[0]:
+        hints.append("the robot never touched the box: make the push stronger or the gap smaller")
+    if furthest[0] > far_face - th["max_intrusion_m"]:
+        hints.append(
+            f"a link's centre of mass reached {fmt_len(beyond)} past the box's near face: the "
+            "robot passes through; give its links <collision> geometry (not only <visual>)"
+        )
+    return judged(
+        "collision",
+        "physics",
+        f"deepest link COM {fmt_len(beyond)} past the near face",
+        f"< {fmt_len(scenario.obstacles[0].size[0] - th['max_intrusion_m'])}",
+        hints,
+        value=beyond,
+    )

@@ -1,0 +1,129 @@
+"""Where a spawned entity starts: its lowest point, and overlaps with the ground or others."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from twin_cli.world.entities import EntityIndex
+
+PENETRATION_TOL = 1e-4  # [m] overlap below this is resting contact, not a bad start
+_G = mujoco.mjtGeom
+
+
+@dataclass(frozen=True)
+class Overlap:
+    """The deepest overlap between the new entity and one other party.
+
+    Attributes:
+        other: "ground", "entity [name]" or a geom name.
+        depth: penetration depth [m] (> 0).
+    """
+
+    other: str
+    depth: float
+
+
+def positioned(model: mujoco.MjModel, qpos: np.ndarray) -> mujoco.MjData:
+    """A scratch MjData at configuration `qpos` with kinematics and contacts computed.
+
+    The world's own data is never touched, so checking a spawn cannot change any trajectory.
+    """
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_fwdPosition(model, data)
+    return data
+
+
+def collision_geoms(model: mujoco.MjModel, geoms: np.ndarray) -> np.ndarray:
+    """The geoms among `geoms` that take part in collisions (contype or conaffinity set)."""
+    live = (model.geom_contype[geoms] != 0) | (model.geom_conaffinity[geoms] != 0)
+    return geoms[live]
+
+
+def lowest_point(model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray) -> float | None:
+    """The lowest world z [m] of the given geoms' surfaces (planes and height fields skipped)."""
+    lows = [_geom_low(model, data, int(g)) for g in geoms]
+    lows = [z for z in lows if z is not None]
+    return min(lows) if lows else None
+
+
+def _geom_low(model: mujoco.MjModel, data: mujoco.MjData, g: int) -> float | None:
+    kind, size = model.geom_type[g], model.geom_size[g]
+    z, rot_z = data.geom_xpos[g][2], data.geom_xmat[g].reshape(3, 3)[2]
+    if kind == _G.mjGEOM_SPHERE:
+        return z - size[0]
+    if kind == _G.mjGEOM_CAPSULE:
+        return z - abs(rot_z[2]) * size[1] - size[0]
+    if kind == _G.mjGEOM_CYLINDER:
+        return z - abs(rot_z[2]) * size[1] - size[0] * np.sqrt(max(0.0, 1.0 - rot_z[2] ** 2))
+    if kind == _G.mjGEOM_BOX:
+        return z - float(np.abs(rot_z) @ size)
+    if kind == _G.mjGEOM_ELLIPSOID:
+        return z - float(np.sqrt(np.sum((rot_z * size) ** 2)))
+    if kind == _G.mjGEOM_MESH:
+        mesh = model.geom_dataid[g]
+        start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+        return z + float(np.min(model.mesh_vert[start : start + count] @ rot_z))
+    return None
+
+
+def overlaps(
+    data: mujoco.MjData,
+    geoms: np.ndarray,
+    party_of: Callable[[int], str],
+) -> list[Overlap]:
+    """The deepest overlap of `geoms` with each other party, deepest first.
+
+    Args:
+        data: positioned data (see `positioned`) whose contacts are computed.
+        geoms: the new entity's geom ids.
+        party_of: names the owner of a geom outside `geoms` ("ground", "entity [x]").
+    """
+    mine = np.isin(data.contact.geom, geoms)  # (ncon, 2): which side is the new entity's
+    deepest: dict[str, float] = {}
+    for (g1, g2), (in1, in2), dist in zip(data.contact.geom, mine, data.contact.dist, strict=True):
+        if in1 == in2 or -dist <= PENETRATION_TOL:
+            continue
+        other = party_of(int(g2 if in1 else g1))
+        deepest[other] = max(deepest.get(other, 0.0), -float(dist))
+    return sorted((Overlap(o, d) for o, d in deepest.items()), key=lambda o: -o.depth)
+
+
+def overlap_warnings(name: str, z: float, found: list[Overlap]) -> list[str]:
+    """One warning per overlap, with the depth and the spawn height that clears it."""
+    return [
+        f"entity [{name}]: collision geometry starts {o.depth:.4f} m inside {o.other}; "
+        f"spawn at z >= {z + o.depth:.4f} m to clear it, or use --on-ground"
+        for o in found
+    ]
+
+
+def start_warnings(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    index: dict[str, EntityIndex],
+    name: str,
+    z: float,
+) -> list[str]:
+    """Warnings for entity `name` starting inside the ground or another entity.
+
+    Args:
+        model, data: the world with the new entity seeded (data is not modified).
+        index: every entity's index in `model`; name: the new entity; z: its spawn height [m].
+    """
+    scratch = positioned(model, data.qpos)
+    body_owner = {int(b): n for n, ix in index.items() for b in ix.bodies}
+
+    def party_of(geom: int) -> str:
+        owner = body_owner.get(int(model.geom_bodyid[geom]))
+        if owner:
+            return f"entity [{owner}]"
+        geom_name = model.geom(geom).name
+        return "the ground" if geom_name == "ground" else f"geom [{geom_name}]"
+
+    geoms = collision_geoms(model, index[name].geoms)
+    return overlap_warnings(name, z, overlaps(scratch, geoms, party_of))

@@ -1,0 +1,92 @@
+"""Read-only views of an entity in a compiled world: root pose, joint states, link poses."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from twin_cli.world.entities import EntityIndex, element_names
+from twin_cli.world.pose import Pose
+
+_FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
+
+
+@dataclass(frozen=True)
+class JointState:
+    """One joint of an entity.
+
+    Attributes:
+        name: joint name without the entity prefix.
+        position: [rad] or [m] (ball joints: rotation angle [rad]).
+        velocity: [rad/s] or [m/s] (ball joints: angular speed [rad/s]).
+        effort: actuator force on the joint [N m] or [N], from the last step.
+    """
+
+    name: str
+    position: float
+    velocity: float
+    effort: float
+
+
+def root_pose(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, spawn: Pose) -> Pose:
+    """The entity's root pose now: its free joint's qpos, else its fixed root body's pose."""
+    if index.free_qpos >= 0:
+        q = data.qpos[index.free_qpos : index.free_qpos + 7]
+        return Pose.from_quat(q[0], q[1], q[2], q[3:7])
+    if index.root >= 0:
+        pos, quat = model.body_pos[index.root], model.body_quat[index.root]
+        return Pose.from_quat(pos[0], pos[1], pos[2], quat)
+    return spawn
+
+
+def joint_states(
+    model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
+) -> list[JointState]:
+    """States of the entity's joints other than its free joint, in model order."""
+    names = element_names(model, model.name_jntadr[index.joints])
+    states = []
+    for j, name in zip(index.joints, names, strict=True):
+        kind, qa, da = model.jnt_type[j], model.jnt_qposadr[j], model.jnt_dofadr[j]
+        if kind == _FREE:
+            continue
+        if kind == _BALL:
+            angle = 2.0 * math.acos(min(1.0, abs(float(data.qpos[qa]))))
+            speed = float(np.linalg.norm(data.qvel[da : da + 3]))
+            states.append(JointState(name.removeprefix(prefix), angle, speed, 0.0))
+            continue
+        effort = float(data.qfrc_actuator[da])
+        states.append(
+            JointState(
+                name.removeprefix(prefix), float(data.qpos[qa]), float(data.qvel[da]), effort
+            )
+        )
+    return states
+
+
+def link_poses(
+    model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
+) -> dict[str, Pose]:
+    """World poses of the entity's bodies, computed on scratch data (the live data is untouched)."""
+    scratch = mujoco.MjData(model)
+    scratch.qpos[:] = data.qpos
+    scratch.mocap_pos[:] = data.mocap_pos
+    scratch.mocap_quat[:] = data.mocap_quat
+    mujoco.mj_kinematics(model, scratch)
+    names = element_names(model, model.name_bodyadr[index.bodies])
+    return {
+        name.removeprefix(prefix): Pose.from_quat(*scratch.xpos[b], scratch.xquat[b])
+        for b, name in zip(index.bodies, names, strict=True)
+    }
+
+
+def joint_names(model: mujoco.MjModel, index: EntityIndex, prefix: str) -> list[str]:
+    """The entity's joint names without prefix (free joint excluded)."""
+    names = element_names(model, model.name_jntadr[index.joints])
+    return [
+        n.removeprefix(prefix)
+        for j, n in zip(index.joints, names, strict=True)
+        if model.jnt_type[j] != _FREE
+    ]

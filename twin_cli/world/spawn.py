@@ -1,0 +1,254 @@
+"""Spawning: load a source into an MjSpec, attach it at a pose, seed it, check where it starts.
+
+The world calls these with its lock held, on a *copy* of its spec, so that a failure at any
+point leaves the world's spec, model and data untouched (peers.md §4.6: an orphan subtree left
+by a failed compile bricks the world).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from twin_cli.errors import InvalidRequestError, SpawnError
+from twin_cli.world.entities import EntityIndex
+from twin_cli.world.pose import Pose, quat_multiply, rotate
+from twin_cli.world.scene import adopt_world_globals
+
+MJCF_SUFFIXES = (".xml", ".mjcf")
+URDF_SUFFIXES = (".urdf", ".xacro")
+PENETRATION_TOL = 1e-4  # [m] overlap below this is contact, not a bad start
+HOME_KEY = "home"
+ROOT_DEFAULT = "main"  # MjSpec's root default class, "<entity>/main" once attached
+_QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
+
+
+@dataclass(frozen=True)
+class LoadedSource:
+    """A spawn source read into a fresh MjSpec that the world may attach.
+
+    Attributes:
+        spec: the entity's own spec (a copy; the caller's MjSpec is never modified).
+        source: absolute path of the file, or "<MjSpec>".
+        report: the converter's report as a dict (URDF/xacro), else None.
+        xml: MJCF text of an MjSpec source, for save/load; else None.
+        default_name: the robot's own name (model name or file stem).
+    """
+
+    spec: mujoco.MjSpec
+    source: str
+    report: dict | None
+    xml: str | None
+    default_name: str
+
+
+def load_source(
+    source: str | os.PathLike | mujoco.MjSpec,
+    args: dict[str, str] | None,
+    package_paths: dict[str, str] | None,
+) -> LoadedSource:
+    """Reads a URDF/xacro (through the converter), an MJCF file or an MjSpec.
+
+    Raises:
+        SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
+        converters.ConversionError: the converter refused a URDF/xacro file.
+    """
+    if isinstance(source, mujoco.MjSpec):
+        spec = source.copy()
+        return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
+    path = Path(source).expanduser().resolve()
+    if not path.is_file():
+        raise SpawnError(path.stem, str(path), "no such file", "check the path")
+    lower = path.name.lower()
+    if lower.endswith(MJCF_SUFFIXES):
+        return _load_mjcf(path)
+    if lower.endswith(URDF_SUFFIXES):
+        return _load_urdf(path, args, package_paths)
+    raise SpawnError(
+        path.stem,
+        str(path),
+        "unknown file kind",
+        f"give a URDF/xacro ({', '.join(URDF_SUFFIXES)}) or MJCF ({', '.join(MJCF_SUFFIXES)}) file",
+    )
+
+
+def _load_mjcf(path: Path) -> LoadedSource:
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as exc:
+        raise SpawnError(path.stem, str(path), f"not valid MJCF ({exc})", "fix the file") from exc
+    return LoadedSource(spec, str(path), None, None, spec.modelname or path.stem)
+
+
+def _load_urdf(
+    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+) -> LoadedSource:
+    from converters.pipeline import convert
+
+    spec, report = convert(path, args=args, package_paths=package_paths)
+    name = report.robot or spec.modelname or path.name.split(".")[0]
+    return LoadedSource(spec, str(path), report.to_dict(), None, name)
+
+
+def _xml_or_none(spec: mujoco.MjSpec) -> str | None:
+    try:
+        return spec.to_xml()
+    except (ValueError, RuntimeError):
+        return None
+
+
+def check_entity_name(name: str) -> str:
+    """Returns `name` if it can prefix element names ("<name>/...").
+
+    Raises:
+        InvalidRequestError: empty, or contains '/' or whitespace.
+    """
+    if not name or "/" in name or any(c.isspace() for c in name):
+        raise InvalidRequestError(
+            f"entity name [{name}]",
+            "must be non-empty, without '/' or spaces",
+            "choose a name such as robot_1",
+        )
+    return name
+
+
+def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | None:
+    """Makes `child` safe to attach; returns its `home` keyframe qpos (its own layout) or None.
+
+    Names every unnamed body, joint, actuator and equality (state moves by name, and an unnamed
+    free joint cannot be found again), adopts the world's global settings, and removes the
+    child's keyframes: attached keyframes get lost or collide ("repeated name 'home'",
+    peers.md §4.6), so the home pose is read here and seeded by the world instead.
+    """
+    _name_unnamed(child)
+    _min_friction_priorities(child)
+    adopt_world_globals(child, world)
+    if len(child.keys) == 0:
+        return None
+    key = next((k for k in child.keys if k.name == HOME_KEY), child.keys[0])
+    home = _key_qpos(child, key)
+    for k in list(child.keys):
+        child.delete(k)
+    return home
+
+
+def _key_qpos(child: mujoco.MjSpec, key: mujoco.MjsKey) -> np.ndarray:
+    """The key's full qpos; read from the spec when complete, else compiled (qpos0 fill-in).
+
+    Compiling the child only for this costs about 1 ms for a humanoid, a quarter of a spawn.
+    """
+    nq = sum(_QPOS_WIDTH[int(j.type)] for j in child.joints)
+    if len(key.qpos) == nq:
+        return np.array(key.qpos, dtype=float)
+    model = child.copy().compile()
+    return np.array(model.key(key.name).qpos) if key.name else np.array(model.key_qpos[0])
+
+
+def _name_unnamed(child: mujoco.MjSpec) -> None:
+    for i, body in enumerate(child.bodies[1:], start=1):
+        if not body.name:
+            body.name = f"body{i}"
+        for k, joint in enumerate(body.joints):
+            if not joint.name:
+                joint.name = f"{body.name}_joint{k}"
+    for kind, items in (("actuator", child.actuators), ("equality", child.equalities)):
+        for i, item in enumerate(items):
+            if not item.name:
+                item.name = f"{kind}{i}"
+
+
+def _min_friction_priorities(child: mujoco.MjSpec) -> None:
+    """Gives geoms without a priority the converter's min-μ priority (MJCF and MjSpec sources).
+
+    MuJoCo combines friction by maximum unless priorities differ; Gazebo by minimum. Converted
+    robots already carry `friction_priority(μ)`; a plain MJCF geom (priority 0) would otherwise
+    take the ground's μ=100, which MuJoCo's pyramidal cone cannot resolve: measured, a 1 kg
+    ball falls through such a ground.
+    """
+    from converters.gazebo.contact import friction_priority
+
+    for geom in child.geoms:
+        if geom.priority == 0:
+            geom.priority = friction_priority(float(geom.friction[0]))
+
+
+def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) -> None:
+    """Attaches `child` to `world` in a frame "<name>/" at `pose`, prefixing names "<name>/"."""
+    frame = world.worldbody.add_frame(name=f"{name}/", pos=list(pose.position()))
+    frame.quat = list(pose.quat())
+    world.attach(child, frame=frame, prefix=f"{name}/")
+
+
+def move_frame(world: mujoco.MjSpec, name: str, pose: Pose) -> None:
+    """Moves the attach frame of entity `name` (fixed-base entities) to `pose`."""
+    frame = world.frame(f"{name}/")
+    frame.pos = list(pose.position())
+    frame.quat = list(pose.quat())
+
+
+_PREFIXED_LISTS = (
+    "meshes",
+    "materials",
+    "textures",
+    "hfields",
+    "skins",
+    "numerics",
+    "texts",
+    "tuples",
+    "keys",
+    "actuators",
+    "sensors",
+    "tendons",
+    "equalities",
+    "excludes",
+    "pairs",
+)
+
+
+def remove_entity(world: mujoco.MjSpec, name: str) -> None:
+    """Deletes entity `name` from `world`: frame, prefixed elements and default classes.
+
+    Also undoes a partial spawn (frame added, attach or compile failed): whatever of the entity
+    is present is removed, and the spec writes the same MJCF as before the spawn (tested).
+    Assets are copied on attach and are not referenced by bodies, so they are deleted by prefix;
+    so is the child's default tree ("<name>/main"); orphans would clash with a later spawn.
+    """
+    prefix = f"{name}/"
+    frame = world.frame(prefix)
+    if frame is not None:
+        world.delete(frame)
+    for attr in _PREFIXED_LISTS:
+        for element in list(getattr(world, attr)):
+            if element.name.startswith(prefix):
+                world.delete(element)
+    defaults = world.find_default(f"{prefix}{ROOT_DEFAULT}")
+    if defaults is not None:
+        world.delete(defaults)
+
+
+def initial_qpos(
+    model: mujoco.MjModel, index: EntityIndex, home: np.ndarray | None, pose: Pose
+) -> np.ndarray:
+    """The entity's own initial configuration at its spawn pose, at rest.
+
+    Without a home key this is the compiled `qpos0` (the free joint's part already includes the
+    attach frame). With one, the key's joint values are used and its free-joint pose (expressed
+    in the child's own world) is composed with the attach frame `pose`.
+    """
+    q0 = model.qpos0[index.qpos].copy()
+    if home is None or len(home) != len(q0):
+        return q0
+    q = np.array(home, dtype=float)
+    if index.free_qpos >= 0:
+        at = int(np.flatnonzero(index.qpos == index.free_qpos)[0])
+        frame_quat = pose.quat()
+        key_pos = (float(home[at]), float(home[at + 1]), float(home[at + 2]))
+        q[at : at + 3] = np.add(pose.position(), rotate(frame_quat, key_pos))
+        q[at + 3 : at + 7] = quat_multiply(
+            frame_quat, tuple(float(v) for v in home[at + 3 : at + 7])
+        )
+    return q
