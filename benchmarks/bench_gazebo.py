@@ -20,6 +20,7 @@ from converters.gazebo.blocks import parse_gazebo
 from converters.gazebo.contact import add_gazebo_ground
 from converters.pipeline import convert, convert_full
 from converters.report import Report
+from converters.urdf.xml_checks import parse_xml
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGES = REPO.parent / "shared" / "corpus" / "packages"
@@ -45,7 +46,7 @@ def _stage_timing(robot: dict) -> dict[str, float]:
         if numeric.name.startswith(DAMPING_FACTOR_PREFIX):
             spec.delete(numeric)
     start = time.perf_counter()
-    ext = parse_gazebo(done.parsed.root, robot["entry"])
+    ext = parse_gazebo(parse_xml(done.description.text, robot["entry"]), robot["entry"])
     apply_gazebo(spec, ext, done.provenance, Report())
     stage = time.perf_counter() - start
     return {"convert_s": round(total, 4), "gazebo_stage_s": round(stage, 4)}

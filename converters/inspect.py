@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from converters.description import RobotDescription
+
 
 @dataclass(frozen=True)
 class InertialStats:
@@ -15,7 +17,7 @@ class InertialStats:
         total_mass: [kg].
         com: centre of mass (3,) [m].
         inertia: inertia tensor about the centre of mass (3, 3) [kg·m²].
-        link_masses: URDF link → mass [kg] as declared (lumped links included).
+        link_masses: link → mass [kg] as declared (lumped links included).
         tree: (depth, link, joint, joint type) rows, depth-first from the base link.
     """
 
@@ -38,7 +40,7 @@ class InertialStats:
         }
 
 
-def inertial_stats(spec: object, parsed: object) -> InertialStats:
+def inertial_stats(spec: object, robot: RobotDescription) -> InertialStats:
     """Compile `spec`, pose it at qpos0 and sum every body's mass properties (parallel axis)."""
     import mujoco
 
@@ -55,22 +57,14 @@ def inertial_stats(spec: object, parsed: object) -> InertialStats:
         tensor += R @ np.diag(model.body_inertia[body]) @ R.T
         tensor += masses[body] * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
     links = {
-        link.name: float(link.inertial.mass or 0.0) if link.inertial is not None else 0.0
-        for link in parsed.model.links
+        link.name: link.inertial.mass if link.inertial is not None else 0.0 for link in robot.links
     }
-    return InertialStats(total, com, tensor, links, link_tree(parsed))
+    return InertialStats(total, com, tensor, links, link_tree(robot))
 
 
-def link_tree(parsed: object) -> tuple[tuple[int, str, str, str], ...]:
+def link_tree(robot: RobotDescription) -> tuple[tuple[int, str, str, str], ...]:
     """Depth-first (depth, link, parent joint, joint type) rows from the base link."""
-    children: dict[str, list[object]] = {}
-    for joint in parsed.model.joints:
-        children.setdefault(joint.parent, []).append(joint)
-    rows: list[tuple[int, str, str, str]] = []
-    stack: list[tuple[int, str, object | None]] = [(0, parsed.base_link, None)]
-    while stack:
-        depth, link, joint = stack.pop()
-        rows.append((depth, link, joint.name if joint else "", joint.type if joint else ""))
-        for child in reversed(children.get(link, [])):
-            stack.append((depth + 1, child.child, child))
-    return tuple(rows)
+    return tuple(
+        (depth, link, joint.name if joint else "", joint.kind if joint else "")
+        for depth, link, joint in robot.walk()
+    )

@@ -1,4 +1,7 @@
-"""The conversion pipeline: file → xacro → URDF → MjSpec → Gazebo semantics, with a report."""
+"""The conversion pipeline: file → xacro → URDF → description → MjSpec → Gazebo semantics.
+
+The single entry of `converters`; each stage adds its findings to one report.
+"""
 
 from __future__ import annotations
 
@@ -6,24 +9,24 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
+from converters.description import RobotDescription
 from converters.errors import InputFileError
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
 from converters.report import Report
 from converters.resources.packages import PackageResolver
-from converters.urdf.reader import ParsedRobot, parse_urdf
+from converters.urdf.reader import parse_urdf
 from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
 
 @dataclass(frozen=True)
 class Conversion:
-    """Everything one conversion produced: the spec, the report, provenance and the inputs."""
+    """Everything one conversion produced: the spec, the report, provenance and the description."""
 
     spec: object
     report: Report
     provenance: Provenance
-    parsed: ParsedRobot
-    extensions: object
+    description: RobotDescription
 
 
 def read_description(
@@ -75,28 +78,18 @@ def convert_full(
         ConversionError: any subclass, with file/link/joint and the fix in its message.
     """
     from converters.gazebo.apply import apply_gazebo
-    from converters.gazebo.blocks import parse_gazebo
 
     path = Path(path)
     options = options or ConvertOptions()
     resolver = PackageResolver.create(path, package_paths)
     report = Report(source=str(path))
     text = read_description(path, dict(args or {}), resolver, report)
-    parsed = parse_urdf(text, str(path), path.resolve().parent)
-    report.robot = parsed.model.name
-    extensions = parse_gazebo(parsed.root, str(path))
+    robot = parse_urdf(text, str(path), path.resolve().parent, resolver)
+    report.robot = robot.name
     provenance = Provenance()
-    spec = build_spec(
-        parsed,
-        static=extensions.static,
-        preserved=extensions.preserved_joints,
-        options=options,
-        resolver=resolver,
-        report=report,
-        provenance=provenance,
-    )
-    apply_gazebo(spec, extensions, provenance, report)
-    return Conversion(spec, report, provenance, parsed, extensions)
+    spec = build_spec(robot, options=options, report=report, provenance=provenance)
+    apply_gazebo(spec, robot.gazebo, provenance, report)
+    return Conversion(spec, report, provenance, robot)
 
 
 def convert(

@@ -183,7 +183,7 @@ def test_inspect_json_reports_total_mass_and_tree(tmp_path: Path) -> None:
     stats = json.loads(result.stdout)
     declared = sum(
         float(link.inertial.mass)
-        for link in convert_full(HUMANOID).parsed.model.links
+        for link in convert_full(HUMANOID).description.links
         if link.inertial is not None
     )
     assert stats["total_mass_kg"] == pytest.approx(declared, rel=1e-12), "total mass [kg]"

@@ -2,39 +2,39 @@
 
 from __future__ import annotations
 
+from converters.description import Joint, RobotDescription
 from converters.errors import URDFStructureError
 from converters.report import Report
 
 ACTUATABLE = ("revolute", "continuous", "prismatic")
 
 
-def actuated_joints(parsed: object, report: Report) -> list[object]:
-    """The URDF joints that get a motor, and a report line saying how they were chosen.
+def actuated_joints(robot: RobotDescription, report: Report) -> list[Joint]:
+    """The joints that get a motor, and a report line saying how they were chosen.
 
     Joints named by `<transmission>` or `<ros2_control>` when the file has any; otherwise every
     revolute, continuous or prismatic joint that is not a mimic follower.
     """
-    joints = {j.name: j for j in parsed.model.joints}
-    named = [n for n in (*parsed.transmission_joints, *parsed.ros2_control_joints) if n in joints]
-    named = list(dict.fromkeys(named))
+    joints = {j.name: j for j in robot.joints}
+    named = [n for n in robot.actuated if n in joints]
     if named:
         source = "<transmission>/<ros2_control>"
         chosen = [joints[n] for n in named]
     else:
         source = "all movable non-mimic joints (no <transmission> or <ros2_control>)"
         chosen = list(joints.values())
-    chosen = [j for j in chosen if j.type in ACTUATABLE and j.mimic is None]
+    chosen = [j for j in chosen if j.kind in ACTUATABLE and j.mimic is None]
     with_effort = [j for j in chosen if _effort(j) > 0]
     report.mapped("actuators", f"{len(with_effort)} motor(s) on joints chosen from {source}")
     return chosen
 
 
-def _effort(joint: object) -> float:
-    """The joint's `<limit effort>` [N or N·m], 0 when absent."""
-    return float(joint.limit.effort) if joint.limit and joint.limit.effort else 0.0
+def _effort(joint: Joint) -> float:
+    """The joint's effort limit [N or N·m], 0 when absent."""
+    return joint.limit.effort if joint.limit and joint.limit.effort else 0.0
 
 
-def add_motors(spec: object, joints: list[object], report: Report) -> None:
+def add_motors(spec: object, joints: list[Joint], report: Report) -> None:
     """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m]."""
     import mujoco
 
@@ -59,7 +59,7 @@ def add_motors(spec: object, joints: list[object], report: Report) -> None:
         actuator.forcerange = [-effort, effort]
 
 
-def add_mimics(spec: object, parsed: object, report: Report) -> None:
+def add_mimics(spec: object, robot: RobotDescription, report: Report) -> None:
     """Each `<mimic>`: follower = offset + multiplier · leader, as a joint equality.
 
     MuJoCo's joint equality constrains `joint1 = polycoef[0] + polycoef[1]·joint2 + …`
@@ -67,20 +67,19 @@ def add_mimics(spec: object, parsed: object, report: Report) -> None:
     """
     import mujoco
 
-    movable = {j.name for j in parsed.model.joints if j.type in ACTUATABLE}
-    for joint in parsed.model.joints:
+    movable = {j.name for j in robot.joints if j.kind in ACTUATABLE}
+    for joint in robot.joints:
         mimic = joint.mimic
         if mimic is None:
             continue
-        if mimic.joint not in movable or joint.type not in ACTUATABLE:
+        if mimic.joint not in movable or joint.kind not in ACTUATABLE:
             raise URDFStructureError(
-                parsed.source,
+                robot.source,
                 f"joint '{joint.name}' <mimic joint='{mimic.joint}'>",
                 "a mimic needs a revolute, continuous or prismatic follower and leader",
                 f"name one of: {', '.join(sorted(movable)) or 'none'}",
             )
-        multiplier = 1.0 if mimic.multiplier is None else float(mimic.multiplier)
-        offset = 0.0 if mimic.offset is None else float(mimic.offset)
+        multiplier, offset = mimic.multiplier, mimic.offset
         equality = spec.add_equality(name=f"mimic_{joint.name}")
         equality.type = mujoco.mjtEq.mjEQ_JOINT
         equality.objtype = mujoco.mjtObj.mjOBJ_JOINT

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from converters.description import RobotDescription
 from converters.errors import InertiaError
 from converters.mjcf import inertia as inr
 from converters.mjcf.geometry import GeomPlan
@@ -11,7 +12,7 @@ from converters.mjcf.lumping import WORLDBODY, BodyPlan
 from converters.report import Report
 
 
-def link_inertias(parsed: object, repair: bool, report: Report) -> dict[str, inr.Inertia]:
+def link_inertias(robot: RobotDescription, repair: bool, report: Report) -> dict[str, inr.Inertia]:
     """Each link's inertia in its own frame, checked; links without `<inertial>` are absent.
 
     Raises:
@@ -19,8 +20,8 @@ def link_inertias(parsed: object, repair: bool, report: Report) -> dict[str, inr
             (unless `repair`, which bounds the tensor and reports the link).
     """
     out: dict[str, inr.Inertia] = {}
-    for link in parsed.model.links:
-        value = inr.from_urdf(link.inertial)
+    for link in robot.links:
+        value = inr.from_inertial(link.inertial)
         if value is None:
             continue
         if value.mass == 0 and not np.any(value.tensor):
@@ -35,20 +36,20 @@ def link_inertias(parsed: object, repair: bool, report: Report) -> dict[str, inr
             )
             value = fixed
         elif trouble is not None and (value.mass != 0 or not repair):
-            raise InertiaError(parsed.source, link.name, trouble, inr.describe(value))
+            raise InertiaError(robot.source, link.name, trouble, inr.describe(value))
         out[link.name] = value
     return out
 
 
 def body_inertias(
-    parsed: object, plan: BodyPlan, geoms: list[GeomPlan], repair: bool, report: Report
+    robot: RobotDescription, plan: BodyPlan, geoms: list[GeomPlan], repair: bool, report: Report
 ) -> dict[str, inr.Inertia]:
     """Merged inertia of every body (its link plus the links lumped into it), in body frame.
 
     A moving body (one with a joint, or the floating base) needs mass; without it conversion
     fails, or with `repair` it gets a solid box of 1000 kg/m³ spanning its collision geometry.
     """
-    links = link_inertias(parsed, repair, report)
+    links = link_inertias(robot, repair, report)
     parts: dict[str, list[inr.Inertia]] = {}
     for name, value in links.items():
         placement = plan.placements[name]
@@ -60,14 +61,14 @@ def body_inertias(
     for body in plan.bodies:
         merged = inr.combine(parts.get(body.name, [])) if body.name in parts else inr.Inertia.zero()
         if body.name in moving and merged.mass <= 0:
-            merged = _massless(parsed, body.name, links, geoms, repair, report)
+            merged = _massless(robot, body.name, links, geoms, repair, report)
         out[body.name] = merged
     out.pop(WORLDBODY, None)
     return out
 
 
 def _massless(
-    parsed: object,
+    robot: RobotDescription,
     body: str,
     links: dict[str, inr.Inertia],
     geoms: list[GeomPlan],
@@ -78,7 +79,7 @@ def _massless(
         problem = "moving link has no <inertial>" if body not in links else "moving link"
         value = links.get(body, inr.Inertia.zero())
         raise InertiaError(
-            parsed.source, body, f"{problem} with mass {value.mass:g} kg", inr.describe(value)
+            robot.source, body, f"{problem} with mass {value.mass:g} kg", inr.describe(value)
         )
     own = [g for g in geoms if g.body == body and g.role == "collision"] or [
         g for g in geoms if g.body == body

@@ -1,4 +1,7 @@
-"""Typed robot → MjSpec: bodies, joints, inertials, sites, geoms, meshes, actuators, keyframe."""
+"""Robot description → MjSpec: bodies, joints, inertials, sites, geoms, meshes, actuators, keyframe.
+
+Format-free: it reads only `converters.description`, so URDF and SDF robots build the same way.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +11,7 @@ import numpy as np
 
 from converters.collision.plan import CollisionRequest, CollisionSettings
 from converters.collision.prepare import prepare_collision_meshes
+from converters.description import RobotDescription
 from converters.mjcf import inertia as inr
 from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
 from converters.mjcf.bodies import body_inertias
@@ -17,7 +21,6 @@ from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
 from converters.provenance import GeomOrigin, Provenance
 from converters.report import Report
 from converters.resources.meshes import MeshData
-from converters.resources.packages import PackageResolver
 
 # Menagerie conventions and Gazebo's default world step (SDF physics max_step_size 0.001 s).
 TIMESTEP = 0.001
@@ -67,39 +70,38 @@ def new_spec(name: str) -> object:
 
 
 def build_spec(
-    parsed: object,
+    robot: RobotDescription,
     *,
-    static: bool,
-    preserved: frozenset[str],
     options: ConvertOptions,
-    resolver: PackageResolver,
     report: Report,
     provenance: Provenance,
 ) -> object:
     """Build the robot's MjSpec (Gazebo tags are applied afterwards by the caller).
 
+    Gazebo's model flags shape the bodies: `<static>` welds the base, preserveFixedJoint and
+    disableFixedJointLumping keep a fixed joint's child as its own body.
+
     Raises:
-        InertiaError, PackageNotFoundError, ResourceNotFoundError, MeshError.
+        InertiaError, MeshError, URDFStructureError (a mimic of a joint that cannot move).
     """
     plan = plan_bodies(
-        parsed.model,
-        parsed.base_link,
-        preserved=preserved,
+        robot,
+        preserved=robot.gazebo.preserved_joints,
         keep_fixed=options.keep_fixed,
-        static=static,
+        static=robot.gazebo.static,
     )
-    geoms = plan_geoms(parsed, plan, resolver, report)
-    inertias = body_inertias(parsed, plan, geoms, options.repair_inertia, report)
-    spec = new_spec(parsed.model.name)
+    geoms = plan_geoms(robot, plan, report)
+    inertias = body_inertias(robot, plan, geoms, options.repair_inertia, report)
+    spec = new_spec(robot.name)
     bodies, joints = _add_bodies(spec, plan, inertias, report, provenance)
     _add_sites(bodies, plan, provenance)
     _add_geoms(spec, bodies, geoms, options.collision, report, provenance)
-    add_motors(spec, actuated_joints(parsed, report), report)
-    add_mimics(spec, parsed, report)
-    spec.add_key(name=HOME_KEY, qpos=_home(joints, parsed))
+    add_motors(spec, actuated_joints(robot, report), report)
+    add_mimics(spec, robot, report)
+    spec.add_key(name=HOME_KEY, qpos=_home(joints, robot))
     _summarise(plan, inertias, geoms, report)
     report.summary.update(
-        joints=len(parsed.model.joints),
+        joints=len(robot.joints),
         mujoco_joints=len(joints),
         actuators=len(spec.actuators),
         mimic_equalities=len(spec.equalities),
@@ -259,16 +261,14 @@ class _MeshAssets:
         return name
 
 
-def _home(joints: list[MjJointPlan], parsed: object) -> list[float]:
+def _home(joints: list[MjJointPlan], robot: RobotDescription) -> list[float]:
     """The `home` keyframe: zero (clamped into range), mimic followers consistent."""
     values = {j.name: j.home for j in joints}
-    for joint in parsed.model.joints:
+    for joint in robot.joints:
         mimic = joint.mimic
         if mimic is not None and joint.name in values and mimic.joint in values:
             leader = values[mimic.joint][0]
-            multiplier = 1.0 if mimic.multiplier is None else float(mimic.multiplier)
-            offset = 0.0 if mimic.offset is None else float(mimic.offset)
-            values[joint.name] = (offset + multiplier * leader,)
+            values[joint.name] = (mimic.offset + mimic.multiplier * leader,)
     return [v for j in joints for v in values[j.name]]
 
 
@@ -287,7 +287,7 @@ def _summarise(
 
 
 def _primitive(kind: str) -> object:
-    """The MuJoCo geom type of a primitive URDF shape."""
+    """The MuJoCo geom type of a primitive shape."""
     import mujoco
 
     return {

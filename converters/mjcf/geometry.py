@@ -1,17 +1,16 @@
-"""URDF `<visual>`/`<collision>` geometry → planned geoms in body frames (meshes loaded)."""
+"""Visual and collision shapes of the description → planned geoms in body frames, meshes loaded."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from converters.description import Geometry, RobotDescription
 from converters.mjcf.lumping import BodyPlan
-from converters.mjcf.materials import VisualColour, robot_materials, visual_colour
+from converters.mjcf.materials import VisualColour, visual_colour
 from converters.report import Report
 from converters.resources.meshes import MeshCache, MeshData, mesh_problem
-from converters.resources.packages import PackageResolver
 
 ROLES = ("visual", "collision")
 
@@ -21,7 +20,7 @@ class GeomPlan:
     """One geom to create.
 
     Attributes:
-        link, body, role, index: provenance (URDF link, MuJoCo body, visual|collision, n-th).
+        link, body, role, index: provenance (link, MuJoCo body, visual|collision, n-th).
         kind: box | cylinder | sphere | capsule | mesh.
         size: MuJoCo size (half extents, radius, half length) [m]; empty for meshes.
         T_body_geom: pose in the body (4×4).
@@ -67,24 +66,17 @@ def _half_extents(kind: str, size: tuple[float, ...]) -> np.ndarray:
     return np.array([size[0], size[0], size[1]])
 
 
-def plan_geoms(
-    parsed: object, plan: BodyPlan, resolver: PackageResolver, report: Report
-) -> list[GeomPlan]:
+def plan_geoms(robot: RobotDescription, plan: BodyPlan, report: Report) -> list[GeomPlan]:
     """Every visual and collision geom of every link, placed in its body, meshes loaded."""
     cache = MeshCache()
-    named = robot_materials(parsed.model)
     out: list[GeomPlan] = []
-    for link in parsed.model.links:
+    for link in robot.links:
         placement = plan.placements[link.name]
-        for role in ROLES:
-            for index, item in enumerate(getattr(link, f"{role}s")):
-                origin = item.origin if item.origin is not None else np.eye(4)
-                T = placement.T_body_link @ np.asarray(origin, dtype=float)
-                colour = visual_colour(item.material, named) if role == "visual" else None
-                capsule = (link.name, role, index) in parsed.capsules
-                geom = _plan_one(
-                    item.geometry, capsule, link.name, role, index, parsed.base_dir, resolver, cache
-                )
+        for role, items in (("visual", link.visuals), ("collision", link.collisions)):
+            for index, item in enumerate(items):
+                T = placement.T_body_link @ item.origin
+                colour = visual_colour(item.material) if role == "visual" else None
+                geom = _plan_one(item.geometry, link.name, cache)
                 if geom is None:
                     report.ignored(f"link '{link.name}' {role} {index}", "no geometry")
                     continue
@@ -128,40 +120,22 @@ def _assemble(
     )
 
 
-def _plan_one(
-    geometry: object | None,
-    capsule: bool,
-    link: str,
-    role: str,
-    index: int,
-    base_dir: Path,
-    resolver: PackageResolver,
-    cache: MeshCache,
-) -> tuple | None:
-    """(kind, size, mesh, mesh_file, scale) for one URDF geometry, or None if empty."""
+def _plan_one(geometry: Geometry | None, link: str, cache: MeshCache) -> tuple | None:
+    """(kind, MuJoCo size, mesh, mesh_file, scale) for one shape, or None if empty.
+
+    MuJoCo sizes are halves: box half extents, cylinder/capsule (radius, half length).
+    """
     if geometry is None:
         return None
     unit = (1.0, 1.0, 1.0)
-    if geometry.box is not None:
-        return "box", tuple(float(v) / 2 for v in geometry.box.size), None, None, unit
-    if geometry.cylinder is not None:
-        kind = "capsule" if capsule else "cylinder"
-        size = (float(geometry.cylinder.radius), float(geometry.cylinder.length) / 2)
-        return kind, size, None, None, unit
-    if geometry.sphere is not None:
-        return "sphere", (float(geometry.sphere.radius),), None, None, unit
-    if geometry.mesh is not None:
-        element = f"link '{link}' <{role}> {index} <mesh>"
-        path = resolver.resolve(geometry.mesh.filename, base_dir=base_dir, element=element)
-        scale = _scale(geometry.mesh.scale)
-        return "mesh", (), cache.get(path, scale, link), str(path), scale
+    if geometry.shape == "box":
+        return "box", tuple(v / 2 for v in geometry.size), None, None, unit
+    if geometry.shape in ("cylinder", "capsule"):
+        radius, length = geometry.size
+        return geometry.shape, (radius, length / 2), None, None, unit
+    if geometry.shape == "sphere":
+        return "sphere", (geometry.size[0],), None, None, unit
+    if geometry.shape == "mesh" and geometry.mesh is not None:
+        mesh = cache.get(geometry.mesh, geometry.scale, link)
+        return "mesh", (), mesh, str(geometry.mesh), geometry.scale
     return None
-
-
-def _scale(value: object) -> tuple[float, float, float]:
-    if value is None:
-        return (1.0, 1.0, 1.0)
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
-    if arr.size == 1:
-        arr = np.repeat(arr, 3)
-    return (float(arr[0]), float(arr[1]), float(arr[2]))

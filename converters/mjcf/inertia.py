@@ -1,10 +1,12 @@
-"""Rigid-body inertia: URDF inertials in body frames, merging (lumping), validation, repair."""
+"""Rigid-body inertia: link inertials in body frames, merging (lumping), validation, repair."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from converters.description import Inertial
 
 # Tolerance of the checks, relative to the largest principal moment: MuJoCo itself rejects a
 # triangle-inequality violation only beyond its mjMINVAL (1e-15), so this is stricter than needed.
@@ -39,14 +41,13 @@ class Inertia:
         return Inertia(self.mass, R @ self.com + T[:3, 3], R @ self.tensor @ R.T)
 
 
-def from_urdf(inertial: object) -> Inertia | None:
-    """A yourdfpy `Inertial` in its link frame (origin rpy rotates the full tensor)."""
+def from_inertial(inertial: Inertial | None) -> Inertia | None:
+    """A description's inertial in its link frame (the origin's rotation turns the full tensor)."""
     if inertial is None:
         return None
-    origin = inertial.origin if inertial.origin is not None else np.eye(4)
-    tensor = np.asarray(inertial.inertia if inertial.inertia is not None else np.zeros((3, 3)))
-    local = Inertia(float(inertial.mass or 0.0), np.zeros(3), (tensor + tensor.T) / 2)
-    return local.transformed(np.asarray(origin, dtype=float))
+    tensor = inertial.inertia
+    local = Inertia(inertial.mass, np.zeros(3), (tensor + tensor.T) / 2)
+    return local.transformed(inertial.origin)
 
 
 def combine(parts: list[Inertia]) -> Inertia:

@@ -1,4 +1,4 @@
-"""URDF joints → MuJoCo joints (hinge, slide, free, planar as slides + hinge), with limits."""
+"""Description joints → MuJoCo joints (hinge, slide, free; planar as slides + hinge), limits."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from converters.description import Joint
 from converters.report import Report
 
 # Name of the free joint of a floating base (prefixed by the entity name after attach).
@@ -14,7 +15,10 @@ FREE_JOINT = "floating_base"
 
 @dataclass(frozen=True)
 class MjJointPlan:
-    """One MuJoCo joint made for a URDF joint: its name, kind, qpos width, home value, range."""
+    """One MuJoCo joint made for a description joint: its name, kind, home value, range.
+
+    `urdf_joint` names the description joint it came from (None for the free joint).
+    """
 
     name: str
     urdf_joint: str | None
@@ -23,33 +27,32 @@ class MjJointPlan:
     home: tuple[float, ...]
 
 
-def add_joints(body: object, joint: object | None, report: Report) -> list[MjJointPlan]:
+def add_joints(body: object, joint: Joint | None, report: Report) -> list[MjJointPlan]:
     """Add the MuJoCo joint(s) for `joint` to `body`; returns them in qpos order."""
     if joint is None:
         return []
-    for extra in ("safety_controller", "calibration"):
-        if getattr(joint, extra, None) is not None:
-            report.ignored(
-                f"joint '{joint.name}' <{extra}>",
-                "a ROS controller setting; Gazebo's physics does not use it either",
-            )
-    adder = _ADDERS.get(joint.type)
+    for extra in joint.ignored:
+        report.ignored(
+            f"joint '{joint.name}' <{extra}>",
+            "a ROS controller setting; Gazebo's physics does not use it either",
+        )
+    adder = _ADDERS.get(joint.kind)
     if adder is None:
         report.ignored(
             f"joint '{joint.name}'",
-            f"type {joint.type!r} is not a URDF joint type; the child is welded",
+            f"type {joint.kind!r} is not a URDF joint type; the child is welded",
         )
         return []
     return adder(body, joint, report)
 
 
-def _axis(joint: object) -> np.ndarray:
-    axis = np.asarray(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+def _axis(joint: Joint) -> np.ndarray:
+    axis = np.asarray(joint.axis, dtype=float)
     norm = np.linalg.norm(axis)
     return axis / norm if norm > 0 else np.array([1.0, 0.0, 0.0])
 
 
-def _limited(body: object, joint: object, kind: int, report: Report) -> list[MjJointPlan]:
+def _limited(body: object, joint: Joint, kind: int, report: Report) -> list[MjJointPlan]:
     """revolute (hinge) or prismatic (slide) with range, damping and friction."""
     import mujoco
 
@@ -60,44 +63,41 @@ def _limited(body: object, joint: object, kind: int, report: Report) -> list[MjJ
         mj.limited = mujoco.mjtLimited.mjLIMITED_TRUE
         mj.range = [lower, upper]
         home = min(max(0.0, lower), upper)
-        return [MjJointPlan(joint.name, joint.name, joint.type, (lower, upper), (home,))]
+        return [MjJointPlan(joint.name, joint.name, joint.kind, (lower, upper), (home,))]
     mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     report.warn(
         f"joint '{joint.name}'",
-        f"{joint.type} joint without a usable <limit> "
+        f"{joint.kind} joint without a usable <limit> "
         f"(lower={lower}, upper={upper}); left unlimited",
     )
-    return [MjJointPlan(joint.name, joint.name, joint.type, None, (0.0,))]
+    return [MjJointPlan(joint.name, joint.name, joint.kind, None, (0.0,))]
 
 
-def _bounds(joint: object) -> tuple[float | None, float | None]:
-    limit = joint.limit
-    if limit is None:
+def _bounds(joint: Joint) -> tuple[float | None, float | None]:
+    if joint.limit is None:
         return None, None
-    lower = None if limit.lower is None else float(limit.lower)
-    upper = None if limit.upper is None else float(limit.upper)
-    return lower, upper
+    return joint.limit.lower, joint.limit.upper
 
 
-def _dynamics(mj: object, joint: object) -> None:
+def _dynamics(mj: object, joint: Joint) -> None:
     if joint.dynamics is not None:
-        mj.damping = [float(joint.dynamics.damping or 0.0), 0.0, 0.0]
-        mj.frictionloss = float(joint.dynamics.friction or 0.0)
+        mj.damping = [joint.dynamics.damping, 0.0, 0.0]
+        mj.frictionloss = joint.dynamics.friction
 
 
-def _revolute(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _revolute(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     return _limited(body, joint, mujoco.mjtJoint.mjJNT_HINGE, report)
 
 
-def _prismatic(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _prismatic(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     return _limited(body, joint, mujoco.mjtJoint.mjJNT_SLIDE, report)
 
 
-def _continuous(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _continuous(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     mj = body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=_axis(joint))
@@ -106,7 +106,7 @@ def _continuous(body: object, joint: object, report: Report) -> list[MjJointPlan
     return [MjJointPlan(joint.name, joint.name, "continuous", None, (0.0,))]
 
 
-def _planar(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     """Motion in the plane normal to the axis: two slides in the plane and a hinge about it."""
     import mujoco
 
@@ -128,7 +128,7 @@ def _planar(body: object, joint: object, report: Report) -> list[MjJointPlan]:
     return out
 
 
-def _floating(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _floating(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     """A nested floating joint: three slides and a ball (MuJoCo free joints must be top-level)."""
     import mujoco
 
@@ -144,7 +144,7 @@ def _floating(body: object, joint: object, report: Report) -> list[MjJointPlan]:
     return out
 
 
-def _spherical(body: object, joint: object, report: Report) -> list[MjJointPlan]:
+def _spherical(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     """Non-standard `spherical` (accepted by several parsers): a ball joint, unlimited."""
     import mujoco
 

@@ -1,4 +1,4 @@
-"""Which URDF links become MuJoCo bodies, and fixed-joint lumping as sdformat does it."""
+"""Which links become MuJoCo bodies, and fixed-joint lumping as sdformat does it."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from converters.urdf.reader import WORLD_LINK
+from converters.description import WORLD_LINK, Joint, RobotDescription
 
 # Name of the MuJoCo world body, as placements refer to it.
 WORLDBODY = "world"
@@ -14,7 +14,7 @@ WORLDBODY = "world"
 
 @dataclass(frozen=True)
 class LinkPlacement:
-    """Where a URDF link ended up: its body and the link frame's pose in it (4×4)."""
+    """Where a link ended up: its body and the link frame's pose in it (4×4)."""
 
     body: str
     T_body_link: np.ndarray
@@ -25,16 +25,16 @@ class BodyNode:
     """One MuJoCo body to create.
 
     Attributes:
-        name: body name (= its URDF link).
+        name: body name (= its link).
         parent: parent body name (`WORLDBODY` for top-level bodies).
         T_parent_body: pose of this body in its parent body (4×4).
-        joint: the URDF joint that moves it (None for the root or a welded body).
+        joint: the description's joint that moves it (None for the root or a welded body).
     """
 
     name: str
     parent: str
     T_parent_body: np.ndarray
-    joint: object | None
+    joint: Joint | None
 
 
 @dataclass(frozen=True)
@@ -49,8 +49,7 @@ class BodyPlan:
 
 
 def plan_bodies(
-    model: object,
-    base_link: str,
+    robot: RobotDescription,
     *,
     preserved: frozenset[str],
     keep_fixed: bool,
@@ -64,15 +63,13 @@ def plan_bodies(
     the world) or the model is static.
 
     Args:
-        model: yourdfpy `Robot`.
-        base_link: the tree's root link.
+        robot: the description (its base link is the tree's root).
         preserved: fixed joints whose child must stay a body (Gazebo preserveFixedJoint).
         keep_fixed: keep every fixed joint as a welded body (`--keep-fixed`).
         static: Gazebo `<static>`: the base is welded to the world.
     """
-    children: dict[str, list[object]] = {}
-    for joint in model.joints:
-        children.setdefault(joint.parent, []).append(joint)
+    base_link = robot.base_link
+    children = robot.children()
     placements: dict[str, LinkPlacement] = {}
     bodies: list[BodyNode] = []
     lumped: list[str] = []
@@ -86,15 +83,14 @@ def plan_bodies(
         parent = stack.pop()
         here = placements[parent]
         for joint in children.get(parent, []):
-            origin = np.asarray(joint.origin if joint.origin is not None else np.eye(4), float)
-            T_body_child = here.T_body_link @ origin
-            lump = joint.type == "fixed" and not keep_fixed and joint.name not in preserved
+            T_body_child = here.T_body_link @ joint.origin
+            lump = joint.kind == "fixed" and not keep_fixed and joint.name not in preserved
             if lump and here.body != WORLDBODY:
                 placements[joint.child] = LinkPlacement(here.body, T_body_child)
                 lumped.append(joint.child)
             else:
                 placements[joint.child] = LinkPlacement(joint.child, np.eye(4))
-                moving = None if joint.type == "fixed" else joint
+                moving = None if joint.kind == "fixed" else joint
                 bodies.append(BodyNode(joint.child, here.body, T_body_child, moving))
         stack.extend(reversed([j.child for j in children.get(parent, [])]))
     root = base_link if base_link != WORLD_LINK else WORLDBODY

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from converters.urdf.reader import ParsedRobot, parse_urdf
+from converters.urdf.reader import parse_urdf
 from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
-__all__ = ["ParsedRobot", "expand_xacro", "needs_xacro", "parse_urdf"]
+__all__ = ["expand_xacro", "needs_xacro", "parse_urdf"]

@@ -1,86 +1,55 @@
-"""URDF text → typed robot: yourdfpy for links/joints, raw XML for the tags yourdfpy drops."""
+"""URDF text → the neutral robot description: yourdfpy reads links and joints, raw XML the rest.
+
+yourdfpy parses the standard elements; what it drops (`<gazebo>`, `<transmission>`,
+`<ros2_control>`, `<capsule>`) is read from the XML here. Mesh references are resolved to files
+now, so later stages never see `package://` or the file's directory.
+"""
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 
-from converters.errors import BadNumberError, MalformedXMLError, URDFStructureError
+import numpy as np
 
-# Attributes holding numbers: tag → {attribute: count} (0 = any count ≥ 1).
-NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
-    "origin": {"xyz": 3, "rpy": 3},
-    "axis": {"xyz": 3},
-    "mass": {"value": 1},
-    "inertia": {k: 1 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
-    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
-    "dynamics": {"damping": 1, "friction": 1},
-    "box": {"size": 3},
-    "cylinder": {"radius": 1, "length": 1},
-    "capsule": {"radius": 1, "length": 1},
-    "sphere": {"radius": 1},
-    "mesh": {"scale": 3},
-    "mimic": {"multiplier": 1, "offset": 1},
-    "color": {"rgba": 4},
-}
+from converters.description import (
+    Collision,
+    Dynamics,
+    Geometry,
+    Inertial,
+    Joint,
+    Limit,
+    Link,
+    Material,
+    Mimic,
+    RobotDescription,
+    Visual,
+)
+from converters.errors import URDFStructureError
+from converters.gazebo.blocks import parse_gazebo
+from converters.resources.packages import PackageResolver
+from converters.urdf.xml_checks import check_numbers, check_tree, parse_xml
 
-WORLD_LINK = "world"
-
-
-@dataclass(frozen=True)
-class ParsedRobot:
-    """A URDF robot, checked to be a tree.
-
-    Attributes:
-        model: yourdfpy's `Robot` (links, joints, materials; capsules parsed as cylinders).
-        root: the raw `<robot>` element (for `<gazebo>`, `<transmission>`, `<ros2_control>`).
-        source: the description file, for messages.
-        base_dir: directory relative mesh paths are taken from.
-        base_link: the one link that is nobody's child.
-        capsules: (link, role, index) of geometries that were `<capsule>` in the source.
-        transmission_joints: joints named by `<transmission>` elements, in document order.
-        ros2_control_joints: joints named inside `<ros2_control>` blocks, in document order.
-    """
-
-    model: object
-    root: ET.Element
-    source: str
-    base_dir: Path
-    base_link: str
-    capsules: frozenset[tuple[str, str, int]]
-    transmission_joints: tuple[str, ...]
-    ros2_control_joints: tuple[str, ...]
+# Joint children that only ROS controllers read; reported as ignored by the builder.
+CONTROLLER_ONLY = ("safety_controller", "calibration")
 
 
-def parse_xml(text: str, source: str) -> ET.Element:
-    """Parse XML text; malformed input → `MalformedXMLError` with file:line:column."""
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        line, column = exc.position
-        message = str(exc).split(":")[0]
-        raise MalformedXMLError(source, line, column + 1, message) from exc
-    for element in root.iter():
-        if isinstance(element.tag, str) and element.tag.startswith("{"):
-            element.tag = element.tag.split("}", 1)[1]  # a default xmlns on <robot>
-    return root
-
-
-def parse_urdf(text: str, source: str, base_dir: Path) -> ParsedRobot:
-    """Parse and check URDF text.
+def parse_urdf(
+    text: str, source: str, base_dir: Path, resolver: PackageResolver | None = None
+) -> RobotDescription:
+    """Parse and check URDF text into a robot description.
 
     Args:
         text: the URDF XML (after xacro).
         source: file name for messages.
-        base_dir: directory for relative mesh paths.
+        base_dir: directory relative mesh paths are taken from.
+        resolver: finds `package://`, `model://` and relative mesh files (default: search
+            the directories above `base_dir`).
 
     Raises:
-        MalformedXMLError, BadNumberError, URDFStructureError.
+        MalformedXMLError, BadNumberError, URDFStructureError, GazeboTagError,
+        PackageNotFoundError, ResourceNotFoundError.
     """
-    import lxml.etree
-    import yourdfpy
-
     root = parse_xml(text, source)
     if root.tag != "robot":
         raise URDFStructureError(
@@ -92,129 +61,156 @@ def parse_urdf(text: str, source: str, base_dir: Path) -> ParsedRobot:
     check_numbers(root, source)
     base_link = check_tree(root, source)
     capsules = _capsules_as_cylinders(root)
-    lxml_root = lxml.etree.fromstring(ET.tostring(root))
+    model = _yourdfpy_robot(root, source)
+    resolver = resolver or PackageResolver.create(Path(source) if source else None)
+    named = {m.name: m for m in getattr(model, "materials", []) if getattr(m, "name", None)}
+    gazebo = parse_gazebo(root, source)  # tag errors first, as Gazebo reads them before meshes
+    reading = _LinkReader(capsules, named, base_dir, resolver)
+    return RobotDescription(
+        name=model.name,
+        source=source,
+        base_link=base_link,
+        links=tuple(reading.link(link) for link in model.links),
+        joints=tuple(_joint(joint) for joint in model.joints),
+        gazebo=gazebo,
+        actuated=_named_joints(root, ("transmission", "ros2_control")),
+        text=text,
+    )
+
+
+def _yourdfpy_robot(root: ET.Element, source: str) -> object:
+    import lxml.etree
+    import yourdfpy
+
     try:
-        model = yourdfpy.URDF._parse_robot(lxml_root)
+        return yourdfpy.URDF._parse_robot(lxml.etree.fromstring(ET.tostring(root)))
     except (ValueError, KeyError, TypeError) as exc:
         raise URDFStructureError(
             source, "<robot>", f"yourdfpy cannot read it: {exc}", "fix the element named above"
         ) from exc
-    return ParsedRobot(
-        model=model,
-        root=root,
-        source=source,
-        base_dir=base_dir,
-        base_link=base_link,
-        capsules=frozenset(capsules),
-        transmission_joints=_named_joints(root, "transmission"),
-        ros2_control_joints=_named_joints(root, "ros2_control"),
-    )
 
 
-def _where(owner: ET.Element | None, element: ET.Element) -> str:
-    if owner is None:
-        return f"<{element.tag}>"
-    return f"{owner.tag} '{owner.get('name', '?')}' <{element.tag}>"
+def _pose(origin: object | None) -> np.ndarray:
+    return np.eye(4) if origin is None else np.asarray(origin, dtype=float)
 
 
-def check_numbers(root: ET.Element, source: str) -> None:
-    """Every numeric attribute of links/joints/materials parses as the right count of floats."""
-    for owner in list(root):
-        for element in owner.iter():
-            for attr, count in NUMERIC_ATTRIBUTES.get(element.tag, {}).items():
-                value = element.get(attr)
-                if value is None:
-                    continue
-                expected = "a number" if count == 1 else f"{count} numbers"
-                try:
-                    numbers = [float(v) for v in value.split()]
-                except ValueError as exc:
-                    raise BadNumberError(
-                        source, _where(owner, element), attr, value, expected
-                    ) from exc
-                if len(numbers) != count or not all(abs(v) < float("inf") for v in numbers):
-                    raise BadNumberError(source, _where(owner, element), attr, value, expected)
+def _number(value: object | None, default: float | None = None) -> float | None:
+    return default if value is None else float(value)
 
 
-def _unique_names(root: ET.Element, tag: str, source: str) -> list[str]:
-    names: list[str] = []
-    for element in root.findall(tag):
-        name = element.get("name")
-        if not name:
-            raise URDFStructureError(source, f"a <{tag}>", "has no name", "give it a name")
-        if name in names:
-            raise URDFStructureError(
-                source,
-                f"{tag} '{name}'",
-                "is defined twice",
-                f"rename or remove one of the two <{tag}> elements",
+class _LinkReader:
+    """Turns yourdfpy links into description links: shapes, resolved meshes, materials."""
+
+    def __init__(
+        self,
+        capsules: set[tuple[str, str, int]],
+        named: dict[str, object],
+        base_dir: Path,
+        resolver: PackageResolver,
+    ) -> None:
+        self.capsules = capsules
+        self.named = named
+        self.base_dir = base_dir
+        self.resolver = resolver
+
+    def link(self, link: object) -> Link:
+        visuals = tuple(
+            Visual(
+                _pose(v.origin),
+                self.geometry(v.geometry, link.name, "visual", i),
+                self.material(v.material),
+                v.name,
             )
-        names.append(name)
-    return names
-
-
-def check_tree(root: ET.Element, source: str) -> str:
-    """Links and joints form one tree; returns its root link.
-
-    Raises:
-        URDFStructureError: duplicate names, unknown parent/child, a link with two parents,
-            a cycle, several roots, or no links.
-    """
-    links = _unique_names(root, "link", source)
-    _unique_names(root, "joint", source)
-    if not links:
-        raise URDFStructureError(source, "<robot>", "has no <link>", "add at least one link")
-    known = ", ".join(links)
-    parent_of: dict[str, str] = {}
-    for joint in root.findall("joint"):
-        name = joint.get("name")
-        for role in ("parent", "child"):
-            element = joint.find(role)
-            link = element.get("link") if element is not None else None
-            if link not in links:
-                raise URDFStructureError(
-                    source,
-                    f"joint '{name}'",
-                    f"{role} link {link!r} does not exist",
-                    f"use one of the links: {known}",
-                )
-        child = joint.find("child").get("link")
-        if child in parent_of:
-            raise URDFStructureError(
-                source,
-                f"link '{child}'",
-                f"is the child of two joints (parents '{parent_of[child]}' "
-                f"and '{joint.find('parent').get('link')}')",
-                "a URDF must be a tree: remove one joint",
-            )
-        parent_of[child] = joint.find("parent").get("link")
-    _check_acyclic(parent_of, source)
-    roots = [link for link in links if link not in parent_of]
-    if len(roots) != 1:
-        raise URDFStructureError(
-            source,
-            "links " + ", ".join(roots),
-            f"the model has {len(roots)} root links (links with no parent joint)",
-            "connect them with joints so exactly one root remains",
+            for i, v in enumerate(link.visuals)
         )
-    return roots[0]
+        collisions = tuple(
+            Collision(_pose(c.origin), self.geometry(c.geometry, link.name, "collision", i), c.name)
+            for i, c in enumerate(link.collisions)
+        )
+        return Link(link.name, _inertial(link.inertial), visuals, collisions)
+
+    def geometry(
+        self, geometry: object | None, link: str, role: str, index: int
+    ) -> Geometry | None:
+        """The shape of one `<visual>`/`<collision>`; None when it names no shape."""
+        if geometry is None:
+            return None
+        if geometry.box is not None:
+            return Geometry("box", tuple(float(v) for v in geometry.box.size))
+        if geometry.cylinder is not None:
+            shape = "capsule" if (link, role, index) in self.capsules else "cylinder"
+            return Geometry(
+                shape, (float(geometry.cylinder.radius), float(geometry.cylinder.length))
+            )
+        if geometry.sphere is not None:
+            return Geometry("sphere", (float(geometry.sphere.radius),))
+        if geometry.mesh is not None:
+            element = f"link '{link}' <{role}> {index} <mesh>"
+            uri = geometry.mesh.filename
+            path = self.resolver.resolve(uri, base_dir=self.base_dir, element=element)
+            return Geometry("mesh", (), Path(path), uri, _scale(geometry.mesh.scale))
+        return None
+
+    def material(self, material: object | None) -> Material | None:
+        """A visual's material with its colour and texture filled in from the named ones."""
+        if material is None:
+            return None
+        name = getattr(material, "name", None)
+        colour = getattr(material, "color", None)
+        texture = getattr(material, "texture", None)
+        if (colour is None or texture is None) and name in self.named:
+            shared = self.named[name]
+            colour = colour if colour is not None else getattr(shared, "color", None)
+            texture = texture if texture is not None else getattr(shared, "texture", None)
+        rgba = tuple(float(c) for c in colour.rgba) if colour is not None else None
+        return Material(name, rgba, getattr(texture, "filename", None))  # type: ignore[arg-type]
 
 
-def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
-    for start in parent_of:
-        path = [start]
-        link = start
-        while link in parent_of:
-            link = parent_of[link]
-            if link in path:
-                cycle = " → ".join(reversed(path[path.index(link) :] + [link]))  # parent → child
-                raise URDFStructureError(
-                    source,
-                    f"links {cycle}",
-                    "form a cycle",
-                    "a URDF must be a tree: remove one joint of the cycle",
-                )
-            path.append(link)
+def _scale(value: object | None) -> tuple[float, float, float]:
+    if value is None:
+        return (1.0, 1.0, 1.0)
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.size == 1:
+        arr = np.repeat(arr, 3)
+    return (float(arr[0]), float(arr[1]), float(arr[2]))
+
+
+def _inertial(inertial: object | None) -> Inertial | None:
+    if inertial is None:
+        return None
+    tensor = inertial.inertia if inertial.inertia is not None else np.zeros((3, 3))
+    mass = _number(inertial.mass, 0.0)
+    return Inertial(mass, np.asarray(tensor, dtype=float), _pose(inertial.origin))
+
+
+def _joint(joint: object) -> Joint:
+    limit = joint.limit
+    dynamics = joint.dynamics
+    mimic = joint.mimic
+    axis = joint.axis if joint.axis is not None else (1.0, 0.0, 0.0)
+    return Joint(
+        name=joint.name,
+        kind=joint.type,
+        parent=joint.parent,
+        child=joint.child,
+        origin=_pose(joint.origin),
+        axis=tuple(float(v) for v in axis),  # type: ignore[arg-type]
+        limit=None
+        if limit is None
+        else Limit(
+            _number(limit.lower),
+            _number(limit.upper),
+            _number(limit.effort),
+            _number(limit.velocity),
+        ),
+        dynamics=None
+        if dynamics is None
+        else Dynamics(_number(dynamics.damping, 0.0), _number(dynamics.friction, 0.0)),
+        mimic=None
+        if mimic is None
+        else Mimic(mimic.joint, _number(mimic.multiplier, 1.0), _number(mimic.offset, 0.0)),
+        ignored=tuple(name for name in CONTROLLER_ONLY if getattr(joint, name, None) is not None),
+    )
 
 
 def _capsules_as_cylinders(root: ET.Element) -> set[tuple[str, str, int]]:
@@ -230,11 +226,13 @@ def _capsules_as_cylinders(root: ET.Element) -> set[tuple[str, str, int]]:
     return found
 
 
-def _named_joints(root: ET.Element, tag: str) -> tuple[str, ...]:
+def _named_joints(root: ET.Element, tags: tuple[str, ...]) -> tuple[str, ...]:
+    """Joints named inside `<transmission>` then `<ros2_control>` blocks, in document order."""
     names: list[str] = []
-    for block in root.iter(tag):
-        for joint in block.iter("joint"):
-            name = joint.get("name")
-            if name and name not in names:
-                names.append(name)
+    for tag in tags:
+        for block in root.iter(tag):
+            for joint in block.iter("joint"):
+                name = joint.get("name")
+                if name and name not in names:
+                    names.append(name)
     return tuple(names)

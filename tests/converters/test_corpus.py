@@ -76,9 +76,7 @@ def test_non_physical_inertia_fails_with_link_named_and_converts_with_repair(
             args=robot["xacro_args"],
             package_paths=package_paths(robot),
         )
-    assert caught.value.link in {
-        link.name for link in converted_corpus(robot_id).parsed.model.links
-    }
+    assert caught.value.link in {link.name for link in converted_corpus(robot_id).description.links}
     assert f"link '{caught.value.link}'" in str(caught.value) and "--repair-inertia" in str(
         caught.value
     )
@@ -93,7 +91,7 @@ def test_link_masses_and_total_mass_equal_the_urdf_after_lumping(
     done = converted_corpus(robot_id)
     model = done.spec.compile()
     declared: dict[str, float] = {}
-    for link in done.parsed.model.links:
+    for link in done.description.links:
         mass = float(link.inertial.mass) if link.inertial is not None else 0.0
         body = done.provenance.body_of_link[link.name]
         declared[body] = declared.get(body, 0.0) + mass

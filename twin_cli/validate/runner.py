@@ -11,11 +11,15 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from twin_cli.errors import ScenarioError, TwinError, UnknownCheckError
 from twin_cli.validate.checks import CHECKS, MODEL_CHECKS
 from twin_cli.validate.checks.base import CheckResult, DeclaredJoint, RobotUnderTest, Status, result
 from twin_cli.validate.scenario import Scenario, load_builtin, resolve, with_joints
+
+if TYPE_CHECKING:
+    from converters.description import Joint
 
 
 @dataclass(frozen=True)
@@ -87,24 +91,21 @@ def load_robot(
 def robot_from_conversion(done, path: str | Path, *, repair_inertia: bool) -> RobotUnderTest:
     """The robot under test from a `converters.Conversion` (spec, report, provenance)."""
     body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
-    joints = tuple(_declared(j) for j in done.parsed.model.joints)
+    joints = tuple(_declared(j) for j in done.description.joints)
     return _robot(done.spec, done.report, Path(path), repair_inertia, body_links, joints)
 
 
-def _declared(joint) -> DeclaredJoint:
-    limit = joint.limit
+def _declared(joint: Joint) -> DeclaredJoint:
+    from converters.description import Limit
 
-    def value(name: str) -> float | None:
-        raw = getattr(limit, name, None) if limit is not None else None
-        return None if raw is None else float(raw)
-
+    limit = joint.limit or Limit()
     return DeclaredJoint(
         joint.name,
-        joint.type,
-        value("lower"),
-        value("upper"),
-        value("effort"),
-        value("velocity"),
+        joint.kind,
+        limit.lower,
+        limit.upper,
+        limit.effort,
+        limit.velocity,
         joint.mimic is not None,
     )
 

@@ -165,7 +165,7 @@ def inspect_command(
         **source_inputs(arg, package),
         options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}),
     )
-    stats = inertial_stats(done.spec, done.parsed)
+    stats = inertial_stats(done.spec, done.description)
     out = Output(json_mode)
     if json_mode:
         out.data({"robot": done.report.robot, **stats.to_dict()})

@@ -1,0 +1,148 @@
+"""URDF as XML, checked before any reader trusts it: well-formed, numbers parse, one tree.
+
+Every failure names the file and the element (link, joint, attribute) and says how to fix it,
+so a hand-edited file never reaches yourdfpy or the builder with a value they would choke on.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from converters.errors import BadNumberError, MalformedXMLError, URDFStructureError
+
+# Attributes holding numbers: tag → {attribute: count} (0 = any count ≥ 1).
+NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
+    "origin": {"xyz": 3, "rpy": 3},
+    "axis": {"xyz": 3},
+    "mass": {"value": 1},
+    "inertia": {k: 1 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+    "dynamics": {"damping": 1, "friction": 1},
+    "box": {"size": 3},
+    "cylinder": {"radius": 1, "length": 1},
+    "capsule": {"radius": 1, "length": 1},
+    "sphere": {"radius": 1},
+    "mesh": {"scale": 3},
+    "mimic": {"multiplier": 1, "offset": 1},
+    "color": {"rgba": 4},
+}
+
+
+def parse_xml(text: str, source: str) -> ET.Element:
+    """Parse XML text; malformed input → `MalformedXMLError` with file:line:column."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        line, column = exc.position
+        message = str(exc).split(":")[0]
+        raise MalformedXMLError(source, line, column + 1, message) from exc
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith("{"):
+            element.tag = element.tag.split("}", 1)[1]  # a default xmlns on <robot>
+    return root
+
+
+def _where(owner: ET.Element | None, element: ET.Element) -> str:
+    if owner is None:
+        return f"<{element.tag}>"
+    return f"{owner.tag} '{owner.get('name', '?')}' <{element.tag}>"
+
+
+def check_numbers(root: ET.Element, source: str) -> None:
+    """Every numeric attribute of links/joints/materials parses as the right count of floats."""
+    for owner in list(root):
+        for element in owner.iter():
+            for attr, count in NUMERIC_ATTRIBUTES.get(element.tag, {}).items():
+                value = element.get(attr)
+                if value is None:
+                    continue
+                expected = "a number" if count == 1 else f"{count} numbers"
+                try:
+                    numbers = [float(v) for v in value.split()]
+                except ValueError as exc:
+                    raise BadNumberError(
+                        source, _where(owner, element), attr, value, expected
+                    ) from exc
+                if len(numbers) != count or not all(abs(v) < float("inf") for v in numbers):
+                    raise BadNumberError(source, _where(owner, element), attr, value, expected)
+
+
+def _unique_names(root: ET.Element, tag: str, source: str) -> list[str]:
+    names: list[str] = []
+    for element in root.findall(tag):
+        name = element.get("name")
+        if not name:
+            raise URDFStructureError(source, f"a <{tag}>", "has no name", "give it a name")
+        if name in names:
+            raise URDFStructureError(
+                source,
+                f"{tag} '{name}'",
+                "is defined twice",
+                f"rename or remove one of the two <{tag}> elements",
+            )
+        names.append(name)
+    return names
+
+
+def check_tree(root: ET.Element, source: str) -> str:
+    """Links and joints form one tree; returns its root link.
+
+    Raises:
+        URDFStructureError: duplicate names, unknown parent/child, a link with two parents,
+            a cycle, several roots, or no links.
+    """
+    links = _unique_names(root, "link", source)
+    _unique_names(root, "joint", source)
+    if not links:
+        raise URDFStructureError(source, "<robot>", "has no <link>", "add at least one link")
+    known = ", ".join(links)
+    parent_of: dict[str, str] = {}
+    for joint in root.findall("joint"):
+        name = joint.get("name")
+        for role in ("parent", "child"):
+            element = joint.find(role)
+            link = element.get("link") if element is not None else None
+            if link not in links:
+                raise URDFStructureError(
+                    source,
+                    f"joint '{name}'",
+                    f"{role} link {link!r} does not exist",
+                    f"use one of the links: {known}",
+                )
+        child = joint.find("child").get("link")
+        if child in parent_of:
+            raise URDFStructureError(
+                source,
+                f"link '{child}'",
+                f"is the child of two joints (parents '{parent_of[child]}' "
+                f"and '{joint.find('parent').get('link')}')",
+                "a URDF must be a tree: remove one joint",
+            )
+        parent_of[child] = joint.find("parent").get("link")
+    _check_acyclic(parent_of, source)
+    roots = [link for link in links if link not in parent_of]
+    if len(roots) != 1:
+        raise URDFStructureError(
+            source,
+            "links " + ", ".join(roots),
+            f"the model has {len(roots)} root links (links with no parent joint)",
+            "connect them with joints so exactly one root remains",
+        )
+    return roots[0]
+
+
+def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
+    for start in parent_of:
+        path = [start]
+        link = start
+        while link in parent_of:
+            link = parent_of[link]
+            if link in path:
+                cycle = " → ".join(reversed(path[path.index(link) :] + [link]))  # parent → child
+                raise URDFStructureError(
+                    source,
+                    f"links {cycle}",
+                    "form a cycle",
+                    "a URDF must be a tree: remove one joint of the cycle",
+                )
+            path.append(link)
