@@ -46,9 +46,17 @@ class PackageNotFoundError(ConversionError):
 
     def __init__(self, package: str, uri: str, element: str, tried: list[str]) -> None:
         places = "\n  ".join(tried) or "(no search paths)"
+        kind, variable = (
+            ("model", "GAZEBO_MODEL_PATH")
+            if uri.startswith("model://")
+            else (
+                "package",
+                "ROS_PACKAGE_PATH",
+            )
+        )
         super().__init__(
-            f"package '{package}' not found for {uri!r} used by {element}; tried:\n  {places}\n"
-            f"fix: pass --package {package}=PATH or add its parent directory to ROS_PACKAGE_PATH"
+            f"{kind} '{package}' not found for {uri!r} used by {element}; tried:\n  {places}\n"
+            f"fix: pass --package {package}=PATH or add its parent directory to {variable}"
         )
         self.package = package
         self.uri = uri
@@ -138,3 +146,14 @@ class CollisionSettingsError(ConversionError):
         )
         self.option = option
         self.value = value
+
+
+class SDFError(ConversionError):
+    """An SDFormat file that twin cannot read: names file:line, the element and the fix."""
+
+    def __init__(self, path: str, line: int | None, element: str, problem: str, fix: str) -> None:
+        where = f"{path}:{line}" if line else path
+        super().__init__(f"{where}: {element}: {problem}; {fix}")
+        self.path = path
+        self.line = line
+        self.element = element

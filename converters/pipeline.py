@@ -1,4 +1,4 @@
-"""The conversion pipeline: file → xacro → URDF → description → MjSpec → Gazebo semantics.
+"""The conversion pipeline: file → xacro → URDF or SDF → description → MjSpec → Gazebo semantics.
 
 The single entry of `converters`; each stage adds its findings to one report.
 """
@@ -11,6 +11,7 @@ from pathlib import Path
 
 from converters.description import RobotDescription
 from converters.errors import InputFileError
+from converters.formats import format_of
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
 from converters.report import Report
@@ -32,17 +33,19 @@ class Conversion:
 def read_description(
     path: Path, args: Mapping[str, str], resolver: PackageResolver, report: Report
 ) -> str:
-    """URDF text of `path`: xacro files are expanded, plain URDF files read as they are.
+    """The description text of `path`: xacro files are expanded, URDF and SDF read as they are.
 
     Raises:
         InputFileError: the file is missing or unreadable.
         XacroError, PackageNotFoundError: from xacro.
     """
     if not path.is_file():
-        raise InputFileError(str(path), "no such file", "give the path of a .urdf or .xacro file")
+        raise InputFileError(
+            str(path), "no such file", "give the path of a .urdf, .xacro or .sdf file"
+        )
     if not needs_xacro(path):
         if args:
-            report.ignored("--arg", f"{path.name} is plain URDF; xacro arguments are not used")
+            report.ignored("--arg", f"{path.name} is not xacro; xacro arguments are not used")
         try:
             return path.read_text()
         except (OSError, UnicodeDecodeError) as exc:
@@ -59,6 +62,27 @@ def read_description(
     return result.text
 
 
+def read_robot(
+    text: str, source: str, base_dir: Path, resolver: PackageResolver, report: Report
+) -> RobotDescription:
+    """The robot description of a URDF or SDF text, chosen by its root element.
+
+    Raises:
+        InputFileError: the text is MJCF (nothing to convert) or of no known format.
+        ConversionError: any subclass from the format's reader.
+    """
+    kind = format_of(text)
+    if kind == "sdf":
+        from converters.sdf import read_sdf_model
+
+        return read_sdf_model(text, source, base_dir, resolver, report)
+    if kind == "mjcf":
+        raise InputFileError(
+            source, "is MJCF, already MuJoCo's format", "spawn it directly; nothing to convert"
+        )
+    return parse_urdf(text, source, base_dir, resolver)
+
+
 def convert_full(
     path: str | Path,
     *,
@@ -66,10 +90,10 @@ def convert_full(
     package_paths: Mapping[str, str | Path] | None = None,
     options: ConvertOptions | None = None,
 ) -> Conversion:
-    """Convert a xacro/URDF file into an MjSpec carrying Gazebo's semantics.
+    """Convert a xacro, URDF or SDF model file into an MjSpec carrying Gazebo's semantics.
 
     Args:
-        path: the `.urdf` or `.xacro` file.
+        path: the `.urdf`, `.xacro` or `.sdf` file.
         args: xacro arguments (`NAME:=VALUE` pairs as a dict).
         package_paths: package name → directory (`--package`), searched first.
         options: keep_fixed, repair_inertia, collision settings.
@@ -77,14 +101,45 @@ def convert_full(
     Raises:
         ConversionError: any subclass, with file/link/joint and the fix in its message.
     """
-    from converters.gazebo.apply import apply_gazebo
-
     path = Path(path)
-    options = options or ConvertOptions()
     resolver = PackageResolver.create(path, package_paths)
     report = Report(source=str(path))
     text = read_description(path, dict(args or {}), resolver, report)
-    robot = parse_urdf(text, str(path), path.resolve().parent, resolver)
+    robot = read_robot(text, str(path), path.resolve().parent, resolver, report)
+    return build_description(robot, options, report)
+
+
+def convert_text(
+    text: str,
+    *,
+    source: str = "<text>",
+    base_dir: str | Path | None = None,
+    package_paths: Mapping[str, str | Path] | None = None,
+    options: ConvertOptions | None = None,
+) -> Conversion:
+    """Convert a description given as text (URDF, xacro output or SDF), as SpawnEntity's `xml`.
+
+    Args:
+        text: the description.
+        source: a name for messages (`<stdin>`, `<xml>`, a request id).
+        base_dir: where relative mesh paths start (default: the working directory).
+        package_paths, options: as for `convert_full`.
+    """
+    directory = Path(base_dir or Path.cwd()).resolve()
+    resolver = PackageResolver.create(directory / "description", package_paths)
+    report = Report(source=source)
+    robot = read_robot(text, source, directory, resolver, report)
+    return build_description(robot, options, report)
+
+
+def build_description(
+    robot: RobotDescription, options: ConvertOptions | None = None, report: Report | None = None
+) -> Conversion:
+    """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
+    from converters.gazebo.apply import apply_gazebo
+
+    options = options or ConvertOptions()
+    report = report or Report(source=robot.source)
     report.robot = robot.name
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)

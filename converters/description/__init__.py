@@ -1,7 +1,8 @@
 """The neutral robot description: what format readers produce and every later stage consumes.
 
 `robot` holds links, joints, shapes and inertials; `gazebo` holds Gazebo's typed values
-(surfaces, link and joint flags, plugins and sensors). Nothing here knows a file format.
+(surfaces, link and joint flags, plugins and sensors); `world` holds a world's physics, lights
+and placed models. Nothing here knows a file format.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from converters.description.robot import (
     WORLD_LINK,
     Collision,
     Dynamics,
+    Frame,
     Geometry,
     Inertial,
     Joint,
@@ -31,6 +33,7 @@ from converters.description.robot import (
     RobotDescription,
     Visual,
 )
+from converters.description.world import Light, PlacedModel, WorldDescription
 
 __all__ = [
     "JOINT_TYPES",
@@ -39,6 +42,7 @@ __all__ = [
     "Blob",
     "Collision",
     "Dynamics",
+    "Frame",
     "GazeboExtensions",
     "Geometry",
     "Inertial",
@@ -46,12 +50,15 @@ __all__ = [
     "Joint",
     "JointExtension",
     "Limit",
+    "Light",
     "Link",
     "LinkExtension",
     "Material",
     "Mimic",
+    "PlacedModel",
     "RobotDescription",
     "Surface",
     "TagSource",
     "Visual",
+    "WorldDescription",
 ]

@@ -21,7 +21,7 @@ from converters.description.gazebo import GazeboExtensions
 WORLD_LINK = "world"
 
 # Shapes a geometry can have; `size` below gives each one's numbers.
-SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh")
+SHAPES = ("box", "cylinder", "sphere", "capsule", "ellipsoid", "plane", "mesh")
 
 # Joint kinds: URDF's six, plus `spherical`, which several parsers accept.
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
@@ -39,7 +39,8 @@ class Geometry:
     Attributes:
         shape: one of `SHAPES`.
         size: [m] box edge lengths (x, y, z); cylinder and capsule (radius, length);
-            sphere (radius,); empty for a mesh.
+            sphere (radius,); ellipsoid radii (a, b, c); plane extent (x, y), normal +z;
+            empty for a mesh.
         mesh: the resolved mesh file (meshes only); uri: the reference as the file wrote it.
         scale: the mesh's per-axis scale (unitless).
     """
@@ -140,6 +141,8 @@ class Joint:
         kind: one of `JOINT_TYPES` (anything else is welded, with a report line).
         origin: pose of the child link frame in the parent link frame at zero position (4×4).
         axis: the motion axis in the child frame (not normalised here).
+        anchor: [m] the point the joint turns about, in the child frame (URDF: its origin;
+            SDF: the joint frame's position).
         ignored: child elements no physics engine uses (`safety_controller`, `calibration`).
     """
 
@@ -149,10 +152,20 @@ class Joint:
     child: str
     origin: np.ndarray = field(default_factory=identity)
     axis: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    anchor: tuple[float, float, float] = (0.0, 0.0, 0.0)
     limit: Limit | None = None
     dynamics: Dynamics | None = None
     mimic: Mimic | None = None
     ignored: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A named frame fixed to a link (SDF `<frame>`): kept as a site so it can be addressed."""
+
+    name: str
+    link: str
+    pose: np.ndarray = field(default_factory=identity)
 
 
 @dataclass(frozen=True)
@@ -168,6 +181,10 @@ class RobotDescription:
             in document order; empty when it has none.
         gazebo: Gazebo's typed values (surfaces, link and joint flags, plugins, sensors).
         text: the description as text (URDF after xacro), for tools that want the original.
+        base_pose: the base link's pose in the model frame (URDF: identity; SDF: its `<pose>`).
+        frames: named frames fixed to links (SDF `<frame>`).
+        model_frame_site: mark the model frame with a `__model__` site when it is not the root
+            link's frame (SDF), so a running world can report the model's pose as Gazebo does.
     """
 
     name: str
@@ -178,6 +195,9 @@ class RobotDescription:
     gazebo: GazeboExtensions
     actuated: tuple[str, ...] = ()
     text: str = ""
+    base_pose: np.ndarray = field(default_factory=identity)
+    frames: tuple[Frame, ...] = ()
+    model_frame_site: bool = False
 
     def link(self, name: str) -> Link:
         """The link called `name` (KeyError when there is none)."""

@@ -171,7 +171,11 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
             f"kd={inline.surface.kd}",
             tag="surface",
         )
-    untagged = sum(1 for g in provenance.geoms if g.role == "collision" and g.link not in ext.links)
+    untagged = sum(
+        1
+        for g in provenance.geoms
+        if g.role == "collision" and ext.surface_of(g.link, g.index).mu1 is None
+    )
     report.mapped(
         "collision geoms",
         f"Gazebo default μ={DEFAULT_MU} (priority {friction_priority(DEFAULT_MU)}) on "

@@ -29,6 +29,8 @@ COLLISION_CLASS = "collision"
 VISUAL_GROUP = 2
 COLLISION_GROUP = 3
 HOME_KEY = "home"
+# Site marking the model frame where it is not the root body's frame (SDF `__model__`).
+MODEL_SITE = "__model__"
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,7 @@ def build_spec(
     inertias = body_inertias(robot, plan, geoms, options.repair_inertia, report)
     spec = new_spec(robot.name)
     bodies, joints = _add_bodies(spec, plan, inertias, report, provenance)
-    _add_sites(bodies, plan, provenance)
+    _add_sites(bodies, plan, robot)
     _add_geoms(spec, bodies, geoms, options.collision, report, provenance)
     add_motors(spec, actuated_joints(robot, report), report)
     add_mimics(spec, robot, report)
@@ -124,7 +126,7 @@ def _add_bodies(
         bodies[node.name] = body
         _set_inertial(body, inertias[node.name])
         if node.name == plan.root_body and plan.floating:
-            joints.append(add_free_joint(body, np.asarray(pos)))
+            joints.append(add_free_joint(body, pos, quat))
         joints += add_joints(body, node.joint, report)
     for made in joints:
         if made.urdf_joint is not None:
@@ -145,12 +147,20 @@ def _set_inertial(body: object, value: inr.Inertia) -> None:
     body.inertia = moments.tolist()
 
 
-def _add_sites(bodies: dict[str, object], plan: BodyPlan, provenance: Provenance) -> None:
-    """Every lumped link stays addressable as a site named after it, at its frame."""
-    for link in plan.lumped:
-        placement = plan.placements[link]
-        pos, quat = pose(placement.T_body_link)
-        bodies[placement.body].add_site(name=link, pos=pos, quat=quat, group=VISUAL_GROUP + 3)
+def _add_sites(bodies: dict[str, object], plan: BodyPlan, robot: RobotDescription) -> None:
+    """Lumped links and named frames (SDF `<frame>`) stay addressable as sites at their poses."""
+    placed = [(link, plan.placements[link].T_body_link, link) for link in plan.lumped]
+    for frame in robot.frames:
+        placement = plan.placements[frame.link]
+        placed.append((frame.name, placement.T_body_link @ frame.pose, frame.link))
+    for name, T_body_site, link in placed:
+        pos, quat = pose(T_body_site)
+        body = bodies[plan.placements[link].body]
+        body.add_site(name=name, pos=pos, quat=quat, group=VISUAL_GROUP + 3)
+    if robot.model_frame_site and (plan.root_body != WORLDBODY or not plan.floating):
+        T_root_model = np.linalg.inv(robot.base_pose)
+        pos, quat = pose(T_root_model if plan.root_body != WORLDBODY else np.eye(4))
+        bodies[plan.root_body].add_site(name=MODEL_SITE, pos=pos, quat=quat, group=VISUAL_GROUP + 3)
 
 
 def _add_geoms(
@@ -291,6 +301,8 @@ def _primitive(kind: str) -> object:
     import mujoco
 
     return {
+        "ellipsoid": mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+        "plane": mujoco.mjtGeom.mjGEOM_PLANE,
         "box": mujoco.mjtGeom.mjGEOM_BOX,
         "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
         "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,

@@ -57,8 +57,10 @@ class GeomPlan:
 
 
 def _half_extents(kind: str, size: tuple[float, ...]) -> np.ndarray:
-    if kind == "box":
+    if kind in ("box", "ellipsoid"):
         return np.asarray(size)
+    if kind == "plane":
+        return np.array([size[0], size[1], 0.0])
     if kind == "sphere":
         return np.full(3, size[0])
     if kind == "capsule":
@@ -135,6 +137,12 @@ def _plan_one(geometry: Geometry | None, link: str, cache: MeshCache) -> tuple |
         return geometry.shape, (radius, length / 2), None, None, unit
     if geometry.shape == "sphere":
         return "sphere", (geometry.size[0],), None, None, unit
+    if geometry.shape == "ellipsoid":
+        return "ellipsoid", tuple(geometry.size), None, None, unit
+    if geometry.shape == "plane":
+        # MuJoCo: half extents for drawing (0 = infinite) and the grid spacing; it collides
+        # as an infinite plane either way, as Gazebo's does.
+        return "plane", (geometry.size[0] / 2, geometry.size[1] / 2, 1.0), None, None, unit
     if geometry.shape == "mesh" and geometry.mesh is not None:
         mesh = cache.get(geometry.mesh, geometry.scale, link)
         return "mesh", (), mesh, str(geometry.mesh), geometry.scale

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from converters.description import Joint
+from converters.description import WORLD_LINK, Joint
 from converters.report import Report
 
 # Name of the free joint of a floating base (prefixed by the entity name after attach).
@@ -56,7 +56,7 @@ def _limited(body: object, joint: Joint, kind: int, report: Report) -> list[MjJo
     """revolute (hinge) or prismatic (slide) with range, damping and friction."""
     import mujoco
 
-    mj = body.add_joint(name=joint.name, type=kind, axis=_axis(joint))
+    mj = body.add_joint(name=joint.name, type=kind, axis=_axis(joint), pos=list(joint.anchor))
     _dynamics(mj, joint)
     lower, upper = _bounds(joint)
     if lower is not None and upper is not None and lower < upper:
@@ -100,7 +100,9 @@ def _prismatic(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
 def _continuous(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
-    mj = body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=_axis(joint))
+    mj = body.add_joint(
+        name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=_axis(joint), pos=list(joint.anchor)
+    )
     mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     _dynamics(mj, joint)
     return [MjJointPlan(joint.name, joint.name, "continuous", None, (0.0,))]
@@ -121,7 +123,9 @@ def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
         ("y", mujoco.mjtJoint.mjJNT_SLIDE, v),
         ("yaw", mujoco.mjtJoint.mjJNT_HINGE, normal),
     ):
-        mj = body.add_joint(name=f"{joint.name}_{suffix}", type=kind, axis=axis)
+        mj = body.add_joint(
+            name=f"{joint.name}_{suffix}", type=kind, axis=axis, pos=list(joint.anchor)
+        )
         _dynamics(mj, joint)
         out.append(MjJointPlan(mj.name, joint.name, "planar", None, (0.0,)))
     report.mapped(f"joint '{joint.name}'", "planar → two slides and a hinge about the normal")
@@ -129,8 +133,12 @@ def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
 
 
 def _floating(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
-    """A nested floating joint: three slides and a ball (MuJoCo free joints must be top-level)."""
+    """A floating joint: a free joint on a top-level body, else three slides and a ball (MuJoCo
+    free joints must be top-level)."""
     import mujoco
+
+    if joint.parent == WORLD_LINK:
+        return [add_free_joint(body, list(body.pos), list(body.quat), joint.name)]
 
     out = []
     for suffix, axis in (("x", (1, 0, 0)), ("y", (0, 1, 0)), ("z", (0, 0, 1))):
@@ -138,7 +146,9 @@ def _floating(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
             name=f"{joint.name}_{suffix}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=axis
         )
         out.append(MjJointPlan(mj.name, joint.name, "floating", None, (0.0,)))
-    body.add_joint(name=f"{joint.name}_rot", type=mujoco.mjtJoint.mjJNT_BALL)
+    body.add_joint(
+        name=f"{joint.name}_rot", type=mujoco.mjtJoint.mjJNT_BALL, pos=list(joint.anchor)
+    )
     out.append(MjJointPlan(f"{joint.name}_rot", joint.name, "floating", None, (1.0, 0, 0, 0)))
     report.mapped(f"joint '{joint.name}'", "floating → three slides and a ball joint")
     return out
@@ -148,15 +158,18 @@ def _spherical(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     """Non-standard `spherical` (accepted by several parsers): a ball joint, unlimited."""
     import mujoco
 
-    body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_BALL)
+    body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_BALL, pos=list(joint.anchor))
     report.mapped(f"joint '{joint.name}'", "spherical → ball joint (limits not mapped)")
     return [MjJointPlan(joint.name, joint.name, "spherical", None, (1.0, 0.0, 0.0, 0.0))]
 
 
-def add_free_joint(body: object, pos: np.ndarray) -> MjJointPlan:
-    """The named free joint of a floating base; home = the body's pose."""
-    body.add_freejoint(name=FREE_JOINT)
-    return MjJointPlan(FREE_JOINT, None, "free", None, (*map(float, pos), 1.0, 0.0, 0.0, 0.0))
+def add_free_joint(
+    body: object, pos: list[float], quat: list[float], name: str = FREE_JOINT
+) -> MjJointPlan:
+    """A named free joint; home = the body's pose (position [m], quaternion w-x-y-z)."""
+    body.add_freejoint(name=name)
+    source = None if name == FREE_JOINT else name
+    return MjJointPlan(name, source, "free", None, (*map(float, pos), *map(float, quat)))
 
 
 _ADDERS = {

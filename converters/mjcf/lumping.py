@@ -77,7 +77,7 @@ def plan_bodies(
         placements[base_link] = LinkPlacement(WORLDBODY, np.eye(4))
     else:
         placements[base_link] = LinkPlacement(base_link, np.eye(4))
-        bodies.append(BodyNode(base_link, WORLDBODY, np.eye(4), None))
+        bodies.append(BodyNode(base_link, WORLDBODY, robot.base_pose, None))
     stack = [base_link]
     while stack:
         parent = stack.pop()

@@ -94,19 +94,20 @@ def entities(world: WorldDep) -> list[dict]:
 
 @router.post("/entities", status_code=201)
 def spawn(body: SpawnBody, world: WorldDep) -> dict:
-    """Spawn a URDF/xacro/MJCF file; replies once the entity exists (gazebo_ros semantics)."""
-    from twin_cli.world import Pose
+    """Spawn a URDF/xacro/SDF/MJCF file or text; replies once the entity exists (gazebo_ros)."""
+    from twin_cli.world.spawn import DescriptionText
 
+    source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
     result = world.spawn(
-        body.source,
+        source,
         name=body.name,
-        pose=Pose(**body.pose.model_dump()),
+        pose=_pose(body.pose),
         args=body.args,
         package_paths=body.package_paths,
         on_ground=body.on_ground,
         joints=body.joints,
     )
-    log.info("spawned %s from %s", result.name, body.source)
+    log.info("spawned %s from %s", result.name, body.source or "<xml>")
     return _plain(result)
 
 
@@ -124,10 +125,18 @@ def get_pose(name: str, world: WorldDep) -> dict:
 
 @router.put("/entities/{name}/pose")
 def set_pose(name: str, body: PoseBody, world: WorldDep) -> dict:
+    world.set_pose(name, _pose(body))
+    return world.get_pose(name).to_dict()
+
+
+def _pose(body: PoseBody) -> Any:
+    """The world's Pose from a request pose (roll-pitch-yaw, or a quaternion x, y, z, w)."""
     from twin_cli.world import Pose
 
-    world.set_pose(name, Pose(**body.model_dump()))
-    return world.get_pose(name).to_dict()
+    if body.quat is None:
+        return Pose(**body.model_dump(exclude={"quat"}))
+    x, y, z, w = body.quat
+    return Pose.from_quat(body.x, body.y, body.z, (w, x, y, z))
 
 
 @router.get("/entities/{name}/joints")
@@ -209,10 +218,10 @@ def save(body: PathBody, world: WorldDep) -> dict:
 
 @router.post("/load")
 def load(body: PathBody, request: Request) -> dict:
-    """Replace the served world by one read from a file written by `save`."""
-    from twin_cli.world import World
+    """Replace the served world by one read from a file: `twin save` JSON or an SDF world."""
+    from twin_cli.world.sdf_world import load_world
 
-    new_world = World.load(body.path)
+    new_world = load_world(body.path, name=request.app.state.world_name)
     request.app.state.holder.replace(new_world)
     log.info("loaded world from %s", body.path)
     return {"loaded": body.path, "entities": [e.name for e in new_world.entities()]}

@@ -22,7 +22,8 @@ class Body(BaseModel):
 
 
 class PoseBody(Body):
-    """A pose: position [m] and extrinsic roll-pitch-yaw [rad], as Gazebo's -x..-Y."""
+    """A pose: position [m] and extrinsic roll-pitch-yaw [rad] (Gazebo's -x..-Y), or instead of
+    roll-pitch-yaw a quaternion `quat` (x, y, z, w) as geometry_msgs/Pose and SpawnEntity give."""
 
     x: Finite = 0.0
     y: Finite = 0.0
@@ -30,12 +31,34 @@ class PoseBody(Body):
     roll: Finite = 0.0
     pitch: Finite = 0.0
     yaw: Finite = 0.0
+    quat: tuple[Finite, Finite, Finite, Finite] | None = Field(
+        default=None, description="orientation (x, y, z, w); replaces roll, pitch, yaw"
+    )
+
+    @model_validator(mode="after")
+    def _one_orientation(self) -> PoseBody:
+        if self.quat is None:
+            return self
+        if any((self.roll, self.pitch, self.yaw)):
+            raise ValueError("give either 'quat' or 'roll'/'pitch'/'yaw', not both")
+        if sum(v * v for v in self.quat) < 1e-12:
+            raise ValueError("'quat' must not be zero; a unit quaternion (x, y, z, w) is expected")
+        return self
 
 
 class SpawnBody(Body):
-    """Spawn a file (absolute path on the server host) at a pose, with xacro args and packages."""
+    """Spawn a description at a pose: a file on the server host (`source`), or its text (`xml`:
+    URDF, xacro output, SDF or MJCF, as SpawnEntity's `xml`), with xacro args and packages."""
 
-    source: Annotated[str, Field(min_length=1, description="absolute path on the server host")]
+    source: Annotated[str, Field(min_length=1)] | None = Field(
+        default=None, description="absolute path on the server host"
+    )
+    xml: Annotated[str, Field(min_length=1, max_length=50_000_000)] | None = Field(
+        default=None, description="the description as text, instead of `source`"
+    )
+    base_dir: str | None = Field(
+        default=None, description="where relative mesh paths in `xml` start (server host path)"
+    )
     name: EntityName | None = None
     pose: PoseBody = PoseBody()
     args: dict[str, str] = {}
@@ -44,6 +67,12 @@ class SpawnBody(Body):
     joints: dict[str, Finite] = Field(
         default={}, description="initial joint positions [rad] or [m] by URDF joint name (-J)"
     )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> SpawnBody:
+        if (self.source is None) == (self.xml is None):
+            raise ValueError("give exactly one of 'source' (a file path) or 'xml' (its text)")
+        return self
 
 
 class PushBody(Body):

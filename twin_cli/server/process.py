@@ -28,7 +28,7 @@ class ServeOptions:
 
     Attributes:
         world: world name (one server per name).
-        world_file: a world saved by `twin save`, or None for an empty world.
+        world_file: a Gazebo SDF world, a world saved by `twin save`, or None (empty world).
         rate: real-time update rate [Hz]; 0 = unthrottled; None = the world's default.
         step: physics timestep [s]; None = the world's default.
         paused: start paused.
@@ -101,10 +101,11 @@ def write_private(path: Path, text: str) -> None:
 def build_world(opts: ServeOptions) -> Any:
     """The world to serve, loaded or empty, with the requested rate, step and pause state."""
     from twin_cli.world import World, WorldSettings
+    from twin_cli.world.sdf_world import load_world
 
     changes = {k: v for k, v in (("timestep", opts.step), ("rate", opts.rate)) if v is not None}
     if opts.world_file:
-        world = World.load(opts.world_file)
+        world = load_world(opts.world_file, name=opts.world)
         if changes:
             world.set_physics(**changes)
     else:

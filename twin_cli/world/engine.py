@@ -23,6 +23,7 @@ import numpy as np
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
 from twin_cli.world import actuation as control
 from twin_cli.world import placement, posture, queries, spawn
+from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.driving import EntityControl
 from twin_cli.world.entities import (
@@ -241,6 +242,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = spec, model, data, index
+        cap_contact_stiffness(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
         control.apply_pushes(model, data, self._pushes, {p.body for p in self._pushes})
@@ -284,6 +286,8 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 self._entities[name] = replace(self._entities[name], pose=pose)
                 self._commit(trial, *self._rebuild(trial, None, self._entities[name].source))
                 return
+            if ix.model_site >= 0:
+                pose = queries.root_from_model(self.model, ix, pose)
             self.data.qpos[ix.free_qpos : ix.free_qpos + 3] = pose.position()
             self.data.qpos[ix.free_qpos + 3 : ix.free_qpos + 7] = pose.quat()
             self.data.qvel[ix.dofs] = 0.0

@@ -7,7 +7,7 @@ each one and moves state by name, never by position.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -17,6 +17,9 @@ from twin_cli.world.pose import Pose
 _QPOS_WIDTH = np.array([7, 4, 1, 1])  # by mjtJoint: free, ball, slide, hinge
 _DOF_WIDTH = np.array([6, 3, 1, 1])
 _INT = np.int64
+
+# Site that marks a model frame apart from the root body (written by the converter for SDF).
+MODEL_SITE = "__model__"
 
 
 @dataclass(frozen=True)
@@ -30,6 +33,8 @@ class EntityIndex:
         free_qpos: qpos address of the root's free joint, or -1 (fixed base).
         actuators: actuator ids; `acts`: their activation addresses.
         equalities, mocaps, geoms: equality ids, mocap ids, geom ids (of the entity's bodies).
+        model_site: id of the site marking the model frame (`<name>/__model__`, SDF models
+            whose frame is not their root link's), or -1.
     """
 
     bodies: np.ndarray
@@ -43,6 +48,7 @@ class EntityIndex:
     equalities: np.ndarray
     mocaps: np.ndarray
     geoms: np.ndarray
+    model_site: int = -1
 
 
 @dataclass(frozen=True)
@@ -121,7 +127,10 @@ def index_entities(model: mujoco.MjModel, names: list[str]) -> dict[str, EntityI
         body_owner[parts[name][0]] = k
     geom_owner = body_owner[model.geom_bodyid]
     return {
-        name: _index_one(model, *parts[name], np.flatnonzero(geom_owner == k).astype(_INT))
+        name: replace(
+            _index_one(model, *parts[name], np.flatnonzero(geom_owner == k).astype(_INT)),
+            model_site=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/{MODEL_SITE}"),
+        )
         for k, name in enumerate(names)
     }
 

@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.world.entities import EntityIndex, element_names
-from twin_cli.world.pose import Pose
+from twin_cli.world.pose import Pose, quat_multiply, rotate
 
 _FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
 
@@ -32,10 +32,16 @@ class JointState:
 
 
 def root_pose(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, spawn: Pose) -> Pose:
-    """The entity's root pose now: its free joint's qpos, else its fixed root body's pose."""
+    """The entity's pose now: its model frame where it has one (SDF), else its root's pose.
+
+    The root's pose is its free joint's qpos, else its fixed root body's pose.
+    """
+    if index.model_site >= 0 and index.free_qpos < 0:
+        return spawn  # a fixed model stays where its attach frame (the model frame) was put
     if index.free_qpos >= 0:
         q = data.qpos[index.free_qpos : index.free_qpos + 7]
-        return Pose.from_quat(q[0], q[1], q[2], q[3:7])
+        root = Pose.from_quat(q[0], q[1], q[2], q[3:7])
+        return root if index.model_site < 0 else model_from_root(model, index, root)
     if index.root >= 0:
         pos, quat = model.body_pos[index.root], model.body_quat[index.root]
         return Pose.from_quat(pos[0], pos[1], pos[2], quat)
@@ -90,3 +96,22 @@ def joint_names(model: mujoco.MjModel, index: EntityIndex, prefix: str) -> list[
         for j, n in zip(index.joints, names, strict=True)
         if model.jnt_type[j] != _FREE
     ]
+
+
+def model_from_root(model: mujoco.MjModel, index: EntityIndex, root: Pose) -> Pose:
+    """The model frame's pose given the root body's: root ∘ (the site's pose in the root)."""
+    site_pos = tuple(float(v) for v in model.site_pos[index.model_site])
+    site_quat = tuple(float(v) for v in model.site_quat[index.model_site])
+    q_root = root.quat()
+    offset = rotate(q_root, site_pos)  # type: ignore[arg-type]
+    position = [p + o for p, o in zip(root.position(), offset, strict=True)]
+    return Pose.from_quat(*position, quat_multiply(q_root, site_quat))  # type: ignore[arg-type]
+
+
+def root_from_model(model: mujoco.MjModel, index: EntityIndex, pose: Pose) -> Pose:
+    """The root body's pose that puts the model frame at `pose` (inverse of model_from_root)."""
+    w, x, y, z = (float(v) for v in model.site_quat[index.model_site])
+    q_root = quat_multiply(pose.quat(), (w, -x, -y, -z))
+    offset = rotate(q_root, tuple(float(v) for v in model.site_pos[index.model_site]))
+    position = [p - o for p, o in zip(pose.position(), offset, strict=True)]
+    return Pose.from_quat(*position, q_root)  # type: ignore[arg-type]

@@ -21,10 +21,26 @@ from twin_cli.world.scene import adopt_world_globals
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 URDF_SUFFIXES = (".urdf", ".xacro")
+SDF_SUFFIXES = (".sdf",)
 PENETRATION_TOL = 1e-4  # [m] overlap below this is contact, not a bad start
 HOME_KEY = "home"
 ROOT_DEFAULT = "main"  # MjSpec's root default class, "<entity>/main" once attached
 _QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
+
+
+@dataclass(frozen=True)
+class DescriptionText:
+    """A description given as text (URDF, xacro output, SDF or MJCF), as SpawnEntity's `xml`.
+
+    Attributes:
+        text: the description; its root element says the format.
+        base_dir: where relative mesh paths start (the client's working directory).
+        label: how the source is shown (`<xml>`, `<stdin>`).
+    """
+
+    text: str
+    base_dir: str | None = None
+    label: str = "<xml>"
 
 
 @dataclass(frozen=True)
@@ -47,32 +63,67 @@ class LoadedSource:
 
 
 def load_source(
-    source: str | os.PathLike | mujoco.MjSpec,
+    source: str | os.PathLike | mujoco.MjSpec | DescriptionText,
     args: dict[str, str] | None,
     package_paths: dict[str, str] | None,
 ) -> LoadedSource:
-    """Reads a URDF/xacro (through the converter), an MJCF file or an MjSpec.
+    """Reads a URDF/xacro/SDF (through the converter), an MJCF file, a text or an MjSpec.
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
-        converters.ConversionError: the converter refused a URDF/xacro file.
+        converters.ConversionError: the converter refused the description.
     """
     if isinstance(source, mujoco.MjSpec):
         spec = source.copy()
         return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
+    if isinstance(source, DescriptionText):
+        return _load_text(source, package_paths)
     path = Path(source).expanduser().resolve()
     if not path.is_file():
         raise SpawnError(path.stem, str(path), "no such file", "check the path")
     lower = path.name.lower()
     if lower.endswith(MJCF_SUFFIXES):
         return _load_mjcf(path)
-    if lower.endswith(URDF_SUFFIXES):
-        return _load_urdf(path, args, package_paths)
+    if lower.endswith(URDF_SUFFIXES + SDF_SUFFIXES) or _sniff(path) in ("urdf", "sdf"):
+        return _load_description(path, args, package_paths)
+    if _sniff(path) == "mjcf":
+        return _load_mjcf(path)
+    kinds = ", ".join(URDF_SUFFIXES + SDF_SUFFIXES + MJCF_SUFFIXES)
     raise SpawnError(
-        path.stem,
-        str(path),
-        "unknown file kind",
-        f"give a URDF/xacro ({', '.join(URDF_SUFFIXES)}) or MJCF ({', '.join(MJCF_SUFFIXES)}) file",
+        path.stem, str(path), "unknown file kind", f"give a URDF, xacro, SDF or MJCF file ({kinds})"
+    )
+
+
+def _sniff(path: Path) -> str | None:
+    """The format by the root element, for files with an unusual suffix."""
+    from converters.formats import format_of
+
+    try:
+        with path.open(encoding="utf-8", errors="replace") as handle:
+            return format_of(handle.read(4096))
+    except OSError:
+        return None
+
+
+def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) -> LoadedSource:
+    """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
+    from converters.formats import format_of
+    from converters.pipeline import convert_text
+
+    if format_of(source.text) == "mjcf":
+        try:
+            spec = mujoco.MjSpec.from_string(source.text)
+        except ValueError as exc:
+            raise SpawnError(
+                source.label, source.label, f"not valid MJCF ({exc})", "fix it"
+            ) from exc
+        return LoadedSource(spec, source.label, None, source.text, spec.modelname or "model")
+    done = convert_text(
+        source.text, source=source.label, base_dir=source.base_dir, package_paths=package_paths
+    )
+    name = done.report.robot or "model"
+    return LoadedSource(
+        done.spec, source.label, done.report.to_dict(), _xml_or_none(done.spec), name
     )
 
 
@@ -84,7 +135,7 @@ def _load_mjcf(path: Path) -> LoadedSource:
     return LoadedSource(spec, str(path), None, None, spec.modelname or path.stem)
 
 
-def _load_urdf(
+def _load_description(
     path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
 ) -> LoadedSource:
     from converters.pipeline import convert

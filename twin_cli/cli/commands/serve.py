@@ -14,7 +14,9 @@ from twin_cli.cli.options import WorldOpt
 
 
 def serve(
-    world_file: Annotated[Path | None, typer.Argument(help="World saved by `twin save`.")] = None,
+    world_file: Annotated[
+        Path | None, typer.Argument(help="A Gazebo SDF world (.sdf, .world) or a `twin save` file.")
+    ] = None,
     world: WorldOpt = "default",
     rate: Annotated[float | None, typer.Option(help="Real-time update rate (Hz); 0 = max.")] = None,
     step: Annotated[float | None, typer.Option(help="Physics step (s) (default 0.001).")] = None,

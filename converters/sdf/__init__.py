@@ -1,0 +1,79 @@
+"""The SDFormat reader (1.4-1.11): models and worlds → the neutral descriptions.
+
+`document` parses and reads values with file:line errors, `poses` resolves SDFormat's pose
+frame semantics, `links` and `joints` read a model's parts, `model` assembles a robot
+description, `include` brings in `model://` models, `world` reads a world. The builder and the
+Gazebo stage consume what this produces exactly as they consume a URDF robot.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from converters.description import RobotDescription, WorldDescription
+from converters.report import Report
+from converters.resources.packages import PackageResolver
+from converters.sdf.document import SdfContext, parse_document
+from converters.sdf.model import read_model
+from converters.sdf.world import read_world
+
+__all__ = ["read_sdf_model", "read_sdf_world"]
+
+
+def _context(
+    text: str, source: str, base_dir: Path, resolver: PackageResolver | None, report: Report | None
+) -> tuple[SdfContext, object]:
+    root = parse_document(text, source)
+    resolver = resolver or PackageResolver.create(Path(source) if source else None)
+    ctx = SdfContext(source, base_dir, resolver, report or Report(source=source))
+    ctx.version = root.get("version")
+    return ctx, root
+
+
+def read_sdf_model(
+    text: str,
+    source: str,
+    base_dir: Path,
+    resolver: PackageResolver | None = None,
+    report: Report | None = None,
+) -> RobotDescription:
+    """The one model of an SDF model file (a world with exactly one model is refused: serve it).
+
+    Raises:
+        MalformedXMLError, SDFError, PackageNotFoundError, ResourceNotFoundError.
+    """
+    ctx, root = _context(text, source, base_dir, resolver, report)
+    from converters.sdf.include import expand_includes
+
+    expand_includes(ctx, root)
+    models = root.findall("model")
+    if root.find("world") is not None:
+        raise ctx.error(
+            root.find("world"),
+            "is a world, not a model",
+            "serve it (`twin serve WORLD.sdf`), or convert one of its models",
+        )
+    if len(models) != 1:
+        raise ctx.error(root, f"holds {len(models)} <model> elements", "give exactly one model")
+    return read_model(ctx, models[0], text)
+
+
+def read_sdf_world(
+    text: str,
+    source: str,
+    base_dir: Path,
+    resolver: PackageResolver | None = None,
+    report: Report | None = None,
+) -> WorldDescription:
+    """The `<world>` of an SDF world file.
+
+    Raises:
+        MalformedXMLError, SDFError, PackageNotFoundError, ResourceNotFoundError.
+    """
+    ctx, root = _context(text, source, base_dir, resolver, report)
+    worlds = root.findall("world")
+    if len(worlds) != 1:
+        raise ctx.error(
+            root, f"holds {len(worlds)} <world> elements", "give one <world> (or spawn a model)"
+        )
+    return read_world(ctx, worlds[0], text)

@@ -1,0 +1,228 @@
+"""An SDFormat document: parsed with line numbers, version checked, typed values read from it.
+
+Every value read goes through `SdfContext`, so a bad number or a missing element becomes an
+`SDFError` naming `file:line`, the element and the fix, never a Python exception.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from converters.errors import MalformedXMLError, SDFError
+from converters.gazebo.tags import ValueContext
+from converters.report import Report
+from converters.resources.packages import PackageResolver
+
+# SDFormat versions twin reads: 1.4 (Gazebo 2) to 1.11 (Gazebo Ionic).
+VERSIONS = ("1.4", "1.5", "1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
+# Pose frame semantics (`relative_to`, `<frame attached_to>`) start at 1.7.
+FRAME_SEMANTICS_FROM = (1, 7)
+
+
+def version_tuple(version: str) -> tuple[int, int]:
+    major, _, minor = version.partition(".")
+    return int(major), int(minor or 0)
+
+
+@dataclass
+class SdfContext:
+    """What reading one file needs: its name, directory, package resolver, report, version."""
+
+    source: str
+    base_dir: Path
+    resolver: PackageResolver
+    report: Report = field(default_factory=Report)
+    version: str = "1.11"
+
+    @property
+    def frame_semantics(self) -> bool:
+        """True from SDFormat 1.7 on (`relative_to`, `attached_to`, `expressed_in`)."""
+        return version_tuple(self.version) >= FRAME_SEMANTICS_FROM
+
+    def error(self, element: Any, problem: str, fix: str) -> SDFError:
+        """An SDFError at `element` (in the file an `<include>` brought it from, if any)."""
+        return SDFError(
+            source_of(element, self.source), line_of(element), describe(element), problem, fix
+        )
+
+    def values(self, element: Any) -> ValueContext:
+        """A value context whose failures name this file, line and element."""
+        return _SdfValues(self, element)
+
+    def text(self, parent: Any, tag: str, default: str | None = None) -> str | None:
+        child = parent.find(tag)
+        if child is None or child.text is None:
+            return default
+        return child.text.strip()
+
+    def number(self, parent: Any, tag: str, default: float) -> float:
+        """A finite number from child `tag` of `parent`, `default` when the child is absent."""
+        raw = self.text(parent, tag)
+        return default if raw is None else self.parse_number(parent.find(tag), raw)
+
+    def parse_number(self, element: Any, raw: str) -> float:
+        try:
+            value = float(raw)
+        except ValueError as exc:
+            raise self.error(element, f"{raw!r} is not a number", "write a decimal number") from exc
+        if not math.isfinite(value):
+            raise self.error(element, f"{raw!r} is not finite", "write a finite number")
+        return value
+
+    def vector(self, parent: Any, tag: str, size: int, default: tuple[float, ...]) -> tuple:
+        """`size` numbers from child `tag` (space-separated), `default` when absent."""
+        raw = self.text(parent, tag)
+        if raw is None:
+            return default
+        element = parent.find(tag)
+        parts = raw.split()
+        if len(parts) != size:
+            raise self.error(element, f"{raw!r} has {len(parts)} numbers", f"write {size} numbers")
+        return tuple(self.parse_number(element, p) for p in parts)
+
+    def flag(self, parent: Any, tag: str, default: bool) -> bool:
+        raw = self.text(parent, tag)
+        if raw is None:
+            return default
+        word = raw.lower()
+        if word in ("true", "1"):
+            return True
+        if word in ("false", "0"):
+            return False
+        raise self.error(parent.find(tag), f"{raw!r} is not a boolean", "write true or false")
+
+
+class _SdfValues(ValueContext):
+    """Gazebo's value readers (shared with URDF `<gazebo>` tags), failing as SDF errors."""
+
+    def __init__(self, ctx: SdfContext, element: Any) -> None:
+        super().__init__(ctx.source, describe(element))
+        self.ctx = ctx
+        self.element = element
+
+    def fail(self, tag: str, value: str, expected: str) -> SDFError:  # type: ignore[override]
+        found = self.element.find(tag)
+        at = found if found is not None else self.element
+        return self.ctx.error(at, f"<{tag}> {value!r} is not {expected}", f"write {expected}")
+
+
+def source_of(element: Any, default: str) -> str:
+    for ancestor in (element, *element.iterancestors()):
+        marked = ancestor.get("_twin_source")
+        if marked:
+            return marked
+    return default
+
+
+def line_of(element: Any) -> int | None:
+    return getattr(element, "sourceline", None)
+
+
+def describe(element: Any) -> str:
+    """`<tag name='x'>` for messages."""
+    name = element.get("name")
+    return f"<{element.tag} name='{name}'>" if name else f"<{element.tag}>"
+
+
+def parse_document(text: str, source: str) -> Any:
+    """The `<sdf>` root element of `text`, with line numbers; namespaces stripped.
+
+    Raises:
+        MalformedXMLError: not well-formed.
+        SDFError: the root is not `<sdf>`, or its version is not one twin reads.
+    """
+    from lxml import etree
+
+    parser = etree.XMLParser(remove_comments=True, resolve_entities=False, no_network=True)
+    try:
+        root = etree.fromstring(text.encode(), parser)
+    except etree.XMLSyntaxError as exc:
+        line, column = exc.position
+        raise MalformedXMLError(source, line, column, exc.msg) from exc
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith("{"):
+            element.tag = element.tag.split("}", 1)[1]
+    if root.tag != "sdf":
+        raise SDFError(
+            source,
+            line_of(root),
+            f"<{root.tag}>",
+            "the root element is not <sdf>",
+            "give an SDF file",
+        )
+    version = (root.get("version") or "").strip()
+    if version not in VERSIONS:
+        raise SDFError(
+            source,
+            line_of(root),
+            "<sdf>",
+            f"version {version or '(none)'!r} is not one twin reads",
+            f"write version= one of {', '.join(VERSIONS)}",
+        )
+    return root
+
+
+def pose_matrix(values: tuple[float, ...]) -> np.ndarray:
+    """SDF `x y z roll pitch yaw` → 4×4 (R = Rz(yaw)·Ry(pitch)·Rx(roll), extrinsic X-Y-Z)."""
+    x, y, z, roll, pitch, yaw = values
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
+    T = np.eye(4)
+    T[:3, :3] = [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+    T[:3, 3] = (x, y, z)
+    return T
+
+
+def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
+    """The `<pose>` child of `parent` as 4×4 and its `relative_to` (None when not given).
+
+    SDF 1.9+ also accepts `rotation_format="quat_xyzw"` (7 numbers) and `degrees="true"`.
+    """
+    element = parent.find("pose")
+    if element is None:
+        return np.eye(4), None
+    raw = (element.text or "").split()
+    quat = element.get("rotation_format") == "quat_xyzw"
+    expected = 7 if quat else 6
+    if raw and len(raw) != expected:
+        raise ctx.error(
+            element, f"has {len(raw)} numbers", f"write {expected} numbers: x y z and the rotation"
+        )
+    values = tuple(ctx.parse_number(element, v) for v in raw) or (0.0,) * 6
+    if quat:
+        T = np.eye(4)
+        T[:3, :3] = quat_matrix(values[3:])
+        T[:3, 3] = values[:3]
+    else:
+        if (element.get("degrees") or "").lower() == "true":
+            values = values[:3] + tuple(math.radians(v) for v in values[3:])
+        T = pose_matrix(values)
+    return T, element.get("relative_to") or None
+
+
+def quat_matrix(xyzw: tuple[float, ...]) -> np.ndarray:
+    x, y, z, w = xyzw
+    n = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
+    x, y, z, w = x / n, y / n, z / n, w / n
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )

@@ -1,0 +1,117 @@
+"""`<include><uri>model://NAME</uri>`: find the model (model.config), splice it in, apply overrides.
+
+Models are found as Gazebo finds them: `model://` through `GAZEBO_MODEL_PATH` /
+`GZ_SIM_RESOURCE_PATH` (and the directories above the file), then among the models twin ships
+(`ground_plane`, `sun`), so a stock Gazebo world loads without a Gazebo install.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from converters.errors import PackageNotFoundError
+from converters.sdf.document import (
+    SdfContext,
+    line_of,
+    parse_document,
+    source_of,
+    version_tuple,
+)
+from converters.sdf.links import INCLUDED_DIR, directory_of
+
+SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
+INCLUDED_SOURCE = "_twin_source"
+# What an <include> may bring in (a Gazebo model directory holds one of these).
+INCLUDABLE = ("model", "light", "actor")
+
+
+def expand_includes(ctx: SdfContext, parent: Any) -> None:
+    """Replace every `<include>` under `parent` (and its nested models) by what it names."""
+    for include in parent.findall("include"):
+        parent.replace(include, included_element(ctx, include))
+    for nested in parent.findall("model"):
+        expand_includes(ctx, nested)
+
+
+def included_element(ctx: SdfContext, include: Any) -> Any:
+    """The `<model>` (or `<light>`) an include names, with its `<name>`, `<pose>`, `<static>`.
+
+    Raises:
+        SDFError: no `<uri>`, or the file holds no model; PackageNotFoundError: the model
+            was found nowhere (the message lists every place searched).
+    """
+    uri = ctx.text(include, "uri")
+    if not uri:
+        raise ctx.error(include, "has no <uri>", "write <uri>model://NAME</uri>")
+    path = _model_file(ctx, include, uri)
+    root = parse_document(path.read_text(), str(path))
+    element = next((c for c in root if isinstance(c.tag, str) and c.tag in INCLUDABLE), None)
+    if element is None:
+        raise ctx.error(include, f"{path} holds no <model> or <light>", "include a model file")
+    element.set(INCLUDED_DIR, str(path.parent))
+    element.set(INCLUDED_SOURCE, str(path))
+    _override(ctx, include, element)
+    return element
+
+
+def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
+    element = f"{source_of(include, ctx.source)}:{line_of(include)}: <include>"
+    base = directory_of(ctx, include)
+    try:
+        target = ctx.resolver.resolve(uri, base_dir=base, element=element, must_exist=False)
+    except PackageNotFoundError:
+        shipped = _shipped(uri)
+        if shipped is None:
+            raise
+        target = shipped
+    if target.is_dir():
+        return _from_config(ctx, include, target)
+    if not target.is_file():
+        raise ctx.error(include, f"{uri} resolves to {target}, which does not exist", "fix the uri")
+    return target
+
+
+def _shipped(uri: str) -> Path | None:
+    if not uri.startswith("model://"):
+        return None
+    name, _, rest = uri[len("model://") :].partition("/")
+    candidate = SHIPPED_MODELS / name / rest
+    return candidate if (SHIPPED_MODELS / name).is_dir() else None
+
+
+def _from_config(ctx: SdfContext, include: Any, directory: Path) -> Path:
+    """The SDF file a model directory's model.config names (its newest version), else model.sdf."""
+    from lxml import etree
+
+    config = directory / "model.config"
+    if config.is_file():
+        try:
+            files = etree.parse(str(config)).getroot().findall("sdf")
+        except etree.XMLSyntaxError as exc:
+            raise ctx.error(include, f"{config} is not valid XML ({exc.msg})", "fix it") from exc
+        ranked = sorted(files, key=lambda f: version_tuple(f.get("version") or "0.0"), reverse=True)
+        for entry in ranked:
+            if entry.text and (directory / entry.text.strip()).is_file():
+                return directory / entry.text.strip()
+    fallback = directory / "model.sdf"
+    if fallback.is_file():
+        return fallback
+    raise ctx.error(
+        include, f"{directory} has no model.config naming an SDF file", "add model.config"
+    )
+
+
+def _override(ctx: SdfContext, include: Any, element: Any) -> None:
+    """`<name>`, `<pose>` and `<static>` written in the include win over the model's own."""
+    name = ctx.text(include, "name")
+    if name:
+        element.set("name", name)
+    for tag in ("pose", "static"):
+        given = include.find(tag)
+        if given is None:
+            continue
+        own = element.find(tag)
+        if own is not None:
+            element.remove(own)
+        element.insert(0, given)

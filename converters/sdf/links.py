@@ -1,0 +1,223 @@
+"""SDF `<link>` → description link: inertial, shapes, materials, surfaces, sensors, link flags."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from converters.description import (
+    Blob,
+    Collision,
+    Geometry,
+    Inertial,
+    InlineSurface,
+    Link,
+    LinkExtension,
+    Material,
+    Visual,
+)
+from converters.gazebo.blocks import read_surface
+from converters.gazebo.materials import gazebo_rgba
+from converters.gazebo.tags import to_xml
+from converters.sdf.document import SdfContext, line_of, read_pose
+from converters.sdf.poses import PoseGraph, scoped
+
+# SDF's defaults for a link without <inertial>: 1 kg and a unit inertia (sdformat's Inertial).
+DEFAULT_MASS = 1.0
+# Shapes SDF has that twin does not build (reported, not an error: the link stays).
+UNSUPPORTED_SHAPES = ("heightmap", "polyline", "image", "cone")
+# Link children that only rendering, sensing or other engines use.
+LINK_IGNORED = ("kinematic", "must_be_base_link", "enable_wind", "light", "audio_sink")
+
+
+def read_link(
+    ctx: SdfContext, graph: PoseGraph, element: Any, prefix: str
+) -> tuple[Link, LinkExtension, tuple[InlineSurface, ...]]:
+    """One link with its shapes in the link frame, its Gazebo flags and collision surfaces."""
+    name = prefix + element.get("name", "")
+    X_M_L = graph.pose(name)
+    visuals = tuple(_visual(ctx, graph, v, name, prefix, X_M_L) for v in element.findall("visual"))
+    collisions, surfaces = [], []
+    for index, c in enumerate(element.findall("collision")):
+        pose = _part_pose(ctx, graph, c, prefix, X_M_L)
+        collisions.append(Collision(pose, _geometry(ctx, c, name), c.get("name")))
+        if c.find("surface") is not None or c.find("max_contacts") is not None:
+            surface, _ = read_surface(c, ctx.values(c))
+            surfaces.append(InlineSurface(name, index, surface))
+    link = Link(name, _inertial(ctx, element, name), visuals, tuple(collisions))
+    return link, _extension(ctx, element, name), tuple(surfaces)
+
+
+def _part_pose(ctx: SdfContext, graph: PoseGraph, element: Any, prefix: str, X_M_L: np.ndarray):
+    """A visual's or collision's pose in its link frame (1.8+ may name another frame)."""
+    pose, relative_to = read_pose(ctx, element)
+    if relative_to is None or not ctx.frame_semantics:
+        return pose
+    X_M_F = graph.pose(scoped(relative_to, prefix), element)
+    return np.linalg.inv(X_M_L) @ X_M_F @ pose
+
+
+def _inertial(ctx: SdfContext, link: Any, name: str) -> Inertial:
+    element = link.find("inertial")
+    if element is None:
+        ctx.report.mapped(
+            f"link '{name}' <inertial>",
+            f"absent: SDF's default {DEFAULT_MASS:g} kg, unit inertia (as Gazebo simulates it)",
+        )
+        return Inertial(DEFAULT_MASS, np.eye(3))
+    pose, _ = read_pose(ctx, element)
+    mass = ctx.number(element, "mass", DEFAULT_MASS)
+    tensor = np.eye(3)
+    moments = element.find("inertia")
+    if moments is not None:
+        value = {k: ctx.number(moments, k, 0.0) for k in ("ixy", "ixz", "iyz")}
+        value |= {k: ctx.number(moments, k, 1.0) for k in ("ixx", "iyy", "izz")}
+        tensor = np.array(
+            [
+                [value["ixx"], value["ixy"], value["ixz"]],
+                [value["ixy"], value["iyy"], value["iyz"]],
+                [value["ixz"], value["iyz"], value["izz"]],
+            ]
+        )
+    return Inertial(mass, tensor, pose)
+
+
+def _visual(
+    ctx: SdfContext, graph: PoseGraph, element: Any, link: str, prefix: str, X_M_L: np.ndarray
+) -> Visual:
+    pose = _part_pose(ctx, graph, element, prefix, X_M_L)
+    return Visual(pose, _geometry(ctx, element, link), _material(ctx, element), element.get("name"))
+
+
+def _geometry(ctx: SdfContext, owner: Any, link: str) -> Geometry | None:
+    """The one shape inside `<geometry>`; None (reported) when empty or unsupported."""
+    geometry = owner.find("geometry")
+    shape = (
+        None if geometry is None else next((c for c in geometry if isinstance(c.tag, str)), None)
+    )
+    subject = f"link '{link}' <{owner.tag} name='{owner.get('name', '')}'>"
+    if shape is None or shape.tag == "empty":
+        return None
+    reader = _SHAPES.get(shape.tag)
+    if reader is None:
+        ctx.report.ignored(
+            subject, f"<{shape.tag}> geometry is not supported; the shape is left out"
+        )
+        return None
+    return reader(ctx, shape, subject)
+
+
+def _box(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    return Geometry("box", _positive(ctx, shape, ctx.vector(shape, "size", 3, (1.0, 1.0, 1.0))))
+
+
+def _sphere(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    return Geometry("sphere", _positive(ctx, shape, (ctx.number(shape, "radius", 1.0),)))
+
+
+def _cylinder(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    size = (ctx.number(shape, "radius", 1.0), ctx.number(shape, "length", 1.0))
+    return Geometry(str(shape.tag), _positive(ctx, shape, size))
+
+
+def _ellipsoid(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    radii = _positive(ctx, shape, ctx.vector(shape, "radii", 3, (1.0, 1.0, 1.0)))
+    return Geometry("ellipsoid", radii)
+
+
+def _plane(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    normal = np.asarray(ctx.vector(shape, "normal", 3, (0.0, 0.0, 1.0)))
+    if np.linalg.norm(normal[:2]) > 1e-9 or normal[2] <= 0:
+        ctx.report.approximated(subject, f"plane normal {tuple(normal)} drawn as +z")
+    return Geometry("plane", ctx.vector(shape, "size", 2, (0.0, 0.0)))
+
+
+def _mesh(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
+    uri = ctx.text(shape, "uri")
+    if not uri:
+        raise ctx.error(shape, "has no <uri>", "give the mesh file, e.g. model://NAME/meshes/X.stl")
+    if shape.find("submesh") is not None:
+        ctx.report.ignored(subject, "<submesh> is not supported; the whole mesh is used")
+    path = ctx.resolver.resolve(uri, base_dir=directory_of(ctx, shape), element=subject)
+    scale = ctx.vector(shape, "scale", 3, (1.0, 1.0, 1.0))
+    return Geometry("mesh", (), Path(path), uri, scale)  # type: ignore[arg-type]
+
+
+_SHAPES = {
+    "box": _box,
+    "sphere": _sphere,
+    "cylinder": _cylinder,
+    "capsule": _cylinder,
+    "ellipsoid": _ellipsoid,
+    "plane": _plane,
+    "mesh": _mesh,
+}
+
+
+def _positive(ctx: SdfContext, shape: Any, size: tuple[float, ...]) -> tuple[float, ...]:
+    if any(v <= 0 for v in size):
+        raise ctx.error(shape, f"size {size} has a value ≤ 0", "give positive sizes in metres")
+    return size
+
+
+def _material(ctx: SdfContext, visual: Any) -> Material | None:
+    """`<diffuse>` (else `<ambient>`), else the colour of a `Gazebo/<Name>` script material."""
+    material = visual.find("material")
+    if material is None:
+        return None
+    name = ctx.text(material, "script/name")
+    rgba = None
+    for tag in ("diffuse", "ambient"):
+        raw = ctx.text(material, tag)
+        if raw is not None:
+            values = raw.split()
+            element = material.find(tag)
+            if len(values) not in (3, 4):
+                raise ctx.error(element, f"{raw!r} is not a colour", "write r g b [a] in 0-1")
+            numbers = [ctx.parse_number(element, v) for v in values] + [1.0]
+            rgba = tuple(numbers[:4])
+            break
+    if rgba is None and name is not None:
+        rgba = gazebo_rgba(name)
+    return Material(name, rgba, None)  # type: ignore[arg-type]
+
+
+def _extension(ctx: SdfContext, link: Any, name: str) -> LinkExtension:
+    """Link-level Gazebo values: gravity, self_collide, velocity_decay, sensors."""
+    for tag in LINK_IGNORED:
+        if link.find(tag) is not None:
+            ctx.report.ignored(f"link '{name}' <{tag}>", "not simulated by twin")
+    decay = link.find("velocity_decay")
+    damping = None
+    if decay is not None:
+        damping = max(ctx.number(decay, "linear", 0.0), ctx.number(decay, "angular", 0.0)) or None
+    sensors = tuple(
+        Blob("sensor", s.get("name"), s.get("type"), to_xml(s), f"{ctx.source}:{line_of(s)}")
+        for s in link.findall("sensor")
+    )
+    gravity = None if link.find("gravity") is None else ctx.flag(link, "gravity", True)
+    self_collide = (
+        None if link.find("self_collide") is None else ctx.flag(link, "self_collide", False)
+    )
+    return LinkExtension(
+        link=name,
+        self_collide=self_collide,
+        gravity=gravity,
+        damping_factor=damping,
+        sensors=sensors,
+    )
+
+
+def directory_of(ctx: SdfContext, element: Any) -> Path:
+    """The directory relative URIs start from: the file an `<include>` brought the element from."""
+    for ancestor in (element, *element.iterancestors()):
+        marked = ancestor.get(INCLUDED_DIR)
+        if marked:
+            return Path(marked)
+    return ctx.base_dir
+
+
+# Attribute set on a model element spliced in by `<include>`: the directory of its file.
+INCLUDED_DIR = "_twin_dir"

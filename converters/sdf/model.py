@@ -1,0 +1,143 @@
+"""SDF `<model>` → the neutral robot description (nested models flattened with `::` names).
+
+Gazebo semantics that differ from URDF and are kept here: SDF fixed joints are not lumped (the
+child stays its own link); a link that no joint moves floats on its own (each gets a free
+joint), or is welded when the model is `<static>`; a joint to `world` anchors its child.
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from converters.description import (
+    WORLD_LINK,
+    Blob,
+    Frame,
+    GazeboExtensions,
+    Joint,
+    JointExtension,
+    LinkExtension,
+    RobotDescription,
+)
+from converters.gazebo.tags import to_xml
+from converters.sdf.document import SdfContext, line_of
+from converters.sdf.include import expand_includes
+from converters.sdf.joints import read_joint
+from converters.sdf.links import read_link
+from converters.sdf.poses import SEP, PoseGraph
+
+# Model children twin reads elsewhere or on purpose leaves to Gazebo's other engines.
+MODEL_IGNORED = ("allow_auto_disable", "enable_wind", "gripper")
+
+
+def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
+    """One `<model>` (its `<include>`s expanded) as a robot description.
+
+    Raises:
+        SDFError: a model without links, bad names, poses, joints or values (file:line).
+    """
+    expand_includes(ctx, model)
+    graph = PoseGraph(ctx, model)
+    scopes = list(_scopes(model, ""))
+    links, ext_links, surfaces = [], {}, []
+    for element, prefix in ((el, p) for m, p in scopes for el in m.findall("link")):
+        link, extension, inline = read_link(ctx, graph, element, prefix)
+        links.append(link)
+        if extension != LinkExtension(link.name):
+            ext_links[link.name] = extension
+        surfaces.extend(inline)
+    if not links:
+        raise ctx.error(model, "has no <link>", "add at least one link")
+    joints, ext_joints = [], {}
+    for element, prefix in ((el, p) for m, p in scopes for el in m.findall("joint")):
+        joint, extension = read_joint(ctx, graph, element, prefix)
+        joints.append(joint)
+        if _has_values(extension):
+            ext_joints[joint.name] = extension
+    static = ctx.flag(model, "static", False)
+    base, base_pose, anchors = _base(graph, [link.name for link in links], joints, static)
+    _report_ignored(ctx, model)
+    gazebo = GazeboExtensions(
+        source=ctx.source,
+        static=static,
+        self_collide=ctx.flag(model, "self_collide", False),
+        preserved_joints=frozenset(j.name for j in joints if j.kind == "fixed"),
+        links=MappingProxyType(ext_links),
+        joints=MappingProxyType(ext_joints),
+        inline_surfaces=tuple(surfaces),
+        plugins=tuple(_plugins(ctx, model)),
+    )
+    return RobotDescription(
+        name=model.get("name", "model"),
+        source=ctx.source,
+        base_link=base,
+        links=tuple(links),
+        joints=tuple(anchors + joints),
+        gazebo=gazebo,
+        text=text,
+        base_pose=base_pose,
+        frames=_frames(graph),
+        model_frame_site=True,
+    )
+
+
+def _scopes(model: Any, prefix: str):
+    """(model element, name prefix) for the model and every nested model, depth first."""
+    yield model, prefix
+    for nested in model.findall("model"):
+        yield from _scopes(nested, prefix + nested.get("name", "") + SEP)
+
+
+def _base(
+    graph: PoseGraph, links: list[str], joints: list[Joint], static: bool
+) -> tuple[str, np.ndarray, list[Joint]]:
+    """The base link, its pose in the model frame, and joints that anchor extra roots.
+
+    One root link and no joint to the world: that link is the base (floating unless static).
+    Otherwise the world is the base: roots weld to it when the model is static, else each
+    gets a `floating` joint (a free joint in MuJoCo), as separate SDF bodies move freely.
+    """
+    children = {j.child for j in joints}
+    roots = [name for name in links if name not in children]
+    to_world = any(j.parent == WORLD_LINK for j in joints)
+    if len(roots) == 1 and not to_world:
+        return roots[0], graph.pose(roots[0]), []
+    kind = "fixed" if static else "floating"
+    anchors = [
+        Joint(f"{root}_{kind}", kind, WORLD_LINK, root, origin=graph.pose(root)) for root in roots
+    ]
+    return WORLD_LINK, np.eye(4), anchors
+
+
+def _frames(graph: PoseGraph) -> tuple[Frame, ...]:
+    """Every `<frame>` as a pose in the link it is attached to."""
+    out = []
+    for name, node in graph.nodes.items():
+        if node.kind != "frame":
+            continue
+        link = graph.link_of(name, node.element)
+        X_M_L = np.eye(4) if link == WORLD_LINK else graph.pose(link)
+        out.append(Frame(name, link, np.linalg.inv(X_M_L) @ graph.pose(name)))
+    return tuple(out)
+
+
+def _plugins(ctx: SdfContext, model: Any) -> list[Blob]:
+    return [
+        Blob("plugin", p.get("name"), p.get("filename"), to_xml(p), f"{ctx.source}:{line_of(p)}")
+        for p in model.iter("plugin")
+    ]
+
+
+def _has_values(extension: JointExtension) -> bool:
+    names = ("spring_stiffness", "spring_reference", "stop_erp", "stop_cfm")
+    return any(getattr(extension, n) is not None for n in names)
+
+
+def _report_ignored(ctx: SdfContext, model: Any) -> None:
+    name = model.get("name", "")
+    for tag in MODEL_IGNORED:
+        if model.find(tag) is not None:
+            ctx.report.ignored(f"model '{name}' <{tag}>", "not simulated by twin")

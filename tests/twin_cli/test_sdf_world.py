@@ -1,0 +1,150 @@
+"""Gazebo worlds and SDF models in a running twin: physics, entities, poses, spawning from text."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from twin_cli.world import Pose, World
+from twin_cli.world.sdf_world import world_from_sdf
+from twin_cli.world.spawn import DescriptionText
+
+ROOT = Path(__file__).resolve().parents[2]
+HUMANOID = ROOT / "scenarios" / "robots" / "humanoid.urdf.xacro"
+MOON_G = 1.62  # [m/s²], the file's gravity
+
+# A world in Gazebo's usual shape: stock includes, a custom <physics>, Moon gravity, two models
+# (one with a nested model placed relative_to a link of its parent).
+WORLD = """<?xml version="1.0"?>
+<sdf version="1.8">
+  <world name="moon_lab">
+    <physics name="fast" type="ode">
+      <max_step_size>0.002</max_step_size>
+      <real_time_update_rate>500</real_time_update_rate>
+      <ode><solver><type>quick</type><iters>80</iters></solver></ode>
+    </physics>
+    <gravity>0 0 -1.62</gravity>
+    <include><uri>model://ground_plane</uri></include>
+    <include><uri>model://sun</uri></include>
+    <model name="crate">
+      <pose>1 0 2 0 0 0</pose>
+      <link name="body">
+        <inertial><mass>5</mass>
+          <inertia><ixx>0.075</ixx><iyy>0.075</iyy><izz>0.075</izz></inertia></inertial>
+        <collision name="c"><geometry><box><size>0.3 0.3 0.3</size></box></geometry></collision>
+      </link>
+    </model>
+    <model name="table">
+      <static>true</static>
+      <pose>-1 0.5 0 0 0 0.5</pose>
+      <link name="top">
+        <pose>0 0 0.7 0 0 0</pose>
+        <collision name="c"><geometry><box><size>1 1 0.05</size></box></geometry></collision>
+      </link>
+      <model name="lamp">
+        <pose relative_to="top">0.2 0 0.1 0 0 0</pose>
+        <link name="bulb">
+          <collision name="c">
+            <geometry><sphere><radius>0.05</radius></sphere></geometry>
+          </collision>
+        </link>
+      </model>
+    </model>
+  </world>
+</sdf>
+"""
+
+LESSON_BOX = """<sdf version="1.6"><model name="test_box"><static>true</static><link name="link">
+  <collision name="collision"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision>
+  <visual name="visual"><geometry><box><size>0.5 0.5 0.5</size></box></geometry>
+    <material><script><uri>file://media/materials/scripts/gazebo.material</uri>
+    <name>Gazebo/Red</name></script></material></visual></link></model></sdf>"""
+
+
+@pytest.fixture
+def world_file(tmp_path: Path) -> Path:
+    path = tmp_path / "moon_lab.world"
+    path.write_text(WORLD)
+    return path
+
+
+def test_world_file_sets_physics_gravity_and_entities(world_file: Path) -> None:
+    world = world_from_sdf(world_file)
+    physics = world.physics()
+    assert (physics["timestep"], physics["rate"], physics["iterations"]) == (0.002, 500.0, 80)
+    assert world.gravity() == (0.0, 0.0, -MOON_G), "gravity [m/s²]"
+    assert [e.name for e in world.entities()] == ["ground_plane", "crate", "table"]
+    assert world.get_pose("crate") == Pose(1.0, 0.0, 2.0), "model pose as in the file"
+    table = world.get_pose("table")
+    assert (table.x, table.y, table.z, table.yaw) == pytest.approx((-1.0, 0.5, 0.0, 0.5), abs=1e-12)
+    links = world.link_poses("table")
+    # lamp::bulb = table ∘ top (0, 0, 0.7) ∘ (0.2, 0, 0.1), table yawed 0.5 rad about z.
+    c, s = np.cos(0.5), np.sin(0.5)
+    expected = (-1.0 + 0.2 * c, 0.5 + 0.2 * s, 0.8)
+    bulb = links["lamp::bulb"]
+    assert (bulb.x, bulb.y, bulb.z) == pytest.approx(expected, abs=1e-12), "nested link [m]"
+
+
+def test_a_dropped_box_falls_at_the_files_gravity(world_file: Path) -> None:
+    world = world_from_sdf(world_file)
+    z0 = world.get_pose("crate").z
+    steps = 500  # 1 s at the file's 2 ms step; ½·1.62·1² = 0.81 m, above the ground
+    world.step(steps)
+    t = steps * 0.002
+    drop = z0 - world.get_pose("crate").z
+    assert drop == pytest.approx(0.5 * MOON_G * t**2, rel=0.01), "½gt² at the file's g [m]"
+
+
+def test_the_ground_plane_model_holds_a_box_at_rest(world_file: Path) -> None:
+    world = world_from_sdf(world_file)
+    world.step(1500)  # 3 s: the crate lands (1.85 m at 1.62 m/s² takes 1.5 s) and settles
+    assert world.get_pose("crate").z == pytest.approx(0.15, abs=2e-3), "resting on the plane [m]"
+
+
+def test_lesson_box_spawned_from_text_is_static_and_red() -> None:
+    world = World()
+    result = world.spawn(DescriptionText(LESSON_BOX), pose=Pose(2.0, 0.0, 0.25))
+    assert result.name == "test_box", "the model's own name"
+    world.step(500)
+    assert world.get_pose("test_box") == Pose(2.0, 0.0, 0.25), "static: it never moves"
+    model = world.model
+    visual = model.geom("test_box/link_visual_0")
+    assert visual.rgba[:3].tolist() == [1.0, 0.0, 0.0], "Gazebo/Red"
+
+
+def test_a_pushed_robot_does_not_pass_through_the_sdf_box() -> None:
+    """The collision check's physics against the lesson's box: 15 N/kg for 0.3 s towards it."""
+    world = World()
+    world.spawn(HUMANOID, name="robot", pose=Pose(0.0, 0.0, 0.0), on_ground=True)
+    mujoco.mj_forward(world.model, world.data)
+    front = max(
+        world.data.geom_xpos[g][0] + world.model.geom_rbound[g]
+        for g in range(world.model.ngeom)
+        if world.model.geom(g).name.startswith("robot/")
+    )
+    near_face = front + 0.1
+    world.spawn(DescriptionText(LESSON_BOX), pose=Pose(near_face + 0.25, 0.0, 0.25))
+    mass = sum(world.model.body_mass[b] for b in range(world.model.nbody))
+    world.push("robot", force=(15.0 * mass, 0.0, 0.0), duration=0.3)
+    robot = [b for b in range(world.model.nbody) if world.model.body(b).name.startswith("robot/")]
+    deepest = -np.inf
+    for _ in range(100):  # 1 s in 10 ms samples: links level with the box stay in front of it
+        world.step(10)
+        com = world.data.xipos[robot]
+        level = (np.abs(com[:, 1]) < 0.25) & (com[:, 2] < 0.5)
+        if level.any():
+            deepest = max(deepest, float(com[level, 0].max()) - near_face)
+    assert deepest > -0.3, f"the push never brought the robot to the box ({deepest:.3f} m)"
+    assert deepest < 0.05, f"a link COM went {deepest:.3f} m into the box (limit 0.05 m)"
+    assert world.get_pose("test_box") == Pose(near_face + 0.25, 0.0, 0.25), "the box held"
+
+
+def test_quaternion_and_rpy_poses_agree() -> None:
+    world = World()
+    world.spawn(DescriptionText(LESSON_BOX), name="a", pose=Pose(0, 0, 0.25, 0.0, 0.0, 0.7))
+    quat = Pose(0, 0, 0.25, 0.0, 0.0, 0.7).quat()
+    from_quat = Pose.from_quat(0.0, 0.0, 0.25, quat)
+    assert from_quat.yaw == pytest.approx(0.7, abs=1e-12), "yaw from (w, x, y, z)"

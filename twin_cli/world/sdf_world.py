@@ -1,0 +1,75 @@
+"""A World built from an SDF world file, as gzserver starts from `worlds/empty.world`.
+
+The file's `<physics>` and `<gravity>` become the world's settings; each `<model>` (includes
+expanded, `model://ground_plane` and `model://sun` shipped with twin) becomes an entity named
+after the model at its pose, so `twin list`, `twin pose` and `twin delete` know them.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from twin_cli.world.engine import World
+from twin_cli.world.pose import Pose
+from twin_cli.world.values import WorldSettings
+
+# Suffixes of Gazebo world files (`twin serve`, `twin load`).
+WORLD_SUFFIXES = (".sdf", ".world")
+
+
+def is_world_file(path: str | os.PathLike) -> bool:
+    """True for an SDF file whose content is a `<world>` (a model file is spawned instead)."""
+    path = Path(path)
+    if path.suffix.lower() not in WORLD_SUFFIXES or not path.is_file():
+        return False
+    with path.open(encoding="utf-8", errors="replace") as handle:
+        return "<world" in handle.read()
+
+
+def world_from_sdf(
+    path: str | os.PathLike, *, name: str = "default", package_paths: dict[str, str] | None = None
+) -> World:
+    """A new, stopped world with the file's physics and its models spawned.
+
+    Raises:
+        converters.ConversionError: the file or a model in it cannot be read (file:line).
+        SpawnError, EntityExistsError: a model cannot be placed.
+    """
+    from converters.pipeline import build_description
+    from converters.resources.packages import PackageResolver
+    from converters.sdf import read_sdf_world
+
+    path = Path(path).resolve()
+    resolver = PackageResolver.create(path, package_paths)
+    description = read_sdf_world(path.read_text(), str(path), path.parent, resolver)
+    settings = WorldSettings(
+        timestep=description.timestep,
+        rate=description.rate,
+        gravity=description.gravity,
+        iterations=description.iterations,
+        ground=False,
+    )
+    world = World(settings, name=name)
+    for placed in description.models:
+        spec = build_description(placed.robot).spec
+        world.spawn(spec, name=placed.robot.name, pose=pose_of(placed.pose))
+    return world
+
+
+def load_world(path: str | os.PathLike, *, name: str = "default") -> World:
+    """A world from a file: a Gazebo SDF world (`.sdf`, `.world`), or one `twin save` wrote."""
+    if is_world_file(path):
+        return world_from_sdf(path, name=name)
+    return World.load(path)
+
+
+def pose_of(T: np.ndarray) -> Pose:
+    """A 4×4 model pose as twin's Pose (position and roll-pitch-yaw)."""
+    import mujoco
+
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).reshape(-1))
+    return Pose.from_quat(*T[:3, 3], quat)
