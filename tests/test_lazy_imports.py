@@ -1,4 +1,4 @@
-"""Client commands start light: `twin stats` and `twin gravity` never import mujoco and friends."""
+"""Client commands start light: no world command imports mujoco and friends, nor Typer or httpx."""
 
 from __future__ import annotations
 
@@ -8,11 +8,17 @@ import subprocess
 import sys
 
 import pytest
+from models import block
 
+from twin_cli.cli.commands.world import COMMANDS
+from twin_cli.cli.fast import GRAMMARS
 from twin_cli.server import runtime
 from twin_cli.server.client import Client
 
 HEAVY = ("mujoco", "numpy", "trimesh", "coacd", "fastapi", "uvicorn", "scipy")
+# What the fast path leaves out: the CLI framework (Typer, click, rich) and httpx.
+FRAMEWORK = ("typer", "click", "rich", "httpx")
+WORLD = "lazy"
 
 
 def _imported(args: list[str], env: dict[str, str]) -> tuple[subprocess.CompletedProcess, set]:
@@ -28,6 +34,33 @@ def _imported(args: list[str], env: dict[str, str]) -> tuple[subprocess.Complete
     return proc, {n.split(".")[0] for n in names}
 
 
+def _client_commands(tmp_path) -> list[list[str]]:
+    """Every world command once, in an order that works on one world (stop last)."""
+    box = tmp_path / "box.urdf"
+    box.write_text(block(size=0.2, name="box"))
+    saved = tmp_path / "world.twin"
+    return [
+        ["spawn", str(box), "-z", "1", "--name", "box"],
+        ["list"],
+        ["pose", "box"],
+        ["pose", "box", "--set", "0", "0", "2", "0", "0", "0"],
+        ["joints", "box", "--json"],
+        ["push", "box", "--force", "0", "0", "5", "--duration", "0.05"],
+        ["gravity", "--moon"],
+        ["physics", "--json"],
+        ["pause"],
+        ["step", "3"],
+        ["resume"],
+        ["reset", "--time-only"],
+        ["stats", "-d", "0.2"],
+        ["save", str(saved)],
+        ["load", str(saved)],
+        ["delete", "box"],
+        ["logs", "-n", "3"],
+        ["stop"],
+    ]
+
+
 def test_stats_without_a_world_imports_nothing_heavy(tmp_path):
     env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
     proc, modules = _imported(["stats", "-d", "0"], env)
@@ -36,23 +69,36 @@ def test_stats_without_a_world_imports_nothing_heavy(tmp_path):
     assert not modules & set(HEAVY), f"heavy imports: {sorted(modules & set(HEAVY))}"
 
 
-def test_client_commands_against_a_running_world_import_nothing_heavy(tmp_path, monkeypatch):
+def test_the_lazy_import_list_covers_every_world_command(tmp_path):
+    listed = {args[0] for args in _client_commands(tmp_path)}
+    assert listed == set(COMMANDS) == set(GRAMMARS), (
+        f"not covered: {sorted(set(COMMANDS) - listed)}; "
+        f"without a fast-path grammar: {sorted(set(COMMANDS) - set(GRAMMARS))}"
+    )
+
+
+def test_every_world_command_against_a_running_world_imports_nothing_heavy(tmp_path, monkeypatch):
     monkeypatch.setenv(runtime.RUNTIME_ENV, str(tmp_path))
     env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
+    env.pop("TWIN_WORLD", None)
     server = subprocess.Popen(
-        [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", "lazy"],
+        [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", WORLD],
         env=env,
         stderr=subprocess.DEVNULL,
     )
-    client = Client("lazy")
+    client = Client(WORLD)
     try:
         runtime.wait_until(client.paths, client.alive, server, 60.0)
-        for args in (["gravity", "--moon"], ["stats", "-d", "0.2"], ["list"]):
-            proc, modules = _imported([*args, "--world", "lazy"], env)
+        for args in _client_commands(tmp_path):
+            if args[0] == "stop":
+                assert client.gravity()["gravity"] == pytest.approx([0.0, 0.0, -1.62])
+            proc, modules = _imported([*args, "--world", WORLD], env)
             assert proc.returncode == 0, f"twin {args}: {proc.stderr[-500:]}"
             assert not modules & set(HEAVY), f"twin {args} imported {modules & set(HEAVY)}"
-        assert client.gravity()["gravity"] == pytest.approx([0.0, 0.0, -1.62])
+            assert not modules & set(FRAMEWORK), f"twin {args} imported {modules & set(FRAMEWORK)}"
+        assert server.wait(timeout=30) == 0, "`twin stop` should end the server"
     finally:
         client.close()
-        server.terminate()
-        server.wait(timeout=20)
+        if server.poll() is None:
+            server.terminate()
+            server.wait(timeout=20)

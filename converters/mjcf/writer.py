@@ -55,18 +55,26 @@ def robot_xml(spec: object, assets_dir: Path) -> str:
 
 
 def scene_xml(robot_file: str, model_name: str) -> str:
-    """A scene with Gazebo's ground plane (via `add_gazebo_ground`), a light, the robot included."""
+    """A scene with Gazebo's ground plane (via `add_gazebo_ground`), a light, the robot included,
+    and the options a twin world steps with (`world_options`: integrator, solver, iterations,
+    tolerance, gravity, timestep), so plain MuJoCo runs the physics `twin validate` proved.
+
+    The robot is included after the ground, as a world attaches it: the same body, geom and
+    contact order gives the same trajectory as the world to rounding.
+    """
     import mujoco
 
     from converters.gazebo.contact import add_gazebo_ground
+    from converters.mjcf.world_options import apply_world_options
 
     scene = mujoco.MjSpec()
     scene.modelname = f"{model_name} scene"
     add_gazebo_ground(scene)
     scene.worldbody.add_light(name="sun", pos=[0, 0, 5], dir=[0, 0, -1])
+    apply_world_options(scene)
     text = scene.to_xml()
-    head, sep, rest = text.partition(">\n")
-    return f'{head}{sep}  <include file="{robot_file}"/>\n{rest}'
+    head, sep, rest = text.rpartition("</mujoco>")
+    return f'{head}  <include file="{robot_file}"/>\n{sep}{rest}'
 
 
 def write_model(spec: object, report: Report, out_dir: str | Path) -> Path:

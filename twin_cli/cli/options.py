@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Annotated
 
 import typer
+
+from twin_cli.cli import pairs
 
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
 WorldOpt = Annotated[
@@ -36,38 +40,27 @@ YawOpt = Annotated[float, typer.Option("-Y", help="Spawn yaw [rad].")]
 
 
 def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:
-    """Parse repeated `NAME<sep>VALUE` options into a dict, with a clear error for bad items."""
-    out: dict[str, str] = {}
-    for item in items or []:
-        if sep not in item:
-            raise typer.BadParameter(f"{what} {item!r} must look like NAME{sep}VALUE")
-        name, value = item.split(sep, 1)
-        out[name.strip()] = value.strip()
-    return out
+    """`pairs.parse_pairs`, with a bad item reported as Typer's usage error (exit code 2)."""
+    with usage_errors():
+        return pairs.parse_pairs(items, sep, what)
 
 
 def joint_positions(items: list[str] | None) -> dict[str, float]:
-    """Repeated `-J NAME=POS` as joint name → position [rad] or [m].
-
-    Gazebo's `spawn_model -J NAME POS` takes two values per flag; Typer cannot repeat an option
-    of two values ("List types with complex sub-types are not currently supported"), so twin
-    takes one `NAME=POS` value per flag.
-    """
-    out: dict[str, float] = {}
-    for name, value in parse_pairs(items, "=", "-J").items():
-        try:
-            out[name] = float(value)
-        except ValueError:
-            raise typer.BadParameter(
-                f"-J {name}={value}: {value!r} is not a number; give e.g. -J {name}=0.5"
-            ) from None
-    return out
+    """`pairs.joint_positions` (`-J NAME=POS`), a bad item reported as a usage error."""
+    with usage_errors():
+        return pairs.joint_positions(items)
 
 
 def source_inputs(arg: list[str] | None, package: list[str] | None) -> dict[str, dict[str, str]]:
-    """`--arg NAME:=VALUE` and `--package NAME=PATH` as the `args` and `package_paths` keywords
-    that `convert`, `convert_full`, `validate` and `spawn` all take."""
-    return {
-        "args": parse_pairs(arg, ":=", "--arg"),
-        "package_paths": parse_pairs(package, "=", "--package"),
-    }
+    """`pairs.source_inputs` (`--arg`, `--package`), a bad item reported as a usage error."""
+    with usage_errors():
+        return pairs.source_inputs(arg, package)
+
+
+@contextmanager
+def usage_errors() -> Iterator[None]:
+    """Turns BadOption into typer.BadParameter: usage, the message, exit code 2."""
+    try:
+        yield
+    except pairs.BadOption as exc:
+        raise typer.BadParameter(str(exc)) from None

@@ -1,7 +1,8 @@
 """HTTP client of a world server over its Unix socket; server errors come back as the same class.
 
-Imports httpx and the standard library only: never mujoco, numpy, trimesh, coacd, fastapi or
-uvicorn: a client command costs Python, typer and httpx start-up only (~0.25 s).
+Imports the standard library only (`http.client` through `transport`): never mujoco, numpy,
+trimesh, coacd, fastapi, uvicorn or httpx, so a client command costs little more than Python's
+own start-up.
 """
 
 from __future__ import annotations
@@ -16,19 +17,12 @@ from typing import Any
 from twin_cli import errors as twin_errors
 from twin_cli.errors import NotRunningError, RequestError
 from twin_cli.server import runtime
-
-# httpx imports its own command line (rich, click, pygments: ~40 ms of a ~250 ms command) only
-# to offer `httpx.main`, inside `try: ... except ImportError`; a None entry makes that import
-# fail at once and httpx falls back to a stub. Nothing in twin uses httpx's command line.
-sys.modules.setdefault("httpx._main", None)  # type: ignore[arg-type]
-
-import httpx  # noqa: E402
+from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
 
 # Seconds: most requests are a lock and a copy; spawn converts (CoACD can take minutes cold).
 DEFAULT_TIMEOUT_S = 10.0
 SPAWN_TIMEOUT_S = 600.0
 STOP_TIMEOUT_S = 15.0
-BASE_URL = "http://twin"
 
 
 def _error_class(name: str) -> type[Exception] | None:
@@ -82,18 +76,15 @@ class Client:
         self.world = world
         self.paths = runtime.world_paths(world)
         headers = {"Authorization": f"Bearer {token}"} if token else {}
-        # No TLS over the socket or plain-http TCP: skip loading CA certificates (~60 ms).
-        verify = bool(url and url.startswith("https:"))
-        transport = httpx.HTTPTransport(uds=None if url else str(self.paths.socket), verify=verify)
-        self._http = httpx.Client(
-            transport=transport,
-            base_url=url or BASE_URL,
+        self._http = Http(
+            socket_path=None if url else str(self.paths.socket),
+            url=url,
             headers=headers,
             timeout=DEFAULT_TIMEOUT_S,
         )
 
     def close(self) -> None:
-        """Close the connection pool."""
+        """Release the transport (each request has its own connection)."""
         self._http.close()
 
     def __enter__(self) -> Client:
@@ -113,14 +104,14 @@ class Client:
         """
         try:
             reply = self._http.request(method, path, json=body, timeout=timeout)
-        except (httpx.ConnectError, httpx.RemoteProtocolError, FileNotFoundError) as exc:
-            raise NotRunningError(self.world) from exc
-        except httpx.TimeoutException as exc:
+        except TimeoutError as exc:
             raise RequestError(
                 f"{method} {path}",
                 f"no answer from world [{self.world}] in {timeout:.0f} s",
                 "the server may be busy; see `twin logs`",
             ) from exc
+        except NOT_ANSWERING as exc:
+            raise NotRunningError(self.world) from exc
         try:
             payload = reply.json()
         except ValueError:
@@ -237,7 +228,7 @@ class Client:
 
 def _seg(name: str) -> str:
     """An entity name as one URL path segment."""
-    return httpx.URL("/" + name.replace("/", "%2F")).raw_path.decode()[1:]
+    return path_segment(name)
 
 
 def connect(

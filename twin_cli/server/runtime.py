@@ -7,15 +7,18 @@ import fcntl
 import os
 import re
 import stat
-import subprocess
 import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from twin_cli.errors import ServerStartError, TwinError, WorldRunningError
+
+if TYPE_CHECKING:
+    import subprocess
 
 RUNTIME_ENV = "TWIN_RUNTIME_DIR"
 DEFAULT_WORLD = "default"
@@ -239,6 +242,8 @@ def launch_background(paths: WorldPaths, serve_args: list[str]) -> subprocess.Po
 
     Call with `start_lock` held; the child is told so and does not take it.
     """
+    import subprocess  # here, not at the top: world commands that find a server never need it
+
     cmd = [sys.executable, "-m", "twin_cli", "serve", "--world", paths.world, "--background"]
     with os.fdopen(open_log(paths), "ab") as log:
         return subprocess.Popen(

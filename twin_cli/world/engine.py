@@ -73,6 +73,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
         self._pushes: list[control.Push] = []
         self._damping: control.Damping | None = None
         self._iterations = 0
+        self._stepping_time = 0.0  # [s] inside mj_step (RunControl.stepping_time)
         self._paused = False
         self.divergences = 0
         self.divergence_log: list[Divergence] = []

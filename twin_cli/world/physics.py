@@ -9,9 +9,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world import actuation as control
 from twin_cli.world.entities import element_names
-from twin_cli.world.scene import INTEGRATORS, ODE_ONLY_FIELDS, SOLVERS
+from twin_cli.world.scene import ODE_ONLY_FIELDS
 from twin_cli.world.values import check_settings, finite_vector
 
 

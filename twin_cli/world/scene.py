@@ -6,23 +6,7 @@ from dataclasses import dataclass
 
 import mujoco
 
-# MuJoCo's solver and integrator names, as users type them (lower case).
-SOLVERS = {
-    "newton": mujoco.mjtSolver.mjSOL_NEWTON,
-    "cg": mujoco.mjtSolver.mjSOL_CG,
-    "pgs": mujoco.mjtSolver.mjSOL_PGS,
-}
-INTEGRATORS = {
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-}
-# implicitfast integrates joint damping and the PD gains of joint commands implicitly, so they
-# stay stable at the 1 ms step; Euler would need much smaller gains (MuJoCo doc "Numerical
-# integration").
-DEFAULT_INTEGRATOR = "implicitfast"
-DEFAULT_SOLVER = "newton"
+from converters.mjcf.world_options import INTEGRATOR, SOLVER, WorldOptions, apply_world_options
 
 # The SDF/ODE physics fields MuJoCo has no counterpart for (sdf/1.11/physics.sdf, ode section).
 ODE_ONLY_FIELDS = (
@@ -45,14 +29,15 @@ class SceneSettings:
 
     Attributes:
         timestep: [s]; gravity: [m/s²]; iterations: solver iterations; solver, integrator: names
-        in SOLVERS / INTEGRATORS; ground: whether to add Gazebo's ground plane.
+        in `converters.mjcf.world_options` SOLVERS / INTEGRATORS; ground: whether to add
+        Gazebo's ground plane.
     """
 
     timestep: float
     gravity: tuple[float, float, float]
     iterations: int
-    solver: str = DEFAULT_SOLVER
-    integrator: str = DEFAULT_INTEGRATOR
+    solver: str = SOLVER
+    integrator: str = INTEGRATOR
     ground: bool = True
 
 
@@ -76,23 +61,18 @@ def build_world_spec(settings: SceneSettings) -> mujoco.MjSpec:
 
 
 def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:
-    """Writes timestep, gravity, iterations, solver and integrator into `spec.option`."""
-    spec.option.timestep = settings.timestep
-    spec.option.gravity = list(settings.gravity)
-    spec.option.iterations = settings.iterations
-    spec.option.solver = SOLVERS[settings.solver]
-    spec.option.integrator = INTEGRATORS[settings.integrator]
-    spec.option.tolerance = SOLVER_TOLERANCE
+    """Writes the world's options (the same ones `twin convert` exports in scene.xml) into
+    `spec.option`, and disables MuJoCo's auto-reset."""
+    options = WorldOptions(
+        settings.timestep,
+        tuple(settings.gravity),
+        settings.iterations,
+        settings.solver,
+        settings.integrator,
+    )
+    apply_world_options(spec, options)
     # A diverging entity must not reset the whole world (twin resets only that entity).
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
-
-
-# Solver convergence threshold, fixed in every world. MuJoCo 4 solves each constraint island on its
-# own, but an island's stopping point still shifts with what else is in the model: measured on a
-# falling humanoid while a second one spawns, MuJoCo's default 1e-8 lets the first robot's qpos
-# move 1.4e-7 m (and scaling the tolerance by meaninertia·nv, as once done here, 6 mm); 1e-12
-# keeps it within 1.3e-13 m for 0.3 % more solver iterations (1145 against 1142 in 700 steps).
-SOLVER_TOLERANCE = 1e-12
 
 
 _OPTION_FIELDS = (

@@ -5,8 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from converters.mjcf import world_options as options
+from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.errors import InvalidRequestError
-from twin_cli.world.scene import INTEGRATORS, SOLVERS, SceneSettings
+from twin_cli.world.scene import SceneSettings
 
 # Gravity presets [m/s²] (issue 4; `earth` is the --earth preset 9.81, not empty.world's 9.8).
 GRAVITY_PRESETS = {
@@ -24,16 +26,16 @@ class WorldSettings:
     Attributes:
         timestep: [s]; rate: real-time update rate [Hz], 0 = as fast as possible;
         gravity: [m/s²]; iterations: solver iterations; ground: Gazebo's ground plane;
-        solver, integrator: MuJoCo names (see twin_cli.world.scene).
+        solver, integrator: MuJoCo names (see converters.mjcf.world_options).
     """
 
-    timestep: float = 0.001
-    rate: float = 1000.0
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    iterations: int = 50
+    timestep: float = options.TIMESTEP_S
+    rate: float = options.UPDATE_RATE_HZ
+    gravity: tuple[float, float, float] = options.GRAVITY
+    iterations: int = options.ITERATIONS
     ground: bool = True
-    solver: str = "newton"
-    integrator: str = "implicitfast"
+    solver: str = options.SOLVER
+    integrator: str = options.INTEGRATOR
 
 
 @dataclass(frozen=True)

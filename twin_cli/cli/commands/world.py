@@ -1,19 +1,20 @@
 """World commands (Gazebo's verbs) on a running world: stop, spawn, list, pose, gravity, stats...
 
-Thin: each command parses its options, makes one client call and hands the reply to `Output`.
+Declarations only: each command's options and help, for Typer. What a command does lives in
+`twin_cli.cli.world_actions`, which the fast path (`twin_cli.cli.fast`) calls with the same
+options without importing Typer; `tests/test_cli_fast.py` holds the two to the same grammar.
 This module and everything it imports stay client-side: no mujoco, numpy or fastapi (an import
 contract in `make lint` holds it to that); `twin serve` lives in `serve.py`.
 """
 
 from __future__ import annotations
 
-import sys
-import time
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from twin_cli.cli import world_actions as act
 from twin_cli.cli.options import (
     ArgOpt,
     JointOpt,
@@ -26,43 +27,16 @@ from twin_cli.cli.options import (
     YawOpt,
     YOpt,
     ZOpt,
-    joint_positions,
-    source_inputs,
+    usage_errors,
 )
-from twin_cli.cli.output import Output
 
 NameArg = Annotated[str, typer.Argument(help="Entity name (see `twin list`).")]
-POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
-
-
-def _connect(world: str, *, start: bool = True):
-    """A client of the world's server; starts the server in the background if allowed."""
-    from twin_cli.server import client
-
-    return client.connect(world, start=start)
-
-
-def _not_running(world: str) -> typer.Exit:
-    """gz's readiness-probe wording on stderr, exit code 1 (scripts grep for it)."""
-    sys.stderr.write("An instance of twin is not running.\n")
-    return typer.Exit(1)
-
-
-def _pose_text(pose: dict) -> str:
-    """`x y z roll pitch yaw` as `gz model -p` prints it (rounding first: no `-0.000000`)."""
-    return " ".join(f"{round(float(pose[k]), 6) + 0.0:.6f}" for k in POSE_KEYS)
+Vec3 = tuple[float, float, float]
 
 
 def stop(world: WorldOpt = "default") -> None:
     """Stop the world's server (waits until its process has ended)."""
-    from twin_cli.errors import NotRunningError
-    from twin_cli.server import client
-
-    try:
-        pid = client.stop(world)
-    except NotRunningError:
-        raise _not_running(world) from None
-    sys.stderr.write(f"twin: stopped world [{world}] (pid {pid})\n")
+    act.stop(world=world)
 
 
 def spawn(
@@ -82,39 +56,33 @@ def spawn(
     json: JsonOpt = False,
 ) -> None:
     """Spawn a robot; prints its name once it exists in the world."""
-    inputs = source_inputs(arg, package)
-    joints = joint_positions(joint)
-    pose = dict(zip(POSE_KEYS, (x, y, z, roll, pitch, yaw), strict=True))
-    with _connect(world) as c:
-        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, joints=joints, **inputs)
-    out = Output(json)
-    if json:
-        out.data(result)
-        return
-    for warning in result.get("warnings") or []:
-        sys.stderr.write(f"twin: warning: {warning}\n")
-    out.line(result["name"])
+    with usage_errors():
+        act.spawn(
+            file=file,
+            x=x,
+            y=y,
+            z=z,
+            roll=roll,
+            pitch=pitch,
+            yaw=yaw,
+            name=name,
+            arg=arg,
+            package=package,
+            on_ground=on_ground,
+            joint=joint,
+            world=world,
+            json=json,
+        )
 
 
 def delete(name: NameArg, world: WorldOpt = "default") -> None:
     """Delete an entity."""
-    with _connect(world) as c:
-        c.delete(name)
+    act.delete(name=name, world=world)
 
 
 def list_(world: WorldOpt = "default", json: JsonOpt = False) -> None:
     """List the entities in the world."""
-    with _connect(world) as c:
-        rows = c.entities()
-    out = Output(json)
-    if json:
-        out.data(rows)
-        return
-    out.table(
-        "entities",
-        ["name", "x", "y", "z", "joints", "source"],
-        [[e["name"], *e["position"], e["n_joints"], e["source"]] for e in rows],
-    )
+    act.list_(world=world, json=json)
 
 
 def pose(
@@ -127,34 +95,12 @@ def pose(
     json: JsonOpt = False,
 ) -> None:
     """Print an entity's pose as `x y z roll pitch yaw` (or move it with --set)."""
-    with _connect(world) as c:
-        if set_ is None:
-            result = c.pose(name)
-        else:
-            result = c.set_pose(name, dict(zip(POSE_KEYS, set_, strict=True)))
-    out = Output(json)
-    if json:
-        out.data(result)
-    else:
-        out.line(_pose_text(result))
+    act.pose(name=name, set_=set_, world=world, json=json)
 
 
 def joints(name: NameArg, world: WorldOpt = "default", json: JsonOpt = False) -> None:
     """Print an entity's joint positions, velocities and efforts."""
-    with _connect(world) as c:
-        rows = c.joints(name)
-    out = Output(json)
-    if json:
-        out.data(rows)
-        return
-    out.table(
-        f"joints of {name}",
-        ["joint", "position", "velocity", "effort"],
-        [[j["name"], j["position"], j["velocity"], j["effort"]] for j in rows],
-    )
-
-
-Vec3 = tuple[float, float, float]
+    act.joints(name=name, world=world, json=json)
 
 
 def push(
@@ -166,8 +112,7 @@ def push(
     world: WorldOpt = "default",
 ) -> None:
     """Apply a force and torque to an entity for a while."""
-    with _connect(world) as c:
-        c.push(name, force, torque, link=link, duration=duration)
+    act.push(name=name, force=force, torque=torque, link=link, duration=duration, world=world)
 
 
 def gravity(
@@ -180,23 +125,8 @@ def gravity(
     json: JsonOpt = False,
 ) -> None:
     """Print the gravity vector, or set it from a preset or --set X Y Z."""
-    presets = [
-        p for p, on in (("earth", earth), ("moon", moon), ("mars", mars), ("zero", zero)) if on
-    ]
-    if len(presets) + (set_ is not None) > 1:
-        raise typer.BadParameter("give one of --earth, --moon, --mars, --zero or --set")
-    with _connect(world) as c:
-        if presets:
-            result = c.set_gravity(preset=presets[0])
-        elif set_ is not None:
-            result = c.set_gravity(vector=set_)
-        else:
-            result = c.gravity()
-    out = Output(json)
-    if json:
-        out.data(result)
-    else:
-        out.line(" ".join(f"{v:g}" for v in result["gravity"]))
+    with usage_errors():
+        act.gravity(earth=earth, moon=moon, mars=mars, zero=zero, set_=set_, world=world, json=json)
 
 
 def physics(
@@ -207,30 +137,17 @@ def physics(
     json: JsonOpt = False,
 ) -> None:
     """Print the physics settings, or change step, rate or iterations."""
-    changes = {
-        k: v
-        for k, v in (("timestep", step), ("rate", rate), ("iterations", iterations))
-        if v is not None
-    }
-    with _connect(world) as c:
-        result = c.set_physics(**changes) if changes else c.physics()
-    out = Output(json)
-    if json:
-        out.data(result)
-        return
-    out.table("physics", ["setting", "value"], [[k, v] for k, v in result.items()])
+    act.physics(step=step, rate=rate, iterations=iterations, world=world, json=json)
 
 
 def pause(world: WorldOpt = "default") -> None:
     """Pause the simulation."""
-    with _connect(world) as c:
-        c.pause()
+    act.pause(world=world)
 
 
 def resume(world: WorldOpt = "default") -> None:
     """Resume the simulation."""
-    with _connect(world) as c:
-        c.resume()
+    act.resume(world=world)
 
 
 def step(
@@ -239,15 +156,7 @@ def step(
     json: JsonOpt = False,
 ) -> None:
     """Advance the simulation N steps (also while paused)."""
-    from twin_cli.cli.stats_format import stats_line
-
-    with _connect(world) as c:
-        result = c.step(n)
-    out = Output(json)
-    if json:
-        out.data(result)
-    else:
-        out.line(stats_line(result))
+    act.step(n=n, world=world, json=json)
 
 
 def reset(
@@ -255,8 +164,7 @@ def reset(
     world: WorldOpt = "default",
 ) -> None:
     """Reset the world (entities to their spawn poses, time to 0), or only its time."""
-    with _connect(world) as c:
-        c.reset(time_only=time_only)
+    act.reset(time_only=time_only, world=world)
 
 
 def stats(
@@ -268,25 +176,7 @@ def stats(
     json: JsonOpt = False,
 ) -> None:
     """Print `Factor[..] SimTime[..] RealTime[..] Paused[..]` about five times a second."""
-    from twin_cli.cli import stats_format as fmt
-    from twin_cli.errors import NotRunningError
-
-    try:
-        c = _connect(world, start=False)
-    except NotRunningError:
-        raise _not_running(world) from None
-    render = fmt.stats_json if json else fmt.stats_csv_row if plot else fmt.stats_line
-    try:
-        with c:
-            if plot and not json:
-                print(fmt.CSV_HEADER, flush=True)
-            for tick in fmt.sample_times(time.monotonic(), duration):
-                time.sleep(max(0.0, tick - time.monotonic()))
-                print(render(c.stats()), flush=True)
-    except NotRunningError:
-        raise _not_running(world) from None
-    except (KeyboardInterrupt, BrokenPipeError):
-        return
+    act.stats(duration=duration, plot=plot, world=world, json=json)
 
 
 def save(
@@ -294,8 +184,7 @@ def save(
     world: WorldOpt = "default",
 ) -> None:
     """Save the world (entities, state, physics) to a file `twin load` reads."""
-    with _connect(world) as c:
-        c.save(file)
+    act.save(file=file, world=world)
 
 
 def load(
@@ -303,8 +192,7 @@ def load(
     world: WorldOpt = "default",
 ) -> None:
     """Replace the running world by one saved with `twin save`."""
-    with _connect(world) as c:
-        c.load(file)
+    act.load(file=file, world=world)
 
 
 def logs(
@@ -312,13 +200,7 @@ def logs(
     world: WorldOpt = "default",
 ) -> None:
     """Print the world server's log file."""
-    from twin_cli.server import runtime
-
-    paths = runtime.world_paths(world)
-    if not paths.log.exists():
-        sys.stderr.write(f"twin: no log for world [{world}] in {paths.directory}\n")
-        raise typer.Exit(1)
-    sys.stdout.write(runtime.log_tail(paths, lines))
+    act.logs(lines=lines, world=world)
 
 
 COMMANDS = {

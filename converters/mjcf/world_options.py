@@ -1,0 +1,69 @@
+"""The physics options of a twin world (SDF defaults, Newton, implicitfast) written into an MjSpec.
+
+One source for the world engine (`twin_cli.world.scene`) and the exported `scene.xml`
+(`converters.mjcf.writer`), so a model opened in plain MuJoCo steps with the physics that
+`twin validate` proved. Here rather than in `twin_cli`: converters never import twin_cli.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+
+# MuJoCo's solver and integrator names, as users type them (lower case).
+SOLVERS = {
+    "newton": mujoco.mjtSolver.mjSOL_NEWTON,
+    "cg": mujoco.mjtSolver.mjSOL_CG,
+    "pgs": mujoco.mjtSolver.mjSOL_PGS,
+}
+INTEGRATORS = {
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+}
+
+# SDF world defaults (sdf/1.11/physics.sdf): 1 ms step at 1000 Hz; ODE quick solver 50 iterations.
+TIMESTEP_S = 0.001  # [s]
+UPDATE_RATE_HZ = 1000.0  # [Hz]
+ITERATIONS = 50
+# twin's --earth preset [m/s²] (design.md §2.7; Gazebo's empty.world has 9.8).
+GRAVITY = (0.0, 0.0, -9.81)
+# implicitfast integrates joint damping and the PD gains of joint commands implicitly, so they
+# stay stable at the 1 ms step; Euler would need much smaller gains (MuJoCo doc "Numerical
+# integration").
+INTEGRATOR = "implicitfast"
+SOLVER = "newton"
+# Solver convergence threshold, fixed in every world. MuJoCo 4 solves each constraint island on its
+# own, but an island's stopping point still shifts with what else is in the model: measured on a
+# falling humanoid while a second one spawns, MuJoCo's default 1e-8 lets the first robot's qpos
+# move 1.4e-7 m (and scaling the tolerance by meaninertia·nv, as once done here, 6 mm); 1e-12
+# keeps it within 1.3e-13 m for 0.3 % more solver iterations (1145 against 1142 in 700 steps).
+SOLVER_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class WorldOptions:
+    """The MuJoCo options of a world.
+
+    Attributes:
+        timestep: [s]; gravity: [m/s²]; iterations: solver iterations; solver, integrator: names
+        in SOLVERS / INTEGRATORS.
+    """
+
+    timestep: float = TIMESTEP_S
+    gravity: tuple[float, float, float] = GRAVITY
+    iterations: int = ITERATIONS
+    solver: str = SOLVER
+    integrator: str = INTEGRATOR
+
+
+def apply_world_options(spec: mujoco.MjSpec, options: WorldOptions = WorldOptions()) -> None:
+    """Writes timestep, gravity, iterations, solver, integrator and tolerance into `spec.option`."""
+    spec.option.timestep = options.timestep
+    spec.option.gravity = list(options.gravity)
+    spec.option.iterations = options.iterations
+    spec.option.solver = SOLVERS[options.solver]
+    spec.option.integrator = INTEGRATORS[options.integrator]
+    spec.option.tolerance = SOLVER_TOLERANCE

@@ -1,0 +1,267 @@
+"""What each world command does, without Typer: check the values, one client call, the output.
+
+Called by the Typer commands (`commands/world.py`, which declare the options and help) and by
+the fast path (`fast.py`, which parses the same options without importing Typer). Parameters keep
+the Typer functions' names. Imports stay client-side: no mujoco, numpy, fastapi or typer.
+
+Raises:
+    BadOption: a value that does not parse (both callers turn it into a usage error, exit 2).
+    SystemExit(1): no world runs, for the commands that must not start one (gz's wording).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from twin_cli.cli import pairs
+from twin_cli.cli.output import Output
+
+POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
+GRAVITY_PRESETS = ("earth", "moon", "mars", "zero")
+Vec3 = tuple[float, float, float]
+
+
+def _connect(world: str, *, start: bool = True) -> Any:
+    """A client of the world's server; starts the server in the background if allowed."""
+    from twin_cli.server import client
+
+    return client.connect(world, start=start)
+
+
+def _not_running() -> SystemExit:
+    """gz's readiness-probe wording on stderr, exit code 1 (scripts grep for it)."""
+    sys.stderr.write("An instance of twin is not running.\n")
+    return SystemExit(1)
+
+
+def _pose_text(pose: dict) -> str:
+    """`x y z roll pitch yaw` as `gz model -p` prints it (rounding first: no `-0.000000`)."""
+    return " ".join(f"{round(float(pose[k]), 6) + 0.0:.6f}" for k in POSE_KEYS)
+
+
+def stop(*, world: str) -> None:
+    from twin_cli.errors import NotRunningError
+    from twin_cli.server import client
+
+    try:
+        pid = client.stop(world)
+    except NotRunningError:
+        raise _not_running() from None
+    sys.stderr.write(f"twin: stopped world [{world}] (pid {pid})\n")
+
+
+def spawn(
+    *,
+    file: Path,
+    x: float,
+    y: float,
+    z: float,
+    roll: float,
+    pitch: float,
+    yaw: float,
+    name: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    on_ground: bool,
+    joint: list[str] | None,
+    world: str,
+    json: bool,
+) -> None:
+    inputs = pairs.source_inputs(arg, package)
+    joints = pairs.joint_positions(joint)
+    pose = dict(zip(POSE_KEYS, (x, y, z, roll, pitch, yaw), strict=True))
+    with _connect(world) as c:
+        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, joints=joints, **inputs)
+    out = Output(json)
+    if json:
+        out.data(result)
+        return
+    for warning in result.get("warnings") or []:
+        sys.stderr.write(f"twin: warning: {warning}\n")
+    out.line(result["name"])
+
+
+def delete(*, name: str, world: str) -> None:
+    with _connect(world) as c:
+        c.delete(name)
+
+
+def list_(*, world: str, json: bool) -> None:
+    with _connect(world) as c:
+        rows = c.entities()
+    out = Output(json)
+    if json:
+        out.data(rows)
+        return
+    out.table(
+        "entities",
+        ["name", "x", "y", "z", "joints", "source"],
+        [[e["name"], *e["position"], e["n_joints"], e["source"]] for e in rows],
+    )
+
+
+def pose(*, name: str, set_: tuple[float, ...] | None, world: str, json: bool) -> None:
+    with _connect(world) as c:
+        if set_ is None:
+            result = c.pose(name)
+        else:
+            result = c.set_pose(name, dict(zip(POSE_KEYS, set_, strict=True)))
+    out = Output(json)
+    if json:
+        out.data(result)
+    else:
+        out.line(_pose_text(result))
+
+
+def joints(*, name: str, world: str, json: bool) -> None:
+    with _connect(world) as c:
+        rows = c.joints(name)
+    out = Output(json)
+    if json:
+        out.data(rows)
+        return
+    out.table(
+        f"joints of {name}",
+        ["joint", "position", "velocity", "effort"],
+        [[j["name"], j["position"], j["velocity"], j["effort"]] for j in rows],
+    )
+
+
+def push(
+    *, name: str, force: Vec3, torque: Vec3, link: str | None, duration: float, world: str
+) -> None:
+    with _connect(world) as c:
+        c.push(name, force, torque, link=link, duration=duration)
+
+
+def gravity_choice(
+    *, earth: bool, moon: bool, mars: bool, zero: bool, set_: Vec3 | None
+) -> str | None:
+    """The one preset asked for (None: --set or nothing).
+
+    Raises:
+        BadOption: more than one of --earth, --moon, --mars, --zero and --set.
+    """
+    chosen = [p for p, on in zip(GRAVITY_PRESETS, (earth, moon, mars, zero), strict=True) if on]
+    if len(chosen) + (set_ is not None) > 1:
+        raise pairs.BadOption("give one of --earth, --moon, --mars, --zero or --set")
+    return chosen[0] if chosen else None
+
+
+def gravity(
+    *,
+    earth: bool,
+    moon: bool,
+    mars: bool,
+    zero: bool,
+    set_: Vec3 | None,
+    world: str,
+    json: bool,
+) -> None:
+    preset = gravity_choice(earth=earth, moon=moon, mars=mars, zero=zero, set_=set_)
+    with _connect(world) as c:
+        if preset is not None:
+            result = c.set_gravity(preset=preset)
+        elif set_ is not None:
+            result = c.set_gravity(vector=set_)
+        else:
+            result = c.gravity()
+    out = Output(json)
+    if json:
+        out.data(result)
+    else:
+        out.line(" ".join(f"{v:g}" for v in result["gravity"]))
+
+
+def physics(
+    *,
+    step: float | None,
+    rate: float | None,
+    iterations: int | None,
+    world: str,
+    json: bool,
+) -> None:
+    changes = {
+        k: v
+        for k, v in (("timestep", step), ("rate", rate), ("iterations", iterations))
+        if v is not None
+    }
+    with _connect(world) as c:
+        result = c.set_physics(**changes) if changes else c.physics()
+    out = Output(json)
+    if json:
+        out.data(result)
+        return
+    out.table("physics", ["setting", "value"], [[k, v] for k, v in result.items()])
+
+
+def pause(*, world: str) -> None:
+    with _connect(world) as c:
+        c.pause()
+
+
+def resume(*, world: str) -> None:
+    with _connect(world) as c:
+        c.resume()
+
+
+def step(*, n: int, world: str, json: bool) -> None:
+    from twin_cli.cli.stats_format import stats_line
+
+    with _connect(world) as c:
+        result = c.step(n)
+    out = Output(json)
+    if json:
+        out.data(result)
+    else:
+        out.line(stats_line(result))
+
+
+def reset(*, time_only: bool, world: str) -> None:
+    with _connect(world) as c:
+        c.reset(time_only=time_only)
+
+
+def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None:
+    from twin_cli.cli import stats_format as fmt
+    from twin_cli.errors import NotRunningError
+
+    try:
+        c = _connect(world, start=False)
+    except NotRunningError:
+        raise _not_running() from None
+    render = fmt.stats_json if json else fmt.stats_csv_row if plot else fmt.stats_line
+    try:
+        with c:
+            if plot and not json:
+                print(fmt.CSV_HEADER, flush=True)
+            for tick in fmt.sample_times(time.monotonic(), duration):
+                time.sleep(max(0.0, tick - time.monotonic()))
+                print(render(c.stats()), flush=True)
+    except NotRunningError:
+        raise _not_running() from None
+    except (KeyboardInterrupt, BrokenPipeError):
+        return
+
+
+def save(*, file: Path, world: str) -> None:
+    with _connect(world) as c:
+        c.save(file)
+
+
+def load(*, file: Path, world: str) -> None:
+    with _connect(world) as c:
+        c.load(file)
+
+
+def logs(*, lines: int | None, world: str) -> None:
+    from twin_cli.server import runtime
+
+    paths = runtime.world_paths(world)
+    if not paths.log.exists():
+        sys.stderr.write(f"twin: no log for world [{world}] in {paths.directory}\n")
+        raise SystemExit(1)
+    sys.stdout.write(runtime.log_tail(paths, lines))
