@@ -32,3 +32,16 @@ def cap_contact_stiffness(model: mujoco.MjModel, original: np.ndarray | None = N
     capped[over, 1] = solref[over, 1] * np.sqrt(ratio[over])  # same damping ratio B/(2√S)
     model.geom_solref[:] = capped
     return int(over.sum())
+
+
+def spec_solrefs(spec: mujoco.MjSpec, model: mujoco.MjModel) -> np.ndarray:
+    """The uncapped solref of every geom of `model`, read from the spec it was compiled from.
+
+    Needed when the timestep changes: the model holds values capped for the old step.
+    """
+    out = np.array(model.geom_solref)
+    for i in range(model.ngeom):
+        geom = spec.geom(model.geom(i).name) if model.geom(i).name else None
+        if geom is not None:
+            out[i] = geom.solref
+    return out

@@ -11,6 +11,7 @@ from dataclasses import replace
 
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world import actuation as control
+from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.entities import element_names
 from twin_cli.world.scene import ODE_ONLY_FIELDS
 from twin_cli.world.values import check_settings, finite_vector
@@ -73,6 +74,8 @@ class PhysicsSettings:
             for target in (self.model.opt, self._spec.option):
                 target.timestep, target.iterations = new.timestep, new.iterations
                 target.solver, target.integrator = SOLVERS[new.solver], INTEGRATORS[new.integrator]
+            if "timestep" in changes:  # contacts resolvable at the old step may not be now
+                cap_contact_stiffness(self.model, spec_solrefs(self._spec, self.model))
             # dampingFactor's per-step keep fraction depends on the timestep.
             self._damping = control.damping_of(
                 self.model, element_names(self.model, self.model.name_numericadr)
