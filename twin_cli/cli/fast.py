@@ -81,7 +81,7 @@ GRAMMARS: dict[str, Grammar] = {
     "stop": Grammar("stop", opts=(WORLD,)),
     "spawn": Grammar(
         "spawn",
-        (Arg("file", Path),),
+        (Arg("file", Path, required=False),),
         (
             *POSE,
             Opt(("--name",), "name", str),
@@ -91,11 +91,17 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("-J", "--joint"), "joint", str, multiple=True),
             WORLD,
             JSON,
+            Opt(("--xml",), "xml", str),
+            Opt(("--quat",), "quat", float, nargs=4),
         ),
     ),
     "delete": Grammar("delete", (NAME,), (WORLD,)),
     "list": Grammar("list_", opts=(WORLD, JSON)),
-    "pose": Grammar("pose", (NAME,), (Opt(("--set",), "set_", float, nargs=6), WORLD, JSON)),
+    "pose": Grammar(
+        "pose",
+        (NAME,),
+        (Opt(("--set",), "set_", float, nargs=6), WORLD, JSON, _flag("--quat", dest="quat")),
+    ),
     "joints": Grammar("joints", (NAME,), (WORLD, JSON)),
     "push": Grammar(
         "push",

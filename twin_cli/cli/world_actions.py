@@ -37,6 +37,39 @@ def _not_running() -> SystemExit:
     return SystemExit(1)
 
 
+def spawn_pose(
+    position: Vec3, rpy: Vec3, quat: tuple[float, float, float, float] | None
+) -> dict[str, Any]:
+    """The request pose: position and roll-pitch-yaw, or position and a quaternion (x, y, z, w).
+
+    Raises:
+        BadOption: both a rotation (-R/-P/-Y) and --quat, or a zero quaternion.
+    """
+    pose: dict[str, Any] = dict(zip(POSE_KEYS[:3], position, strict=True))
+    if quat is None:
+        return pose | dict(zip(POSE_KEYS[3:], rpy, strict=True))
+    if any(rpy):
+        raise pairs.BadOption("give -R/-P/-Y or --quat X Y Z W, not both")
+    if sum(v * v for v in quat) < 1e-12:
+        raise pairs.BadOption("--quat must not be zero; give a unit quaternion X Y Z W")
+    return pose | {"quat": list(quat)}
+
+
+def quat_of(pose: dict) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a reply's roll-pitch-yaw (R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
+    import math
+
+    cr, sr = math.cos(pose["roll"] / 2), math.sin(pose["roll"] / 2)
+    cp, sp = math.cos(pose["pitch"] / 2), math.sin(pose["pitch"] / 2)
+    cy, sy = math.cos(pose["yaw"] / 2), math.sin(pose["yaw"] / 2)
+    return (
+        cy * cp * sr - sy * sp * cr,
+        cy * sp * cr + sy * cp * sr,
+        sy * cp * cr - cy * sp * sr,
+        cy * cp * cr + sy * sp * sr,
+    )
+
+
 def _pose_text(pose: dict) -> str:
     """`x y z roll pitch yaw` as `gz model -p` prints it (rounding first: no `-0.000000`)."""
     return " ".join(f"{round(float(pose[k]), 6) + 0.0:.6f}" for k in POSE_KEYS)
@@ -55,7 +88,7 @@ def stop(*, world: str) -> None:
 
 def spawn(
     *,
-    file: Path,
+    file: Path | None,
     x: float,
     y: float,
     z: float,
@@ -69,12 +102,22 @@ def spawn(
     joint: list[str] | None,
     world: str,
     json: bool,
+    xml: str | None = None,
+    quat: tuple[float, float, float, float] | None = None,
 ) -> None:
+    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`)."""
     inputs = pairs.source_inputs(arg, package)
     joints = pairs.joint_positions(joint)
-    pose = dict(zip(POSE_KEYS, (x, y, z, roll, pitch, yaw), strict=True))
+    pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
+    if (file is None) == (xml is None):
+        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
+    if file is not None and str(file) == "-":
+        file, xml = None, sys.stdin.read()
+    source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
     with _connect(world) as c:
-        result = c.spawn(file, name=name, pose=pose, on_ground=on_ground, joints=joints, **inputs)
+        result = c.spawn(
+            file, name=name, pose=pose, on_ground=on_ground, joints=joints, **source, **inputs
+        )
     out = Output(json)
     if json:
         out.data(result)
@@ -103,15 +146,23 @@ def list_(*, world: str, json: bool) -> None:
     )
 
 
-def pose(*, name: str, set_: tuple[float, ...] | None, world: str, json: bool) -> None:
+def pose(
+    *, name: str, set_: tuple[float, ...] | None, world: str, json: bool, quat: bool = False
+) -> None:
+    """Print (or set) an entity's pose; `quat` prints `x y z qx qy qz qw` (geometry_msgs order)."""
     with _connect(world) as c:
         if set_ is None:
             result = c.pose(name)
         else:
             result = c.set_pose(name, dict(zip(POSE_KEYS, set_, strict=True)))
     out = Output(json)
+    if quat:
+        result = {**result, "quat": list(quat_of(result))}
     if json:
         out.data(result)
+    elif quat:
+        values = [result[k] for k in POSE_KEYS[:3]] + result["quat"]
+        out.line(" ".join(f"{round(float(v), 6) + 0.0:.6f}" for v in values))
     else:
         out.line(_pose_text(result))
 

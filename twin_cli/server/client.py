@@ -136,21 +136,28 @@ class Client:
 
     def spawn(
         self,
-        source: str | os.PathLike,
+        source: str | os.PathLike | None,
         *,
         name: str | None = None,
-        pose: dict[str, float] | None = None,
+        pose: dict[str, Any] | None = None,
         args: dict[str, str] | None = None,
         package_paths: dict[str, str] | None = None,
         on_ground: bool = False,
         joints: dict[str, float] | None = None,
+        xml: str | None = None,
+        base_dir: str | None = None,
     ) -> dict:
-        """Spawn a file (paths made absolute here: the server has its own working directory).
+        """Spawn a file, or a description given as text (`xml`, with `source` None).
 
-        `joints`: initial joint positions [rad] or [m] by joint name (Gazebo's `-J`).
+        Paths are made absolute here: the server has its own working directory. `joints`:
+        initial joint positions [rad] or [m] by joint name (Gazebo's `-J`). `base_dir`: where
+        relative mesh paths in `xml` start.
         """
+        where = {"source": str(Path(source).expanduser().absolute())} if source is not None else {}
+        if xml is not None:
+            where = {"xml": xml, "base_dir": str(Path(base_dir or ".").expanduser().absolute())}
         body = {
-            "source": str(Path(source).expanduser().absolute()),
+            **where,
             "name": name,
             "pose": pose or {},
             "args": args or {},

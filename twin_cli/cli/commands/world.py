@@ -40,7 +40,9 @@ def stop(world: WorldOpt = "default") -> None:
 
 
 def spawn(
-    file: Annotated[Path, typer.Argument(help="URDF, xacro or MJCF file.")],
+    file: Annotated[
+        Path | None, typer.Argument(help="URDF, xacro, SDF or MJCF file; - reads it from stdin.")
+    ] = None,
     x: XOpt = 0.0,
     y: YOpt = 0.0,
     z: ZOpt = 0.0,
@@ -54,8 +56,15 @@ def spawn(
     joint: JointOpt = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
+    xml: Annotated[
+        str | None, typer.Option(help="The description as text (URDF or SDF), instead of FILE.")
+    ] = None,
+    quat: Annotated[
+        tuple[float, float, float, float] | None,
+        typer.Option(help="Orientation as a quaternion X Y Z W, instead of -R -P -Y."),
+    ] = None,
 ) -> None:
-    """Spawn a robot; prints its name once it exists in the world."""
+    """Spawn a robot or model; prints its name once it exists in the world."""
     with usage_errors():
         act.spawn(
             file=file,
@@ -72,6 +81,8 @@ def spawn(
             joint=joint,
             world=world,
             json=json,
+            xml=xml,
+            quat=quat,
         )
 
 
@@ -93,9 +104,12 @@ def pose(
     ] = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
+    quat: Annotated[
+        bool, typer.Option("--quat", help="Print x y z qx qy qz qw (a quaternion).")
+    ] = False,
 ) -> None:
     """Print an entity's pose as `x y z roll pitch yaw` (or move it with --set)."""
-    act.pose(name=name, set_=set_, world=world, json=json)
+    act.pose(name=name, set_=set_, world=world, json=json, quat=quat)
 
 
 def joints(name: NameArg, world: WorldOpt = "default", json: JsonOpt = False) -> None:
