@@ -76,6 +76,10 @@ def test_world_file_sets_physics_gravity_and_entities(world_file: Path) -> None:
     physics = world.physics()
     assert (physics["timestep"], physics["rate"], physics["iterations"]) == (0.002, 500.0, 80)
     assert world.gravity() == (0.0, 0.0, -MOON_G), "gravity [m/s²]"
+    model = world.model
+    lights = {model.light(i).name: i for i in range(model.nlight)}
+    assert list(lights) == ["sun"], "the file's lights (the included sun) replace the default"
+    assert model.light_type[lights["sun"]] == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
     assert [e.name for e in world.entities()] == ["ground_plane", "crate", "table"]
     assert world.get_pose("crate") == Pose(1.0, 0.0, 2.0), "model pose as in the file"
     table = world.get_pose("table")

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import os
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -41,7 +43,7 @@ from twin_cli.world.physics import PhysicsSettings
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.running import STATE, RunControl
-from twin_cli.world.scene import build_world_spec
+from twin_cli.world.scene import build_world_spec, replace_lights
 from twin_cli.world.values import (
     EntityInfo,
     SpawnResult,
@@ -198,6 +200,13 @@ class World(RunControl, PhysicsSettings, EntityControl):
             k += 1
             candidate = f"{base}_{k}"
         return candidate
+
+    def set_lights(self, lights: Sequence[Any]) -> None:
+        """Replace the world's lights (an SDF world's `<light>`s, its included `sun` among them)."""
+        with self.lock:
+            trial = self._spec.copy()
+            replace_lights(trial, lights)
+            self._commit(trial, *self._rebuild(trial, None, "<lights>"))
 
     def _rebuild(self, trial: mujoco.MjSpec, new: str | None, source: str) -> _Built:
         """Compiles `trial` into a new model and data carrying every existing entity's state."""

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 
@@ -58,6 +60,29 @@ def build_world_spec(settings: SceneSettings) -> mujoco.MjSpec:
     )
     apply_physics(spec, settings)
     return spec
+
+
+def replace_lights(spec: mujoco.MjSpec, lights: Sequence[Any]) -> None:
+    """Replace the world's own lights by `lights` (SDF `<light>`: kind, pose, direction, diffuse).
+
+    SDF kinds map to MuJoCo's: directional, spot, point.
+    """
+    for light in [light for light in spec.lights if light.parent.name == spec.worldbody.name]:
+        spec.delete(light)
+    kinds = {
+        "directional": mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+        "spot": mujoco.mjtLightType.mjLIGHT_SPOT,
+        "point": mujoco.mjtLightType.mjLIGHT_POINT,
+    }
+    for light in lights:
+        spec.worldbody.add_light(
+            name=light.name,
+            type=kinds.get(light.kind, mujoco.mjtLightType.mjLIGHT_POINT),
+            pos=[float(v) for v in light.pose[:3, 3]],
+            dir=list(light.direction),
+            diffuse=list(light.diffuse),
+            castshadow=light.cast_shadows,
+        )
 
 
 def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:

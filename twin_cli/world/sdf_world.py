@@ -53,6 +53,7 @@ def world_from_sdf(
         ground=False,
     )
     world = World(settings, name=name)
+    world.set_lights(description.lights)
     for placed in description.models:
         spec = build_description(placed.robot).spec
         world.spawn(spec, name=placed.robot.name, pose=pose_of(placed.pose))
