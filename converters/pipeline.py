@@ -63,7 +63,13 @@ def read_description(
 
 
 def read_robot(
-    text: str, source: str, base_dir: Path, resolver: PackageResolver, report: Report
+    text: str,
+    source: str,
+    base_dir: Path,
+    resolver: PackageResolver,
+    report: Report,
+    *,
+    as_written: bool = False,
 ) -> RobotDescription:
     """The robot description of a URDF or SDF text, chosen by its root element.
 
@@ -80,7 +86,7 @@ def read_robot(
         raise InputFileError(
             source, "is MJCF, already MuJoCo's format", "spawn it directly; nothing to convert"
         )
-    return parse_urdf(text, source, base_dir, resolver)
+    return parse_urdf(text, source, base_dir, resolver, as_written=as_written)
 
 
 def convert_full(
@@ -105,7 +111,10 @@ def convert_full(
     resolver = PackageResolver.create(path, package_paths)
     report = Report(source=str(path))
     text = read_description(path, dict(args or {}), resolver, report)
-    robot = read_robot(text, str(path), path.resolve().parent, resolver, report)
+    options = options or ConvertOptions()
+    robot = read_robot(
+        text, str(path), path.resolve().parent, resolver, report, as_written=options.as_written
+    )
     return build_description(robot, options, report)
 
 
@@ -128,7 +137,8 @@ def convert_text(
     directory = Path(base_dir or Path.cwd()).resolve()
     resolver = PackageResolver.create(directory / "description", package_paths)
     report = Report(source=source)
-    robot = read_robot(text, source, directory, resolver, report)
+    options = options or ConvertOptions()
+    robot = read_robot(text, source, directory, resolver, report, as_written=options.as_written)
     return build_description(robot, options, report)
 
 

@@ -135,6 +135,11 @@ class GazeboExtensions:
 
     `preserved_joints` are fixed joints that must not be lumped (preserveFixedJoint or
     disableFixedJointLumping). `unresolved` lists references naming no link and no joint.
+
+    What Gazebo's URDF parser (sdformat) drops is kept apart, so the Gazebo stage can say so:
+    `dropped_surfaces` are `<surface>` blocks written inside a URDF `<collision>` (sdformat
+    ignores them), `named_collisions` the (link, index) of collisions with a `name` attribute,
+    which receive none of their link's `<gazebo>` surface values (sdformat issue 333).
     """
 
     source: str
@@ -144,6 +149,8 @@ class GazeboExtensions:
     links: Mapping[str, LinkExtension] = field(default_factory=lambda: MappingProxyType({}))
     joints: Mapping[str, JointExtension] = field(default_factory=lambda: MappingProxyType({}))
     inline_surfaces: tuple[InlineSurface, ...] = ()
+    dropped_surfaces: tuple[InlineSurface, ...] = ()
+    named_collisions: frozenset[tuple[str, int]] = frozenset()
     plugins: tuple[Blob, ...] = ()
     model_blobs: tuple[Blob, ...] = ()
     unresolved: tuple[str, ...] = ()
@@ -154,9 +161,12 @@ class GazeboExtensions:
         return self.links.get(name) or LinkExtension(name)
 
     def surface_of(self, link: str, index: int) -> Surface:
-        """Surface of collision `index` of `link`: inline `<surface>`, then `<gazebo>` tags win."""
+        """Surface of collision `index` of `link`: inline `<surface>`, then `<gazebo>` tags win
+        (except on a named URDF collision, which Gazebo leaves without its link's values)."""
         base = Surface()
         for inline in self.inline_surfaces:
             if inline.link == link and inline.index == index:
                 base = inline.surface
+        if (link, index) in self.named_collisions:
+            return base
         return base.overridden_by(self.link(link).surface)

@@ -171,6 +171,7 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
             f"kd={inline.surface.kd}",
             tag="surface",
         )
+    _report_gazebo_drops(ext, report)
     untagged = sum(
         1
         for g in provenance.geoms
@@ -182,6 +183,27 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
         f"{untagged} collision geoms without μ1",
         tag="mu1",
     )
+
+
+def _report_gazebo_drops(ext: GazeboExtensions, report: Report) -> None:
+    """What Gazebo's URDF parser leaves out, left out here too (see GazeboExtensions)."""
+    for dropped in ext.dropped_surfaces:
+        report.ignored(
+            f"link '{dropped.link}' collision {dropped.index} <surface>",
+            "Gazebo's URDF parser (sdformat) ignores a <surface> inside a URDF <collision>, so "
+            "Gazebo simulates μ 1, kp 1e12 there; write it in <gazebo reference='"
+            f"{dropped.link}'><collision>, or convert with --as-written to apply it",
+            tag="surface",
+        )
+    for link, index in sorted(ext.named_collisions):
+        if ext.link(link).surface.is_empty():
+            continue
+        report.ignored(
+            f"link '{link}' collision {index}",
+            "has a name attribute, so Gazebo gives it none of the link's <gazebo> surface values "
+            "(sdformat issue 333); remove the name, or convert with --as-written to apply them",
+            tag="surface",
+        )
 
 
 def _report_ignored_surface(subject: str, surface: Surface, report: Report) -> None:

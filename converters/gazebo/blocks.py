@@ -127,12 +127,17 @@ def _read_model_block(block: ET.Element, ctx: ValueContext, model: dict[str, Any
         model["sources"].append(TagSource("", tag, raw if len(child) == 0 else "<blob>"))
 
 
-def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
+def parse_gazebo(root: ET.Element, source: str, *, as_written: bool = False) -> GazeboExtensions:
     """Read every `<gazebo>` block and inline `<collision><surface>` of an expanded URDF.
+
+    By default the values end up where Gazebo's own URDF parser (sdformat) puts them: an inline
+    `<surface>` is dropped and a named `<collision>` gets none of its link's surface values;
+    `as_written` applies what the file says instead.
 
     Args:
         root: the `<robot>` element after xacro expansion.
         source: the file name used in error messages.
+        as_written: apply inline surfaces and link values to named collisions.
 
     Returns:
         The typed extensions of the model, its links and its joints.
@@ -164,6 +169,7 @@ def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
         if ref in link_names or ref not in joint_types
     }
     joints = {ref: _joint_extension(ref, acc) for ref, acc in accs.items() if ref in joint_types}
+    inline = _inline_surfaces(root, source)
     return GazeboExtensions(
         source=source,
         static=model.get("static", False),
@@ -171,7 +177,9 @@ def parse_gazebo(root: ET.Element, source: str) -> GazeboExtensions:
         preserved_joints=_preserved(joints, joint_types),
         links=MappingProxyType(links),
         joints=MappingProxyType(joints),
-        inline_surfaces=_inline_surfaces(root, source),
+        inline_surfaces=inline if as_written else (),
+        dropped_surfaces=() if as_written else inline,
+        named_collisions=frozenset() if as_written else _named_collisions(root),
         plugins=tuple(model["plugins"]),
         model_blobs=tuple(model["blobs"]),
         unresolved=tuple(unresolved),
@@ -216,3 +224,14 @@ def _inline_surfaces(root: ET.Element, source: str) -> tuple[InlineSurface, ...]
             surface, _ = read_surface(collision, ValueContext(source, name))
             found.append(InlineSurface(name, index, surface))
     return tuple(found)
+
+
+def _named_collisions(root: ET.Element) -> frozenset[tuple[str, int]]:
+    """(link, index) of every `<collision name="...">`: sdformat matches a link's `<gazebo>`
+    surface values only to the collision names it generates itself, never to a given name."""
+    return frozenset(
+        (link.get("name", ""), index)
+        for link in root.findall("link")
+        for index, collision in enumerate(link.findall("collision"))
+        if collision.get("name")
+    )

@@ -76,11 +76,12 @@ def _massless(
     report: Report,
 ) -> inr.Inertia:
     if not repair:
-        problem = "moving link has no <inertial>" if body not in links else "moving link"
         value = links.get(body, inr.Inertia.zero())
-        raise InertiaError(
-            robot.source, body, f"{problem} with mass {value.mass:g} kg", inr.describe(value)
-        )
+        problem = f"moving link with mass {value.mass:g} kg"
+        if body not in links:
+            dropped = ", ".join(_subtree(robot, body))
+            problem = f"moving link has no <inertial>; Gazebo would silently drop {dropped}"
+        raise InertiaError(robot.source, body, problem, inr.describe(value))
     own = [g for g in geoms if g.body == body and g.role == "collision"] or [
         g for g in geoms if g.body == body
     ]
@@ -97,3 +98,14 @@ def _massless(
         f"{inr.REPAIR_DENSITY:g} kg/m³ over its geometry ({inr.describe(value)})",
     )
     return value
+
+
+def _subtree(robot: RobotDescription, link: str) -> list[str]:
+    """`link` and every link below it, depth first (what sdformat drops with a massless link)."""
+    children = robot.children()
+    out, stack = [], [link]
+    while stack:
+        name = stack.pop()
+        out.append(name)
+        stack.extend(reversed([j.child for j in children.get(name, [])]))
+    return out

@@ -35,11 +35,14 @@ MODEL_SITE = "__model__"
 
 @dataclass(frozen=True)
 class ConvertOptions:
-    """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan."""
+    """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan, and
+    `as_written`: apply what a URDF says where Gazebo's own parser drops it (inline `<surface>`,
+    link surface values on named collisions) instead of simulating what Gazebo simulates."""
 
     keep_fixed: bool = False
     repair_inertia: bool = False
     collision: CollisionSettings = field(default_factory=CollisionSettings)
+    as_written: bool = False
 
 
 def pose(T: np.ndarray) -> tuple[list[float], list[float]]:

@@ -35,7 +35,12 @@ CONTROLLER_ONLY = ("safety_controller", "calibration")
 
 
 def parse_urdf(
-    text: str, source: str, base_dir: Path, resolver: PackageResolver | None = None
+    text: str,
+    source: str,
+    base_dir: Path,
+    resolver: PackageResolver | None = None,
+    *,
+    as_written: bool = False,
 ) -> RobotDescription:
     """Parse and check URDF text into a robot description.
 
@@ -45,6 +50,7 @@ def parse_urdf(
         base_dir: directory relative mesh paths are taken from.
         resolver: finds `package://`, `model://` and relative mesh files (default: search
             the directories above `base_dir`).
+        as_written: keep what Gazebo's URDF parser drops (see `converters.gazebo.blocks`).
 
     Raises:
         MalformedXMLError, BadNumberError, URDFStructureError, GazeboTagError,
@@ -64,7 +70,9 @@ def parse_urdf(
     model = _yourdfpy_robot(root, source)
     resolver = resolver or PackageResolver.create(Path(source) if source else None)
     named = {m.name: m for m in getattr(model, "materials", []) if getattr(m, "name", None)}
-    gazebo = parse_gazebo(root, source)  # tag errors first, as Gazebo reads them before meshes
+    gazebo = parse_gazebo(
+        root, source, as_written=as_written
+    )  # tag errors first, as Gazebo reads them before meshes
     reading = _LinkReader(capsules, named, base_dir, resolver)
     return RobotDescription(
         name=model.name,

@@ -307,15 +307,26 @@ def test_preserved_joints_are_only_fixed_joints_with_the_flag():
     assert ext.preserved_joints == frozenset({"tip_joint"}), "preserved fixed joints"
 
 
-def test_inline_surface_and_gazebo_tag_precedence():
-    text = tagbot(_ref("base", "<kd>7</kd>")).replace(
+def _inline_surface_bot() -> str:
+    return tagbot(_ref("base", "<kd>7</kd>")).replace(
         '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>',
         '<collision><geometry><box size="0.2 0.2 0.2"/></geometry><surface><friction><ode>'
         "<mu1>3</mu1><mu2>3</mu2></ode></friction><contact><ode><kp>1e5</kp><kd>1</kd>"
         "</ode></contact></surface></collision>",
     )
-    surface = _parse(text).surface_of("base", 0)
+
+
+def test_inline_surface_and_gazebo_tag_precedence_as_written():
+    root = ET.fromstring(_inline_surface_bot())
+    surface = parse_gazebo(root, "t.urdf", as_written=True).surface_of("base", 0)
     assert (surface.mu1, surface.kp, surface.kd) == (3.0, 1e5, 7.0), "inline, then <gazebo>"
+
+
+def test_inline_surface_is_dropped_as_gazebo_drops_it():
+    ext = _parse(_inline_surface_bot())
+    surface = ext.surface_of("base", 0)
+    assert (surface.mu1, surface.kp, surface.kd) == (None, None, 7.0), "only <gazebo> values"
+    assert [(d.link, d.index, d.surface.mu1) for d in ext.dropped_surfaces] == [("base", 0, 3.0)]
 
 
 def test_model_level_tags():

@@ -60,8 +60,9 @@ def load_robot(
     package_paths: dict[str, str] | None = None,
     repair_inertia: bool = False,
     collision: str | None = None,
+    as_written: bool = False,
 ) -> RobotUnderTest:
-    """Convert (URDF/xacro) or load (MJCF .xml) a robot and compile it alone.
+    """Convert (URDF/xacro/SDF) or load (MJCF .xml) a robot and compile it alone.
 
     Raises:
         ConversionError: the description cannot be converted (exit 2 at the CLI).
@@ -83,7 +84,7 @@ def load_robot(
         path,
         args=args,
         package_paths=package_paths,
-        options=ConvertOptions(repair_inertia=True, collision=settings),
+        options=ConvertOptions(repair_inertia=True, collision=settings, as_written=as_written),
     )
     return robot_from_conversion(done, path, repair_inertia=repair_inertia)
 
@@ -201,11 +202,12 @@ def validate(
     collision: str | None = None,
     joints: dict[str, float] | None = None,
     debug: bool = False,
+    as_written: bool = False,
 ) -> ValidationRun:
     """Validate one robot: convert it, run the planned checks, return every result.
 
     Args:
-        robot_path: URDF, xacro or MJCF file.
+        robot_path: URDF, xacro, SDF or MJCF file.
         args: xacro arguments NAME → VALUE.
         package_paths: package NAME → directory.
         scenarios: bundled scenario names or .toml paths (default: the built-in checklist).
@@ -215,6 +217,7 @@ def validate(
         joints: start posture, joint name → [rad] or [m] (`-J`), over each scenario's
             `[robot] joints`; what a scenario's `[hold]` holds.
         debug: re-raise errors inside checks instead of reporting them as failures.
+        as_written: apply what a URDF says where Gazebo's parser drops it.
     """
     start = time.perf_counter()
     todo = [with_joints(sc, joints or {}) for sc in plan(scenarios, only, skip)]
@@ -224,6 +227,7 @@ def validate(
         package_paths=package_paths,
         repair_inertia=repair_inertia,
         collision=collision,
+        as_written=as_written,
     )
     check_start_postures(robot, todo, joints or {})
     results = tuple(run_check(robot, sc, debug=debug) for sc in todo)

@@ -9,7 +9,17 @@ import typer
 
 from twin_cli.cli.options import ArgOpt, JsonOpt, PackageOpt, parse_pairs, source_inputs
 
-RobotArg = Annotated[Path, typer.Argument(help="Robot description: .urdf or .xacro file.")]
+RobotArg = Annotated[
+    Path, typer.Argument(help="Robot description: .urdf, .xacro or .sdf (SDF model) file.")
+]
+AsWrittenOpt = Annotated[
+    bool,
+    typer.Option(
+        "--as-written",
+        help="Apply what the URDF says where Gazebo's parser drops it (inline <surface>, "
+        "link friction on named collisions) instead of simulating what Gazebo simulates.",
+    ),
+]
 KeepFixedOpt = Annotated[
     bool, typer.Option("--keep-fixed", help="Keep fixed joints as welded bodies (no lumping).")
 ]
@@ -19,11 +29,18 @@ RepairOpt = Annotated[
 ]
 
 
-def _options(keep_fixed: bool, repair: bool, collision: dict[str, Any] | None = None) -> Any:
+def _options(
+    keep_fixed: bool,
+    repair: bool,
+    collision: dict[str, Any] | None = None,
+    as_written: bool = False,
+) -> Any:
     from converters.collision.plan import CollisionSettings
     from converters.mjcf.builder import ConvertOptions
 
-    return ConvertOptions(keep_fixed, repair, CollisionSettings(**(collision or {})))
+    return ConvertOptions(
+        keep_fixed, repair, CollisionSettings(**(collision or {})), as_written=as_written
+    )
 
 
 def _collision_settings(
@@ -99,8 +116,9 @@ def convert_command(
     no_cache: Annotated[
         bool, typer.Option("--no-cache", help="Ignore the decomposition cache.")
     ] = False,
+    as_written: AsWrittenOpt = False,
 ) -> None:
-    """Convert a xacro/URDF robot (with Gazebo tags) into a MuJoCo MJCF directory."""
+    """Convert a xacro/URDF (with Gazebo tags) or SDF robot into a MuJoCo MJCF directory."""
     from converters.mjcf.writer import write_model
     from converters.pipeline import convert_full
     from twin_cli.cli.output import Output
@@ -121,7 +139,7 @@ def convert_command(
     done = convert_full(
         robot,
         **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, settings),
+        options=_options(keep_fixed, repair_inertia, settings, as_written),
     )
     if print_xml:
         typer.echo(done.spec.to_xml(), nl=False)
@@ -154,6 +172,7 @@ def inspect_command(
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
     json_mode: JsonOpt = False,
+    as_written: AsWrittenOpt = False,
 ) -> None:
     """Link tree, total mass, centre of mass and inertia (like `gz sdf --inertial-stats`)."""
     from converters.inspect import inertial_stats
@@ -163,7 +182,7 @@ def inspect_command(
     done = convert_full(
         robot,
         **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}),
+        options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}, as_written),
     )
     stats = inertial_stats(done.spec, done.description)
     out = Output(json_mode)

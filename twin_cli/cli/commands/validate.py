@@ -48,7 +48,7 @@ CollisionOpt = Annotated[
 
 
 def validate(
-    robot: Annotated[Path, typer.Argument(help="URDF, xacro or MJCF file of the robot.")],
+    robot: Annotated[Path, typer.Argument(help="URDF, xacro, SDF or MJCF file of the robot.")],
     arg: ArgOpt = None,
     package: PackageOpt = None,
     scenario: ScenarioOpt = None,
@@ -61,6 +61,12 @@ def validate(
     repair_inertia: RepairOpt = False,
     collision: CollisionOpt = None,
     joint: JointOpt = None,
+    as_written: Annotated[
+        bool,
+        typer.Option(
+            "--as-written", help="Apply what the URDF says where Gazebo's parser drops it."
+        ),
+    ] = False,
 ) -> None:
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
     from twin_cli.cli.output import Output
@@ -76,6 +82,7 @@ def validate(
         repair_inertia=repair_inertia,
         collision=collision,
         joints=joint_positions(joint),
+        as_written=as_written,
     )
     out = Output(json)
     if json:
