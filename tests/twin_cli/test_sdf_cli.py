@@ -109,3 +109,20 @@ def test_bad_sdf_text_is_one_message_and_exit_2(served: Path, text: str, needle:
     assert needle in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
     names = [e["name"] for e in json.loads(_ok(served, "list", "--json"))]
     assert "m" not in names, "a refused spawn leaves the world unchanged"
+
+
+def test_convert_and_validate_take_an_sdf_model(tmp_path: Path) -> None:
+    model = tmp_path / "box.sdf"
+    model.write_text(LESSON_BOX.replace("<static>true</static>", ""))
+    out = tmp_path / "out"
+
+    def twin(*args: str) -> subprocess.CompletedProcess:
+        command = [sys.executable, "-m", "twin_cli", *args]
+        return subprocess.run(command, capture_output=True, text=True, timeout=120)
+
+    converted = twin("convert", str(model), "-o", str(out))
+    assert converted.returncode == 0, converted.stderr
+    assert (out / "test_box.xml").is_file() and (out / "scene.xml").is_file()
+    run = twin("validate", str(model), "--only", "gravity", "--json")
+    assert run.returncode == 0, run.stderr
+    assert [r["check"] for r in json.loads(run.stdout)["results"]] == ["gravity"]
