@@ -125,4 +125,5 @@ def test_convert_and_validate_take_an_sdf_model(tmp_path: Path) -> None:
     assert (out / "test_box.xml").is_file() and (out / "scene.xml").is_file()
     run = twin("validate", str(model), "--only", "gravity", "--json")
     assert run.returncode == 0, run.stderr
-    assert [r["check"] for r in json.loads(run.stdout)["results"]] == ["gravity"]
+    checks = json.loads(run.stdout)["checks"]
+    assert [(c["check"], c["status"]) for c in checks] == [("gravity", "pass")], checks
