@@ -62,7 +62,6 @@ def new_spec(name: str) -> object:
     spec.modelname = name
     spec.compiler.degree = False
     spec.compiler.autolimits = True
-    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
     spec.option.timestep = TIMESTEP
     visual = spec.add_default(VISUAL_CLASS, spec.default)
     visual.geom.group = VISUAL_GROUP

@@ -64,3 +64,24 @@ def test_stl_bytes_round_trip_through_mujoco(tmp_path: Path) -> None:
     model = spec.compile()
     assert model.mesh_vertnum[0] == 4, "tetrahedron vertices after STL de-duplication"
     assert model.nmeshface == 4, "tetrahedron faces"
+
+
+def test_a_users_scene_can_include_the_robot_and_add_a_geom_only_body(tmp_path: Path) -> None:
+    """The robot file must not force a global `inertiafromgeom="false"` on the user's bodies."""
+    from converters import convert
+    from scenarios import HUMANOID
+
+    spec, report = convert(HUMANOID)
+    robot_xml = write_model(spec, report, tmp_path / "out")
+    scene = tmp_path / "out" / "my_scene.xml"
+    scene.write_text(
+        f'<mujoco><include file="{robot_xml.name}"/><worldbody>'
+        '<body name="my_ball" pos="1 0 1"><freejoint/><geom type="sphere" size="0.1"/></body>'
+        "</worldbody></mujoco>"
+    )
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    ball = model.body("my_ball")
+    assert ball.mass[0] == np.float64(1000.0 * 4.0 / 3.0 * np.pi * 0.1**3), "mass from its geom"
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=100)
+    assert np.isfinite(data.qpos).all(), "the combined scene steps"
