@@ -18,9 +18,10 @@ DROP_Z = 1.2  # [m] spawn height of the root
 # [m] root position, scene.xml against a world spawning the same robot file, at every step.
 # Measured 7.8e-13; with MuJoCo's default options (Euler, 100 iterations, tolerance 1e-8) 1.8e-7.
 SAME_FILE_M = 1e-9
-# [m] the same, the world spawning the xacro source: MjSpec.to_xml (MuJoCo 4.0) writes numbers
-# with 6 significant digits (inertia 0.208333, solref 1.11803), which moves the root 3.6e-8 m.
-XML_ROUNDING_M = 1e-7
+# [m] the same, the world spawning the xacro source. MjSpec.to_xml (MuJoCo 4.0) writes 6
+# significant digits (inertia 0.208333, solref 1.11803: 3.6e-8 m); the writer restores full
+# precision (converters/mjcf/precision.py), so the file is the spec.
+XML_ROUNDING_M = 1e-9
 OPTION_FIELDS = ("timestep", "gravity", "integrator", "iterations", "solver", "tolerance")
 
 

@@ -51,7 +51,9 @@ def robot_xml(spec: object, assets_dir: Path) -> str:
         mesh.file = f"{ASSETS}/{filename}"
         mesh.uservert = []
         mesh.userface = []
-    return copy.to_xml()
+    from converters.mjcf.precision import restore_precision
+
+    return restore_precision(copy.to_xml(), copy)
 
 
 def scene_xml(robot_file: str, model_name: str) -> str:
