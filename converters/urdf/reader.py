@@ -28,7 +28,7 @@ from converters.description import (
 from converters.errors import URDFStructureError
 from converters.gazebo.blocks import parse_gazebo
 from converters.resources.packages import PackageResolver
-from converters.urdf.xml_checks import check_numbers, check_tree, parse_xml
+from converters.urdf.xml_checks import check_kinds, check_numbers, check_tree, parse_xml
 
 # Joint children that only ROS controllers read; reported as ignored by the builder.
 CONTROLLER_ONLY = ("safety_controller", "calibration")
@@ -66,6 +66,7 @@ def parse_urdf(
         )
     check_numbers(root, source)
     base_link = check_tree(root, source)
+    check_kinds(root, source)
     capsules = _capsules_as_cylinders(root)
     model = _yourdfpy_robot(root, source)
     resolver = resolver or PackageResolver.create(Path(source) if source else None)

@@ -146,3 +146,50 @@ def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
                     "a URDF must be a tree: remove one joint of the cycle",
                 )
             path.append(link)
+
+
+# URDF joint types (and `spherical`, which several parsers accept); anything else is refused.
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
+# Shapes a URDF `<geometry>` may hold (`capsule` as ROS 2's urdfdom reads it).
+SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh")
+
+
+def check_kinds(root: ET.Element, source: str) -> None:
+    """Every joint has a known type and every `<geometry>` exactly one known shape.
+
+    urdfdom (and so Gazebo) refuses such files too; without this check a typo such as
+    `type="fixd"` was welded silently and an emptied `<geometry/>` crashed the parser.
+
+    Raises:
+        URDFStructureError: naming the joint or link, the value, and the allowed ones.
+    """
+    for joint in root.findall("joint"):
+        kind = joint.get("type")
+        if kind not in JOINT_TYPES:
+            raise URDFStructureError(
+                source,
+                f"joint '{joint.get('name', '?')}'",
+                f"type {kind!r} is not a URDF joint type",
+                f"use one of: {', '.join(JOINT_TYPES)}",
+            )
+    for link in root.findall("link"):
+        for role in ("visual", "collision"):
+            for index, element in enumerate(link.findall(role)):
+                _check_geometry(element, f"link '{link.get('name', '?')}' <{role}> {index}", source)
+
+
+def _check_geometry(element: ET.Element, where: str, source: str) -> None:
+    geometry = element.find("geometry")
+    if geometry is None:
+        raise URDFStructureError(
+            source, where, "has no <geometry>", "add <geometry> with one shape or remove it"
+        )
+    shapes = [child.tag for child in geometry]
+    if len(shapes) != 1 or shapes[0] not in SHAPES:
+        found = ", ".join(f"<{s}>" for s in shapes) or "nothing"
+        raise URDFStructureError(
+            source,
+            f"{where} <geometry>",
+            f"holds {found}",
+            f"give exactly one of: {', '.join(f'<{s}>' for s in SHAPES)}",
+        )

@@ -77,6 +77,17 @@ def test_transmissions_choose_the_actuated_joints(tmp_path: Path) -> None:
             URDFStructureError,
             "joint 'j'",
         ),
+        (
+            '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixd">'
+            '<parent link="a"/><child link="b"/></joint></robot>',
+            URDFStructureError,
+            "type 'fixd' is not a URDF joint type; use one of: revolute, continuous",
+        ),
+        (
+            '<robot name="r"><link name="a"><collision><geometry/></collision></link></robot>',
+            URDFStructureError,
+            "link 'a' <collision> 0 <geometry>: holds nothing; give exactly one of: <box>",
+        ),
     ],
 )
 def test_structural_errors_name_the_culprit(text: str, error: type, needle: str) -> None:

@@ -69,26 +69,52 @@ def _known(exc: Exception) -> bool:
     return isinstance(exc, ConversionError)
 
 
+# Exit code of an unexpected failure (sysexits' EX_SOFTWARE): a bug, never bad input.
+INTERNAL_ERROR = 70
+
+
 def main() -> None:
-    """Console entry point: known errors become one message on stderr and exit code 2.
+    """Console entry point: known errors become one message on stderr and exit code 2; anything
+    else is a bug: one line saying where its traceback was written, exit code 70.
 
     `--debug` anywhere on the command line re-raises with the traceback instead.
     """
     debug = "--debug" in sys.argv
     if debug:
         sys.argv = [a for a in sys.argv if a != "--debug"]
+    if sys.argv[1:] == ["--version"]:
+        return version()
     from twin_cli.cli import fast
 
     try:
         if not fast.run(sys.argv[1:]):
             build_app()()  # standalone: typer itself turns usage errors into exit code 2
     except Exception as exc:
-        if debug or not _known(exc):
+        if debug:
             raise
         from twin_cli.cli.output import error
 
-        error(str(exc))
-        sys.exit(getattr(exc, "exit_code", 2))
+        if _known(exc):
+            error(str(exc))
+            sys.exit(getattr(exc, "exit_code", 2))
+        error(_internal_error(exc))
+        sys.exit(INTERNAL_ERROR)
+
+
+def _internal_error(exc: Exception) -> str:
+    """Write the traceback to a private file; the one line that says what failed and where."""
+    import os
+    import tempfile
+    import traceback
+
+    fd, path = tempfile.mkstemp(prefix="twin-error-", suffix=".txt")
+    with os.fdopen(fd, "w") as handle:
+        handle.write(f"twin {' '.join(sys.argv[1:])}\n\n")
+        traceback.print_exception(exc, file=handle)
+    return (
+        f"internal error: {type(exc).__name__}: {exc}; the traceback is in {path} "
+        "(run again with --debug to see it); please report it with that file"
+    )
 
 
 if __name__ == "__main__":
