@@ -4,7 +4,10 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench lint format install clean
+.PHONY: demo test bench lint format install clean fuzz
+
+# `make fuzz`: the file-input fuzz properties with many more cases (FUZZ_EXAMPLES per property).
+FUZZ_EXAMPLES ?= 5000
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -21,6 +24,13 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 --timeout 300 -q
+
+fuzz: $(STAMP)
+	@start=$$(date +%s); \
+	TWIN_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/python -m pytest tests/fuzz -q -p no:cacheprovider \
+		--hypothesis-show-statistics; status=$$?; \
+	seconds=$$(( $$(date +%s) - start )); \
+	echo "fuzz: up to $$(( 3 * $(FUZZ_EXAMPLES) )) cases in $$seconds s"; exit $$status
 
 bench: $(STAMP)
 	$(BIN)/python -m benchmarks

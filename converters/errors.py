@@ -35,7 +35,14 @@ class GazeboTagError(ConversionError):
 
 
 def _gazebo_example(expected: str) -> str:
-    return {"a number": "0.5", "an integer": "10", "three numbers": "1 0 0"}.get(expected, "true")
+    examples = {
+        "a number": "0.5",
+        "a number ≥ 0": "0.5",
+        "a number > 0": "1e5",
+        "an integer": "10",
+        "three numbers": "1 0 0",
+    }
+    return examples.get(expected, "true")
 
 
 # --- Converter core: packages, xacro, URDF structure, inertia, meshes -----------------------

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from typing import Any
@@ -29,12 +30,29 @@ def text_of(el: ET.Element) -> str:
 
 
 def read_float(ctx: ValueContext, tag: str, raw: str) -> float:
+    """A finite number (nan and ±inf are not physical values)."""
     try:
         value = float(raw)
     except ValueError as exc:
         raise ctx.fail(tag, raw, "a number") from exc
-    if value != value:
+    if not math.isfinite(value):
         raise ctx.fail(tag, raw, "a number")
+    return value
+
+
+def read_positive(ctx: ValueContext, tag: str, raw: str) -> float:
+    """A finite number > 0: a contact stiffness of 0 would let bodies fall through."""
+    value = read_float(ctx, tag, raw)
+    if value <= 0:
+        raise ctx.fail(tag, raw, "a number > 0")
+    return value
+
+
+def read_magnitude(ctx: ValueContext, tag: str, raw: str) -> float:
+    """A finite number ≥ 0: friction coefficients, stiffness, damping, speeds, depths."""
+    value = read_float(ctx, tag, raw)
+    if value < 0:
+        raise ctx.fail(tag, raw, "a number ≥ 0")
     return value
 
 
@@ -70,27 +88,27 @@ Reader = Callable[[ValueContext, str, str], Any]
 
 # tag -> (group, field, reader). group "surface" = collision level, "link" = link level.
 LINK_TAGS: dict[str, tuple[str, str, Reader]] = {
-    "mu1": ("surface", "mu1", read_float),
-    "mu2": ("surface", "mu2", read_float),
+    "mu1": ("surface", "mu1", read_magnitude),
+    "mu2": ("surface", "mu2", read_magnitude),
     "fdir1": ("surface", "fdir1", read_vec3),
-    "kp": ("surface", "kp", read_float),
-    "kd": ("surface", "kd", read_float),
-    "maxVel": ("surface", "max_vel", read_float),
-    "minDepth": ("surface", "min_depth", read_float),
+    "kp": ("surface", "kp", read_positive),
+    "kd": ("surface", "kd", read_magnitude),
+    "maxVel": ("surface", "max_vel", read_magnitude),
+    "minDepth": ("surface", "min_depth", read_magnitude),
     "maxContacts": ("surface", "max_contacts", read_int),
     "laserRetro": ("surface", "laser_retro", read_float),
     "selfCollide": ("link", "self_collide", read_bool),
     "self_collide": ("link", "self_collide", read_bool),
     "turnGravityOff": ("link", "turn_gravity_off", read_bool),
     "gravity": ("link", "gravity", read_bool),
-    "dampingFactor": ("link", "damping_factor", read_float),
+    "dampingFactor": ("link", "damping_factor", read_magnitude),
     "material": ("link", "material", read_str),
 }
 
 JOINT_TAGS: dict[str, tuple[str, Reader]] = {
     "stopErp": ("stop_erp", read_float),
     "stopCfm": ("stop_cfm", read_float),
-    "springStiffness": ("spring_stiffness", read_float),
+    "springStiffness": ("spring_stiffness", read_magnitude),
     "springReference": ("spring_reference", read_float),
     "fudgeFactor": ("fudge_factor", read_float),
     "provideFeedback": ("provide_feedback", read_bool),
@@ -102,15 +120,15 @@ JOINT_TAGS: dict[str, tuple[str, Reader]] = {
 
 # Paths inside an SDF <surface> (or a <collision> block) -> (Surface field, reader).
 SURFACE_PATHS: dict[str, tuple[str, Reader]] = {
-    "surface/friction/ode/mu": ("mu1", read_float),
-    "surface/friction/ode/mu1": ("mu1", read_float),
-    "surface/friction/ode/mu2": ("mu2", read_float),
+    "surface/friction/ode/mu": ("mu1", read_magnitude),
+    "surface/friction/ode/mu1": ("mu1", read_magnitude),
+    "surface/friction/ode/mu2": ("mu2", read_magnitude),
     "surface/friction/ode/fdir1": ("fdir1", read_vec3),
-    "surface/friction/torsional/coefficient": ("torsional", read_float),
-    "surface/contact/ode/kp": ("kp", read_float),
-    "surface/contact/ode/kd": ("kd", read_float),
-    "surface/contact/ode/max_vel": ("max_vel", read_float),
-    "surface/contact/ode/min_depth": ("min_depth", read_float),
+    "surface/friction/torsional/coefficient": ("torsional", read_magnitude),
+    "surface/contact/ode/kp": ("kp", read_positive),
+    "surface/contact/ode/kd": ("kd", read_magnitude),
+    "surface/contact/ode/max_vel": ("max_vel", read_magnitude),
+    "surface/contact/ode/min_depth": ("min_depth", read_magnitude),
     "surface/contact/category_bitmask": ("category_bitmask", read_int),
     "surface/contact/collide_bitmask": ("collide_bitmask", read_int),
     "surface/bounce/restitution_coefficient": ("restitution", read_float),

@@ -51,9 +51,10 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         surfaces.extend(inline)
     if not links:
         raise ctx.error(model, "has no <link>", "add at least one link")
-    joints, ext_joints = [], {}
+    joints, ext_joints, parent_of = [], {}, {}
     for element, prefix in ((el, p) for m, p in scopes for el in m.findall("joint")):
         joint, extension = read_joint(ctx, graph, element, prefix)
+        _check_edge(ctx, element, joint, parent_of)
         joints.append(joint)
         if _has_values(extension):
             ext_joints[joint.name] = extension
@@ -82,6 +83,31 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         frames=_frames(graph),
         model_frame_site=True,
     )
+
+
+def _check_edge(ctx: SdfContext, element: Any, joint: Joint, parent_of: dict[str, str]) -> None:
+    """The joints must keep the links a tree (MuJoCo's bodies are one): no link moved by two
+    joints, none its own parent, no cycle.
+
+    Raises:
+        SDFError: naming the joint and the links.
+    """
+    if joint.child == joint.parent:
+        raise ctx.error(element, f"joins link '{joint.child}' to itself", "name two links")
+    if joint.child in parent_of:
+        raise ctx.error(
+            element,
+            f"link '{joint.child}' already has a parent joint (from '{parent_of[joint.child]}')",
+            "a link can be the child of one joint only; remove one of the joints",
+        )
+    link = joint.parent
+    while link in parent_of:
+        link = parent_of[link]
+        if link == joint.child:
+            raise ctx.error(
+                element, f"closes a loop through link '{joint.child}'", "remove one joint"
+            )
+    parent_of[joint.child] = joint.parent
 
 
 def _scopes(model: Any, prefix: str):

@@ -92,8 +92,8 @@ def _yourdfpy_robot(root: ET.Element, source: str) -> object:
     import yourdfpy
 
     try:
-        return yourdfpy.URDF._parse_robot(lxml.etree.fromstring(ET.tostring(root)))
-    except (ValueError, KeyError, TypeError) as exc:
+        return yourdfpy.URDF._parse_robot(lxml.etree.fromstring(ET.tostring(root, "unicode")))
+    except (ValueError, KeyError, TypeError, lxml.etree.XMLSyntaxError) as exc:
         raise URDFStructureError(
             source, "<robot>", f"yourdfpy cannot read it: {exc}", "fix the element named above"
         ) from exc

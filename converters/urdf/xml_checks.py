@@ -150,8 +150,15 @@ def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
 
 # URDF joint types (and `spherical`, which several parsers accept); anything else is refused.
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar", "spherical")
-# Shapes a URDF `<geometry>` may hold (`capsule` as ROS 2's urdfdom reads it).
-SHAPES = ("box", "cylinder", "sphere", "capsule", "mesh")
+# Shapes a URDF `<geometry>` may hold (`capsule` as ROS 2's urdfdom reads it), with the
+# attributes each must have.
+SHAPES = {
+    "box": ("size",),
+    "cylinder": ("radius", "length"),
+    "sphere": ("radius",),
+    "capsule": ("radius", "length"),
+    "mesh": ("filename",),
+}
 
 
 def check_kinds(root: ET.Element, source: str) -> None:
@@ -193,3 +200,20 @@ def _check_geometry(element: ET.Element, where: str, source: str) -> None:
             f"holds {found}",
             f"give exactly one of: {', '.join(f'<{s}>' for s in SHAPES)}",
         )
+    shape = geometry[0]
+    for attribute in SHAPES[shape.tag]:
+        value = shape.get(attribute)
+        if value is None or not value.strip():
+            raise URDFStructureError(
+                source,
+                f"{where} <{shape.tag}>",
+                f"has no {attribute}",
+                f'write <{shape.tag} {attribute}="..."/>',
+            )
+        if shape.tag != "mesh" and any(float(v) <= 0 for v in value.split()):
+            raise URDFStructureError(
+                source,
+                f"{where} <{shape.tag}>",
+                f"{attribute}={value!r} is not positive",
+                "give sizes in metres above 0",
+            )
