@@ -23,6 +23,56 @@ def _time(fn: object) -> float:
     return best
 
 
+# A primitive-only robot: what `twin convert` costs with no mesh to load (target < 0.5 s wall).
+PRIMITIVE = """<robot name="box"><link name="b"><inertial><mass value="1"/>
+<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>"""
+CLI_REPEATS = 7
+
+
+def cli_wall(args: list[str]) -> dict[str, float]:
+    """Median and minimum wall time [s] of `twin ARGS` as a user runs it (a fresh process)."""
+    import statistics
+    import subprocess
+    import sys
+
+    times = []
+    for _ in range(CLI_REPEATS):
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "twin_cli", *args], capture_output=True, check=True)
+        times.append(time.perf_counter() - start)
+    return {"median_s": round(statistics.median(times), 3), "min_s": round(min(times), 3)}
+
+
+def cli_figures(tmp: Path) -> dict[str, object]:
+    """`twin convert` of a primitive robot and of a mesh robot whose collision parts are cached,
+    and `twin validate` of the bundled humanoid (model checks and 10 physics scenarios)."""
+    import os
+
+    from scenarios import HUMANOID
+
+    primitive = tmp / "box.urdf"
+    primitive.write_text(PRIMITIVE)
+    ur = CORPUS / "packages" / "ur_description"
+    config = ur / "config" / "ur5e"
+    ur_args = ["--package", f"ur_description={ur}", "--arg", "robot_model:=ur5e"]
+    for name, file in (
+        ("joint_limit_params", "joint_limits.yaml"),
+        ("kinematics_params", "default_kinematics.yaml"),
+        ("physical_params", "physical_parameters.yaml"),
+        ("visual_params", "visual_parameters.yaml"),
+    ):
+        ur_args += ["--arg", f"{name}:={config / file}"]
+    mesh = ["convert", str(ur / "urdf" / "ur.xacro"), *ur_args, "-o", str(tmp / "ur")]
+    cli_wall(mesh)  # the first run fills the collision cache
+    return {
+        "load_average": os.getloadavg()[0],
+        "convert_primitive": cli_wall(["convert", str(primitive), "-o", str(tmp / "box")]),
+        "convert_cached_mesh_ur5e": cli_wall(mesh),
+        "validate_humanoid": cli_wall(["validate", str(HUMANOID), "--json"]),
+    }
+
+
 def run() -> dict[str, object]:
     """Per robot: convert [s] with hull collisions, convert with the default `auto` plan (cached
     CoACD after the first run) [s], compile [s], and mesh triangles carried in the spec."""
@@ -42,7 +92,10 @@ def run() -> dict[str, object]:
         )
         for r in robots
     ]
-    results: dict[str, object] = {}
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        results: dict[str, object] = {"cli": cli_figures(Path(tmp))}
     for robot_id, path, args, packages, repair in entries:
         paths = {p: CORPUS / "packages" / p for p in packages}
 

@@ -53,6 +53,27 @@ class MeshCache:
 
 
 def load_mesh(path: Path, link: str) -> MeshData:
+    """A mesh file's triangles in metres: from the mesh store when these bytes were loaded
+    before, else read with trimesh (and stored).
+
+    Raises:
+        MeshError: the file cannot be parsed or holds no triangles.
+    """
+    from converters.resources import mesh_store
+
+    try:
+        key = mesh_store.key_of(path)
+    except OSError as exc:
+        raise MeshError(str(path), link, f"cannot be read ({exc})") from exc
+    stored = mesh_store.load(key)
+    if stored is not None:
+        return stored
+    mesh = read_mesh_file(path, link)
+    mesh_store.store(key, mesh)
+    return mesh
+
+
+def read_mesh_file(path: Path, link: str) -> MeshData:
     """Read any mesh format trimesh knows, flattening scenes (DAE/GLB) with their transforms.
 
     COLLADA unit declarations are applied. Textures and materials are not copied (copying

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from converters.description.transforms import pose_matrix, quat_matrix
 from converters.errors import MalformedXMLError, SDFError
 from converters.gazebo.tags import ValueContext
 from converters.report import Report
@@ -167,27 +168,6 @@ def parse_document(text: str, source: str) -> Any:
     return root
 
 
-def pose_matrix(values: tuple[float, ...]) -> np.ndarray:
-    """SDF `x y z roll pitch yaw` → 4×4 (R = Rz(yaw)·Ry(pitch)·Rx(roll), extrinsic X-Y-Z)."""
-    x, y, z, roll, pitch, yaw = values
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(roll),
-        math.sin(roll),
-        math.cos(pitch),
-        math.sin(pitch),
-        math.cos(yaw),
-        math.sin(yaw),
-    )
-    T = np.eye(4)
-    T[:3, :3] = [
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ]
-    T[:3, 3] = (x, y, z)
-    return T
-
-
 def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
     """The `<pose>` child of `parent` as 4×4 and its `relative_to` (None when not given).
 
@@ -213,16 +193,3 @@ def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
             values = values[:3] + tuple(math.radians(v) for v in values[3:])
         T = pose_matrix(values)
     return T, element.get("relative_to") or None
-
-
-def quat_matrix(xyzw: tuple[float, ...]) -> np.ndarray:
-    x, y, z, w = xyzw
-    n = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
-    x, y, z, w = x / n, y / n, z / n, w / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )

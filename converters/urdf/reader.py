@@ -1,8 +1,10 @@
-"""URDF text → the neutral robot description: yourdfpy reads links and joints, raw XML the rest.
+"""URDF text → the neutral robot description, read from the XML tree that `xml_checks` vetted.
 
-yourdfpy parses the standard elements; what it drops (`<gazebo>`, `<transmission>`,
-`<ros2_control>`, `<capsule>`) is read from the XML here. Mesh references are resolved to files
-now, so later stages never see `package://` or the file's directory.
+URDF is a thin schema over XML: once the tree is checked (numbers parse, one tree, known joint
+types, one shape per `<geometry>` with its sizes), its links and joints are a few attribute
+reads. twin used to hand the tree to yourdfpy for them; importing yourdfpy costs 0.95 s
+(it imports trimesh, which imports scipy) for what these functions read directly. Mesh
+references are resolved to files here, so later stages never see `package://`.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from converters.description import (
     RobotDescription,
     Visual,
 )
+from converters.description.transforms import pose_matrix
 from converters.errors import URDFStructureError
 from converters.gazebo.blocks import parse_gazebo
 from converters.resources.packages import PackageResolver
@@ -32,6 +35,8 @@ from converters.urdf.xml_checks import check_kinds, check_numbers, check_tree, p
 
 # Joint children that only ROS controllers read; reported as ignored by the builder.
 CONTROLLER_ONLY = ("safety_controller", "calibration")
+# URDF's default joint axis.
+DEFAULT_AXIS = (1.0, 0.0, 0.0)
 
 
 def parse_urdf(
@@ -67,172 +72,153 @@ def parse_urdf(
     check_numbers(root, source)
     base_link = check_tree(root, source)
     check_kinds(root, source)
-    capsules = _capsules_as_cylinders(root)
-    model = _yourdfpy_robot(root, source)
+    # Tag errors first, as Gazebo reads the <gazebo> blocks before any mesh.
+    gazebo = parse_gazebo(root, source, as_written=as_written)
     resolver = resolver or PackageResolver.create(Path(source) if source else None)
-    named = {m.name: m for m in getattr(model, "materials", []) if getattr(m, "name", None)}
-    gazebo = parse_gazebo(
-        root, source, as_written=as_written
-    )  # tag errors first, as Gazebo reads them before meshes
-    reading = _LinkReader(capsules, named, base_dir, resolver)
+    reading = _LinkReader(_named_materials(root), base_dir, resolver)
     return RobotDescription(
-        name=model.name,
+        name=root.get("name") or "robot",
         source=source,
         base_link=base_link,
-        links=tuple(reading.link(link) for link in model.links),
-        joints=tuple(_joint(joint) for joint in model.joints),
+        links=tuple(reading.link(link) for link in root.findall("link")),
+        joints=tuple(_joint(joint) for joint in root.findall("joint")),
         gazebo=gazebo,
         actuated=_named_joints(root, ("transmission", "ros2_control")),
         text=text,
     )
 
 
-def _yourdfpy_robot(root: ET.Element, source: str) -> object:
-    import lxml.etree
-    import yourdfpy
-
-    try:
-        return yourdfpy.URDF._parse_robot(lxml.etree.fromstring(ET.tostring(root, "unicode")))
-    except (ValueError, KeyError, TypeError, lxml.etree.XMLSyntaxError) as exc:
-        raise URDFStructureError(
-            source, "<robot>", f"yourdfpy cannot read it: {exc}", "fix the element named above"
-        ) from exc
+def _floats(element: ET.Element | None, attribute: str, default: tuple[float, ...]) -> tuple:
+    raw = element.get(attribute) if element is not None else None
+    return default if raw is None else tuple(float(v) for v in raw.split())
 
 
-def _pose(origin: object | None) -> np.ndarray:
-    return np.eye(4) if origin is None else np.asarray(origin, dtype=float)
+def _number(element: ET.Element | None, attribute: str, default: float | None) -> float | None:
+    raw = element.get(attribute) if element is not None else None
+    return default if raw is None else float(raw)
 
 
-def _number(value: object | None, default: float | None = None) -> float | None:
-    return default if value is None else float(value)
+def _origin(owner: ET.Element) -> np.ndarray:
+    """The `<origin xyz rpy>` of `owner` as 4×4 (R = Rz(yaw)·Ry(pitch)·Rx(roll))."""
+    origin = owner.find("origin")
+    xyz = _floats(origin, "xyz", (0.0, 0.0, 0.0))
+    rpy = _floats(origin, "rpy", (0.0, 0.0, 0.0))
+    return pose_matrix(xyz + rpy)
+
+
+def _named_materials(root: ET.Element) -> dict[str, Material]:
+    """Robot-level `<material>` definitions by name (later definitions win, as in urdfdom)."""
+    out: dict[str, Material] = {}
+    for element in root.findall("material"):
+        name = element.get("name")
+        if name:
+            out[name] = _material_of(element)
+    return out
+
+
+def _material_of(element: ET.Element) -> Material:
+    colour = element.find("color")
+    texture = element.find("texture")
+    rgba = _floats(colour, "rgba", ()) or None
+    return Material(
+        element.get("name"), rgba, texture.get("filename") if texture is not None else None
+    )
 
 
 class _LinkReader:
-    """Turns yourdfpy links into description links: shapes, resolved meshes, materials."""
+    """Reads `<link>` elements into description links: shapes, resolved meshes, materials."""
 
     def __init__(
-        self,
-        capsules: set[tuple[str, str, int]],
-        named: dict[str, object],
-        base_dir: Path,
-        resolver: PackageResolver,
+        self, named: dict[str, Material], base_dir: Path, resolver: PackageResolver
     ) -> None:
-        self.capsules = capsules
         self.named = named
         self.base_dir = base_dir
         self.resolver = resolver
 
-    def link(self, link: object) -> Link:
+    def link(self, link: ET.Element) -> Link:
+        name = link.get("name", "")
         visuals = tuple(
-            Visual(
-                _pose(v.origin),
-                self.geometry(v.geometry, link.name, "visual", i),
-                self.material(v.material),
-                v.name,
-            )
-            for i, v in enumerate(link.visuals)
+            Visual(_origin(v), self.geometry(v, name, "visual", i), self.material(v), v.get("name"))
+            for i, v in enumerate(link.findall("visual"))
         )
         collisions = tuple(
-            Collision(_pose(c.origin), self.geometry(c.geometry, link.name, "collision", i), c.name)
-            for i, c in enumerate(link.collisions)
+            Collision(_origin(c), self.geometry(c, name, "collision", i), c.get("name"))
+            for i, c in enumerate(link.findall("collision"))
         )
-        return Link(link.name, _inertial(link.inertial), visuals, collisions)
+        return Link(name, _inertial(link.find("inertial")), visuals, collisions)
 
-    def geometry(
-        self, geometry: object | None, link: str, role: str, index: int
-    ) -> Geometry | None:
-        """The shape of one `<visual>`/`<collision>`; None when it names no shape."""
-        if geometry is None:
-            return None
-        if geometry.box is not None:
-            return Geometry("box", tuple(float(v) for v in geometry.box.size))
-        if geometry.cylinder is not None:
-            shape = "capsule" if (link, role, index) in self.capsules else "cylinder"
-            return Geometry(
-                shape, (float(geometry.cylinder.radius), float(geometry.cylinder.length))
-            )
-        if geometry.sphere is not None:
-            return Geometry("sphere", (float(geometry.sphere.radius),))
-        if geometry.mesh is not None:
-            element = f"link '{link}' <{role}> {index} <mesh>"
-            uri = geometry.mesh.filename
-            path = self.resolver.resolve(uri, base_dir=self.base_dir, element=element)
-            return Geometry("mesh", (), Path(path), uri, _scale(geometry.mesh.scale))
-        return None
+    def geometry(self, owner: ET.Element, link: str, role: str, index: int) -> Geometry:
+        """The one shape of a `<visual>`/`<collision>` (xml_checks guarantees there is one)."""
+        shape = owner.find("geometry")[0]
+        if shape.tag == "box":
+            return Geometry("box", _floats(shape, "size", ()))
+        if shape.tag in ("cylinder", "capsule"):
+            return Geometry(shape.tag, (float(shape.get("radius")), float(shape.get("length"))))
+        if shape.tag == "sphere":
+            return Geometry("sphere", (float(shape.get("radius")),))
+        element = f"link '{link}' <{role}> {index} <mesh>"
+        uri = shape.get("filename", "")
+        path = self.resolver.resolve(uri, base_dir=self.base_dir, element=element)
+        return Geometry("mesh", (), Path(path), uri, _scale(shape))
 
-    def material(self, material: object | None) -> Material | None:
+    def material(self, visual: ET.Element) -> Material | None:
         """A visual's material with its colour and texture filled in from the named ones."""
-        if material is None:
+        element = visual.find("material")
+        if element is None:
             return None
-        name = getattr(material, "name", None)
-        colour = getattr(material, "color", None)
-        texture = getattr(material, "texture", None)
-        if (colour is None or texture is None) and name in self.named:
-            shared = self.named[name]
-            colour = colour if colour is not None else getattr(shared, "color", None)
-            texture = texture if texture is not None else getattr(shared, "texture", None)
-        rgba = tuple(float(c) for c in colour.rgba) if colour is not None else None
-        return Material(name, rgba, getattr(texture, "filename", None))  # type: ignore[arg-type]
+        own = _material_of(element)
+        shared = self.named.get(own.name or "")
+        if shared is None:
+            return own
+        return Material(own.name, own.rgba or shared.rgba, own.texture or shared.texture)
 
 
-def _scale(value: object | None) -> tuple[float, float, float]:
-    if value is None:
-        return (1.0, 1.0, 1.0)
-    arr = np.atleast_1d(np.asarray(value, dtype=float))
-    if arr.size == 1:
-        arr = np.repeat(arr, 3)
-    return (float(arr[0]), float(arr[1]), float(arr[2]))
+def _scale(mesh: ET.Element) -> tuple[float, float, float]:
+    values = _floats(mesh, "scale", (1.0, 1.0, 1.0))
+    if len(values) == 1:
+        values = values * 3
+    return (values[0], values[1], values[2])
 
 
-def _inertial(inertial: object | None) -> Inertial | None:
-    if inertial is None:
+def _inertial(element: ET.Element | None) -> Inertial | None:
+    if element is None:
         return None
-    tensor = inertial.inertia if inertial.inertia is not None else np.zeros((3, 3))
-    mass = _number(inertial.mass, 0.0)
-    return Inertial(mass, np.asarray(tensor, dtype=float), _pose(inertial.origin))
+    moments = element.find("inertia")
+    i = {k: _number(moments, k, 0.0) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    tensor = np.array(
+        [
+            [i["ixx"], i["ixy"], i["ixz"]],
+            [i["ixy"], i["iyy"], i["iyz"]],
+            [i["ixz"], i["iyz"], i["izz"]],
+        ]
+    )
+    return Inertial(_number(element.find("mass"), "value", 0.0), tensor, _origin(element))
 
 
-def _joint(joint: object) -> Joint:
-    limit = joint.limit
-    dynamics = joint.dynamics
-    mimic = joint.mimic
-    axis = joint.axis if joint.axis is not None else (1.0, 0.0, 0.0)
+def _joint(joint: ET.Element) -> Joint:
+    limit, dynamics, mimic = joint.find("limit"), joint.find("dynamics"), joint.find("mimic")
     return Joint(
-        name=joint.name,
-        kind=joint.type,
-        parent=joint.parent,
-        child=joint.child,
-        origin=_pose(joint.origin),
-        axis=tuple(float(v) for v in axis),  # type: ignore[arg-type]
+        name=joint.get("name", ""),
+        kind=joint.get("type", ""),
+        parent=joint.find("parent").get("link"),
+        child=joint.find("child").get("link"),
+        origin=_origin(joint),
+        axis=_floats(joint.find("axis"), "xyz", DEFAULT_AXIS),
         limit=None
         if limit is None
-        else Limit(
-            _number(limit.lower),
-            _number(limit.upper),
-            _number(limit.effort),
-            _number(limit.velocity),
-        ),
+        else Limit(*(_number(limit, k, None) for k in ("lower", "upper", "effort", "velocity"))),
         dynamics=None
         if dynamics is None
-        else Dynamics(_number(dynamics.damping, 0.0), _number(dynamics.friction, 0.0)),
+        else Dynamics(_number(dynamics, "damping", 0.0), _number(dynamics, "friction", 0.0)),
         mimic=None
         if mimic is None
-        else Mimic(mimic.joint, _number(mimic.multiplier, 1.0), _number(mimic.offset, 0.0)),
-        ignored=tuple(name for name in CONTROLLER_ONLY if getattr(joint, name, None) is not None),
+        else Mimic(
+            mimic.get("joint", ""),
+            _number(mimic, "multiplier", 1.0),
+            _number(mimic, "offset", 0.0),
+        ),
+        ignored=tuple(name for name in CONTROLLER_ONLY if joint.find(name) is not None),
     )
-
-
-def _capsules_as_cylinders(root: ET.Element) -> set[tuple[str, str, int]]:
-    """Rewrite `<capsule>` to `<cylinder>` (yourdfpy rejects capsules) and remember where."""
-    found: set[tuple[str, str, int]] = set()
-    for link in root.findall("link"):
-        for role in ("visual", "collision"):
-            for index, element in enumerate(link.findall(role)):
-                capsule = element.find("geometry/capsule")
-                if capsule is not None:
-                    capsule.tag = "cylinder"
-                    found.add((link.get("name"), role, index))
-    return found
 
 
 def _named_joints(root: ET.Element, tags: tuple[str, ...]) -> tuple[str, ...]:

@@ -46,15 +46,20 @@ def info(json_mode: JsonOpt = False) -> None:
 
 @cache_app.command("clear")
 def clear(json_mode: JsonOpt = False) -> None:
-    """Remove every cached decomposition (the next conversion recomputes them)."""
+    """Remove every cached decomposition and stored mesh (the next conversion redoes them)."""
     from converters.collision import cache as mesh_cache
+    from converters.resources import mesh_store
 
-    removed = mesh_cache.clear()
+    removed, meshes = mesh_cache.clear(), mesh_store.clear()
     out = Output(json_mode)
     if json_mode:
-        out.data({"path": str(mesh_cache.collision_dir()), "removed": removed})
+        path = str(mesh_cache.collision_dir())
+        out.data({"path": path, "removed": removed, "meshes_removed": meshes})
         return
-    out.line(f"Removed {removed} cached decompositions from {mesh_cache.collision_dir()}")
+    out.line(
+        f"Removed {removed} cached decompositions from {mesh_cache.collision_dir()} "
+        f"and {meshes} stored meshes from {mesh_store.store_dir()}"
+    )
 
 
 def register(app: typer.Typer) -> None:
