@@ -140,37 +140,10 @@ def _report_softness(
 
 def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Report) -> None:
     for link, link_ext in ext.links.items():
-        if link in ext.unresolved:
-            continue
-        surface = link_ext.surface
-        subject = f"link '{link}'"
-        if surface.mu1 is not None:
-            report.mapped(subject, f"μ1={surface.mu1}: friction, min-μ priority", tag="mu1")
-        if surface.mu2 is not None and surface.mu2 != (surface.mu1 or DEFAULT_MU):
-            report.approximated(
-                subject,
-                f"μ2={surface.mu2} ≠ μ1: MuJoCo geoms are isotropic; μ1 is used in every "
-                "direction (keeps a wheel's traction along its rolling direction)",
-                tag="mu2",
-            )
-        if surface.fdir1 is not None:
-            report.approximated(
-                subject, f"fdir1={surface.fdir1}: no friction direction in MuJoCo", tag="fdir1"
-            )
-        if surface.min_depth is not None:
-            report.ignored(
-                subject,
-                f"minDepth={surface.min_depth} m: MuJoCo corrects any penetration (as 0)",
-                tag="minDepth",
-            )
-        _report_ignored_surface(subject, surface, report)
+        if link not in ext.unresolved and not link_ext.surface.is_empty():
+            _report_surface(f"link '{link}'", link_ext.surface, report)
     for inline in ext.inline_surfaces:
-        report.mapped(
-            f"link '{inline.link}' collision {inline.index}",
-            f"inline <surface>: μ1={inline.surface.mu1}, kp={inline.surface.kp}, "
-            f"kd={inline.surface.kd}",
-            tag="surface",
-        )
+        _report_surface(f"link '{inline.link}' collision {inline.index}", inline.surface, report)
     _report_gazebo_drops(ext, report)
     untagged = sum(
         1
@@ -183,6 +156,30 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
         f"{untagged} collision geoms without μ1",
         tag="mu1",
     )
+
+
+def _report_surface(subject: str, surface: Surface, report: Report) -> None:
+    """One report line per surface value: mapped, approximated or ignored, with the reason."""
+    if surface.mu1 is not None:
+        report.mapped(subject, f"μ1={surface.mu1}: friction, min-μ priority", tag="mu1")
+    if surface.mu2 is not None and surface.mu2 != (surface.mu1 or DEFAULT_MU):
+        report.approximated(
+            subject,
+            f"μ2={surface.mu2} ≠ μ1: MuJoCo geoms are isotropic; μ1 is used in every "
+            "direction (keeps a wheel's traction along its rolling direction)",
+            tag="mu2",
+        )
+    if surface.fdir1 is not None:
+        report.approximated(
+            subject, f"fdir1={surface.fdir1}: no friction direction in MuJoCo", tag="fdir1"
+        )
+    if surface.min_depth is not None:
+        report.ignored(
+            subject,
+            f"minDepth={surface.min_depth} m: MuJoCo corrects any penetration (as 0)",
+            tag="minDepth",
+        )
+    _report_ignored_surface(subject, surface, report)
 
 
 def _report_gazebo_drops(ext: GazeboExtensions, report: Report) -> None:

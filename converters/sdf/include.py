@@ -103,10 +103,14 @@ def _from_config(ctx: SdfContext, include: Any, directory: Path) -> Path:
 
 
 def _override(ctx: SdfContext, include: Any, element: Any) -> None:
-    """`<name>`, `<pose>` and `<static>` written in the include win over the model's own."""
+    """`<name>`, `<pose>`, `<static>` and `<placement_frame>` written in the include win over
+    the model's own."""
     name = ctx.text(include, "name")
     if name:
         element.set("name", name)
+    placement = ctx.text(include, "placement_frame")
+    if placement:
+        element.set("placement_frame", placement)
     for tag in ("pose", "static"):
         given = include.find(tag)
         if given is None:

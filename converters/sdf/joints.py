@@ -100,15 +100,18 @@ def _axis(
 ) -> tuple[float, float, float]:
     """The axis in the child link frame.
 
-    `<xyz expressed_in="F">` (1.7+) names its frame, default the joint frame; before 1.7,
-    `<use_parent_model_frame>true` means the model frame.
+    `<xyz expressed_in="F">` (1.7+) names its frame, default the joint frame; in 1.5-1.6
+    `<use_parent_model_frame>true` means the model frame; in 1.4 the axis is always in the model
+    frame (sdformat's 1.4 → 1.5 conversion adds use_parent_model_frame for that reason).
     """
     if axis is None or axis.find("xyz") is None:
         xyz, frame = np.array([0.0, 0.0, 1.0]), None
     else:
         xyz = np.asarray(ctx.vector(axis, "xyz", 3, (0.0, 0.0, 1.0)))
-        frame = axis.find("xyz").get("expressed_in") if ctx.frame_semantics else None
-        if not ctx.frame_semantics and ctx.flag(axis, "use_parent_model_frame", False):
+        frame = axis.find("xyz").get("expressed_in") or None if ctx.frame_semantics else None
+        if ctx.version == "1.4" or (
+            not ctx.frame_semantics and ctx.flag(axis, "use_parent_model_frame", False)
+        ):
             frame = MODEL_FRAME
     if frame is None:
         R_C_axis = X_C_J[:3, :3]

@@ -33,6 +33,8 @@ class FrameNode:
         relative_to: scoped name of the frame the pose is expressed in.
         attached_to: frames: the scoped frame it is fixed to; joints: the child link;
             models: the canonical link (None while the model has no link).
+        placement: models (1.8 `placement_frame`): the frame of the model that `pose` places,
+            instead of the model frame.
     """
 
     kind: str
@@ -40,6 +42,7 @@ class FrameNode:
     pose: np.ndarray
     relative_to: str | None
     attached_to: str | None = None
+    placement: str | None = None
 
 
 class PoseGraph:
@@ -60,6 +63,9 @@ class PoseGraph:
         for nested in model.findall("model"):
             name = prefix + nested.get("name", "")
             self._add(name + SEP + MODEL_FRAME, "model", nested, prefix, here)
+            placement = nested.get("placement_frame")
+            if placement:
+                self.nodes[name + SEP + MODEL_FRAME].placement = name + SEP + placement
             self._collect(nested, name + SEP)
         for joint in model.findall("joint"):
             child = self.ctx.text(joint, "child") or ""
@@ -69,10 +75,14 @@ class PoseGraph:
             attached = scoped(frame.get("attached_to") or MODEL_FRAME, prefix)
             self._add(prefix + frame.get("name", ""), "frame", frame, prefix, attached)
             self.nodes[prefix + frame.get("name", "")].attached_to = attached
+        # The model frame is attached to its canonical link: `canonical_link`, else the first
+        # link, else (no link of its own) the first nested model's frame (SDFormat 1.8).
         canonical = model.get("canonical_link")
-        first = model.find("link")
-        link = canonical or (first.get("name") if first is not None else None)
-        self.nodes[here].attached_to = scoped(link, prefix) if link else None
+        first, nested = model.find("link"), model.find("model")
+        if canonical or first is not None:
+            self.nodes[here].attached_to = prefix + (canonical or first.get("name"))
+        elif nested is not None:
+            self.nodes[here].attached_to = prefix + nested.get("name", "") + SEP + MODEL_FRAME
 
     def _add(self, name: str, kind: str, element: Any, prefix: str, default: str) -> None:
         if not element.get("name"):
@@ -125,8 +135,27 @@ class PoseGraph:
         if node.relative_to is None:
             return np.eye(4)
         base = self._pose(node.relative_to, node.element, (*chain, key))
-        self._resolved[key] = base @ node.pose
+        pose = node.pose
+        if node.placement is not None:  # the pose places that frame: X_M = X · inv(X_M_frame)
+            pose = pose @ np.linalg.inv(self._pose_within(node.placement, key, node.element))
+        self._resolved[key] = base @ pose
         return self._resolved[key]
+
+    def _pose_within(self, name: str, model_key: str, asked_by: Any) -> np.ndarray:
+        """The pose of frame `name` in the frame of model `model_key` (its own scope)."""
+        key, pose, seen = self._known(name, asked_by), np.eye(4), set()
+        while key != model_key:
+            node = self.nodes[key]
+            if key in seen or node.relative_to is None:
+                raise self.ctx.error(
+                    asked_by,
+                    f"placement_frame '{name}' is not a frame of this model",
+                    "name a link or frame inside the model",
+                )
+            seen.add(key)
+            pose = node.pose @ pose
+            key = self._known(node.relative_to, node.element)
+        return pose
 
     def _known(self, name: str, asked_by: Any) -> str:
         try:
@@ -145,7 +174,7 @@ class PoseGraph:
 
         Returns `WORLD_LINK` for the world frame.
         """
-        seen: set[str] = set()
+        seen: list[str] = []
         key = name
         while True:
             if key == WORLD_LINK:
@@ -154,13 +183,20 @@ class PoseGraph:
             node = self.nodes[key]
             if node.kind == "link":
                 return key
-            if key in seen or node.attached_to is None:
+            if key in seen:
+                loop = " → ".join([*seen, key])
+                raise self.ctx.error(
+                    node.element,
+                    f"frames are attached to each other in a cycle ({loop})",
+                    "attach one of them to a link",
+                )
+            if node.attached_to is None:
                 raise self.ctx.error(
                     node.element,
                     f"frame '{name}' is not attached to any link",
                     "attach it (attached_to) to a link, or give the model a link",
                 )
-            seen.add(key)
+            seen.append(key)
             key = node.attached_to
 
 
