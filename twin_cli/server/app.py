@@ -28,11 +28,13 @@ from twin_cli.errors import (
 )
 from twin_cli.server.models import (
     CommandBody,
+    FoxgloveBody,
     GravityBody,
     PathBody,
     PhysicsBody,
     PoseBody,
     PushBody,
+    RecordBody,
     ResetBody,
     SpawnBody,
     StepBody,
@@ -232,6 +234,51 @@ def shutdown(request: Request) -> dict:
     """End the server after this reply (what `twin stop` asks)."""
     request.app.state.request_exit()
     return {"stopping": request.app.state.world_name}
+
+
+def _consumers(request: Request) -> Any:
+    """The server's recording and live stream (`twin_cli.record.service.Consumers`)."""
+    state = request.app.state
+    if getattr(state, "consumers", None) is None:
+        from twin_cli.record.service import Consumers
+
+        state.consumers = Consumers()
+    return state.consumers
+
+
+@router.post("/record", status_code=201)
+def start_recording(body: RecordBody, request: Request, world: WorldDep) -> dict:
+    """Record the world into a rosbag2 MCAP file on the server host (`twin record`)."""
+    status = _consumers(request).record(
+        world, body.path, rate=body.rate, entities=body.entities, duration=body.duration
+    )
+    log.info("recording to %s at %g Hz", body.path, body.rate)
+    return status
+
+
+@router.get("/record")
+def recording_status(request: Request) -> dict:
+    return _consumers(request).record_status()
+
+
+@router.delete("/record")
+def stop_recording(request: Request) -> dict:
+    status = _consumers(request).stop_recording()
+    log.info("recording %s closed: %d samples", status["path"], status["samples"])
+    return status
+
+
+@router.post("/foxglove", status_code=201)
+def start_foxglove(body: FoxgloveBody, request: Request, world: WorldDep) -> dict:
+    """Stream the world's topics over the Foxglove WebSocket protocol (`twin foxglove`)."""
+    reply = _consumers(request).stream(world, port=body.port, host=body.host, rate=body.rate)
+    log.info("Foxglove stream on %s", reply["url"])
+    return reply
+
+
+@router.delete("/foxglove")
+def stop_foxglove(request: Request) -> dict:
+    return _consumers(request).stop_stream()
 
 
 # Status of each error class; other TwinError and ConversionError subclasses are 400.

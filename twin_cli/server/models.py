@@ -131,3 +131,20 @@ class PathBody(Body):
     """A file on the server host (absolute, or relative to the server's working directory)."""
 
     path: Annotated[str, Field(min_length=1)]
+
+
+class RecordBody(Body):
+    """`twin record`: a rosbag2 MCAP file on the server host, sampled in sim time."""
+
+    path: Annotated[str, Field(min_length=1)]
+    rate: Annotated[Finite, Field(gt=0, le=1000)] = 100.0
+    entities: list[EntityName] = []
+    duration: Annotated[Finite, Field(gt=0)] | None = None
+
+
+class FoxgloveBody(Body):
+    """`twin foxglove`: a live Foxglove WebSocket server (loopback unless a host is given)."""
+
+    port: Annotated[int, Field(ge=0, le=65535)] = 8765
+    host: str = "127.0.0.1"
+    rate: Annotated[Finite, Field(gt=0, le=1000)] = 30.0

@@ -34,6 +34,8 @@ class ServeOptions:
         paused: start paused.
         tcp: `HOST:PORT` or `PORT` for an extra TCP listener with a bearer token.
         background: started by a client that holds the world's start lock.
+        record: a rosbag2 MCAP file to record into from the start (100 Hz), or None.
+        foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
     """
 
     world: str = runtime.DEFAULT_WORLD
@@ -43,6 +45,8 @@ class ServeOptions:
     paused: bool = False
     tcp: str | None = None
     background: bool = False
+    record: str | None = None
+    foxglove: int | None = None
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -169,6 +173,7 @@ def serve(opts: ServeOptions) -> None:
             app, log_config=None, access_log=False, lifespan="off", timeout_graceful_shutdown=5
         )
         server = uvicorn.Server(config)
+        consumers = _start_consumers(app, world, opts)
         try:
             world.start()
             sockets = _listen(paths, tcp, token)
@@ -180,8 +185,26 @@ def serve(opts: ServeOptions) -> None:
             with contextlib.suppress(KeyboardInterrupt):
                 server.run(sockets=sockets)
         finally:
+            consumers.close()
             app.state.holder.world.stop()
             log.info("world [%s] stopped", opts.world)
+
+
+def _start_consumers(app: Any, world: Any, opts: ServeOptions) -> Any:
+    """`--record` and `--foxglove`: started before the world steps, so nothing is missed."""
+    from twin_cli.record.service import Consumers
+
+    consumers = app.state.consumers = Consumers()
+    try:
+        if opts.record:
+            consumers.record(world, opts.record)
+        if opts.foxglove is not None:
+            url = consumers.stream(world, port=opts.foxglove)["url"]
+            sys.stderr.write(f"twin: Foxglove stream on {url}\n")
+    except BaseException:
+        consumers.close()
+        raise
+    return consumers
 
 
 def _listen(paths: runtime.WorldPaths, tcp: tuple[str, int] | None, token: str | None) -> list:

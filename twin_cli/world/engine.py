@@ -39,6 +39,7 @@ from twin_cli.world.entities import (
     write_state,
 )
 from twin_cli.world.loop import SteppingLoop, WorldLock
+from twin_cli.world.observers import Observers
 from twin_cli.world.physics import PhysicsSettings
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
@@ -81,6 +82,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
         self.divergence_log: list[Divergence] = []
         self.mujoco_warnings: deque[str] = deque(maxlen=WARNINGS_KEPT)
         self._snapshot = np.empty(mujoco.mj_stateSize(self.model, STATE))
+        self._observers = Observers()  # recorder, live stream: called between batches
         self._loop = SteppingLoop(self)
 
     # ----------------------------------------------------------------- spawning and deleting
@@ -136,6 +138,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 loaded.report,
                 loaded.xml,
                 dict(joints or {}),
+                loaded.description,
             )
             self._commit(self._spec, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report)

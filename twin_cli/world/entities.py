@@ -81,6 +81,7 @@ class Entity:
         report: the converter's report as a dict (URDF/xacro sources), else None.
         xml: MJCF text of an MjSpec source (for save/load), else None.
         joints: initial joint positions given at spawn (`-J`), name → [rad] or [m].
+        description: the URDF text after xacro (for `/robot_description`), else None.
     """
 
     name: str
@@ -93,6 +94,7 @@ class Entity:
     report: dict | None = None
     xml: str | None = field(default=None, repr=False)
     joints: dict[str, float] = field(default_factory=dict)
+    description: str | None = field(default=None, repr=False)
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:

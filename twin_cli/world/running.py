@@ -8,6 +8,7 @@ start with "_" expect the caller to hold the lock (the loop thread and `step`).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import replace
 
 import mujoco
@@ -113,6 +114,23 @@ class RunControl:
         """Whether the stepping thread runs."""
         return self._loop.running
 
+    def add_observer(self, callback: Callable[[], None], rate: float) -> int:
+        """Calls `callback()` every 1/`rate` [Hz] of sim time, between steps, lock held.
+
+        For consumers of the world (recorder, live stream; design.md §7): the stepping splits its
+        `mj_step(nstep)` calls where an observer is due, so there is no Python per physics step.
+        The callback must only copy what it needs. Returns a handle for `remove_observer`.
+        """
+        with self.lock:
+            return self._observers.add(
+                callback, rate, float(self.data.time), self.model.opt.timestep
+            )
+
+    def remove_observer(self, handle: int) -> None:
+        """Stops calling an observer (may be called from within its callback)."""
+        with self.lock:
+            self._observers.remove(handle)
+
     # ----------------------------------------------------------------- stepping (lock held)
     def _loop_view(self) -> tuple[float, bool, float, int]:
         return self.settings.rate, self._paused, float(self.data.time), self._iterations
@@ -138,7 +156,10 @@ class RunControl:
         if n > 1:
             mujoco.mj_getState(m, d, self._snapshot, STATE)
         before = warning_counts(d)
-        self._mj_steps(n)
+        if self._observers:
+            self._observers.run(n, self._mj_steps, d, m.opt.timestep)
+        else:
+            self._mj_steps(n)
         self._iterations += n
         if batch_healthy(d, before):
             return

@@ -168,6 +168,7 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         entity.report,
         entity.xml,
         entity.joints,
+        entity.description,
     )
 
 

@@ -53,6 +53,8 @@ class LoadedSource:
         report: the converter's report as a dict (URDF/xacro), else None.
         xml: MJCF text of an MjSpec source, for save/load; else None.
         default_name: the robot's own name (model name or file stem).
+        description: the URDF text after xacro, for `/robot_description`; None for SDF, MJCF
+            and MjSpec sources (ROS tools draw robots from URDF only).
     """
 
     spec: mujoco.MjSpec
@@ -60,6 +62,7 @@ class LoadedSource:
     report: dict | None
     xml: str | None
     default_name: str
+    description: str | None = None
 
 
 def load_source(
@@ -123,7 +126,12 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
     )
     name = done.report.robot or "model"
     return LoadedSource(
-        done.spec, source.label, done.report.to_dict(), _xml_or_none(done.spec), name
+        done.spec,
+        source.label,
+        done.report.to_dict(),
+        _xml_or_none(done.spec),
+        name,
+        _urdf_or_none(done.description.text),
     )
 
 
@@ -138,11 +146,20 @@ def _load_mjcf(path: Path) -> LoadedSource:
 def _load_description(
     path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
 ) -> LoadedSource:
-    from converters.pipeline import convert
+    from converters.pipeline import convert_full
 
-    spec, report = convert(path, args=args, package_paths=package_paths)
+    done = convert_full(path, args=args, package_paths=package_paths)
+    spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
-    return LoadedSource(spec, str(path), report.to_dict(), None, name)
+    description = _urdf_or_none(done.description.text)
+    return LoadedSource(spec, str(path), report.to_dict(), None, name, description)
+
+
+def _urdf_or_none(text: str) -> str | None:
+    """The text when it is URDF (what robot_state_publisher and Foxglove draw), else None."""
+    from converters.formats import format_of
+
+    return text if text and format_of(text) == "urdf" else None
 
 
 def _xml_or_none(spec: mujoco.MjSpec) -> str | None:

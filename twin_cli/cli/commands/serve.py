@@ -25,13 +25,28 @@ def serve(
         str | None, typer.Option(help="Also listen on HOST:PORT (loopback if only PORT), token.")
     ] = None,
     background: Annotated[bool, typer.Option("--background", hidden=True)] = False,
+    record: Annotated[
+        Path | None, typer.Option(help="Record a rosbag2 MCAP file (100 Hz) from the start.")
+    ] = None,
+    foxglove: Annotated[
+        int | None,
+        typer.Option(help="Stream live to Foxglove on 127.0.0.1:PORT (Foxglove's is 8765)."),
+    ] = None,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
     from twin_cli.server.process import ServeOptions
     from twin_cli.server.process import serve as run_server
 
     opts = ServeOptions(
-        world, str(world_file) if world_file else None, rate, step, paused, tcp, background
+        world,
+        str(world_file) if world_file else None,
+        rate,
+        step,
+        paused,
+        tcp,
+        background,
+        str(record) if record else None,
+        foxglove,
     )
     run_server(opts)
 

@@ -1,0 +1,167 @@
+"""Recording the bundled humanoid falling, read back by readers independent of the writer."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+from record_helpers import compose_links, pose_error, read_bag, seconds
+
+from twin_cli.errors import EntityNotFoundError, InvalidRequestError, RequestError
+from twin_cli.record import BagSink, Recording
+from twin_cli.world import Pose, World
+
+HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+RATE = 100.0  # [Hz]
+STEPS_PER_SAMPLE = 10  # 1 ms world step
+SAMPLES = 200  # 2 s
+POSITION_TOL = 1e-9  # [m]
+QUAT_TOL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def falling(tmp_path_factory) -> tuple[Path, dict[float, dict], dict[float, list]]:
+    """2 s of the humanoid falling from 1 m, sampled at 100 Hz; the world's own link poses and
+    joint states at each sample time, read through World's API as `twin links/joints` do."""
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    path = tmp_path_factory.mktemp("rec") / "fall.mcap"
+    recording = Recording(world, [BagSink(path)], rate=RATE).start()
+    links, joints = {0.0: world.link_poses("h")}, {0.0: world.joint_states("h")}
+    for _ in range(SAMPLES):
+        world.step(STEPS_PER_SAMPLE)
+        if not hasattr(world, "add_observer"):
+            recording.capture_now()
+        t = round(float(world.data.time), 9)
+        links[t], joints[t] = world.link_poses("h"), world.joint_states("h")
+    status = recording.stop()
+    assert status.error is None and status.samples == SAMPLES + 1, status
+    return path, links, joints
+
+
+def test_every_message_deserializes_and_clock_ticks_at_the_rate(falling):
+    path, _, _ = falling
+    bag = read_bag(path)
+    assert {"/clock", "/tf", "/tf_static", "/h/joint_states", "/h/odom"} <= set(bag)
+    clock = np.array([seconds(m.clock) for _, m in bag["/clock"]])
+    assert len(clock) == SAMPLES + 1, "number of /clock messages"
+    assert np.allclose(np.diff(clock), 1.0 / RATE, atol=1e-9), "/clock period"
+    log_times = np.array([stamp for stamp, _ in bag["/clock"]]) * 1e-9
+    assert np.allclose(log_times, clock, atol=1e-9), "log time is sim time"
+
+
+def test_tf_composes_to_the_worlds_link_poses(falling):
+    path, links, _ = falling
+    bag = read_bag(path)
+    ((_, tf_static),) = bag["/tf_static"]
+    assert {t.child_frame_id for t in tf_static.transforms} == {"h/imu_link"}, "lumped link frame"
+    picks = np.linspace(0, SAMPLES, 20).astype(int)
+    for k in picks:
+        _, tf = bag["/tf"][k]
+        t = round(seconds(tf.transforms[0].header.stamp), 9)
+        composed = compose_links(tf, tf_static)
+        for link, pose in links[t].items():
+            dp, dq = pose_error(composed[f"h/{link}"], pose)
+            assert dp < POSITION_TOL, f"position of {link} at t={t}: {dp} m"
+            assert dq < QUAT_TOL, f"orientation of {link} at t={t}: {dq}"
+
+
+def test_joint_states_equal_the_worlds(falling):
+    path, _, joints = falling
+    for _, message in read_bag(path)["/h/joint_states"]:
+        t = round(seconds(message.header.stamp), 9)
+        expected = joints[t]
+        assert list(message.name) == [j.name for j in expected]
+        for field in ("position", "velocity", "effort"):
+            got = np.asarray(getattr(message, field))
+            want = np.array([getattr(j, field) for j in expected])
+            assert np.array_equal(got, want), f"{field} at t={t}"
+
+
+def test_odometry_is_the_root_pose(falling):
+    path, links, _ = falling
+    for _, message in read_bag(path)["/h/odom"][::20]:
+        t = round(seconds(message.header.stamp), 9)
+        p, q = message.pose.pose.position, message.pose.pose.orientation
+        composed = (np.array([p.x, p.y, p.z]), np.array([q.w, q.x, q.y, q.z]))
+        dp, dq = pose_error(composed, links[t]["torso"])
+        assert dp < POSITION_TOL and dq < QUAT_TOL, f"odometry at t={t}"
+        assert message.child_frame_id == "h/torso" and message.header.frame_id == "world"
+
+
+def test_robot_description_is_the_urdf_whose_links_are_the_frames(falling):
+    import yourdfpy
+
+    path, links, _ = falling
+    ((_, message),) = read_bag(path)["/h/robot_description"]
+    urdf = yourdfpy.URDF.load(io.StringIO(message.data), load_meshes=False)
+    assert set(links[0.0]) | {"imu_link"} == set(urdf.link_map), "URDF links vs recorded frames"
+
+
+def test_mcap_library_validates_chunks_summary_and_rosbag2_metadata(falling):
+    import yaml
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    path, _, joints = falling
+    with path.open("rb") as stream:
+        reader = make_reader(stream, validate_crcs=True, decoder_factories=[DecoderFactory()])
+        summary = reader.get_summary()
+        assert summary is not None and summary.chunk_indexes, "summary with chunk indexes"
+        assert all(s.encoding == "ros2msg" for s in summary.schemas.values())
+        assert all(c.message_encoding == "cdr" for c in summary.channels.values())
+        latched = {
+            c.topic
+            for c in summary.channels.values()
+            if "transient_local" in c.metadata["offered_qos_profiles"]
+        }
+        assert latched == {"/tf_static", "/h/robot_description"}
+        decoded = [m for _, _, _, m in reader.iter_decoded_messages(topics=["/h/joint_states"])]
+        count = sum(1 for _ in reader.iter_messages())
+        (meta,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
+    info = yaml.safe_load(meta.metadata["serialized_metadata"])
+    assert info["message_count"] == count == summary.statistics.message_count
+    assert len(decoded) == SAMPLES + 1
+    last = decoded[-1]  # a second CDR decoder agrees with the world
+    t = round(last.header.stamp.sec + last.header.stamp.nanosec * 1e-9, 9)
+    assert list(last.position) == [j.position for j in joints[t]]
+
+
+def test_bad_requests_name_the_subject_and_the_fix(tmp_path):
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    with pytest.raises(RequestError, match="cannot be written.*writable directory"):
+        BagSink(tmp_path / "missing" / "out.mcap")
+    (tmp_path / "taken.mcap").write_bytes(b"")
+    with pytest.raises(RequestError, match="already exists.*remove it"):
+        BagSink(tmp_path / "taken.mcap")
+    with pytest.raises(EntityNotFoundError, match=r"Entity \[nobody\].*entities in this world: h"):
+        Recording(world, [], entities=["nobody"])
+    with pytest.raises(InvalidRequestError, match="rate"):
+        Recording(world, [], rate=0.0)
+
+
+def test_observers_fire_on_the_rate_grid_across_batch_sizes():
+    """The stepping splits batches where an observer is due: any batch size, same sample times."""
+    from twin_cli.world.observers import Observers, next_due, steps_until_due
+
+    assert steps_until_due(0.0, 0.01, 0.001) == 10
+    assert next_due(0.0100000000001, 0.0, 0.01, 0.001) == pytest.approx(0.02)
+    for batch in (1, 7, 10, 333):
+
+        class Data:
+            time = 0.0
+
+        def step(k: int, data=Data) -> None:
+            data.time = round(data.time + k * 0.001, 12)
+
+        seen: list[float] = []
+        observers = Observers()
+        observers.add(lambda data=Data, seen=seen: seen.append(data.time), 100.0, 0.0, 0.001)
+        for _ in range(1000 // batch):
+            observers.run(batch, step, Data, 0.001)
+        expected = [round(0.01 * k, 12) for k in range(1, len(seen) + 1)]
+        assert seen == pytest.approx(expected, abs=1e-12), f"batch {batch}"
+        assert len(seen) == (1000 // batch) * batch // 10

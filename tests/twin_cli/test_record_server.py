@@ -1,0 +1,175 @@
+"""Recording and streaming from a real `twin serve`: the CLI, a SIGKILL mid-recording, and a
+WebSocket client speaking the published Foxglove protocol (no Foxglove code on the reading side).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import os
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from record_helpers import read_bag, seconds
+
+HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+# foxglove/ws-protocol docs/spec.md names the first; foxglove-sdk ≥ 0.x servers answer the second.
+FOXGLOVE_SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
+MESSAGE_DATA, TIME = 0x01, 0x02  # binary opcodes, server → client
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def twin(*args: str, world: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", world],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=os.environ.copy(),
+    )
+
+
+def test_twin_record_for_a_duration_writes_a_bag(tmp_path, serve_world):
+    with serve_world(tmp_path, "rec") as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        out = tmp_path / "fall.mcap"
+        done = twin("record", str(out), "--duration", "0.5", "--rate", "50", world="rec")
+        assert done.returncode == 0, done.stderr
+        assert "26 samples" in done.stdout
+        bag = read_bag(out)
+        clock = np.array([seconds(m.clock) for _, m in bag["/clock"]])
+        assert len(clock) == 26 and np.allclose(np.diff(clock), 0.02, atol=1e-9)
+        assert "/h/robot_description" in bag
+
+
+def test_bad_input_is_one_message_and_exit_2(tmp_path, serve_world):
+    with serve_world(tmp_path, "recbad") as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        done = twin("record", str(tmp_path / "no" / "dir" / "x.mcap"), world="recbad")
+        assert done.returncode == 2 and "cannot be written" in done.stderr, done.stderr
+        done = twin("record", str(tmp_path / "x.mcap"), "--entity", "ghost", world="recbad")
+        assert done.returncode == 2 and "Entity [ghost] does not exist" in done.stderr
+        with socket.socket() as taken:
+            taken.bind(("127.0.0.1", 0))
+            taken.listen()
+            port = str(taken.getsockname()[1])
+            done = twin("foxglove", "--port", port, world="recbad")
+        assert done.returncode == 2 and f"{port}" in done.stderr, done.stderr
+        assert "choose another port" in done.stderr
+
+
+def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path, serve_world):
+    from mcap.exceptions import McapError
+    from mcap.stream_reader import StreamReader
+    from mcap_ros2.decoder import DecoderFactory
+
+    out = tmp_path / "killed.mcap"
+    with serve_world(tmp_path, "reckill") as (client, proc):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        client.request("POST", "/record", body={"path": str(out), "rate": 100})
+        time.sleep(3.0)  # > FLUSH_PERIOD_S: at least one chunk reached the OS
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    schemas, channels, stamps = {}, {}, []
+    decoders = DecoderFactory()  # mcap_ros2: a CDR decoder that is not rosbags'
+    with out.open("rb") as stream:
+        try:
+            for record in StreamReader(stream).records:
+                kind = type(record).__name__
+                if kind == "Schema":
+                    schemas[record.id] = record
+                elif kind == "Channel":
+                    channels[record.id] = record
+                elif kind == "Message" and channels[record.channel_id].topic == "/clock":
+                    schema = schemas[channels[record.channel_id].schema_id]
+                    clock = decoders.decoder_for("cdr", schema)(record.data)
+                    assert clock.clock.sec * 10**9 + clock.clock.nanosec == record.log_time
+                    stamps.append(record.log_time)
+        except (McapError, EOFError, struct.error):
+            pass  # the cut: the chunk being written when the process died
+    assert len(stamps) >= 50, f"{len(stamps)} /clock messages survived"
+    assert np.all(np.diff(stamps) == 10_000_000), "consecutive 100 Hz samples up to the cut"
+
+
+def _foxglove_session(port: int, client, steps: int) -> dict:
+    """Subscribe to /tf and /h/joint_states, step the paused world, spawn a second robot."""
+    import websockets
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+
+    async def run() -> dict:
+        url = f"ws://127.0.0.1:{port}"
+        async with websockets.connect(url, subprotocols=FOXGLOVE_SUBPROTOCOLS) as ws:
+            channels: dict[str, dict] = {}
+            got: dict[str, list] = {"/tf": [], "/h/joint_states": []}
+            subscribed: dict[int, str] = {}
+
+            async def pump(until, timeout=20.0) -> None:
+                deadline = time.monotonic() + timeout
+                while not until():
+                    frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                    if isinstance(frame, str):
+                        op = json.loads(frame)
+                        if op["op"] == "advertise":
+                            channels.update({c["topic"]: c for c in op["channels"]})
+                        continue
+                    if frame[0] == MESSAGE_DATA:
+                        sub, stamp = struct.unpack_from("<IQ", frame, 1)
+                        topic = subscribed[sub]
+                        msgtype = channels[topic]["schemaName"]
+                        got[topic].append((stamp, store.deserialize_cdr(frame[13:], msgtype)))
+
+            await asyncio.to_thread(client.step, 50)  # a paused world is sampled when it steps
+            await pump(lambda: {"/tf", "/h/joint_states"} <= set(channels))
+            subs = []
+            for k, topic in enumerate(("/tf", "/h/joint_states"), start=1):
+                subscribed[k] = topic
+                subs.append({"id": k, "channelId": channels[topic]["id"]})
+            await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+            await asyncio.sleep(0.5)
+            await asyncio.to_thread(client.step, steps - 50)
+            await pump(
+                lambda: (
+                    got["/tf"] and got["/h/joint_states"][-1:][0][0] == steps * 10**6
+                    if got["/h/joint_states"]
+                    else False
+                )
+            )
+            joints = await asyncio.to_thread(client.joints, "h")
+            await asyncio.to_thread(
+                client.spawn, str(HUMANOID), name="h2", pose={"x": 2.0, "z": 1.0}
+            )
+            await asyncio.to_thread(client.step, steps)
+            h2 = {"/h2/joint_states", "/h2/robot_description", "/h2/odom"}
+            await pump(lambda: h2 <= set(channels))
+            return {"got": got, "joints": joints, "channels": channels}
+
+    return asyncio.run(run())
+
+
+def test_foxglove_clients_receive_the_worlds_state_and_new_entities(tmp_path, serve_world):
+    port = free_port()
+    with serve_world(tmp_path, "fox", "--paused", "--foxglove", str(port)) as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        session = _foxglove_session(port, client, steps=300)
+    got, joints = session["got"], session["joints"]
+    stamp, message = got["/h/joint_states"][-1]
+    assert stamp == 300_000_000, "stamped with sim time (paused world stepped 300 × 1 ms)"
+    assert list(message.name) == [j["name"] for j in joints]
+    assert np.array_equal(message.position, [j["position"] for j in joints]), "positions"
+    assert np.array_equal(message.velocity, [j["velocity"] for j in joints]), "velocities"
+    _, tf = got["/tf"][-1]
+    assert ("world", "h/torso") in {(t.header.frame_id, t.child_frame_id) for t in tf.transforms}
+    assert {"/h2/joint_states", "/h2/robot_description", "/h2/odom"} <= set(session["channels"])

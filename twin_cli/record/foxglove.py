@@ -1,0 +1,135 @@
+"""The twin's topics live over the Foxglove WebSocket protocol (foxglove-sdk), on 127.0.0.1.
+
+Each topic is a channel with its `ros2msg` schema and CDR messages, the same bytes as in a
+recording, so Foxglove decodes them as it decodes a ROS 2 bag. The server advertises the `Time`
+capability and broadcasts sim time, so Foxglove's clock is the world's. Channels open and close
+as entities are spawned and deleted. A latched topic's last message is sent again when a client
+subscribes to it (the WebSocket protocol has no transient-local durability).
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+import threading
+from typing import Any
+
+from twin_cli.errors import RequestError
+from twin_cli.record import messages as ros
+from twin_cli.record.topics import Message, Topic
+
+log = logging.getLogger("twin.foxglove")
+DEFAULT_PORT = 8765  # Foxglove's own default
+LOOPBACK = "127.0.0.1"
+
+
+class _Subscriptions:
+    """foxglove-sdk ServerListener: remembers topics whose latched message must be re-sent."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.resend: set[str] = set()
+
+    def on_subscribe(self, client: Any, channel: Any) -> None:
+        with self.lock:
+            self.resend.add(channel.topic)
+
+    def take(self) -> set[str]:
+        with self.lock:
+            topics, self.resend = self.resend, set()
+        return topics
+
+
+class LiveStream:
+    """A Foxglove WebSocket server carrying the world's topics (a recording sink)."""
+
+    def __init__(self, port: int = DEFAULT_PORT, host: str = LOOPBACK, name: str = "twin") -> None:
+        """Raises: RequestError: the port is in use or the address is not valid."""
+        import foxglove
+        from foxglove.websocket import Capability
+
+        _check_address(host, port)
+        self._foxglove = foxglove
+        self._context = foxglove.Context()
+        self._listener = _Subscriptions()
+        try:
+            self._server = foxglove.start_server(
+                name=name,
+                host=host,
+                port=port,
+                capabilities=[Capability.Time],
+                server_listener=self._listener,
+                supported_encodings=["cdr"],
+                context=self._context,
+            )
+        except Exception as exc:  # the SDK raises its own error types for bind failures
+            raise RequestError(
+                f"Foxglove port {host}:{port}",
+                f"cannot be opened ({exc})",
+                "choose another port (e.g. --port 8766), or stop what listens there",
+            ) from exc
+        if not ipaddress.ip_address(host).is_loopback:
+            log.warning("Foxglove server on non-loopback %s:%d: anyone there can watch", host, port)
+        self._channels: dict[str, Any] = {}
+        self._latched: dict[str, bytes] = {}
+        self._last_time = -1
+
+    @property
+    def port(self) -> int:
+        """The port the server listens on (useful with port 0)."""
+        return int(self._server.port)
+
+    def set_topics(self, topics: list[Topic]) -> None:
+        """Opens channels for new topics and closes those of entities that are gone."""
+        wanted = {t.name: t for t in topics}
+        for name in [n for n in self._channels if n not in wanted]:
+            self._channels.pop(name).close()
+            self._latched.pop(name, None)
+        for name, topic in wanted.items():
+            if name not in self._channels:
+                self._channels[name] = self._open(topic)
+
+    def _open(self, topic: Topic) -> Any:
+        d = ros.definition(topic.type)
+        schema = self._foxglove.Schema(name=d.name, encoding="ros2msg", data=d.text.encode())
+        return self._foxglove.Channel(
+            topic.name, schema=schema, message_encoding="cdr", context=self._context
+        )
+
+    def write(self, message: Message) -> None:
+        """Sends one message (and any latched message a new subscriber has not had)."""
+        stamp = ros.nanoseconds(message.time)
+        if stamp != self._last_time:
+            self._server.broadcast_time(stamp)
+            self._last_time = stamp
+        self._resend(stamp)
+        channel = self._channels.get(message.topic)
+        if channel is None:
+            return
+        data = ros.encode(message.message, message.type)
+        if message.topic in ("/tf_static",) or message.topic.endswith("/robot_description"):
+            self._latched[message.topic] = data
+        channel.log(data, log_time=stamp)
+
+    def _resend(self, stamp: int) -> None:
+        for topic in self._listener.take():
+            if topic in self._latched and topic in self._channels:
+                self._channels[topic].log(self._latched[topic], log_time=stamp)
+
+    def close(self) -> None:
+        """Closes every channel and stops the server."""
+        for channel in self._channels.values():
+            channel.close()
+        self._channels.clear()
+        self._server.stop()
+
+
+def _check_address(host: str, port: int) -> None:
+    try:
+        ipaddress.ip_address(host)
+    except ValueError as exc:
+        raise RequestError(
+            f"Foxglove host {host}", "is not an IP address", "use 127.0.0.1"
+        ) from exc
+    if not 0 <= port <= 65535:
+        raise RequestError(f"Foxglove port {port}", "is out of range", "use 1-65535 (0: any)")

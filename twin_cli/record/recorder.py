@@ -1,0 +1,244 @@
+"""A recording: samples taken in the stepping thread, messages made and written in a worker.
+
+The stepping thread only runs `Sampler.capture` (a few copies) and queues the sample; a worker
+thread computes link poses, builds the ROS messages and hands them to the sinks (an MCAP file,
+a Foxglove server). Sinks see topics appear and disappear as entities are spawned and deleted.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import queue
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from twin_cli.errors import InvalidRequestError
+from twin_cli.record.layout import Layout
+from twin_cli.record.sampler import Kinematics, Sample, Sampler
+from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
+
+log = logging.getLogger("twin.record")
+MAX_RATE = 1000.0  # [Hz] of sim time; above the world's step rate a sample is taken every step
+
+
+class Sink(Protocol):
+    """Where messages go: a bag file, a live server."""
+
+    def set_topics(self, topics: list[Topic]) -> None: ...
+
+    def write(self, message: Message) -> None: ...
+
+    def close(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class RecordingStatus:
+    """What a recording has done so far.
+
+    Attributes:
+        active: still sampling; samples: samples written; start, end: their sim times [s].
+        error: why the worker stopped early, or None.
+    """
+
+    active: bool
+    samples: int
+    start: float | None
+    end: float | None
+    error: str | None
+
+
+def check_rate(rate: float) -> float:
+    """The sampling rate [Hz] if it is finite and in (0, MAX_RATE].
+
+    Raises:
+        InvalidRequestError: outside that range.
+    """
+    if not (math.isfinite(rate) and 0.0 < rate <= MAX_RATE):
+        raise InvalidRequestError(
+            "recording rate", f"{rate} Hz is not in (0, {MAX_RATE:g}]", "give e.g. --rate 100"
+        )
+    return rate
+
+
+class Recording:
+    """Samples `world` at `rate` [Hz] of sim time into `sinks` until `stop` (or `duration`)."""
+
+    def __init__(
+        self,
+        world: Any,
+        sinks: Sequence[Sink],
+        *,
+        rate: float = 100.0,
+        entities: Sequence[str] = (),
+        descriptions: dict[str, str] | None = None,
+        duration: float | None = None,
+        latest_only: bool = False,
+    ) -> None:
+        """Args:
+        world: a `twin_cli.world.World` (stepping or not).
+        sinks: receivers of every message.
+        rate: samples per second of sim time.
+        entities: entities to record (empty: all, and those spawned later).
+        descriptions: URDF by entity, for entities spawned from an MjSpec.
+        duration: stop after this much sim time [s] (None: until `stop`).
+        latest_only: while the worker is busy, keep only the newest sample (live views: never
+            slows the loop, never falls behind, always ends on the latest state).
+
+        Raises:
+            EntityNotFoundError, InvalidRequestError: unknown entity, bad rate or duration.
+        """
+        self.rate = check_rate(rate)
+        if duration is not None and not (math.isfinite(duration) and duration > 0):
+            raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
+        self._world = world
+        self._sampler = Sampler(world, entities, descriptions)
+        self._sinks = list(sinks)
+        self._duration = duration
+        self._latest_only = latest_only
+        self._queue: queue.SimpleQueue[Sample | None] = queue.SimpleQueue()
+        self._handle: int | None = None
+        self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
+        self._busy, self._newest = False, None
+        self._until: float | None = None
+        self._done = threading.Event()
+        self._samples, self._span = 0, [None, None]
+        self._error: str | None = None
+        self._worker = threading.Thread(target=self._work, name="twin-record", daemon=True)
+
+    # ------------------------------------------------------------ control (any thread)
+    def start(self) -> Recording:
+        """Takes the first sample now and follows the world's stepping from here on."""
+        self._worker.start()
+        with self._world.lock:
+            now = float(self._world.data.time)
+            self._until = None if self._duration is None else now + self._duration
+            self._capture()
+            if not self._done.is_set() and hasattr(self._world, "add_observer"):
+                self._handle = self._world.add_observer(self._capture, self.rate)
+        return self
+
+    def capture_now(self) -> None:
+        """Takes one sample now (for callers that step the world themselves)."""
+        with self._world.lock:
+            self._capture()
+
+    def stop(self) -> RecordingStatus:
+        """Stops sampling, writes what is queued, closes the sinks; returns the status."""
+        self._finish_sampling()
+        self._worker.join()
+        return self.status()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Waits until the duration is over (or `stop`); True when sampling has ended."""
+        return self._done.wait(timeout)
+
+    def status(self) -> RecordingStatus:
+        start, end = self._span
+        active = not self._done.is_set()
+        return RecordingStatus(active, self._samples, start, end, self._error)
+
+    # ------------------------------------------------------------ stepping thread (lock held)
+    def _capture(self) -> None:
+        if self._done.is_set():
+            return
+        sample = self._sampler.capture()
+        if self._latest_only:
+            with self._slot_lock:
+                if self._busy:
+                    self._newest = sample
+                    return
+                self._busy = True
+        self._queue.put(sample)
+        if self._until is not None and sample.time >= self._until - 1e-9:
+            self._finish_sampling()
+
+    def _finish_sampling(self) -> None:
+        if self._done.is_set():
+            return
+        self._done.set()
+        if self._handle is not None:
+            self._world.remove_observer(self._handle)
+        self._queue.put(None)
+
+    # ------------------------------------------------------------ worker thread
+    def _work(self) -> None:
+        kinematics, layout = Kinematics(), None
+        try:
+            while (sample := self._queue.get()) is not None:
+                while sample is not None:
+                    layout = self._publish(sample, layout, kinematics)
+                    sample = self._next_newest()
+        except Exception as exc:  # disk full, a closed sink: stop sampling, report it
+            log.exception("recording failed")
+            self._error = f"{type(exc).__name__}: {exc}"
+            self._finish_sampling()
+        finally:
+            self._close_sinks()
+
+    def _publish(self, sample: Sample, layout: Layout | None, kinematics: Kinematics) -> Layout:
+        if not sample.finite():
+            return layout
+        if sample.layout is not layout:
+            layout = sample.layout
+            self._relayout(layout, sample.time)
+        xpos, xquat = kinematics.poses(sample)
+        for message in live_messages(sample, xpos, xquat):
+            self._emit(message)
+        self._count(sample.time)
+        return layout
+
+    def _next_newest(self) -> Sample | None:
+        """latest_only: the newest sample kept while busy, or None (and the worker is idle)."""
+        if not self._latest_only:
+            return None
+        with self._slot_lock:
+            sample, self._newest = self._newest, None
+            self._busy = sample is not None
+        return sample
+
+    def _relayout(self, layout: Layout, time: float) -> None:
+        names = topics(layout)
+        for sink in self._sinks:
+            sink.set_topics(names)
+        for message in latched_messages(layout, time):
+            self._emit(message)
+
+    def _emit(self, message: Message) -> None:
+        for sink in self._sinks:
+            sink.write(message)
+
+    def _count(self, time: float) -> None:
+        self._samples += 1
+        if self._span[0] is None:
+            self._span[0] = time
+        self._span[1] = time
+
+    def _close_sinks(self) -> None:
+        for sink in self._sinks:
+            try:
+                sink.close()
+            except Exception as exc:
+                log.exception("closing %s failed", sink)
+                self._error = self._error or f"{type(exc).__name__}: {exc}"
+
+
+class BagSink:
+    """A `BagWriter` as a sink: topics are added as they appear (an MCAP file keeps them all)."""
+
+    def __init__(self, path: Any, *, overwrite: bool = False) -> None:
+        from twin_cli.record.mcap_writer import BagWriter
+
+        self.writer = BagWriter(path, overwrite=overwrite)
+
+    def set_topics(self, topics: list[Topic]) -> None:
+        for topic in topics:
+            self.writer.add_topic(topic)
+
+    def write(self, message: Message) -> None:
+        self.writer.write(message)
+
+    def close(self) -> None:
+        self.writer.close()

@@ -1,0 +1,115 @@
+"""The recording and the live stream a world server runs (at most one of each at a time).
+
+Used by the server's `/record` and `/foxglove` routes and by `twin serve --record/--foxglove`;
+kept here so that the server holds no recording logic.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+from dataclasses import asdict
+from typing import Any
+
+from twin_cli.errors import InvalidRequestError
+from twin_cli.record.foxglove import LiveStream
+from twin_cli.record.recorder import BagSink, Recording
+
+
+class Consumers:
+    """One server's recording and live stream; start/stop are thread safe."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self.recording: Recording | None = None
+        self.recording_path: str | None = None
+        self.live: tuple[Recording, LiveStream] | None = None
+
+    def record(
+        self,
+        world: Any,
+        path: str,
+        *,
+        rate: float = 100.0,
+        entities: Sequence[str] = (),
+        duration: float | None = None,
+    ) -> dict:
+        """Starts recording `world` into `path`.
+
+        Raises:
+            InvalidRequestError: a recording is running. RequestError: unwritable path.
+            EntityNotFoundError: unknown entity.
+        """
+        with self._lock:
+            if self.recording is not None and self.recording.status().active:
+                raise InvalidRequestError(
+                    "recording",
+                    f"already recording into {self.recording_path}",
+                    "stop it first (`twin record --stop` or Ctrl-C the recording command)",
+                )
+            if self.recording is not None:
+                self.recording.stop()
+            sink = BagSink(path)
+            try:
+                recording = Recording(
+                    world, [sink], rate=rate, entities=entities, duration=duration
+                )
+            except BaseException:
+                sink.close()
+                raise
+            self.recording, self.recording_path = recording.start(), path
+            return self.record_status()
+
+    def record_status(self) -> dict:
+        """The recording's status (`active` false once it ended); raises when none was made."""
+        if self.recording is None:
+            raise InvalidRequestError("recording", "none was started", "start one with twin record")
+        return {"path": self.recording_path, **asdict(self.recording.status())}
+
+    def stop_recording(self) -> dict:
+        """Stops the recording and closes its file; returns its final status."""
+        with self._lock:
+            if self.recording is None:
+                raise InvalidRequestError(
+                    "recording", "none is running", "start one with twin record"
+                )
+            self.recording.stop()
+            status = self.record_status()
+            self.recording = None
+            return status
+
+    def stream(self, world: Any, *, port: int, host: str = "127.0.0.1", rate: float = 30.0) -> dict:
+        """Starts the Foxglove server on `host:port` (latest sample only: never slows the loop)."""
+        with self._lock:
+            if self.live is not None:
+                raise InvalidRequestError(
+                    "Foxglove stream",
+                    f"already streaming on port {self.live[1].port}",
+                    "connect Foxglove to it, or stop it first",
+                )
+            live = LiveStream(port, host)
+            try:
+                recording = Recording(world, [live], rate=rate, latest_only=True)
+            except BaseException:
+                live.close()
+                raise
+            self.live = (recording.start(), live)
+            return {"host": host, "port": live.port, "url": f"ws://{host}:{live.port}"}
+
+    def stop_stream(self) -> dict:
+        with self._lock:
+            if self.live is None:
+                raise InvalidRequestError("Foxglove stream", "none is running", "twin foxglove")
+            recording, live = self.live
+            recording.stop()
+            self.live = None
+            return {"stopped": live.port}
+
+    def close(self) -> None:
+        """Stops both (server shutdown): the recording's file gets its summary."""
+        if self.recording is not None:
+            self.recording.stop()
+            self.recording = None
+        if self.live is not None:
+            self.live[0].stop()
+            self.live = None

@@ -1,0 +1,121 @@
+"""Consumers of a running world (recorder, live stream, viewers) called between batches.
+
+An observer asks for a rate in *simulated* time; the stepping code splits each `mj_step(nstep)`
+call at the steps where an observer is due and calls it there, with the world's lock held, so a
+100 Hz recording of a 1 ms world gets a sample every 10 steps exactly, at any real-time factor,
+with no Python per physics step. Callbacks must only copy what they need (a few microseconds)
+and do their encoding and I/O elsewhere (design.md §7). The rules (`steps_until_due`,
+`next_due`) are pure functions, testable without threads.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+DUE_TOLERANCE = 1e-6  # fraction of a step: sim time accumulates rounding (0.01 != 10 * 0.001)
+
+
+def steps_until_due(time: float, due: float, timestep: float) -> int:
+    """Steps from `time` [s] until the sim time reaches `due` [s]; at least 1."""
+    return max(1, math.ceil((due - time) / timestep - DUE_TOLERANCE))
+
+
+def next_due(time: float, origin: float, period: float, timestep: float) -> float:
+    """The first time `origin + k·period` [s] strictly after `time` (within a step's rounding).
+
+    Computed from the origin, not by adding periods, so rounding never accumulates.
+    """
+    k = math.floor((time - origin) / period + DUE_TOLERANCE * timestep / period)
+    return origin + (k + 1) * period
+
+
+def is_due(time: float, due: float, timestep: float) -> bool:
+    """Whether sim `time` [s] has reached `due` [s] (to a millionth of a step)."""
+    return time >= due - DUE_TOLERANCE * timestep
+
+
+@dataclass
+class _Entry:
+    callback: Callable[[], None]
+    period: float  # [s] of simulated time
+    origin: float  # [s] sim time the observer was added (or the clock was reset) at
+    due: float  # [s] next sim time to call at
+
+
+class Observers:
+    """The observers of one world, by handle; empty costs one attribute test per batch."""
+
+    def __init__(self) -> None:
+        self._entries: dict[int, _Entry] = {}
+        self._handles = itertools.count(1)
+
+    def __bool__(self) -> bool:
+        return bool(self._entries)
+
+    def add(self, callback: Callable[[], None], rate: float, time: float, timestep: float) -> int:
+        """Registers `callback` every 1/`rate` [Hz] of sim time after `time` [s]; a handle."""
+        period = 1.0 / rate
+        handle = next(self._handles)
+        self._entries[handle] = _Entry(callback, period, time, time + period)
+        return handle
+
+    def remove(self, handle: int) -> None:
+        """Forgets an observer (unknown handles are ignored: removal may race with a reset)."""
+        self._entries.pop(handle, None)
+
+    def run(self, n: int, step: Callable[[int], None], data: Any, timestep: float) -> None:
+        """Steps `n` times through `step(k)`, calling each observer when it is due.
+
+        A clock that went back (reset) re-anchors the observers at the new time.
+        """
+        while n > 0:
+            self._reanchor(float(data.time))
+            due = min(e.due for e in self._entries.values())
+            k = min(n, steps_until_due(float(data.time), due, timestep))
+            step(k)
+            n -= k
+            self._notify(float(data.time), timestep)
+            if not self._entries:
+                step(n)
+                return
+
+    def _reanchor(self, time: float) -> None:
+        for entry in self._entries.values():
+            if time < entry.origin:
+                entry.origin, entry.due = time, time + entry.period
+
+    def _notify(self, time: float, timestep: float) -> None:
+        for entry in list(self._entries.values()):
+            if is_due(time, entry.due, timestep):
+                entry.due = next_due(time, entry.origin, entry.period, timestep)
+                entry.callback()
+
+
+@dataclass(frozen=True)
+class WorldView:
+    """What an observer may read of a world, under its lock (references, no copies).
+
+    Attributes:
+        model, data: the compiled model and its live data (read only).
+        index: entity name → `twin_cli.world.entities.EntityIndex` in `model`.
+        descriptions: entity name → its URDF text after xacro (None: not a URDF source).
+    """
+
+    model: Any
+    data: Any
+    index: dict
+    descriptions: dict[str, str | None]
+
+
+def world_view(world: Any) -> WorldView:
+    """The world's model, data and entity index; call with `world.lock` held."""
+    return WorldView(
+        world.model,
+        world.data,
+        dict(world._index),
+        {n: e.description for n, e in world._entities.items()},
+    )
