@@ -9,11 +9,13 @@ Gazebo stage consume what this produces exactly as they consume a URDF robot.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from converters.description import RobotDescription, WorldDescription
 from converters.report import Report
 from converters.resources.packages import PackageResolver
 from converters.sdf.document import SdfContext, parse_document
+from converters.sdf.include import expand_includes
 from converters.sdf.model import read_model
 from converters.sdf.world import read_world
 
@@ -22,12 +24,12 @@ __all__ = ["read_sdf_model", "read_sdf_world"]
 
 def _context(
     text: str, source: str, base_dir: Path, resolver: PackageResolver | None, report: Report | None
-) -> tuple[SdfContext, object]:
+) -> tuple[SdfContext, Any]:
+    """The parsed `<sdf>` root and the context its values are read in (its version included)."""
     root = parse_document(text, source)
     resolver = resolver or PackageResolver.create(Path(source) if source else None)
-    ctx = SdfContext(source, base_dir, resolver, report or Report(source=source))
-    ctx.version = root.get("version")
-    return ctx, root
+    report = report or Report(source=source)
+    return SdfContext(source, base_dir, resolver, report, root.get("version")), root
 
 
 def read_sdf_model(
@@ -37,14 +39,12 @@ def read_sdf_model(
     resolver: PackageResolver | None = None,
     report: Report | None = None,
 ) -> RobotDescription:
-    """The one model of an SDF model file (a world with exactly one model is refused: serve it).
+    """The one model of an SDF model file (a world is refused: serve it instead).
 
     Raises:
         MalformedXMLError, SDFError, PackageNotFoundError, ResourceNotFoundError.
     """
     ctx, root = _context(text, source, base_dir, resolver, report)
-    from converters.sdf.include import expand_includes
-
     expand_includes(ctx, root)
     models = root.findall("model")
     if root.find("world") is not None:
