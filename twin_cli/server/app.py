@@ -11,10 +11,9 @@ import dataclasses
 import logging
 import os
 import secrets
-import threading
-from typing import Annotated, Any
+from typing import Any
 
-from fastapi import APIRouter, Depends, FastAPI, Request
+from fastapi import APIRouter, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
@@ -26,15 +25,15 @@ from twin_cli.errors import (
     RequestError,
     TwinError,
 )
+from twin_cli.server import consumer_routes
+from twin_cli.server.holder import WorldDep, WorldHolder
 from twin_cli.server.models import (
     CommandBody,
-    FoxgloveBody,
     GravityBody,
     PathBody,
     PhysicsBody,
     PoseBody,
     PushBody,
-    RecordBody,
     ResetBody,
     SpawnBody,
     StepBody,
@@ -44,26 +43,6 @@ log = logging.getLogger("twin.server")
 API_VERSION = "1"
 
 
-class WorldHolder:
-    """The served world; `load` replaces it under a lock while requests keep arriving."""
-
-    def __init__(self, world: Any) -> None:
-        self.world = world
-        self.swap_lock = threading.Lock()
-
-    def replace(self, new_world: Any) -> None:
-        """Stop the old world's loop and start the new one's."""
-        with self.swap_lock:
-            old, self.world = self.world, new_world
-            old.stop()
-            new_world.start()
-
-
-def current_world(request: Request) -> Any:
-    return request.app.state.holder.world
-
-
-WorldDep = Annotated[Any, Depends(current_world)]
 router = APIRouter()
 
 
@@ -236,51 +215,6 @@ def shutdown(request: Request) -> dict:
     return {"stopping": request.app.state.world_name}
 
 
-def _consumers(request: Request) -> Any:
-    """The server's recording and live stream (`twin_cli.record.service.Consumers`)."""
-    state = request.app.state
-    if getattr(state, "consumers", None) is None:
-        from twin_cli.record.service import Consumers
-
-        state.consumers = Consumers()
-    return state.consumers
-
-
-@router.post("/record", status_code=201)
-def start_recording(body: RecordBody, request: Request, world: WorldDep) -> dict:
-    """Record the world into a rosbag2 MCAP file on the server host (`twin record`)."""
-    status = _consumers(request).record(
-        world, body.path, rate=body.rate, entities=body.entities, duration=body.duration
-    )
-    log.info("recording to %s at %g Hz", body.path, body.rate)
-    return status
-
-
-@router.get("/record")
-def recording_status(request: Request) -> dict:
-    return _consumers(request).record_status()
-
-
-@router.delete("/record")
-def stop_recording(request: Request) -> dict:
-    status = _consumers(request).stop_recording()
-    log.info("recording %s closed: %d samples", status["path"], status["samples"])
-    return status
-
-
-@router.post("/foxglove", status_code=201)
-def start_foxglove(body: FoxgloveBody, request: Request, world: WorldDep) -> dict:
-    """Stream the world's topics over the Foxglove WebSocket protocol (`twin foxglove`)."""
-    reply = _consumers(request).stream(world, port=body.port, host=body.host, rate=body.rate)
-    log.info("Foxglove stream on %s", reply["url"])
-    return reply
-
-
-@router.delete("/foxglove")
-def stop_foxglove(request: Request) -> dict:
-    return _consumers(request).stop_stream()
-
-
 # Status of each error class; other TwinError and ConversionError subclasses are 400.
 ERROR_STATUS: dict[type[Exception], int] = {
     EntityNotFoundError: 404,
@@ -402,6 +336,7 @@ def create_app(
     app.state.world_name = world_name
     app.state.request_exit = request_exit or (lambda: None)
     app.include_router(router)
+    app.include_router(consumer_routes.router)
     app.add_exception_handler(TwinError, _known_error)
     app.add_exception_handler(ConversionError, _known_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
