@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from converters.description import RobotDescription
+from converters.description.sensors import SensorSpec
 from converters.errors import InputFileError
 from converters.formats import format_of
 from converters.mjcf.builder import ConvertOptions, build_spec
@@ -22,12 +23,14 @@ from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
 @dataclass(frozen=True)
 class Conversion:
-    """Everything one conversion produced: the spec, the report, provenance and the description."""
+    """Everything one conversion produced: the spec, the report, provenance, the description and
+    the robot's sensors (typed `<sensor>` elements, each a site `sensor:<name>` in the spec)."""
 
     spec: object
     report: Report
     provenance: Provenance
     description: RobotDescription
+    sensors: tuple[SensorSpec, ...] = ()
 
 
 def read_description(
@@ -147,6 +150,7 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
+    from converters.gazebo.sensor_sites import add_sensors
 
     options = options or ConvertOptions()
     report = report or Report(source=robot.source)
@@ -154,7 +158,8 @@ def build_description(
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
     apply_gazebo(spec, robot.gazebo, provenance, report)
-    return Conversion(spec, report, provenance, robot)
+    sensors = add_sensors(spec, robot, provenance, report)
+    return Conversion(spec, report, provenance, robot, sensors)
 
 
 def convert(

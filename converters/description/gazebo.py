@@ -116,6 +116,7 @@ class JointExtension:
     implicit_spring_damper: bool | None = None
     preserve_fixed_joint: bool | None = None
     disable_fixed_joint_lumping: bool | None = None
+    sensors: tuple[Blob, ...] = ()
     blobs: tuple[Blob, ...] = ()
     sources: tuple[TagSource, ...] = ()
 

@@ -27,7 +27,7 @@ DAMPING_FACTOR_PREFIX = "damping_factor:"
 IGNORED_SURFACE = {  # Surface field -> (Gazebo tag, why MuJoCo does without it)
     "max_vel": ("maxVel", "MuJoCo has no cap on penetration-correction speed; solref sets it"),
     "max_contacts": ("maxContacts", "MuJoCo has no per-geom contact cap"),
-    "laser_retro": ("laserRetro", "twin simulates no ray sensors; the value is not used"),
+    "laser_retro": ("laserRetro", "twin's ray sensors report ranges, not intensities; not used"),
     "restitution": ("restitution_coefficient", "no restitution in MuJoCo; kp/kd set bounce"),
     "category_bitmask": ("category_bitmask", "collision filter follows Gazebo's selfCollide rule"),
     "collide_bitmask": ("collide_bitmask", "collision filter follows Gazebo's selfCollide rule"),

@@ -201,7 +201,11 @@ def _link_extension(link: str, acc: _Acc) -> LinkExtension:
 
 def _joint_extension(joint: str, acc: _Acc) -> JointExtension:
     return JointExtension(
-        joint=joint, blobs=tuple(acc.blobs), sources=tuple(acc.sources), **acc.joint
+        joint=joint,
+        sensors=tuple(acc.sensors),  # force_torque sensors sit on joints
+        blobs=tuple(acc.blobs),
+        sources=tuple(acc.sources),
+        **acc.joint,
     )
 
 

@@ -11,7 +11,7 @@ from converters.report import Report
 
 BLOB_REASONS = {
     "plugin": "Gazebo plugins are not run by twin",
-    "sensor": "Gazebo sensors are not simulated by twin",
+    "sensor": "twin does not simulate this sensor type",
     "canonicalBody": "sdformat itself does nothing with canonicalBody",
     "velocity_decay": "write dampingFactor instead; SDF <velocity_decay> blobs are not read",
     "kinematic": "kinematic links are not supported",
@@ -121,11 +121,14 @@ def _report_joint_flags(ext: JointExtension, subject: str, report: Report) -> No
 
 
 def report_blobs(ext: GazeboExtensions, report: Report) -> None:
-    """Report every kept-verbatim element (plugins, sensors, unknown tags) as ignored, with why."""
+    """Report every kept-verbatim element (plugins, unknown tags) as ignored, with why.
+
+    Sensors are reported by `converters.gazebo.sensor_sites`, which maps them.
+    """
     for blob in ext.plugins + ext.model_blobs:
         _report_blob("model", blob, report)
     for link, link_ext in ext.links.items():
-        for blob in link_ext.sensors + link_ext.blobs:
+        for blob in link_ext.blobs:
             _report_blob(f"link '{link}'", blob, report)
     for joint, joint_ext in ext.joints.items():
         for blob in joint_ext.blobs:

@@ -230,7 +230,7 @@ TAG_TABLE = [
     (
         "sensor",
         _ref("arm", '<sensor name="imu" type="imu"><update_rate>100</update_rate></sensor>'),
-        lambda d, m: _entry(d, "sensor").outcome is Outcome.IGNORED,
+        lambda d, m: _entry(d, "sensor").outcome is Outcome.MAPPED and m.site("sensor:imu"),
     ),
     (
         "collision block torsional friction",

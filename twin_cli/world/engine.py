@@ -139,6 +139,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 loaded.xml,
                 dict(joints or {}),
                 loaded.description,
+                sensors=loaded.sensors,
             )
             self._commit(self._spec, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report)

@@ -82,6 +82,7 @@ class Entity:
         xml: MJCF text of an MjSpec source (for save/load), else None.
         joints: initial joint positions given at spawn (`-J`), name → [rad] or [m].
         description: the URDF text after xacro (for `/robot_description`), else None.
+        sensors: its Gazebo sensors (`converters.description.sensors.SensorSpec`), if any.
     """
 
     name: str
@@ -95,6 +96,7 @@ class Entity:
     xml: str | None = field(default=None, repr=False)
     joints: dict[str, float] = field(default_factory=dict)
     description: str | None = field(default=None, repr=False)
+    sensors: tuple = field(default=(), repr=False)
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:

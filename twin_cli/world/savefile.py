@@ -169,6 +169,7 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         entity.xml,
         entity.joints,
         entity.description,
+        sensors=entity.sensors,
     )
 
 

@@ -55,6 +55,7 @@ class LoadedSource:
         default_name: the robot's own name (model name or file stem).
         description: the URDF text after xacro, for `/robot_description`; None for SDF, MJCF
             and MjSpec sources (ROS tools draw robots from URDF only).
+        sensors: the converter's `converters.description.sensors.SensorSpec`s (URDF/SDF).
     """
 
     spec: mujoco.MjSpec
@@ -63,6 +64,7 @@ class LoadedSource:
     xml: str | None
     default_name: str
     description: str | None = None
+    sensors: tuple = ()
 
 
 def load_source(
@@ -132,6 +134,7 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
         _xml_or_none(done.spec),
         name,
         _urdf_or_none(done.description.text),
+        done.sensors,
     )
 
 
@@ -152,7 +155,7 @@ def _load_description(
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
-    return LoadedSource(spec, str(path), report.to_dict(), None, name, description)
+    return LoadedSource(spec, str(path), report.to_dict(), None, name, description, done.sensors)
 
 
 def _urdf_or_none(text: str) -> str | None:

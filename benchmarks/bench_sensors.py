@@ -1,0 +1,111 @@
+"""Sensor figures in one run: what a 10 Hz 360-ray lidar and a 200 Hz IMU cost the loop (issue 14).
+
+The worst case is measured: every reading is taken at its rate in sim time (as a recorder
+would), so the world steps in 5-step batches (the IMU's period at 1 ms) and reads the IMU after
+each and the lidar after every twentieth; the plain loop steps the same sim time in 500-step
+batches. Target: throughput with sensors ≥ 0.90 of the plain loop (median of alternating pairs
+on one world: the bundled humanoid, a sensor post and a wall). Per-read costs are printed too.
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import mujoco
+
+from twin_cli.sensors import SensorSuite
+from twin_cli.world import Pose, World
+
+HUMANOID = Path(__file__).parents[1] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+STEPS = 2000  # per window: 2 s of sim time
+IMU_EVERY, LIDAR_EVERY = 5, 100  # steps at 1 ms: 200 Hz and 10 Hz
+PAIRS = 7
+TARGETS = {"sensors_vs_plain": 0.90}
+SENSOR_POST = """<robot name="post">
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial><collision><origin xyz="0 0 0.1"/>
+    <geometry><cylinder radius="0.05" length="0.2"/></geometry></collision></link>
+  <gazebo><static>true</static></gazebo>
+  <gazebo reference="base">
+    <sensor type="ray" name="lidar"><pose>0 0 0.3 0 0 0</pose><update_rate>10</update_rate>
+      <ray><scan><horizontal><samples>360</samples><min_angle>-3.14159</min_angle>
+      <max_angle>3.14159</max_angle></horizontal></scan><range><min>0.12</min><max>10</max></range>
+      <noise><type>gaussian</type><mean>0</mean><stddev>0.01</stddev></noise></ray></sensor>
+    <sensor type="imu" name="imu"><update_rate>200</update_rate><imu><angular_velocity><x>
+      <noise type="gaussian"><stddev>2e-4</stddev></noise></x></angular_velocity></imu></sensor>
+  </gazebo>
+</robot>"""
+
+
+def _world(tmp: Path) -> World:
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    post = tmp / "post.urdf"
+    post.write_text(SENSOR_POST)
+    world.spawn(post, name="post", pose=Pose(x=-2.0))
+    wall = mujoco.MjSpec()
+    wall.modelname = "wall"
+    wall.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, 3, 1], pos=[0, 0, 1])
+    world.spawn(wall, name="wall", pose=Pose(x=-4.0))
+    return world
+
+
+def _plain(world: World) -> float:
+    start = time.perf_counter()
+    for _ in range(STEPS // 500):
+        world.step(500)
+    return STEPS / (time.perf_counter() - start)
+
+
+def _with_sensors(world: World, suite: SensorSuite) -> float:
+    start = time.perf_counter()
+    for k in range(STEPS // IMU_EVERY):
+        world.step(IMU_EVERY)
+        due = ["imu", "lidar"] if (k * IMU_EVERY) % LIDAR_EVERY == 0 else ["imu"]
+        suite.read(due)
+    return STEPS / (time.perf_counter() - start)
+
+
+def _read_cost(world: World, suite: SensorSuite, name: str, n: int) -> float:
+    """Median wall time [µs] of a fresh reading of `name` (one step between reads)."""
+    costs = []
+    for _ in range(n):
+        world.step(LIDAR_EVERY if name == "lidar" else IMU_EVERY)
+        start = time.perf_counter()
+        suite.read([name])
+        costs.append(time.perf_counter() - start)
+    return statistics.median(costs) * 1e6
+
+
+def throughput(tmp: Path) -> dict:
+    world = _world(tmp)
+    world.step(2000)  # the humanoid lies on the ground: the same contacts in every window
+    suite = SensorSuite(world, "post")
+    ratios, plain, sensed = [], [], []
+    for _ in range(PAIRS):
+        p = _plain(world)
+        s = _with_sensors(world, suite)
+        plain.append(p)
+        sensed.append(s)
+        ratios.append(s / p)
+    return {
+        "sensors_vs_plain_median": statistics.median(ratios),
+        "ratios": [round(x, 3) for x in ratios],
+        "plain_steps_per_s": statistics.median(plain),
+        "sensors_steps_per_s": statistics.median(sensed),
+        "imu_read_us": _read_cost(world, suite, "imu", 200),
+        "lidar_360_read_us": _read_cost(world, suite, "lidar", 50),
+    }
+
+
+def run() -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        return {
+            "load_average": os.getloadavg()[0],
+            "throughput": throughput(Path(tmp)),
+            "targets": TARGETS,
+        }

@@ -1,0 +1,240 @@
+"""Sensors read from real worlds, against physics oracles (gravity, geometry, statics, contact)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+from corpus_registry import CORPUS, PACKAGES_ROOT, package_paths
+from models import write_urdf
+from sensor_models import bumper_ball, hanging_load, imu_box, lidar_post
+
+from twin_cli.errors import PartNotFoundError
+from twin_cli.sensors import SensorSuite
+from twin_cli.sensors.suite import period_slot
+from twin_cli.world import Pose, World
+
+STATIC = "<gazebo><static>true</static></gazebo>\n</robot>"
+N_DRAWS = 10_000
+
+
+def _world_with(tmp_path: Path, text: str, name: str, pose: Pose = Pose()) -> World:
+    world = World()
+    world.spawn(write_urdf(tmp_path, text, f"{name}.urdf"), name=name, pose=pose)
+    return world
+
+
+def _gravity(world: World) -> float:
+    return float(np.linalg.norm(world.model.opt.gravity))
+
+
+def _site_rotation(world: World, site: str) -> np.ndarray:
+    mujoco.mj_forward(world.model, world.data)
+    return world.data.site(site).xmat.reshape(3, 3).copy()
+
+
+def _wall(x: float, name: str = "wall") -> mujoco.MjSpec:
+    """A static 0.1 m thick, 4 m wide, 2 m high box whose near face is the plane x = `x`."""
+    spec = mujoco.MjSpec()
+    spec.modelname = name
+    spec.worldbody.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, 2.0, 1.0], pos=[x + 0.05, 0.0, 1.0]
+    )
+    return spec
+
+
+# ----------------------------------------------------------------------------------------- IMU
+def test_imu_lying_still_reads_gravity_up_and_zero_rate_in_its_own_frame(tmp_path: Path) -> None:
+    text = (
+        imu_box(yaw=0.5).replace('rpy="0 0 0.5"', 'rpy="0.3 -0.2 0.5"').replace("</robot>", STATIC)
+    )
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    world.step(20)
+    reading = SensorSuite(world, "imu").read()["imu"]
+    R = _site_rotation(world, "imu/sensor:imu")
+    expected = R.T @ np.array([0.0, 0.0, _gravity(world)])  # f = a − g with a = 0
+    np.testing.assert_allclose(reading.linear_acceleration, expected, atol=1e-9)
+    np.testing.assert_allclose(reading.angular_velocity, 0.0, atol=1e-12)
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, R.reshape(-1))
+    x, y, z, w = reading.orientation
+    assert abs(float(np.dot(quat, [w, x, y, z]))) == pytest.approx(1.0, abs=1e-12), "orientation"
+
+
+def test_imu_on_a_flat_resting_box_reads_plus_g_on_z(tmp_path: Path) -> None:
+    text = imu_box().replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    world.step(5)
+    reading = SensorSuite(world, "imu").read()["imu"]
+    np.testing.assert_allclose(reading.linear_acceleration, [0, 0, _gravity(world)], atol=1e-9)
+
+
+def test_imu_in_free_fall_reads_zero_specific_force(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, imu_box(), "imu", Pose(z=5.0))
+    world.step(100)  # 0.1 s: falling 5 cm, far from the ground
+    reading = SensorSuite(world, "imu").read()["imu"]
+    np.testing.assert_allclose(reading.linear_acceleration, 0.0, atol=1e-9)
+
+
+def test_noisy_imu_samples_have_the_tags_mean_and_stddev(tmp_path: Path) -> None:
+    mean, stddev = 0.05, 0.02
+    text = imu_box(stddev=stddev, mean=mean).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    sensor = SensorSuite(world, "imu")._sensors["imu"]
+    clean = np.zeros((N_DRAWS, 3))
+    draws = sensor.accel_noise.apply(clean)
+    se_mean = stddev / math.sqrt(N_DRAWS)
+    se_std = stddev / math.sqrt(2 * (N_DRAWS - 1))
+    for axis in range(3):
+        got_mean, got_std = draws[:, axis].mean(), draws[:, axis].std(ddof=1)
+        assert abs(got_mean - mean) < 3 * se_mean, f"axis {axis} mean {got_mean}"
+        assert abs(got_std - stddev) < 3 * se_std, f"axis {axis} stddev {got_std}"
+
+
+def test_noise_bias_is_drawn_once_with_a_random_sign_and_runs_are_reproducible(
+    tmp_path: Path,
+) -> None:
+    text = imu_box(stddev=1e-6, bias_mean=0.3).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    signs = [
+        np.sign(SensorSuite(world, "imu", seed=seed)._sensors["imu"].gyro_noise.bias[0])
+        for seed in range(400)
+    ]
+    positive = signs.count(1.0)
+    assert abs(positive - 200) < 3 * 10, f"{positive} of 400 biases positive (binomial ½)"
+    first = SensorSuite(world, "imu", seed=7).read()["imu"]
+    again = SensorSuite(world, "imu", seed=7).read()["imu"]
+    assert first == again, "same seed, same state: same reading"
+    assert abs(abs(first.angular_velocity[0]) - 0.3) < 1e-4, "gyro x reads ± the bias at rest"
+
+
+# --------------------------------------------------------------------------------------- lidar
+def test_lidar_two_metres_from_a_wall_reads_the_walls_geometry(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, lidar_post(), "post")
+    world.spawn(_wall(2.0), name="wall")
+    scan = SensorSuite(world, "post").read()["lidar"]
+    angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))
+    ranges = np.array(scan.ranges)
+    centre = len(ranges) // 2
+    assert ranges[centre] == pytest.approx(2.0, abs=1e-9), "central ray"
+    # The wall is 4 m wide: rays at |θ| < atan(2/2) hit the plane x = 2 at 2/cos θ.
+    on_wall = np.abs(np.tan(angles)) * 2.0 < 2.0 - 1e-6
+    np.testing.assert_allclose(ranges[on_wall], 2.0 / np.cos(angles[on_wall]), atol=1e-9)
+    beyond = np.abs(angles) > math.atan2(2.0, 2.0) + 0.05  # past the wall's edge: nothing
+    assert np.isinf(ranges[beyond]).all(), "rays past the wall read +inf"
+    assert scan.range_min == 0.12 and scan.range_max == 3.5
+
+
+def test_lidar_reads_inf_beyond_max_range_and_noise_within_range(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, lidar_post(range_max=1.5, stddev=0.01), "post")
+    world.spawn(_wall(2.0), name="wall")
+    scan = SensorSuite(world, "post").read()["lidar"]
+    assert np.isinf(scan.ranges).all(), "a wall at 2 m is beyond a 1.5 m lidar"
+    near = _world_with(tmp_path, lidar_post(stddev=0.01, samples=1, min_angle=0, max_angle=0), "p")
+    near.spawn(_wall(1.0), name="wall")
+    suite = SensorSuite(near, "p")
+    draws = []
+    for _ in range(200):
+        near.step(100)  # 10 Hz: one fresh scan per 0.1 s
+        draws.append(suite.read()["lidar"].ranges[0])
+    assert abs(np.mean(draws) - 1.0) < 3 * 0.01 / math.sqrt(200), "noisy ranges centre on 1 m"
+
+
+def test_lidar_does_not_see_its_own_robot(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, lidar_post(samples=8, min_angle=-3.1, max_angle=3.1), "post")
+    scan = SensorSuite(world, "post").read()["lidar"]
+    assert np.isinf(scan.ranges).all(), f"own post and scanner housing hidden: {scan.ranges}"
+
+
+# ------------------------------------------------------------------------------ force / torque
+@pytest.mark.parametrize("mass", [0.5, 3.0])
+def test_force_torque_under_a_static_load_reads_m_g(tmp_path: Path, mass: float) -> None:
+    world = _world_with(tmp_path, hanging_load(mass), "hang")
+    world.step(200)
+    wrench = SensorSuite(world, "hang").read()["ft"]
+    np.testing.assert_allclose(wrench.force, [0, 0, mass * _gravity(world)], rtol=1e-6, atol=1e-6)
+    # The load's centre of mass is 0.1 m below the joint, straight down: no moment about it.
+    np.testing.assert_allclose(wrench.torque, 0.0, atol=1e-6)
+
+
+def test_force_torque_child_to_parent_is_the_reaction(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, hanging_load(2.0, direction="child_to_parent"), "hang")
+    world.step(50)
+    wrench = SensorSuite(world, "hang").read()["ft"]
+    assert wrench.force[2] == pytest.approx(-2.0 * _gravity(world), rel=1e-6)
+
+
+# ------------------------------------------------------------------------------------- contact
+def test_bumper_reports_contact_exactly_while_the_ball_touches(tmp_path: Path) -> None:
+    radius = 0.05
+    world = _world_with(tmp_path, bumper_ball(radius), "ball", Pose(z=0.2))
+    suite = SensorSuite(world, "ball")
+    body = world.model.body("ball/ball").id
+    touching, reported = [], []
+    for _ in range(600):
+        world.step(1)
+        with world.lock:
+            mujoco.mj_kinematics(world.model, world.data)
+            gap = float(world.data.xpos[body][2]) - radius  # height of the ball's lowest point
+        reading = suite.read()["bumper"]
+        touching.append(gap <= 0.0)
+        reported.append(reading.in_contact)
+    assert any(touching), "the ball reached the ground"
+    assert reported == touching, "contact reported exactly at the steps the ball touches"
+    resting = suite.read()["bumper"]
+    mass = 0.5
+    assert resting.total_force[2] == pytest.approx(mass * _gravity(world), rel=0.05)
+    assert resting.states[0].collision2 == "ground"
+
+
+# -------------------------------------------------------------------------------- update rates
+def test_a_reading_is_refreshed_only_once_per_period_of_sim_time(tmp_path: Path) -> None:
+    text = imu_box(rate=50.0).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    suite = SensorSuite(world, "imu")
+    stamps = set()
+    for _ in range(100):
+        world.step(1)
+        stamps.add(suite.read()["imu"].time)
+    # The first request reads at once; then one reading per 20 ms period, at its start.
+    expected = [0.001, 0.02, 0.04, 0.06, 0.08, 0.1]
+    np.testing.assert_allclose(sorted(stamps), expected, atol=1e-9, err_msg="50 Hz stamps")
+    assert period_slot(0.2, 5.0, 0.001) == 1 and period_slot(0.1999, 5.0, 0.001) == 0
+
+
+def test_a_bad_sensor_name_lists_the_entitys_sensors(tmp_path: Path) -> None:
+    world = _world_with(tmp_path, lidar_post(), "post")
+    with pytest.raises(PartNotFoundError, match=r"no sensor \[nope\].*lidar"):
+        SensorSuite(world, "post").read(["nope"])
+
+
+# ---------------------------------------------------------------------------------- turtlebot3
+def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
+    robot = CORPUS.get("turtlebot3_burger")
+    if robot is None:
+        pytest.skip("corpus absent")
+    world = World()
+    world.spawn(
+        PACKAGES_ROOT / robot["entry"], name="tb3", package_paths=package_paths(robot)
+    )  # fmt: skip
+    world.step(10)
+    scan_origin = world.data.site("tb3/sensor:lds_lfcd_sensor").xpos.copy()
+    world.spawn(_wall(float(scan_origin[0]) + 1.0, "box"), name="box")
+    suite = SensorSuite(world, "tb3")
+    assert set(suite.names) == {"imu", "lds_lfcd_sensor"}
+    scan = suite.read()["lds_lfcd_sensor"]
+    assert len(scan.ranges) == 360 and scan.range_max == 3.5 and scan.range_min == 0.12
+    ahead = scan.ranges[0]  # angle 0: the robot's +x
+    assert ahead == pytest.approx(1.0, abs=5 * 0.01), f"range ahead {ahead} (noise stddev 0.01)"
+    behind = scan.ranges[180]
+    assert math.isinf(behind), "nothing behind within 3.5 m"
+    # The IMU updates every step (no <update_rate>). A robot that stays where it is has zero
+    # mean acceleration, so its specific force averages to +g even while its contacts chatter.
+    vertical = []
+    for _ in range(1000):
+        world.step(1)
+        vertical.append(suite.read(["imu"])["imu"].linear_acceleration[2])
+    assert np.mean(vertical) == pytest.approx(_gravity(world), abs=0.02), "mean IMU z over 1 s"

@@ -1,0 +1,33 @@
+"""Sensors of a running world: Gazebo's `<sensor>`s read from the world at their own rates.
+
+A consumer of the world (like the recorder): it reads the engine's state under its lock and
+computes outside it; the world never imports it. Modules: `suite` (all sensors of an entity,
+update rates), `snapshot` (state copy and its dynamics), `imu`, `ray`, `contact`,
+`force_torque`, `camera` (one sensor type each), `noise` (Gazebo's Gaussian noise, seeded),
+`readings` (what each reports), `frames` (finding a sensor's elements by name).
+"""
+
+from __future__ import annotations
+
+from twin_cli.sensors.readings import (
+    ContactReading,
+    ContactState,
+    ImageReading,
+    ImuReading,
+    Reading,
+    ScanReading,
+    WrenchReading,
+)
+from twin_cli.sensors.suite import SensorSuite, describe_sensors
+
+__all__ = [
+    "ContactReading",
+    "ContactState",
+    "ImageReading",
+    "ImuReading",
+    "Reading",
+    "ScanReading",
+    "SensorSuite",
+    "WrenchReading",
+    "describe_sensors",
+]

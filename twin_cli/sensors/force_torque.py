@@ -1,0 +1,67 @@
+"""Force/torque sensor: the wrench a joint transmits, at the joint's origin.
+
+After `mj_rnePostConstraint`, `cfrc_int[child]` is the spatial force the parent exerts on the
+child body (torque first), about the subtree centre of mass of the child's kinematic tree,
+in world orientation. It is moved to the sensor's origin (τ_p = τ_c + (c − p) × f), negated for
+Gazebo's default `child_to_parent` (what the child applies on the parent), and expressed in the
+child body, parent body or sensor frame as `<frame>` says. Under a static load of mass m hanging
+from the joint, `parent_to_child` reads +m·g upward.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from converters.description.sensors import ForceTorqueSpec
+from twin_cli.sensors.frames import body_id, site_id
+from twin_cli.sensors.readings import WrenchReading
+
+
+class ForceTorqueSensor:
+    """One `<sensor type="force_torque">` on a joint of an entity."""
+
+    def __init__(self, spec: ForceTorqueSpec, entity: str, rng: np.random.Generator) -> None:
+        self.spec = spec
+        self.entity = entity
+        self.site = self.child = self.parent = -1
+
+    def bind(self, model: Any) -> None:
+        self.site = site_id(model, self.entity, self.spec.site)
+        self.child = body_id(model, self.entity, self.spec.child_body)
+        self.parent = body_id(model, self.entity, self.spec.parent_body)
+
+    def read(self, model: Any, data: Any, time: float) -> WrenchReading:
+        force, torque = self.wrench_world(model, data)
+        R = self._frame(data)
+        return WrenchReading(
+            self.spec.name,
+            self.spec.type,
+            time,
+            self.spec.frame_id,
+            _vec(R.T @ force),
+            _vec(R.T @ torque),
+            self.spec.frame,
+            self.spec.measure_direction,
+        )
+
+    def wrench_world(self, model: Any, data: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(force [N], torque [N m] about the sensor origin), world axes, measured direction."""
+        spatial = data.cfrc_int[self.child]
+        torque_c, force = spatial[:3], spatial[3:]
+        centre = data.subtree_com[model.body_rootid[self.child]]
+        point = data.site_xpos[self.site]
+        torque = torque_c + np.cross(centre - point, force)
+        sign = -1.0 if self.spec.measure_direction == "child_to_parent" else 1.0
+        return sign * force, sign * torque
+
+    def _frame(self, data: Any) -> np.ndarray:
+        if self.spec.frame == "sensor":
+            return data.site_xmat[self.site].reshape(3, 3)
+        body = self.parent if self.spec.frame == "parent" else self.child
+        return data.xmat[body].reshape(3, 3)
+
+
+def _vec(v: np.ndarray) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))

@@ -1,0 +1,38 @@
+"""Finding a sensor's MuJoCo elements in a world by name (`<entity>/sensor:<name>`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mujoco
+
+from twin_cli.errors import PartNotFoundError
+
+
+def element_id(model: Any, kind: Any, label: str, name: str, entity: str) -> int:
+    """The id of element `name` of `kind` (mjtObj) in `model`.
+
+    Raises:
+        PartNotFoundError: no such element (the sensor's site was not built).
+    """
+    found = mujoco.mj_name2id(model, kind, name)
+    if found < 0:
+        raise PartNotFoundError(entity, label, name, [])
+    return int(found)
+
+
+def site_id(model: Any, entity: str, site: str) -> int:
+    return element_id(model, mujoco.mjtObj.mjOBJ_SITE, "site", f"{entity}/{site}", entity)
+
+
+def body_id(model: Any, entity: str, body: str) -> int:
+    """Body `body` of the entity (the world body for "world")."""
+    if body == "world":
+        return 0
+    return element_id(model, mujoco.mjtObj.mjOBJ_BODY, "body", f"{entity}/{body}", entity)
+
+
+def entity_bodies(model: Any, entity: str) -> frozenset[int]:
+    """Ids of every body whose name starts with `<entity>/`."""
+    prefix = f"{entity}/"
+    return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
