@@ -138,7 +138,9 @@ def _foxglove_session(port: int, client, steps: int) -> dict:
                 subscribed[k] = topic
                 subs.append({"id": k, "channelId": channels[topic]["id"]})
             await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
-            await asyncio.sleep(0.5)
+            # The protocol does not acknowledge a subscription; give the server's thread time
+            # to take it even on a loaded 2-core machine before the last sample is published.
+            await asyncio.sleep(2.0)
             await asyncio.to_thread(client.step, steps - 50)
             await pump(
                 lambda: (
