@@ -127,12 +127,12 @@ def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
 
 
 def test_concurrent_first_commands_start_exactly_one_server(twin):
-    cmd = [sys.executable, "-m", "twin_cli.cli.app", "list"]
+    cmd = [sys.executable, "-m", "twin_cli.cli.app", "spawn", twin.box, "--name"]
     procs = [
         subprocess.Popen(
-            cmd, env=twin.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            [*cmd, f"box{i}"], env=twin.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
         )
-        for _ in range(3)
+        for i in range(3)
     ]
     outs = [p.communicate(timeout=120) for p in procs]
     codes = [p.returncode for p in procs]

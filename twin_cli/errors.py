@@ -10,9 +10,14 @@ class TwinError(Exception):
 class NotRunningError(TwinError):
     """No world server answers for this world name."""
 
-    def __init__(self, world: str) -> None:
-        super().__init__("An instance of twin is not running.")
+    # gz's readiness-probe wording and exit code 1: scripts grep the first line.
+    exit_code = 1
+    MESSAGE = "An instance of twin is not running."
+
+    def __init__(self, world: str, detail: str = "") -> None:
+        super().__init__(f"{self.MESSAGE}\n{detail}" if detail else self.MESSAGE)
         self.world = world
+        self.detail = detail
 
 
 class EntityNotFoundError(TwinError):

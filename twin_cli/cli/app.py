@@ -93,7 +93,11 @@ def main() -> None:
         if debug:
             raise
         from twin_cli.cli.output import error
+        from twin_cli.errors import NotRunningError
 
+        if isinstance(exc, NotRunningError):  # gz's readiness-probe line as it is, exit code 1
+            sys.stderr.write(f"{exc}\n")
+            sys.exit(exc.exit_code)
         if _known(exc):
             error(str(exc))
             sys.exit(getattr(exc, "exit_code", 2))

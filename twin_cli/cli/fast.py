@@ -147,7 +147,9 @@ GRAMMARS: dict[str, Grammar] = {
         ),
     ),
     "save": Grammar("save", (Arg("file", Path),), (WORLD,)),
-    "load": Grammar("load", (Arg("file", Path),), (WORLD,)),
+    "load": Grammar(
+        "load", (Arg("file", Path, required=False),), (WORLD, _flag("--last", dest="last"))
+    ),
     "logs": Grammar("logs", opts=(Opt(("-n", "--lines"), "lines", int), WORLD)),
 }
 

@@ -24,16 +24,22 @@ GRAVITY_PRESETS = ("earth", "moon", "mars", "zero")
 Vec3 = tuple[float, float, float]
 
 
-def _connect(world: str, *, start: bool = True) -> Any:
-    """A client of the world's server; starts the server in the background if allowed."""
+def _connect(
+    world: str, *, start: bool = False, serve_args: tuple[str, ...] = (), announce: Any = None
+) -> Any:
+    """A client of the world's server; only `spawn` and `load` may start one in the background.
+
+    Raises:
+        NotRunningError: no server runs (the CLI boundary prints gz's line, exit code 1).
+    """
     from twin_cli.server import client
 
-    return client.connect(world, start=start)
+    return client.connect(world, start=start, serve_args=serve_args, announce=announce)
 
 
-def _not_running() -> SystemExit:
-    """gz's readiness-probe wording on stderr, exit code 1 (scripts grep for it)."""
-    sys.stderr.write("An instance of twin is not running.\n")
+def _not_running(exc: Exception | None = None) -> SystemExit:
+    """gz's readiness-probe wording on stderr (and what died, if so), exit code 1."""
+    sys.stderr.write(f"{exc or 'An instance of twin is not running.'}\n")
     return SystemExit(1)
 
 
@@ -81,8 +87,8 @@ def stop(*, world: str) -> None:
 
     try:
         pid = client.stop(world)
-    except NotRunningError:
-        raise _not_running() from None
+    except NotRunningError as exc:
+        raise _not_running(exc) from None
     sys.stderr.write(f"twin: stopped world [{world}] (pid {pid})\n")
 
 
@@ -114,7 +120,7 @@ def spawn(
     if file is not None and str(file) == "-":
         file, xml = None, sys.stdin.read()
     source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
-    with _connect(world) as c:
+    with _connect(world, start=True) as c:
         result = c.spawn(
             file, name=name, pose=pose, on_ground=on_ground, joints=joints, **source, **inputs
         )
@@ -282,8 +288,8 @@ def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None
 
     try:
         c = _connect(world, start=False)
-    except NotRunningError:
-        raise _not_running() from None
+    except NotRunningError as exc:
+        raise _not_running(exc) from None
     render = fmt.stats_json if json else fmt.stats_csv_row if plot else fmt.stats_line
     try:
         with c:
@@ -292,8 +298,8 @@ def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None
             for tick in fmt.sample_times(time.monotonic(), duration):
                 time.sleep(max(0.0, tick - time.monotonic()))
                 print(render(c.stats()), flush=True)
-    except NotRunningError:
-        raise _not_running() from None
+    except NotRunningError as exc:
+        raise _not_running(exc) from None
     except (KeyboardInterrupt, BrokenPipeError):
         return
 
@@ -303,9 +309,44 @@ def save(*, file: Path, world: str) -> None:
         c.save(file)
 
 
-def load(*, file: Path, world: str) -> None:
-    with _connect(world) as c:
-        c.load(file)
+def load(*, file: Path | None, world: str, last: bool = False) -> None:
+    """Load a saved world (or with `last`, the last autosave) into the world's server.
+
+    With no server running, starts one that serves the file (the user named the world it must
+    hold, so nothing appears silently); with one, replaces its world.
+
+    Raises:
+        BadOption: neither or both of FILE and --last.
+    """
+    if (file is None) == (not last):
+        raise pairs.BadOption("give a FILE written by `twin save`, or --last, not both")
+    if last:
+        file = _last_autosave(world)
+    path = str(Path(file).expanduser().absolute())
+    started: list[str] = []
+
+    def announce(line: str) -> None:
+        started.append(line)
+        sys.stderr.write(f"{line}\n")
+
+    with _connect(world, start=True, serve_args=(path,), announce=announce) as c:
+        if not any("started world" in line for line in started):
+            c.load(path)
+    sys.stderr.write(f"twin: world [{world}] loaded from {path}\n")
+
+
+def _last_autosave(world: str) -> Path:
+    """The world's newest autosave; a dead server is reported (and retired) first."""
+    from twin_cli.server import client, lifecycle
+
+    paths = client.runtime.world_paths(world)
+    with client.runtime.start_lock(paths):
+        if not client.runtime.server_alive(paths):
+            client.runtime.clean_stale(paths)
+            died = lifecycle.retire(paths)
+            if died:
+                sys.stderr.write(f"twin: {died}\n")
+    return lifecycle.last_autosave(paths)
 
 
 def logs(*, lines: int | None, world: str) -> None:

@@ -239,35 +239,55 @@ def _seg(name: str) -> str:
 
 
 def connect(
-    world: str = runtime.DEFAULT_WORLD, *, start: bool = True, announce: Any = None
+    world: str = runtime.DEFAULT_WORLD,
+    *,
+    start: bool = True,
+    announce: Any = None,
+    serve_args: tuple[str, ...] = (),
 ) -> Client:
-    """A client of `world`'s server, starting it in the background when none runs.
+    """A client of `world`'s server; with `start`, starts it in the background when none runs.
+
+    Only `twin spawn` (and `twin load`, which names the world to run) start a world: every other
+    command passes `start=False`, so a typo in --world or a dead server is reported, never
+    replaced by a fresh empty world. A server that is alive (it holds its pid lock) but not yet
+    answering is waited for.
 
     Args:
         world: world name.
         start: start the server when none answers (False: raise NotRunningError).
         announce: callable given one line to tell the user a server was started
             (default: write it to stderr).
+        serve_args: extra `twin serve` arguments for a server started here (a world file).
 
     Raises:
-        NotRunningError: none runs and `start` is False.
+        NotRunningError: none runs and `start` is False; its message says whether the world's
+            server died (pid, how, when, log) and which worlds do run.
         ServerStartError: the background server did not come up.
     """
+    from twin_cli.server import lifecycle
+
     client = Client(world)
     if client.alive():
         return client
-    if not start:
-        client.close()
-        raise NotRunningError(world)
     paths = client.paths
+    if not start:
+        if runtime.server_alive(paths):
+            runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
+            return client
+        client.close()
+        raise NotRunningError(world, lifecycle.not_running_detail(paths))
+    say = announce or _stderr
     with runtime.start_lock(paths):
         if not runtime.server_alive(paths):
             runtime.clean_stale(paths)
-            proc = runtime.launch_background(paths, [])
+            died = lifecycle.retire(paths)
+            if died:
+                say(f"twin: {died}")
+            proc = runtime.launch_background(paths, list(serve_args))
             runtime.wait_until(paths, client.alive, proc, runtime.START_TIMEOUT_S)
-            (announce or _stderr)(
-                f"twin: started world [{world}] in the background (pid {proc.pid}); "
-                f"`twin stop` ends it"
+            say(
+                f"twin: started world [{world}] in the background "
+                f"(pid {runtime.read_pid(paths)}); `twin stop` ends it"
             )
     runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
     return client
@@ -292,9 +312,13 @@ def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) ->
     paths = runtime.world_paths(world)
     pid = runtime.read_pid(paths)
     if not runtime.server_alive(paths):
+        from twin_cli.server import lifecycle
+
         with runtime.start_lock(paths):
+            detail = lifecycle.not_running_detail(paths)
             runtime.clean_stale(paths)
-        raise NotRunningError(world)
+            lifecycle.forget(paths)  # reported here: `twin stop` acknowledges a dead server
+        raise NotRunningError(world, detail)
     with Client(world) as client:
         try:
             client.request("POST", "/shutdown")

@@ -36,6 +36,7 @@ class ServeOptions:
         background: started by a client that holds the world's start lock.
         record: a rosbag2 MCAP file to record into from the start (100 Hz), or None.
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
+        autosave: seconds between autosaves to `<world>.autosave.json`; 0 turns it off.
     """
 
     world: str = runtime.DEFAULT_WORLD
@@ -47,6 +48,7 @@ class ServeOptions:
     background: bool = False
     record: str | None = None
     foxglove: int | None = None
+    autosave: float = 10.0
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -136,14 +138,47 @@ def _terminate(signum: int, frame: Any) -> None:
 
 @contextlib.contextmanager
 def owned_world(paths: runtime.WorldPaths, background: bool) -> Iterator[None]:
-    """Hold the world's pid lock; a foreground server also takes the start lock to get it."""
+    """Hold the world's pid lock; a foreground server also takes the start lock to get it.
+
+    A dead predecessor is reported (log, and stderr in the foreground) before this server's run
+    record replaces its own (`twin_cli.server.lifecycle`).
+    """
+    from twin_cli.server import lifecycle
+
     with contextlib.ExitStack() as stack:
         if background:  # our starter holds the start lock until we answer
             stack.enter_context(runtime.hold_pid_file(paths))
+            died = lifecycle.retire(paths)
         else:
             with runtime.start_lock(paths):
                 stack.enter_context(runtime.hold_pid_file(paths))
+                died = lifecycle.retire(paths)
+        if died:
+            log.warning("%s", died)
+            if not background:
+                sys.stderr.write(f"twin: {died}\n")
         yield
+
+
+@contextlib.contextmanager
+def run_recorded(paths: runtime.WorldPaths, opts: ServeOptions) -> Iterator[Path | None]:
+    """Write the run record; remove it only when the server ends in order.
+
+    Yields:
+        The autosave file, or None when autosave is off.
+    """
+    from twin_cli.server import lifecycle
+
+    autosave = lifecycle.autosave_path(paths) if opts.autosave > 0 else None
+    lifecycle.started(paths, autosave=autosave, supervised=opts.background)
+    try:
+        yield autosave
+    except (KeyboardInterrupt, SystemExit) as exc:
+        if not isinstance(exc, SystemExit) or exc.code in (0, None):
+            lifecycle.ended_in_order(paths)
+        raise
+    else:
+        lifecycle.ended_in_order(paths)
 
 
 def serve(opts: ServeOptions) -> None:
@@ -161,7 +196,7 @@ def serve(opts: ServeOptions) -> None:
     configure_logging(paths)
     tcp = parse_tcp(opts.tcp) if opts.tcp else None
     token = secrets.token_urlsafe(32) if tcp else None
-    with owned_world(paths, opts.background):
+    with owned_world(paths, opts.background), run_recorded(paths, opts) as autosave_file:
         world = build_world(opts)
         app = create_app(
             world,
@@ -174,8 +209,10 @@ def serve(opts: ServeOptions) -> None:
         )
         server = uvicorn.Server(config)
         consumers = _start_consumers(app, world, opts)
+        saver = _autosaver(app, autosave_file, opts.autosave)
         try:
             world.start()
+            saver.start()
             sockets = _listen(paths, tcp, token)
             log.info("serving world [%s] on %s (pid %d)", opts.world, paths.socket, os.getpid())
             if not opts.background:
@@ -186,6 +223,7 @@ def serve(opts: ServeOptions) -> None:
                 server.run(sockets=sockets)
         finally:
             consumers.close()
+            saver.close()
             app.state.holder.world.stop()
             log.info("world [%s] stopped", opts.world)
 
@@ -220,3 +258,12 @@ def _listen(paths: runtime.WorldPaths, tcp: tuple[str, int] | None, token: str |
     if not ipaddress.ip_address(host).is_loopback:
         log.warning("TCP listener on non-loopback %s:%d; every request needs the token", host, port)
     return sockets
+
+
+def _autosaver(app: Any, path: Path | None, interval: float) -> Any:
+    """Saves whichever world the server holds (`/load` may swap it) every `interval` s."""
+    from twin_cli.server.autosave import Autosaver
+
+    saver = Autosaver(lambda: app.state.holder.world, path or Path(os.devnull), interval)
+    app.state.autosaver = saver
+    return saver

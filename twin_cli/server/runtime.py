@@ -245,9 +245,12 @@ def launch_background(paths: WorldPaths, serve_args: list[str]) -> subprocess.Po
     import subprocess  # here, not at the top: world commands that find a server never need it
 
     cmd = [sys.executable, "-m", "twin_cli", "serve", "--world", paths.world, "--background"]
+    # Under a supervisor that records how the server ended (twin_cli.server.lifecycle).
+    exit_file = paths.directory / f"{paths.world}.exit.json"
+    supervisor = [sys.executable, "-m", "twin_cli.server.supervisor", str(exit_file), "--"]
     with os.fdopen(open_log(paths), "ab") as log:
         return subprocess.Popen(
-            cmd + serve_args,
+            supervisor + cmd + serve_args,
             stdin=subprocess.DEVNULL,
             stdout=log,
             stderr=log,

@@ -38,7 +38,7 @@ def record(
     body = {"path": str(out.expanduser().resolve()), "rate": rate, "entities": entity or []}
     if duration is not None:
         body["duration"] = duration
-    with connect(world) as client:
+    with connect(world, start=False) as client:
         client.request("POST", "/record", body=body)
         sys.stderr.write(f"twin: recording to {body['path']}; Ctrl-C stops\n")
         try:
@@ -80,7 +80,7 @@ def foxglove(
     """Stream the world's topics live to Foxglove (open ws://127.0.0.1:PORT in Foxglove)."""
     from twin_cli.server.client import connect
 
-    with connect(world, start=not stop) as client:
+    with connect(world, start=False) as client:
         if stop:
             reply = client.request("DELETE", "/foxglove")
         else:

@@ -37,7 +37,7 @@ def sensors(
 
     out = Output(json)
     base = f"/entities/{path_segment(entity)}/sensors"
-    with connect(world) as client:
+    with connect(world, start=False) as client:
         listing = client.request("GET", base)["sensors"]
         if name is not None:
             client.request("GET", f"{base}/{path_segment(name)}")  # a bad name: exit 2, listed

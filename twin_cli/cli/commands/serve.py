@@ -32,6 +32,17 @@ def serve(
         int | None,
         typer.Option(help="Stream live to Foxglove on 127.0.0.1:PORT (Foxglove's is 8765)."),
     ] = None,
+    autosave: Annotated[
+        float,
+        typer.Option(
+            min=0.0,
+            envvar="TWIN_AUTOSAVE",
+            help="Save the world every SECONDS for `twin load --last` (0: off).",
+        ),
+    ] = 10.0,
+    no_autosave: Annotated[
+        bool, typer.Option("--no-autosave", help="Do not autosave (same as --autosave 0).")
+    ] = False,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
     from twin_cli.server.process import ServeOptions
@@ -47,6 +58,7 @@ def serve(
         background,
         str(record) if record else None,
         foxglove,
+        autosave=0.0 if no_autosave else autosave,
     )
     run_server(opts)
 

@@ -202,11 +202,15 @@ def save(
 
 
 def load(
-    file: Annotated[Path, typer.Argument(help="A file written by `twin save`.")],
+    file: Annotated[Path | None, typer.Argument(help="A file written by `twin save`.")] = None,
     world: WorldOpt = "default",
+    last: Annotated[
+        bool, typer.Option("--last", help="The world's last autosave (after a crash).")
+    ] = False,
 ) -> None:
-    """Replace the running world by one saved with `twin save`."""
-    act.load(file=file, world=world)
+    """Replace the running world by one saved with `twin save` (starts the world if none runs)."""
+    with usage_errors():
+        act.load(file=file, world=world, last=last)
 
 
 def logs(
