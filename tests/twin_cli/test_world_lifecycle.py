@@ -1,0 +1,118 @@
+"""Worlds never appear or vanish silently: only spawn/load start one; a dead server is reported."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from models import block
+
+GZ_LINE = "An instance of twin is not running."
+AUTOSAVE_S = 0.3  # [s] the interval the tests ask for (TWIN_AUTOSAVE)
+
+
+class Twin:
+    """`twin ...` in a private runtime directory, as a user types it."""
+
+    def __init__(self, runtime_dir: Path) -> None:
+        self.dir = runtime_dir
+        self.env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime_dir)}
+        self.env.pop("TWIN_WORLD", None)
+        self.env["TWIN_AUTOSAVE"] = str(AUTOSAVE_S)
+
+    def __call__(self, *args: str, check: bool = True) -> subprocess.CompletedProcess:
+        proc = subprocess.run(
+            [sys.executable, "-m", "twin_cli.cli.app", *args],
+            env=self.env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        if check:
+            assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
+        return proc
+
+
+@pytest.fixture
+def twin(tmp_path):
+    t = Twin(tmp_path / "rt")
+    (tmp_path / "box.urdf").write_text(block(size=0.2, name="box"))
+    t.box = str(tmp_path / "box.urdf")
+    yield t
+    t("stop", check=False)
+
+
+def _wait_for_autosave_after(path: Path, moment: float) -> None:
+    deadline = time.time() + 30
+    while not (path.is_file() and path.stat().st_mtime > moment + 0.05):
+        assert time.time() < deadline, f"no autosave written to {path} within 30 s"
+        time.sleep(0.05)
+
+
+def test_commands_other_than_spawn_never_start_a_world(twin):
+    for args in (["list"], ["gravity", "--moon"], ["pause"], ["pose", "x"], ["physics"]):
+        probe = twin(*args, check=False)
+        assert probe.returncode == 1, f"twin {args}: exit {probe.returncode} {probe.stderr}"
+        assert probe.stderr.splitlines()[0] == GZ_LINE, f"twin {args}: {probe.stderr!r}"
+    assert not (twin.dir / "default.pid").exists(), "a command other than spawn started a world"
+
+
+def test_typo_in_world_names_the_worlds_that_run(twin):
+    twin("spawn", twin.box, "--name", "b", "-z", "1")
+    probe = twin("gravity", "--world", "typo", check=False)
+    assert probe.returncode == 1 and probe.stderr.splitlines()[0] == GZ_LINE, probe.stderr
+    assert "running worlds: default" in probe.stderr, probe.stderr
+    assert not (twin.dir / "typo.pid").exists(), "--world typo started a world"
+
+
+def test_sigkilled_server_is_reported_and_load_last_restores_entities_and_poses(twin):
+    twin("spawn", twin.box, "--name", "b1", "-z", "1")
+    twin("spawn", twin.box, "--name", "b2", "-x", "2", "-z", "1")
+    twin("pause")  # a paused world's autosave holds exactly the poses set below
+    twin("pose", "b1", "--set", "1", "2", "3", "0.1", "0.2", "0.3")
+    moved = time.time()
+    poses = {n: json.loads(twin("pose", n, "--json").stdout) for n in ("b1", "b2")}
+    _wait_for_autosave_after(twin.dir / "default.autosave.json", moved)
+    pid = int((twin.dir / "default.pid").read_text())
+    os.kill(pid, signal.SIGKILL)
+    time.sleep(0.5)  # the supervisor reaps the server and writes its exit record
+
+    probe = twin("list", check=False)
+    assert probe.returncode == 1, f"list after SIGKILL: exit {probe.returncode}"
+    first, *detail = probe.stderr.splitlines()
+    assert first == GZ_LINE, probe.stderr
+    text = "\n".join(detail)
+    for fact in ("world [default]", f"pid {pid}", "signal 9 (SIGKILL)", "default.log", "--last"):
+        assert fact in text, f"the death report lacks {fact!r}: {text}"
+
+    loaded = twin("load", "--last")
+    assert "started world" in loaded.stderr, loaded.stderr
+    names = {e["name"] for e in json.loads(twin("list", "--json").stdout)}
+    assert names == {"b1", "b2"}, f"entities after load --last: {names}"
+    for name, before in poses.items():
+        after = json.loads(twin("pose", name, "--json").stdout)
+        for key in ("x", "y", "z", "roll", "pitch", "yaw"):
+            assert after[key] == pytest.approx(before[key], abs=1e-9), f"{name}.{key}"
+    # The death was reported once, when the new server took the world; none is left to report.
+    twin("stop")
+    again = twin("list", check=False)
+    assert again.stderr.strip() == GZ_LINE, f"a clean stop is reported as a death: {again.stderr}"
+
+
+def test_server_that_exits_with_an_error_is_reported_with_its_code(twin):
+    twin("spawn", twin.box, "--name", "b", "-z", "1")
+    pid = int((twin.dir / "default.pid").read_text())
+    os.kill(pid, signal.SIGUSR1)  # default action: the process ends by that signal
+    time.sleep(0.5)
+    probe = twin("stats", "-d", "0", check=False)
+    assert probe.returncode == 1 and f"pid {pid}" in probe.stderr, probe.stderr
+    assert "SIGUSR1" in probe.stderr, probe.stderr
+    stop = twin("stop", check=False)  # acknowledges the death: reported, then forgotten
+    assert stop.returncode == 1 and "SIGUSR1" in stop.stderr, stop.stderr
+    assert twin("list", check=False).stderr.strip() == GZ_LINE
