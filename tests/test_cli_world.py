@@ -130,7 +130,11 @@ def test_concurrent_first_commands_start_exactly_one_server(twin):
     cmd = [sys.executable, "-m", "twin_cli.cli.app", "spawn", twin.box, "--name"]
     procs = [
         subprocess.Popen(
-            [*cmd, f"box{i}"], env=twin.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            [*cmd, f"box{i}"],
+            env=twin.env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
         )
         for i in range(3)
     ]

@@ -123,3 +123,19 @@ class WorldFileError(TwinError):
     def __init__(self, path: object, problem: str, fix: str) -> None:
         super().__init__(f"{path}: {problem}; {fix}")
         self.path = path
+
+
+class OutcomeUnknownError(TwinError):
+    """A spawn or delete got no reply within the client's patience: it may still happen."""
+
+    # sysexits' EX_TEMPFAIL: not bad input (2), not a bug (70); trying again is the remedy.
+    exit_code = 75
+
+    def __init__(self, world: str, what: str, waited: float, repeat: str) -> None:
+        super().__init__(
+            f"{what} on world [{world}]: no reply within {waited:g} s, so the outcome is unknown "
+            f"(the world may still be doing it); check with `twin list --world {world}`, or "
+            f"repeat `{repeat}`: a repeat is safe, it gets this request's outcome; "
+            "set TWIN_TIMEOUT (s) to wait longer"
+        )
+        self.world = world

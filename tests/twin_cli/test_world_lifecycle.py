@@ -116,3 +116,51 @@ def test_server_that_exits_with_an_error_is_reported_with_its_code(twin):
     stop = twin("stop", check=False)  # acknowledges the death: reported, then forgotten
     assert stop.returncode == 1 and "SIGUSR1" in stop.stderr, stop.stderr
     assert twin("list", check=False).stderr.strip() == GZ_LINE
+
+
+def _busy_world(twin: Twin, seconds: float) -> subprocess.Popen:
+    """`twin step N` in the background, N chosen to hold the world's lock about `seconds`."""
+    start = time.monotonic()
+    twin("step", "20000")
+    rate = 20000 / max(time.monotonic() - start, 1e-3)  # steps/s, Python start-up included
+    steps = str(int(rate * seconds) + 1)
+    return subprocess.Popen(
+        [sys.executable, "-m", "twin_cli.cli.app", "step", steps],
+        env=twin.env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def test_delete_and_spawn_that_outlive_the_clients_patience_are_unknown_and_repeats_are_safe(
+    twin,
+):
+    twin("spawn", twin.box, "--name", "box", "-z", "1")
+    twin("pause")
+    busy = _busy_world(twin, 6.0)
+    time.sleep(0.5)  # the step request holds the world's lock now
+    impatient = {**twin.env, "TWIN_TIMEOUT": "1"}
+    outcomes = [
+        subprocess.run(
+            [sys.executable, "-m", "twin_cli.cli.app", *args],
+            env=impatient,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        for args in (["delete", "box"], ["spawn", twin.box, "--name", "b2", "-x", "2"])
+    ]
+    for proc in outcomes:
+        assert proc.returncode == 75, f"exit {proc.returncode}: {proc.stderr}"
+        assert "outcome is unknown" in proc.stderr and "repeat" in proc.stderr, proc.stderr
+    assert busy.wait(timeout=120) == 0, busy.stderr.read()
+
+    again = twin("delete", "box")  # the first delete happened; the repeat gets its outcome
+    assert again.returncode == 0, again.stderr
+    spawned = twin("spawn", twin.box, "--name", "b2", "-x", "2")
+    assert spawned.stdout.strip() == "b2", spawned
+    names = sorted(e["name"] for e in json.loads(twin("list", "--json").stdout))
+    assert names == ["b2"], f"after the repeats: {names}"
+    third = twin("delete", "box", check=False)  # no outcome pending: an ordinary missing entity
+    assert third.returncode == 2 and "Entity [box] does not exist" in third.stderr, third.stderr

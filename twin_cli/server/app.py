@@ -38,6 +38,7 @@ from twin_cli.server.models import (
     SpawnBody,
     StepBody,
 )
+from twin_cli.server.operations import Operations
 
 log = logging.getLogger("twin.server")
 API_VERSION = "1"
@@ -74,8 +75,16 @@ def entities(world: WorldDep) -> list[dict]:
 
 
 @router.post("/entities", status_code=201)
-def spawn(body: SpawnBody, world: WorldDep) -> dict:
-    """Spawn a URDF/xacro/SDF/MJCF file or text; replies once the entity exists (gazebo_ros)."""
+def spawn(body: SpawnBody, world: WorldDep, request: Request) -> dict:
+    """Spawn a URDF/xacro/SDF/MJCF file or text; replies once the entity exists (gazebo_ros).
+
+    A repeat with the same `Idempotency-Key` header gets the first request's outcome.
+    """
+    key = request.headers.get("idempotency-key")
+    return request.app.state.operations.run(key, lambda: _spawn(body, world))
+
+
+def _spawn(body: SpawnBody, world: Any) -> dict:
     from twin_cli.world.spawn import DescriptionText
 
     source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
@@ -93,10 +102,15 @@ def spawn(body: SpawnBody, world: WorldDep) -> dict:
 
 
 @router.delete("/entities/{name}")
-def delete(name: str, world: WorldDep) -> dict:
-    world.delete(name)
-    log.info("deleted %s", name)
-    return {"deleted": name}
+def delete(name: str, world: WorldDep, request: Request) -> dict:
+    """Delete an entity; a repeat with the same `Idempotency-Key` gets the first's outcome."""
+
+    def work() -> dict:
+        world.delete(name)
+        log.info("deleted %s", name)
+        return {"deleted": name}
+
+    return request.app.state.operations.run(request.headers.get("idempotency-key"), work)
 
 
 @router.get("/entities/{name}/pose")
@@ -333,6 +347,7 @@ def create_app(
         description="One running MuJoCo world; see docs/api.md.",
     )
     app.state.holder = WorldHolder(world)
+    app.state.operations = Operations()
     app.state.world_name = world_name
     app.state.request_exit = request_exit or (lambda: None)
     app.include_router(router)

@@ -76,6 +76,7 @@ class Client:
         self.world = world
         self.paths = runtime.world_paths(world)
         headers = {"Authorization": f"Bearer {token}"} if token else {}
+        self._url = url
         self._http = Http(
             socket_path=None if url else str(self.paths.socket),
             url=url,
@@ -112,13 +113,40 @@ class Client:
             ) from exc
         except NOT_ANSWERING as exc:
             raise NotRunningError(self.world) from exc
+        return _decoded(reply)
+
+    def long_request(
+        self, method: str, path: str, *, body: Any = None, what: str, operation: str, repeat: str
+    ) -> Any:
+        """A request that may take long (spawn, delete, load, step): waited for while the server
+        lives, up to `$TWIN_TIMEOUT` seconds if set (`twin_cli.server.patience`).
+
+        Args:
+            what: the request for people, e.g. "delete [box]".
+            operation: its identity for the idempotency key, e.g. "DELETE /entities/box".
+            repeat: the command line that repeats it.
+
+        Raises:
+            OutcomeUnknownError: the limit passed without a reply; a repeat is safe.
+            NotRunningError: the server is gone (died before replying).
+        """
+        from twin_cli.errors import OutcomeUnknownError
+        from twin_cli.server import lifecycle, patience
+
+        key = patience.take_key(self.paths, operation)
+        waiter = patience.Waiter(None if self._url else self.paths, what, patience.limit())
         try:
-            payload = reply.json()
-        except ValueError:
-            payload = reply.text
-        if reply.is_error:
-            raise rebuild_error(reply.status_code, payload)
-        return payload
+            reply = self._http.request(
+                method, path, json=body, headers={patience.KEY_HEADER: key}, patience=waiter
+            )
+        except TimeoutError as exc:
+            patience.keep_key(self.paths, operation, key)
+            raise OutcomeUnknownError(self.world, what, waiter.limit_s or 0, repeat) from exc
+        except NOT_ANSWERING as exc:
+            raise NotRunningError(self.world, lifecycle.not_running_detail(self.paths)) from exc
+        finally:
+            waiter.done()
+        return _decoded(reply)
 
     def alive(self) -> bool:
         """True when the server answers `/health` for this world."""
@@ -167,10 +195,24 @@ class Client:
             "on_ground": on_ground,
             "joints": joints or {},
         }
-        return self.request("POST", "/entities", body=body, timeout=SPAWN_TIMEOUT_S)
+        label = name or str(source or "<xml>")
+        return self.long_request(
+            "POST",
+            "/entities",
+            body=body,
+            what=f"spawn [{label}]",
+            operation=f"spawn {label}",
+            repeat=f"twin spawn ... --name {label}" if name else "twin spawn ...",
+        )
 
     def delete(self, name: str) -> dict:
-        return self.request("DELETE", f"/entities/{_seg(name)}")
+        return self.long_request(
+            "DELETE",
+            f"/entities/{_seg(name)}",
+            what=f"delete [{name}]",
+            operation=f"DELETE /entities/{name}",
+            repeat=f"twin delete {name} --world {self.world}",
+        )
 
     def pose(self, name: str) -> dict:
         return self.request("GET", f"/entities/{_seg(name)}/pose")
@@ -220,7 +262,14 @@ class Client:
         return self.request("POST", "/resume")
 
     def step(self, n: int = 1) -> dict:
-        return self.request("POST", "/step", body={"n": n}, timeout=SPAWN_TIMEOUT_S)
+        return self.long_request(
+            "POST",
+            "/step",
+            body={"n": n},
+            what=f"step {n}",
+            operation=f"step {n} {time.time()}",  # a repeated step is a new step
+            repeat=f"twin step {n}",
+        )
 
     def reset(self, *, time_only: bool = False) -> dict:
         return self.request("POST", "/reset", body={"time_only": time_only})
@@ -230,7 +279,25 @@ class Client:
 
     def load(self, path: str | os.PathLike) -> dict:
         body = {"path": str(Path(path).absolute())}
-        return self.request("POST", "/load", body=body, timeout=SPAWN_TIMEOUT_S)
+        return self.long_request(
+            "POST",
+            "/load",
+            body=body,
+            what=f"load {body['path']}",
+            operation=f"load {body['path']}",
+            repeat=f"twin load {body['path']}",
+        )
+
+
+def _decoded(reply: Any) -> Any:
+    """A reply's JSON (or text); an error reply raised as the server's exception class."""
+    try:
+        payload = reply.json()
+    except ValueError:
+        payload = reply.text
+    if reply.is_error:
+        raise rebuild_error(reply.status_code, payload)
+    return payload
 
 
 def _seg(name: str) -> str:

@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import http.client
 import json as jsonlib
+import select
 import socket
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 from urllib.parse import quote, urlsplit
@@ -25,6 +28,7 @@ from urllib.parse import quote, urlsplit
 NOT_ANSWERING = (OSError, http.client.HTTPException)
 # Characters left as they are in a path segment: RFC 3986 pchar, less '/' (names are one
 # segment) and '%' (names are data, never pre-encoded).
+PATIENCE_TICK_S = 0.5  # [s] how often a patient wait looks at the server and the clock
 _SEGMENT_SAFE = "".join(chr(i) for i in range(0x21, 0x7F) if chr(i) not in '"#<>?`{}/%')
 
 
@@ -51,6 +55,18 @@ class Reply:
     def json(self) -> Any:
         """The body decoded as JSON; raises ValueError when it is not JSON."""
         return jsonlib.loads(self.content)
+
+
+def _await_reply(sock: socket.socket, patience: Callable[[float], bool]) -> None:
+    """Wait until `sock` has something to read (a reply, or the server closing it).
+
+    Raises:
+        TimeoutError: `patience` gave up.
+    """
+    start = time.monotonic()
+    while not select.select([sock], [], [], PATIENCE_TICK_S)[0]:
+        if not patience(time.monotonic() - start):
+            raise TimeoutError("no reply yet")
 
 
 class _UnixConnection(http.client.HTTPConnection):
@@ -102,10 +118,13 @@ class Http:
         content: bytes | None = None,
         headers: dict[str, str] | None = None,
         timeout: float | None = None,
+        patience: Callable[[float], bool] | None = None,
     ) -> Reply:
         """Send `method path` with a JSON body (`json`) or raw bytes (`content`).
 
         JSON is encoded as httpx encodes it (UTF-8, compact, NaN refused with ValueError).
+        `patience(elapsed [s])`, if given, is asked about once a second while no reply has come
+        and replaces `timeout` for the wait: it returns False to give up (TimeoutError).
         """
         sent = {**self._headers, **(headers or {})}
         if json is not None:
@@ -115,6 +134,8 @@ class Http:
         connection = self._connection(self._timeout if timeout is None else timeout)
         try:
             connection.request(method, path, body=content, headers=sent)
+            if patience is not None:
+                _await_reply(connection.sock, patience)
             response = connection.getresponse()
             return Reply(response.status, response.read())
         finally:
