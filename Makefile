@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test bench lint format install clean fuzz
+.PHONY: demo test bench lint format install clean fuzz soak
 
 # `make fuzz`: the file-input fuzz properties with many more cases (FUZZ_EXAMPLES per property).
 FUZZ_EXAMPLES ?= 5000
@@ -46,3 +46,8 @@ format: $(STAMP)
 
 clean:
 	rm -rf $(VENV) build *.egg-info twin_out
+
+# `make soak`: 4 clients drive one world for SOAK_MINUTES; fails on any error (not in `make test`).
+SOAK_MINUTES ?= 10
+soak: $(STAMP)
+	$(BIN)/python -m benchmarks.soak --minutes $(SOAK_MINUTES)
