@@ -8,6 +8,8 @@ STAMP := $(VENV)/.installed
 
 # `make fuzz`: the file-input fuzz properties with many more cases (FUZZ_EXAMPLES per property).
 FUZZ_EXAMPLES ?= 5000
+# ... and the HTTP API fuzz (Schemathesis) with this many cases per operation.
+FUZZ_API_EXAMPLES ?= 200
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -27,7 +29,7 @@ test: $(STAMP)
 
 fuzz: $(STAMP)
 	@start=$$(date +%s); \
-	TWIN_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/python -m pytest tests/fuzz -q -p no:cacheprovider \
+	TWIN_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) TWIN_FUZZ_API_EXAMPLES=$(FUZZ_API_EXAMPLES) $(BIN)/python -m pytest tests/fuzz -q -p no:cacheprovider \
 		--hypothesis-show-statistics; status=$$?; \
 	seconds=$$(( $$(date +%s) - start )); \
 	echo "fuzz: up to $$(( 3 * $(FUZZ_EXAMPLES) )) cases in $$seconds s"; exit $$status

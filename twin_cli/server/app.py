@@ -16,6 +16,8 @@ from typing import Any
 from fastapi import APIRouter, FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from pydantic import BaseModel
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from converters.errors import ConversionError
 from twin_cli.errors import (
@@ -237,6 +239,28 @@ ERROR_STATUS: dict[type[Exception], int] = {
 }
 
 
+class ErrorBody(BaseModel):
+    """Every error reply: the error's class (the client raises it again) and one message."""
+
+    error: str
+    message: str
+
+
+# Documented on every operation, so the OpenAPI schema is the whole contract (422 included:
+# validation errors use this body too, not FastAPI's default).
+ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
+    status: {"model": ErrorBody, "description": text}
+    for status, text in (
+        (400, "bad request: the message names the value and the fix"),
+        (401, "TCP request without the bearer token"),
+        (404, "no such entity, joint, link or sensor"),
+        (409, "the name is taken"),
+        (422, "the body does not match the request schema"),
+        (500, "internal error; the world keeps running"),
+    )
+}
+
+
 def _error(status: int, name: str, message: str) -> JSONResponse:
     return JSONResponse(status_code=status, content={"error": name, "message": message})
 
@@ -264,6 +288,18 @@ def _validation_error(request: Request, exc: RequestValidationError) -> JSONResp
         )
     )
     return _error(422, "RequestError", message)
+
+
+def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    """Starlette's own refusals (a body that is not JSON, an unknown path) in twin's error body."""
+    message = str(
+        RequestError(
+            f"{request.method} {request.url.path}",
+            str(exc.detail),
+            "see docs/api.md or /openapi.json for the request schema",
+        )
+    )
+    return _error(exc.status_code, "RequestError", message)
 
 
 def _os_error(request: Request, exc: OSError) -> JSONResponse:
@@ -350,12 +386,12 @@ def create_app(
     app.state.operations = Operations()
     app.state.world_name = world_name
     app.state.request_exit = request_exit or (lambda: None)
-    app.include_router(router)
-    app.include_router(consumer_routes.router)
-    app.include_router(sensor_routes.router)
+    for routes in (router, consumer_routes.router, sensor_routes.router):
+        app.include_router(routes, responses=ERROR_RESPONSES)
     app.add_exception_handler(TwinError, _known_error)
     app.add_exception_handler(ConversionError, _known_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
+    app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(OSError, _os_error)
     app.add_exception_handler(ValueError, _value_error)
     app.add_exception_handler(Exception, _unexpected)

@@ -108,7 +108,7 @@ class GravityBody(Body):
 class PhysicsBody(Body):
     """Physics settings to change; fields left out keep their value."""
 
-    timestep: Annotated[float, Field(gt=0.0, le=0.1, description="[s]")] | None = None
+    timestep: Annotated[float, Field(ge=1e-6, le=0.1, description="[s]")] | None = None
     rate: Annotated[float, Field(ge=0.0, le=1e7, description="[Hz]; 0 = unthrottled")] | None = None
     iterations: Annotated[int, Field(ge=1, le=100_000)] | None = None
     solver: str | None = None

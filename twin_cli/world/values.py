@@ -94,14 +94,19 @@ def finite_vector(what: str, values: object, size: int) -> list[float]:
     return vector
 
 
+# [s] smallest step accepted: below it the real-time pacer's steps per second overflow (a
+# 5e-324 s step divided by zero; found by the API fuzz), and no robot needs a step under 1 µs.
+MIN_TIMESTEP_S = 1e-6
+
+
 def check_settings(s: WorldSettings) -> None:
     """Raises InvalidRequestError for a setting MuJoCo cannot run with."""
     problems = [
         (
             "timestep",
             s.timestep,
-            math.isfinite(s.timestep) and s.timestep > 0,
-            "give a step > 0 s, e.g. 0.001",
+            math.isfinite(s.timestep) and s.timestep >= MIN_TIMESTEP_S,
+            f"give a step >= {MIN_TIMESTEP_S:g} s, e.g. 0.001",
         ),
         (
             "rate",
