@@ -112,6 +112,7 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--link",), "link", str),
             Opt(("--duration",), "duration", float, 0.1),
             WORLD,
+            JSON,
         ),
     ),
     "gravity": Grammar(

@@ -112,6 +112,13 @@ def spawn(
     quat: tuple[float, float, float, float] | None = None,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`)."""
+    if name is not None:
+        from twin_cli.names import name_message, name_problem
+
+        if name_problem(name) is not None:
+            from twin_cli.errors import InvalidRequestError
+
+            raise InvalidRequestError("--name", name_message(name), "nothing was spawned")
     inputs = pairs.source_inputs(arg, package)
     joints = pairs.joint_positions(joint)
     pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
@@ -188,10 +195,19 @@ def joints(*, name: str, world: str, json: bool) -> None:
 
 
 def push(
-    *, name: str, force: Vec3, torque: Vec3, link: str | None, duration: float, world: str
+    *,
+    name: str,
+    force: Vec3,
+    torque: Vec3,
+    link: str | None,
+    duration: float,
+    world: str,
+    json: bool = False,
 ) -> None:
     with _connect(world) as c:
-        c.push(name, force, torque, link=link, duration=duration)
+        result = c.push(name, force, torque, link=link, duration=duration)
+    if json:
+        Output(json).data(result)
 
 
 def gravity_choice(

@@ -149,7 +149,13 @@ def links(name: str, world: WorldDep) -> dict:
 @router.post("/entities/{name}/push")
 def push(name: str, body: PushBody, world: WorldDep) -> dict:
     world.push(name, body.force, body.torque, link=body.link, duration=body.duration)
-    return {"pushed": name}
+    return {
+        "pushed": name,
+        "link": body.link,
+        "force": list(body.force),
+        "torque": list(body.torque),
+        "duration": body.duration,
+    }
 
 
 @router.post("/entities/{name}/command")
@@ -277,7 +283,8 @@ def _known_error(request: Request, exc: Exception) -> JSONResponse:
 def _validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
     """pydantic's findings as one line naming each bad field."""
     problems = "; ".join(
-        f"{'.'.join(str(p) for p in err['loc'] if p != 'body') or 'body'}: {err['msg']}"
+        f"{'.'.join(str(p) for p in err['loc'] if p != 'body') or 'body'}: "
+        f"{err['msg'].removeprefix('Value error, ')}"
         for err in exc.errors()
     )
     message = str(

@@ -8,11 +8,26 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+
+from twin_cli.names import name_message, name_problem
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Vector = tuple[Finite, Finite, Finite]
-EntityName = Annotated[str, Field(min_length=1, max_length=200, pattern=r"^[^/\s][^/]*$")]
+
+
+def _entity_name(name: str) -> str:
+    """The one name rule (twin_cli.names), with its message instead of a regex's."""
+    if name_problem(name) is not None:
+        raise ValueError(name_message(name))
+    return name
+
+
+EntityName = Annotated[
+    str,
+    AfterValidator(_entity_name),
+    Field(min_length=1, max_length=200, description="1-200 characters without '/' or spaces"),
+]
 
 
 class Body(BaseModel):

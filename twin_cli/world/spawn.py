@@ -178,12 +178,11 @@ def check_entity_name(name: str) -> str:
     Raises:
         InvalidRequestError: empty, or contains '/' or whitespace.
     """
-    if not name or "/" in name or any(c.isspace() for c in name):
-        raise InvalidRequestError(
-            f"entity name [{name}]",
-            "must be non-empty, without '/' or spaces",
-            "choose a name such as robot_1",
-        )
+    from twin_cli.names import EXAMPLE, RULE, name_problem
+
+    problem = name_problem(name)
+    if problem is not None:
+        raise InvalidRequestError(f"entity name [{name}]", problem, f"use {RULE}, e.g. {EXAMPLE}")
     return name
 
 

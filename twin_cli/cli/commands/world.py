@@ -124,9 +124,12 @@ def push(
     link: Annotated[str | None, typer.Option(help="Link to push (default: the root).")] = None,
     duration: Annotated[float, typer.Option(help="How long (s) of sim time.")] = 0.1,
     world: WorldOpt = "default",
+    json: JsonOpt = False,
 ) -> None:
     """Apply a force and torque to an entity for a while."""
-    act.push(name=name, force=force, torque=torque, link=link, duration=duration, world=world)
+    act.push(
+        name=name, force=force, torque=torque, link=link, duration=duration, world=world, json=json
+    )
 
 
 def gravity(
