@@ -123,7 +123,10 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 pose, state, (model, data, index) = self._seed(
                     loaded, name, pose, home, on_ground, joints or {}
                 )
-                warnings = placement.start_warnings(model, data, index, name, pose.z)
+                warnings = [
+                    *loaded.notes,
+                    *placement.start_warnings(model, data, index, name, pose.z),
+                ]
             except BaseException:
                 spawn.remove_entity(self._spec, name)  # the world spec as it was before
                 raise

@@ -56,6 +56,7 @@ class LoadedSource:
         description: the URDF text after xacro, for `/robot_description`; None for SDF, MJCF
             and MjSpec sources (ROS tools draw robots from URDF only).
         sensors: the converter's `converters.description.sensors.SensorSpec`s (URDF/SDF).
+        notes: what was done to the source that the user should hear (a scene's ground left out).
     """
 
     spec: mujoco.MjSpec
@@ -65,6 +66,7 @@ class LoadedSource:
     default_name: str
     description: str | None = None
     sensors: tuple = ()
+    notes: tuple[str, ...] = ()
 
 
 def load_source(
@@ -143,7 +145,31 @@ def _load_mjcf(path: Path) -> LoadedSource:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as exc:
         raise SpawnError(path.stem, str(path), f"not valid MJCF ({exc})", "fix the file") from exc
-    return LoadedSource(spec, str(path), None, None, spec.modelname or path.stem)
+    note = strip_scene(spec, path.name)
+    notes = (note,) if note else ()
+    return LoadedSource(spec, str(path), None, None, spec.modelname or path.stem, notes=notes)
+
+
+def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
+    """Leave out a scene's own ground planes and lights (the world has its own); say so.
+
+    An MJCF with a plane or a light in its worldbody is a scene, such as the `scene.xml` that
+    `twin convert` writes: spawned as it is, its plane became a second ground at the spawn
+    height. Its robot (every body) is kept.
+
+    Returns:
+        The note for the user, or None when `spec` is not a scene.
+    """
+    planes = [g for g in spec.worldbody.geoms if g.type == mujoco.mjtGeom.mjGEOM_PLANE]
+    lights = list(spec.worldbody.lights)
+    if not planes and not lights:
+        return None
+    for element in planes + lights:
+        spec.delete(element)
+    return (
+        f"{label} is a scene ({len(planes)} ground plane(s), {len(lights)} light(s)): spawned "
+        "its robot without its ground and lights, since the world has its own"
+    )
 
 
 def _load_description(
