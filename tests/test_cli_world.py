@@ -156,6 +156,7 @@ def test_spawn_J_starts_at_rest_in_that_posture_mimic_follows_and_reset_returns_
 ):
     # follow = 0.2 - lead (mimic); gravity swings both fingers once stepped.
     (tmp_path / "pincer.urdf").write_text(mimic_pincer(offset=0.2, multiplier=-1.0))
+    twin("spawn", twin.box, "--name", "anchor", "-x", "5", "-z", "0.1")  # only spawn starts one
     twin("pause")
     twin("spawn", str(tmp_path / "pincer.urdf"), "-J", "lead=0.6")
     start = _joints(twin, "pincer")
@@ -172,6 +173,7 @@ def test_spawn_J_starts_at_rest_in_that_posture_mimic_follows_and_reset_returns_
 
 def test_spawn_J_out_of_range_exits_2_naming_joint_and_range_and_world_is_unchanged(twin, tmp_path):
     (tmp_path / "pincer.urdf").write_text(mimic_pincer(offset=0.2, multiplier=-1.0))
+    twin("spawn", twin.box, "--name", "anchor", "-x", "5", "-z", "0.1")  # only spawn starts one
     twin("pause")
     twin("spawn", str(tmp_path / "pincer.urdf"), "-J", "lead=0.5")
     before = _joints(twin, "pincer")
@@ -187,6 +189,6 @@ def test_spawn_J_out_of_range_exits_2_naming_joint_and_range_and_world_is_unchan
         assert proc.returncode == 2, f"-J {value}: exit {proc.returncode}, {proc.stderr}"
         missing = [text for text in expected if text not in proc.stderr]
         assert not missing, f"-J {value}: message lacks {missing}: {proc.stderr}"
-    names = [e["name"] for e in json.loads(twin("list", "--json").stdout)]
-    assert names == ["pincer"], f"entities after failed spawns: {names}"
+    names = sorted(e["name"] for e in json.loads(twin("list", "--json").stdout))
+    assert names == ["anchor", "pincer"], f"entities after failed spawns: {names}"
     assert _joints(twin, "pincer") == before, "the existing entity is untouched"

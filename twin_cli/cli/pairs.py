@@ -6,6 +6,8 @@ path (`fast`, which hands a bad value to the Typer app so that it prints the usa
 
 from __future__ import annotations
 
+import math
+
 
 class BadOption(ValueError):
     """An option value that does not parse; the message names the option and the fix."""
@@ -38,12 +40,18 @@ def joint_positions(items: list[str] | None) -> dict[str, float]:
     """
     out: dict[str, float] = {}
     for name, value in parse_pairs(items, "=", "-J").items():
+        if not name:
+            raise BadOption(f"-J ={value}: the joint name is missing; give e.g. -J elbow=0.5")
         try:
             out[name] = float(value)
         except ValueError:
             raise BadOption(
                 f"-J {name}={value}: {value!r} is not a number; give e.g. -J {name}=0.5"
             ) from None
+        if not math.isfinite(out[name]):  # nan, inf and 1e309 parse as floats (fuzz found it)
+            raise BadOption(
+                f"-J {name}={value}: {value!r} is not a finite number; give e.g. -J {name}=0.5"
+            )
     return out
 
 
