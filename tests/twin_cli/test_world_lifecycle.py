@@ -120,9 +120,16 @@ def test_server_that_exits_with_an_error_is_reported_with_its_code(twin):
 
 def _busy_world(twin: Twin, seconds: float) -> subprocess.Popen:
     """`twin step N` in the background, N chosen to hold the world's lock about `seconds`."""
-    start = time.monotonic()
-    twin("step", "20000")
-    rate = 20000 / max(time.monotonic() - start, 1e-3)  # steps/s, Python start-up included
+    from twin_cli.server.client import Client
+
+    os.environ["TWIN_RUNTIME_DIR"] = str(twin.dir)
+    try:
+        with Client("default") as client:
+            start = time.monotonic()
+            client.step(20000)
+            rate = 20000 / max(time.monotonic() - start, 1e-3)  # [steps/s], no start-up in it
+    finally:
+        del os.environ["TWIN_RUNTIME_DIR"]
     steps = str(int(rate * seconds) + 1)
     return subprocess.Popen(
         [sys.executable, "-m", "twin_cli.cli.app", "step", steps],
@@ -138,27 +145,29 @@ def test_delete_and_spawn_that_outlive_the_clients_patience_are_unknown_and_repe
 ):
     twin("spawn", twin.box, "--name", "box", "-z", "1")
     twin("pause")
-    busy = _busy_world(twin, 6.0)
+    busy = _busy_world(twin, 8.0)
     time.sleep(0.5)  # the step request holds the world's lock now
     impatient = {**twin.env, "TWIN_TIMEOUT": "1"}
-    outcomes = [
-        subprocess.run(
+    runs = [  # both at once, so both give up while the step still holds the world
+        subprocess.Popen(
             [sys.executable, "-m", "twin_cli.cli.app", *args],
             env=impatient,
-            capture_output=True,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
             text=True,
-            timeout=60,
         )
-        for args in (["delete", "box"], ["spawn", twin.box, "--name", "b2", "-x", "2"])
+        for args in (["delete", "box"], ["spawn", twin.box, "--name", "b2", "-x", "2", "-z", "1"])
     ]
-    for proc in outcomes:
-        assert proc.returncode == 75, f"exit {proc.returncode}: {proc.stderr}"
-        assert "outcome is unknown" in proc.stderr and "repeat" in proc.stderr, proc.stderr
+    for proc in runs:
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 75, f"exit {proc.returncode}: {err}"
+        assert "outcome is unknown" in err and "repeat" in err, err
+    assert busy.poll() is None, "the busy step ended before the impatient clients gave up"
     assert busy.wait(timeout=120) == 0, busy.stderr.read()
 
     again = twin("delete", "box")  # the first delete happened; the repeat gets its outcome
     assert again.returncode == 0, again.stderr
-    spawned = twin("spawn", twin.box, "--name", "b2", "-x", "2")
+    spawned = twin("spawn", twin.box, "--name", "b2", "-x", "2", "-z", "1")
     assert spawned.stdout.strip() == "b2", spawned
     names = sorted(e["name"] for e in json.loads(twin("list", "--json").stdout))
     assert names == ["b2"], f"after the repeats: {names}"
