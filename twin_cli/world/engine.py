@@ -142,7 +142,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 sensors=loaded.sensors,
             )
             self._commit(self._spec, model, data, index)
-            return SpawnResult(name, loaded.source, warnings, loaded.report)
+            return SpawnResult(name, loaded.source, warnings, loaded.report, loaded.cached)
 
     def _attach(self, loaded: spawn.LoadedSource, name: str, pose: Pose) -> np.ndarray | None:
         """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""

@@ -56,6 +56,7 @@ class LoadedSource:
         description: the URDF text after xacro, for `/robot_description`; None for SDF, MJCF
             and MjSpec sources (ROS tools draw robots from URDF only).
         sensors: the converter's `converters.description.sensors.SensorSpec`s (URDF/SDF).
+        cached: the conversion came from the server's cache (`conversion_cache`), unconverted.
     """
 
     spec: mujoco.MjSpec
@@ -65,6 +66,7 @@ class LoadedSource:
     default_name: str
     description: str | None = None
     sensors: tuple = ()
+    cached: bool = False
 
 
 def load_source(
@@ -147,6 +149,16 @@ def _load_mjcf(path: Path) -> LoadedSource:
 
 
 def _load_description(
+    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+) -> LoadedSource:
+    """A converted file, from the conversion cache when no file it read has changed."""
+    from twin_cli.world.conversion_cache import CACHE, cache_key
+
+    key = cache_key(path, args, package_paths)
+    return CACHE.load(key, lambda: _convert_description(path, args, package_paths))
+
+
+def _convert_description(
     path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
 ) -> LoadedSource:
     from converters.pipeline import convert_full
