@@ -93,6 +93,8 @@ GRAMMARS: dict[str, Grammar] = {
             JSON,
             Opt(("--xml",), "xml", str),
             Opt(("--quat",), "quat", float, nargs=4),
+            Opt(("--at",), "at", str, multiple=True),
+            Opt(("--names",), "names", str),
         ),
     ),
     "delete": Grammar("delete", (NAME,), (WORLD,)),

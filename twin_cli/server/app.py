@@ -35,6 +35,7 @@ from twin_cli.server.models import (
     PoseBody,
     PushBody,
     ResetBody,
+    SpawnBatchBody,
     SpawnBody,
     StepBody,
 )
@@ -90,6 +91,26 @@ def spawn(body: SpawnBody, world: WorldDep) -> dict:
     )
     log.info("spawned %s from %s", result.name, body.source or "<xml>")
     return _plain(result)
+
+
+@router.post("/entities/batch", status_code=201)
+def spawn_batch(body: SpawnBatchBody, world: WorldDep) -> list[dict]:
+    """Spawn one file or text at many poses: one conversion, one recompile, all or nothing."""
+    from twin_cli.world.spawn import DescriptionText
+
+    source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
+    results = world.spawn_batch(
+        source,
+        poses=[_pose(p) for p in body.poses],
+        names=body.names,
+        base=body.name,
+        args=body.args,
+        package_paths=body.package_paths,
+        on_ground=body.on_ground,
+        joints=body.joints,
+    )
+    log.info("spawned %d entities from %s", len(results), body.source or "<xml>")
+    return _plain(results)
 
 
 @router.delete("/entities/{name}")

@@ -25,6 +25,7 @@ import numpy as np
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
 from twin_cli.world import actuation as control
 from twin_cli.world import placement, posture, queries, spawn
+from twin_cli.world.batch import BatchSpawning
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.driving import EntityControl
@@ -59,7 +60,7 @@ WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
 _Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
 
-class World(RunControl, PhysicsSettings, EntityControl):
+class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning):
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:

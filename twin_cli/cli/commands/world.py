@@ -63,6 +63,16 @@ def spawn(
         tuple[float, float, float, float] | None,
         typer.Option(help="Orientation as a quaternion X Y Z W, instead of -R -P -Y."),
     ] = None,
+    at: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Spawn one entity per pose X,Y[,Z[,YAW]] (repeat it), in one request; "
+            "named NAME_0, NAME_1, … All or nothing."
+        ),
+    ] = None,
+    names: Annotated[
+        str | None, typer.Option(help="Names of the --at entities, comma-separated.")
+    ] = None,
 ) -> None:
     """Spawn a robot or model; prints its name once it exists in the world."""
     with usage_errors():
@@ -83,6 +93,8 @@ def spawn(
             json=json,
             xml=xml,
             quat=quat,
+            at=at,
+            names=names,
         )
 
 
