@@ -131,6 +131,7 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--step",), "step", float),
             Opt(("--rate",), "rate", float),
             Opt(("--iterations",), "iterations", int),
+            Opt(("--threads",), "threads", int),
             WORLD,
             JSON,
         ),

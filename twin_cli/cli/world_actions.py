@@ -298,12 +298,12 @@ def physics(
     iterations: int | None,
     world: str,
     json: bool,
+    threads: int | None = None,
+    sleep: bool | None = None,
 ) -> None:
-    changes = {
-        k: v
-        for k, v in (("timestep", step), ("rate", rate), ("iterations", iterations))
-        if v is not None
-    }
+    given = (("timestep", step), ("rate", rate), ("iterations", iterations))
+    given += (("threads", threads), ("sleep", sleep))
+    changes = {k: v for k, v in given if v is not None}
     with _connect(world) as c:
         result = c.set_physics(**changes) if changes else c.physics()
     out = Output(json)

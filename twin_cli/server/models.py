@@ -113,6 +113,8 @@ class PhysicsBody(Body):
     iterations: Annotated[int, Field(ge=1, le=100_000)] | None = None
     solver: str | None = None
     integrator: str | None = None
+    threads: Annotated[int, Field(ge=1, le=64, description="engine threads")] | None = None
+    sleep: bool | None = Field(default=None, description="sleeping of resting islands")
 
 
 class StepBody(Body):

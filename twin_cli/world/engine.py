@@ -29,6 +29,7 @@ from twin_cli.world.batch import BatchSpawning
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.driving import EntityControl
+from twin_cli.world.engine_threads import EngineThreads
 from twin_cli.world.entities import (
     Entity,
     EntityIndex,
@@ -60,7 +61,7 @@ WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
 _Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
 
-class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning):
+class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads):
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
@@ -257,6 +258,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning):
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = spec, model, data, index
+        self._install_pool(model, data)
         cap_contact_stiffness(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))

@@ -161,9 +161,20 @@ def physics(
     iterations: Annotated[int | None, typer.Option(help="Solver iterations.")] = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
+    threads: Annotated[
+        int | None,
+        typer.Option(min=1, max=64, help="MuJoCo engine threads (default: the cores)."),
+    ] = None,
+    sleep: Annotated[
+        bool | None,
+        typer.Option("--sleep/--no-sleep", help="Let resting robots sleep (off by default)."),
+    ] = None,
 ) -> None:
-    """Print the physics settings, or change step, rate or iterations."""
-    act.physics(step=step, rate=rate, iterations=iterations, world=world, json=json)
+    """Print the physics settings, or change step, rate, iterations, threads or sleeping."""
+    act.physics(
+        step=step, rate=rate, iterations=iterations, world=world, json=json,
+        threads=threads, sleep=sleep,
+    )  # fmt: skip
 
 
 def pause(world: WorldOpt = "default") -> None:
