@@ -132,6 +132,7 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--rate",), "rate", float),
             Opt(("--iterations",), "iterations", int),
             Opt(("--threads",), "threads", int),
+            Opt(("--sleep-tolerance",), "sleep_tolerance", float),
             WORLD,
             JSON,
         ),

@@ -300,9 +300,10 @@ def physics(
     json: bool,
     threads: int | None = None,
     sleep: bool | None = None,
+    sleep_tolerance: float | None = None,
 ) -> None:
     given = (("timestep", step), ("rate", rate), ("iterations", iterations))
-    given += (("threads", threads), ("sleep", sleep))
+    given += (("threads", threads), ("sleep", sleep), ("sleep_tolerance", sleep_tolerance))
     changes = {k: v for k, v in given if v is not None}
     with _connect(world) as c:
         result = c.set_physics(**changes) if changes else c.physics()

@@ -115,6 +115,7 @@ class PhysicsBody(Body):
     integrator: str | None = None
     threads: Annotated[int, Field(ge=1, le=64, description="engine threads")] | None = None
     sleep: bool | None = Field(default=None, description="sleeping of resting islands")
+    sleep_tolerance: Annotated[float, Field(gt=0.0, lt=10.0, description="[m/s]")] | None = None
 
 
 class StepBody(Body):

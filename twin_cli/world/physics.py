@@ -50,6 +50,7 @@ class PhysicsSettings:
                 "threads": self.threads,
                 "pool_threads": self.pool_threads,
                 "sleep": self.sleeping,
+                "sleep_tolerance": float(self.model.opt.sleep_tolerance),
             }
 
     def set_physics(
@@ -62,6 +63,7 @@ class PhysicsSettings:
         integrator: str | None = None,
         threads: int | None = None,
         sleep: bool | None = None,
+        sleep_tolerance: float | None = None,
     ) -> dict:
         """Changes any of the physics settings (None keeps a value); returns `physics()`.
 
@@ -78,7 +80,7 @@ class PhysicsSettings:
         with self.lock:
             new = replace(self.settings, **changes)
             check_settings(new)
-            self.set_engine(threads=threads, sleep=sleep)
+            self.set_engine(threads=threads, sleep=sleep, sleep_tolerance=sleep_tolerance)
             self.settings = new
             for target in (self.model.opt, self._spec.option):
                 target.timestep, target.iterations = new.timestep, new.iterations

@@ -169,11 +169,14 @@ def physics(
         bool | None,
         typer.Option("--sleep/--no-sleep", help="Let resting robots sleep (off by default)."),
     ] = None,
+    sleep_tolerance: Annotated[
+        float | None, typer.Option(help="Speed (m/s) under which a robot may sleep.")
+    ] = None,
 ) -> None:
     """Print the physics settings, or change step, rate, iterations, threads or sleeping."""
     act.physics(
         step=step, rate=rate, iterations=iterations, world=world, json=json,
-        threads=threads, sleep=sleep,
+        threads=threads, sleep=sleep, sleep_tolerance=sleep_tolerance,
     )  # fmt: skip
 
 
