@@ -132,6 +132,8 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--rate",), "rate", float),
             Opt(("--iterations",), "iterations", int),
             Opt(("--threads",), "threads", int),
+            _flag("--sleep", dest="sleep"),
+            _flag("--no-sleep", dest="no_sleep"),
             Opt(("--sleep-tolerance",), "sleep_tolerance", float),
             WORLD,
             JSON,

@@ -299,9 +299,13 @@ def physics(
     world: str,
     json: bool,
     threads: int | None = None,
-    sleep: bool | None = None,
+    sleep: bool = False,
     sleep_tolerance: float | None = None,
+    no_sleep: bool = False,
 ) -> None:
+    if sleep and no_sleep:
+        raise pairs.BadOption("give --sleep or --no-sleep, not both")
+    sleep = True if sleep else (False if no_sleep else None)
     given = (("timestep", step), ("rate", rate), ("iterations", iterations))
     given += (("threads", threads), ("sleep", sleep), ("sleep_tolerance", sleep_tolerance))
     changes = {k: v for k, v in given if v is not None}

@@ -162,13 +162,12 @@ def physics(
     world: WorldOpt = "default",
     json: JsonOpt = False,
     threads: Annotated[
-        int | None,
-        typer.Option(min=1, max=64, help="MuJoCo engine threads (default: the cores)."),
+        int | None, typer.Option(help="MuJoCo engine threads, 1-64 (default: the cores).")
     ] = None,
     sleep: Annotated[
-        bool | None,
-        typer.Option("--sleep/--no-sleep", help="Let resting robots sleep (off by default)."),
-    ] = None,
+        bool, typer.Option("--sleep", help="Let resting robots sleep (off by default).")
+    ] = False,
+    no_sleep: Annotated[bool, typer.Option("--no-sleep", help="Keep every robot awake.")] = False,
     sleep_tolerance: Annotated[
         float | None, typer.Option(help="Speed (m/s) under which a robot may sleep.")
     ] = None,
@@ -176,7 +175,7 @@ def physics(
     """Print the physics settings, or change step, rate, iterations, threads or sleeping."""
     act.physics(
         step=step, rate=rate, iterations=iterations, world=world, json=json,
-        threads=threads, sleep=sleep, sleep_tolerance=sleep_tolerance,
+        threads=threads, sleep=sleep, no_sleep=no_sleep, sleep_tolerance=sleep_tolerance,
     )  # fmt: skip
 
 
