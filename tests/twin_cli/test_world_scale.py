@@ -5,6 +5,7 @@ the pool (bit-equal), and a push on a resting box in a world without sleeping.""
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 from models import block
@@ -112,3 +113,34 @@ def test_a_pushed_sleeping_box_wakes_and_slides_as_an_awake_one(tmp_path):
         assert world.data.ntree_awake == 1
         moved.append(world.get_pose("box").x - x0)
     assert moved[0] > 0.3 and moved[1] == pytest.approx(moved[0], abs=PUSH_TOL), moved
+
+
+def _tetra_stl(path) -> None:
+    """A binary STL tetrahedron (0.1 m edges along the axes)."""
+    v = np.array([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]], dtype="<f4")
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    rec = np.zeros(4, dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = [v[list(f)] for f in faces]
+    path.write_bytes(b"\0" * 80 + np.uint32(4).tobytes() + rec.tobytes())
+
+
+def test_instances_of_a_robot_share_its_meshes_in_the_world(tmp_path):
+    _tetra_stl(tmp_path / "part.stl")
+    (tmp_path / "r.urdf").write_text(
+        '<robot name="r"><link name="base"><inertial><mass value="1"/><inertia ixx="0.01" '
+        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+        '<visual><geometry><mesh filename="part.stl"/></geometry></visual>'
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>'
+    )
+    world = World()
+    world.spawn(tmp_path / "r.urdf", name="a", pose=Pose(z=0.5))
+    one = world.model.nmesh
+    world.spawn_batch(tmp_path / "r.urdf", base="b", poses=[Pose(x=k, z=0.5) for k in (1, 2)])
+    assert one >= 1 and world.model.nmesh == one  # three instances, one copy of each mesh
+    world.delete("a")  # the instance that brought the meshes goes; the others keep them
+    world.step(10)
+    mesh_geoms = world.model.geom_dataid[world.model.geom_type == mujoco.mjtGeom.mjGEOM_MESH]
+    assert world.model.nmesh == one and len(mesh_geoms) == 2 and (mesh_geoms >= 0).all()
+    world.delete("b_0")
+    world.delete("b_1")
+    assert world.model.nmesh == 0 and len(world._spec.meshes) == 0  # none left behind

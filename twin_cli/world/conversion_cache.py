@@ -112,6 +112,17 @@ class _Entry:
     files: tuple[tuple[str, str | None], ...]  # (path, digest) of every file read
 
 
+def mesh_keys(spec: Any, conversion: tuple) -> dict[str, str]:
+    """Mesh name → a digest of the conversion (key and files read) and the name: two meshes
+    with the same key come from the same files through the same conversion, so they are equal."""
+    base = hashlib.blake2b(repr(conversion).encode(), digest_size=16).hexdigest()
+    return {
+        m.name: hashlib.blake2b(f"{base}/{m.name}".encode(), digest_size=12).hexdigest()
+        for m in spec.meshes
+        if m.name
+    }
+
+
 class ConversionCache:
     """Conversions by key, valid while their files' contents are unchanged (LRU, thread-safe)."""
 
@@ -136,10 +147,9 @@ class ConversionCache:
             return replace(entry.loaded, spec=entry.loaded.spec.copy(), cached=True)
         with recording() as files:
             loaded = convert()
-        entry = _Entry(
-            replace(loaded, spec=loaded.spec.copy()),
-            tuple((p, file_digest(p)) for p in sorted(files)),
-        )
+        read = tuple((p, file_digest(p)) for p in sorted(files))
+        loaded = replace(loaded, mesh_keys=mesh_keys(loaded.spec, (key, read)))
+        entry = _Entry(replace(loaded, spec=loaded.spec.copy()), read)
         with self._lock:
             self.misses += 1
             self._entries[key] = entry

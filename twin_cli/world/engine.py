@@ -24,7 +24,7 @@ import numpy as np
 
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
 from twin_cli.world import actuation as control
-from twin_cli.world import placement, posture, queries, spawn
+from twin_cli.world import placement, posture, queries, shared_meshes, spawn
 from twin_cli.world.batch import BatchSpawning
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.divergence import Divergence
@@ -150,6 +150,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
         try:
             home = spawn.prepare_child(loaded.spec, self._spec)
+            shared_meshes.prepare(loaded.spec, self._spec, loaded.mesh_keys)
             spawn.attach(self._spec, loaded.spec, name, pose)
         except ValueError as exc:
             raise SpawnError(

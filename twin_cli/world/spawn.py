@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError, SpawnError
+from twin_cli.world import shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
@@ -57,6 +58,7 @@ class LoadedSource:
             and MjSpec sources (ROS tools draw robots from URDF only).
         sensors: the converter's `converters.description.sensors.SensorSpec`s (URDF/SDF).
         cached: the conversion came from the server's cache (`conversion_cache`), unconverted.
+        mesh_keys: mesh name → a key equal exactly for equal meshes (`shared_meshes`), or None.
     """
 
     spec: mujoco.MjSpec
@@ -67,6 +69,7 @@ class LoadedSource:
     description: str | None = None
     sensors: tuple = ()
     cached: bool = False
+    mesh_keys: dict[str, str] | None = None
 
 
 def load_source(
@@ -264,6 +267,7 @@ def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) ->
     frame = world.worldbody.add_frame(name=f"{name}/", pos=list(pose.position()))
     frame.quat = list(pose.quat())
     world.attach(child, frame=frame, prefix=f"{name}/")
+    shared_meshes.adopt(world, name)  # a robot's meshes compile once per world, not per instance
 
 
 def move_frame(world: mujoco.MjSpec, name: str, pose: Pose) -> None:
@@ -311,6 +315,7 @@ def remove_entity(world: mujoco.MjSpec, name: str) -> None:
     defaults = world.find_default(f"{prefix}{ROOT_DEFAULT}")
     if defaults is not None:
         world.delete(defaults)
+    shared_meshes.prune(world)
 
 
 def initial_qpos(
