@@ -41,6 +41,11 @@ def prepare(child: mujoco.MjSpec, world: mujoco.MjSpec, keys: dict[str, str] | N
             geom.meshname = shared[geom.meshname]
 
 
+def uses_shared(child: mujoco.MjSpec) -> bool:
+    """Whether `prepare` pointed any of the child's geoms at a shared mesh."""
+    return any(g.meshname.startswith(SHARED_PREFIX) for g in child.geoms)
+
+
 def adopt(world: mujoco.MjSpec, entity: str) -> None:
     """After the attach: the entity's shared meshes and references lose its prefix."""
     prefixed = f"{entity}/{SHARED_PREFIX}"

@@ -264,10 +264,12 @@ def _min_friction_priorities(child: mujoco.MjSpec) -> None:
 
 def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) -> None:
     """Attaches `child` to `world` in a frame "<name>/" at `pose`, prefixing names "<name>/"."""
+    shares = shared_meshes.uses_shared(child)
     frame = world.worldbody.add_frame(name=f"{name}/", pos=list(pose.position()))
     frame.quat = list(pose.quat())
     world.attach(child, frame=frame, prefix=f"{name}/")
-    shared_meshes.adopt(world, name)  # a robot's meshes compile once per world, not per instance
+    if shares:  # a robot's meshes compile once per world, not once per instance
+        shared_meshes.adopt(world, name)
 
 
 def move_frame(world: mujoco.MjSpec, name: str, pose: Pose) -> None:
