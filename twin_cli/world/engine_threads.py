@@ -4,7 +4,10 @@ A mixin of `twin_cli.world.engine.World`. The pool (`mujoco.mju_threadpool`, MuJ
 parallelises collision detection and the constraint solve across islands inside one `mj_step`;
 it belongs to an MjData, so it is installed again on every new data (spawn, delete, reset, load).
 It only pays with several islands to share out, so it is installed when the world has at least
-`POOL_MIN_TREES` kinematic trees: a one-robot world steps as before.
+`POOL_MIN_TREES` kinematic trees: a one-robot world steps as before. The pool changes no
+answer (a trajectory of 8 colliding humanoids is bit-equal with and without it), only speed;
+measured on a 2-core machine at load average 12-15 it was *slower* (0.5-0.7x at 8-64 humanoids,
+`benchmarks/bench_scale.py`): with both cores taken its workers wait for a core.
 
 Sleeping (`mjENBL_SLEEP`) freezes islands whose speed stays under `sleep_tolerance` [m/s, rad/s]
 for 10 steps; contacts with awake bodies and pushes wake them. Off by default: a sleeping robot's
