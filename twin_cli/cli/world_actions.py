@@ -110,8 +110,13 @@ def spawn(
     json: bool,
     xml: str | None = None,
     quat: tuple[float, float, float, float] | None = None,
+    at: list[str] | None = None,
+    names: str | None = None,
 ) -> None:
-    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`)."""
+    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
+
+    With `--at` (repeated), one entity per pose in one request (`spawn_many`).
+    """
     if name is not None:
         from twin_cli.names import name_message, name_problem
 
@@ -119,6 +124,13 @@ def spawn(
             from twin_cli.errors import InvalidRequestError
 
             raise InvalidRequestError("--name", name_message(name), "nothing was spawned")
+    if at or names is not None:
+        spawn_many(
+            file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
+            name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
+            world=world, json=json, xml=xml, quat=quat, x=x, y=y,
+        )  # fmt: skip
+        return
     inputs = pairs.source_inputs(arg, package)
     joints = pairs.joint_positions(joint)
     pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
@@ -138,6 +150,58 @@ def spawn(
     for warning in result.get("warnings") or []:
         sys.stderr.write(f"twin: warning: {warning}\n")
     out.line(result["name"])
+
+
+def spawn_many(
+    *,
+    file: Path | None,
+    at: list[str],
+    names: str | None,
+    z: float,
+    roll: float,
+    pitch: float,
+    yaw: float,
+    name: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    on_ground: bool,
+    joint: list[str] | None,
+    world: str,
+    json: bool,
+    xml: str | None,
+    quat: tuple[float, float, float, float] | None,
+    x: float = 0.0,
+    y: float = 0.0,
+) -> None:
+    """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
+    from twin_cli.cli import batch_poses
+
+    if not at:
+        raise pairs.BadOption("--names needs one --at X,Y[,Z[,YAW]] per name")
+    if quat is not None or x or y:
+        raise pairs.BadOption("give positions with --at X,Y[,Z[,YAW]], not -x/-y/--quat")
+    poses = [batch_poses.parse_at(text, z, roll, pitch, yaw) for text in at]
+    listed = batch_poses.parse_names(names, len(poses))
+    inputs = pairs.source_inputs(arg, package)
+    joints = pairs.joint_positions(joint)
+    if (file is None) == (xml is None):
+        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
+    if file is not None and str(file) == "-":
+        file, xml = None, sys.stdin.read()
+    source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
+    with _connect(world, start=True) as c:
+        results = c.spawn_batch(
+            file, poses=poses, names=listed, name=name, on_ground=on_ground, joints=joints,
+            **source, **inputs,
+        )  # fmt: skip
+    out = Output(json)
+    if json:
+        out.data(results)
+        return
+    for result in results:
+        for warning in result.get("warnings") or []:
+            sys.stderr.write(f"twin: warning: {warning}\n")
+        out.line(result["name"])
 
 
 def delete(*, name: str, world: str) -> None:
@@ -256,12 +320,17 @@ def physics(
     iterations: int | None,
     world: str,
     json: bool,
+    threads: int | None = None,
+    sleep: bool = False,
+    sleep_tolerance: float | None = None,
+    no_sleep: bool = False,
 ) -> None:
-    changes = {
-        k: v
-        for k, v in (("timestep", step), ("rate", rate), ("iterations", iterations))
-        if v is not None
-    }
+    if sleep and no_sleep:
+        raise pairs.BadOption("give --sleep or --no-sleep, not both")
+    sleep = True if sleep else (False if no_sleep else None)
+    given = (("timestep", step), ("rate", rate), ("iterations", iterations))
+    given += (("threads", threads), ("sleep", sleep), ("sleep_tolerance", sleep_tolerance))
+    changes = {k: v for k, v in given if v is not None}
     with _connect(world) as c:
         result = c.set_physics(**changes) if changes else c.physics()
     out = Output(json)

@@ -37,6 +37,7 @@ from twin_cli.server.models import (
     PoseBody,
     PushBody,
     ResetBody,
+    SpawnBatchBody,
     SpawnBody,
     StepBody,
 )
@@ -101,6 +102,26 @@ def _spawn(body: SpawnBody, world: Any) -> dict:
     )
     log.info("spawned %s from %s", result.name, body.source or "<xml>")
     return _plain(result)
+
+
+@router.post("/entities/batch", status_code=201)
+def spawn_batch(body: SpawnBatchBody, world: WorldDep) -> list[dict]:
+    """Spawn one file or text at many poses: one conversion, one recompile, all or nothing."""
+    from twin_cli.world.spawn import DescriptionText
+
+    source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
+    results = world.spawn_batch(
+        source,
+        poses=[_pose(p) for p in body.poses],
+        names=body.names,
+        base=body.name,
+        args=body.args,
+        package_paths=body.package_paths,
+        on_ground=body.on_ground,
+        joints=body.joints,
+    )
+    log.info("spawned %d entities from %s", len(results), body.source or "<xml>")
+    return _plain(results)
 
 
 @router.delete("/entities/{name}")

@@ -205,6 +205,33 @@ class Client:
             repeat=f"twin spawn ... --name {label}" if name else "twin spawn ...",
         )
 
+    def spawn_batch(
+        self,
+        source: str | os.PathLike | None,
+        *,
+        poses: list[dict[str, Any]],
+        names: list[str] | None = None,
+        **options: Any,
+    ) -> list[dict]:
+        """Spawn one file (or `xml` text) at every pose in one request, all or nothing.
+
+        `options` are `spawn`'s (name: the base of `name_0`, `name_1`, …); returns one result
+        per pose, in order.
+        """
+        xml, base_dir = options.pop("xml", None), options.pop("base_dir", None)
+        where = {"source": str(Path(source).expanduser().absolute())} if source is not None else {}
+        if xml is not None:
+            where = {"xml": xml, "base_dir": str(Path(base_dir or ".").expanduser().absolute())}
+        packages = options.pop("package_paths", None) or {}
+        body = {
+            **where,
+            **options,
+            "package_paths": {k: str(Path(v).expanduser().absolute()) for k, v in packages.items()},
+            "poses": poses,
+            "names": names,
+        }
+        return self.request("POST", "/entities/batch", body=body, timeout=SPAWN_TIMEOUT_S)
+
     def delete(self, name: str) -> dict:
         return self.long_request(
             "DELETE",

@@ -128,6 +128,9 @@ class PhysicsBody(Body):
     iterations: Annotated[int, Field(ge=1, le=100_000)] | None = None
     solver: str | None = None
     integrator: str | None = None
+    threads: Annotated[int, Field(ge=1, le=64, description="engine threads")] | None = None
+    sleep: bool | None = Field(default=None, description="sleeping of resting islands")
+    sleep_tolerance: Annotated[float, Field(gt=0.0, lt=10.0, description="[m/s]")] | None = None
 
 
 class StepBody(Body):
@@ -163,3 +166,11 @@ class FoxgloveBody(Body):
     port: Annotated[int, Field(ge=0, le=65535)] = 8765
     host: str = "127.0.0.1"
     rate: Annotated[Finite, Field(gt=0, le=1000)] = 30.0
+
+
+class SpawnBatchBody(SpawnBody):
+    """Spawn one description at many poses in one request and one recompile (all or nothing):
+    entities `names`, else `name_0`, `name_1`, … (`name` defaults to the robot's own name)."""
+
+    poses: Annotated[list[PoseBody], Field(min_length=1, max_length=1000)]
+    names: list[EntityName] | None = None

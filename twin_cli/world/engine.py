@@ -24,10 +24,12 @@ import numpy as np
 
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
 from twin_cli.world import actuation as control
-from twin_cli.world import placement, posture, queries, spawn
+from twin_cli.world import placement, posture, queries, shared_meshes, spawn
+from twin_cli.world.batch import BatchSpawning
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.driving import EntityControl
+from twin_cli.world.engine_threads import EngineThreads
 from twin_cli.world.entities import (
     Entity,
     EntityIndex,
@@ -59,7 +61,7 @@ WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
 _Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
 
-class World(RunControl, PhysicsSettings, EntityControl):
+class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads):
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
@@ -145,12 +147,13 @@ class World(RunControl, PhysicsSettings, EntityControl):
                 sensors=loaded.sensors,
             )
             self._commit(self._spec, model, data, index)
-            return SpawnResult(name, loaded.source, warnings, loaded.report)
+            return SpawnResult(name, loaded.source, warnings, loaded.report, loaded.cached)
 
     def _attach(self, loaded: spawn.LoadedSource, name: str, pose: Pose) -> np.ndarray | None:
         """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
         try:
             home = spawn.prepare_child(loaded.spec, self._spec)
+            shared_meshes.prepare(loaded.spec, self._spec, loaded.mesh_keys)
             spawn.attach(self._spec, loaded.spec, name, pose)
         except ValueError as exc:
             raise SpawnError(
@@ -259,6 +262,7 @@ class World(RunControl, PhysicsSettings, EntityControl):
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = spec, model, data, index
+        self._install_pool(model, data)
         cap_contact_stiffness(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))

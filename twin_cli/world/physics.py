@@ -47,6 +47,10 @@ class PhysicsSettings:
                 "gravity": list(s.gravity),
                 "target_factor": s.timestep * s.rate if s.rate > 0 else None,
                 "not_applicable": list(ODE_ONLY_FIELDS),
+                "threads": self.threads,
+                "pool_threads": self.pool_threads,
+                "sleep": self.sleeping,
+                "sleep_tolerance": float(self.model.opt.sleep_tolerance),
             }
 
     def set_physics(
@@ -57,8 +61,14 @@ class PhysicsSettings:
         iterations: int | None = None,
         solver: str | None = None,
         integrator: str | None = None,
+        threads: int | None = None,
+        sleep: bool | None = None,
+        sleep_tolerance: float | None = None,
     ) -> dict:
-        """Changes any of the physics settings (None keeps a value); returns `physics()`."""
+        """Changes any of the physics settings (None keeps a value); returns `physics()`.
+
+        `threads`: MuJoCo engine threads; `sleep`: island sleeping (see `engine_threads`).
+        """
         given = dict(
             timestep=timestep,
             rate=rate,
@@ -70,6 +80,7 @@ class PhysicsSettings:
         with self.lock:
             new = replace(self.settings, **changes)
             check_settings(new)
+            self.set_engine(threads=threads, sleep=sleep, sleep_tolerance=sleep_tolerance)
             self.settings = new
             for target in (self.model.opt, self._spec.option):
                 target.timestep, target.iterations = new.timestep, new.iterations

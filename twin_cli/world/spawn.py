@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError, SpawnError
+from twin_cli.world import shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
@@ -57,6 +58,8 @@ class LoadedSource:
             and MjSpec sources (ROS tools draw robots from URDF only).
         sensors: the converter's `converters.description.sensors.SensorSpec`s (URDF/SDF).
         notes: what was done to the source that the user should hear (a scene's ground left out).
+        cached: the conversion came from the server's cache (`conversion_cache`), unconverted.
+        mesh_keys: mesh name → a key equal exactly for equal meshes (`shared_meshes`), or None.
     """
 
     spec: mujoco.MjSpec
@@ -67,6 +70,8 @@ class LoadedSource:
     description: str | None = None
     sensors: tuple = ()
     notes: tuple[str, ...] = ()
+    cached: bool = False
+    mesh_keys: dict[str, str] | None = None
 
 
 def load_source(
@@ -175,6 +180,16 @@ def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
 def _load_description(
     path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
 ) -> LoadedSource:
+    """A converted file, from the conversion cache when no file it read has changed."""
+    from twin_cli.world.conversion_cache import CACHE, cache_key
+
+    key = cache_key(path, args, package_paths)
+    return CACHE.load(key, lambda: _convert_description(path, args, package_paths))
+
+
+def _convert_description(
+    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+) -> LoadedSource:
     from converters.pipeline import convert_full
 
     done = convert_full(path, args=args, package_paths=package_paths)
@@ -274,9 +289,12 @@ def _min_friction_priorities(child: mujoco.MjSpec) -> None:
 
 def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) -> None:
     """Attaches `child` to `world` in a frame "<name>/" at `pose`, prefixing names "<name>/"."""
+    shares = shared_meshes.uses_shared(child)
     frame = world.worldbody.add_frame(name=f"{name}/", pos=list(pose.position()))
     frame.quat = list(pose.quat())
     world.attach(child, frame=frame, prefix=f"{name}/")
+    if shares:  # a robot's meshes compile once per world, not once per instance
+        shared_meshes.adopt(world, name)
 
 
 def move_frame(world: mujoco.MjSpec, name: str, pose: Pose) -> None:
@@ -324,6 +342,7 @@ def remove_entity(world: mujoco.MjSpec, name: str) -> None:
     defaults = world.find_default(f"{prefix}{ROOT_DEFAULT}")
     if defaults is not None:
         world.delete(defaults)
+    shared_meshes.prune(world)
 
 
 def initial_qpos(

@@ -40,12 +40,14 @@ class WorldSettings:
 
 @dataclass(frozen=True)
 class SpawnResult:
-    """What a spawn did: the entity's name and source, start warnings, converter report."""
+    """What a spawn did: the entity's name and source, start warnings, converter report, and
+    whether the conversion came from the server's cache (nothing was converted)."""
 
     name: str
     source: str
     warnings: list[str]
     report: dict | None
+    cached: bool = False
 
 
 @dataclass(frozen=True)

@@ -63,6 +63,16 @@ def spawn(
         tuple[float, float, float, float] | None,
         typer.Option(help="Orientation as a quaternion X Y Z W, instead of -R -P -Y."),
     ] = None,
+    at: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Spawn one entity per pose X,Y[,Z[,YAW]] (repeat it), in one request; "
+            "named NAME_0, NAME_1, … All or nothing."
+        ),
+    ] = None,
+    names: Annotated[
+        str | None, typer.Option(help="Names of the --at entities, comma-separated.")
+    ] = None,
 ) -> None:
     """Spawn a robot or model; prints its name once it exists in the world."""
     with usage_errors():
@@ -83,6 +93,8 @@ def spawn(
             json=json,
             xml=xml,
             quat=quat,
+            at=at,
+            names=names,
         )
 
 
@@ -152,9 +164,22 @@ def physics(
     iterations: Annotated[int | None, typer.Option(help="Solver iterations.")] = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
+    threads: Annotated[
+        int | None, typer.Option(help="MuJoCo engine threads, 1-64 (default: the cores).")
+    ] = None,
+    sleep: Annotated[
+        bool, typer.Option("--sleep", help="Let resting robots sleep (off by default).")
+    ] = False,
+    no_sleep: Annotated[bool, typer.Option("--no-sleep", help="Keep every robot awake.")] = False,
+    sleep_tolerance: Annotated[
+        float | None, typer.Option(help="Speed (m/s) under which a robot may sleep.")
+    ] = None,
 ) -> None:
-    """Print the physics settings, or change step, rate or iterations."""
-    act.physics(step=step, rate=rate, iterations=iterations, world=world, json=json)
+    """Print the physics settings, or change step, rate, iterations, threads or sleeping."""
+    act.physics(
+        step=step, rate=rate, iterations=iterations, world=world, json=json,
+        threads=threads, sleep=sleep, no_sleep=no_sleep, sleep_tolerance=sleep_tolerance,
+    )  # fmt: skip
 
 
 def pause(world: WorldOpt = "default") -> None:

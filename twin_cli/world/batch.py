@@ -1,0 +1,142 @@
+"""Batch spawning: many instances of one robot in one request, one conversion and one recompile.
+
+A mixin of `twin_cli.world.engine.World` (it uses the world's lock, spec, entities and its
+`_attach`, `_rebuild`, `_ground` and `_commit` steps). All or nothing: every name and pose is
+checked before anything is attached, and on any later failure every attached instance is removed
+from the world spec, so the world is left exactly as it was.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from twin_cli.errors import EntityExistsError, InvalidRequestError
+from twin_cli.world import placement, posture, spawn
+from twin_cli.world.entities import Entity, index_entities, rest_state, write_state
+from twin_cli.world.pose import Pose
+from twin_cli.world.values import SpawnResult
+
+MAX_BATCH = 1000  # instances per request: a guard against a runaway script, not a model limit
+
+
+def batch_names(base: str, count: int) -> list[str]:
+    """Gazebo-style instance names `base_0`, `base_1`, … for `count` poses."""
+    return [f"{base}_{i}" for i in range(count)]
+
+
+def check_batch(names: Sequence[str], poses: Sequence[Pose], taken: Sequence[str]) -> None:
+    """Refuses a batch before anything is attached.
+
+    Raises:
+        InvalidRequestError: no poses, counts differ, a name repeats, a pose is not finite.
+        EntityExistsError: a name is already an entity of the world.
+    """
+    if not poses or len(poses) > MAX_BATCH:
+        raise InvalidRequestError(
+            "batch spawn", f"{len(poses)} poses", f"give 1 to {MAX_BATCH} poses (--at X,Y)"
+        )
+    if len(names) != len(poses):
+        raise InvalidRequestError(
+            "batch spawn",
+            f"{len(names)} names for {len(poses)} poses",
+            "give one name per pose (--names a,b,c) or a base --name",
+        )
+    seen: set[str] = set()
+    for i, (name, pose) in enumerate(zip(names, poses, strict=True)):
+        spawn.check_entity_name(name)
+        if name in seen:
+            raise InvalidRequestError(f"entity name [{name}]", "given twice", "make names unique")
+        seen.add(name)
+        if name in taken:
+            raise EntityExistsError(name)
+        values = (pose.x, pose.y, pose.z, pose.roll, pose.pitch, pose.yaw)
+        if not all(math.isfinite(v) for v in values):
+            raise InvalidRequestError(
+                f"pose {i} of entity [{name}]", f"{values} is not finite", "give finite numbers"
+            )
+
+
+class BatchSpawning:
+    """`spawn_batch` for a World (mixin)."""
+
+    def spawn_batch(
+        self,
+        source: str | os.PathLike,
+        *,
+        poses: Sequence[Pose],
+        names: Sequence[str] | None = None,
+        base: str | None = None,
+        args: dict[str, str] | None = None,
+        package_paths: dict[str, str] | None = None,
+        on_ground: bool = False,
+        joints: dict[str, float] | None = None,
+    ) -> list[SpawnResult]:
+        """Adds one entity per pose, converting the source once and compiling the world once.
+
+        Instances are named `names`, else `base_0`, `base_1`, … (`base` defaults to the robot's
+        own name). Each starts as `spawn` would start it (home key, `joints`, `on_ground`).
+        Raises what `spawn` raises, plus `check_batch`'s errors; on any error no instance is
+        added and the world is unchanged.
+        """
+        poses = list(poses)
+        if names is None and base is not None:
+            names = batch_names(spawn.check_entity_name(base), len(poses))
+        if names is not None:
+            check_batch(list(names), poses, list(self._entities))
+        loaded = spawn.load_source(source, args, package_paths)
+        if names is None:
+            default = "".join(c if c.isalnum() or c in "-_." else "_" for c in loaded.default_name)
+            names = batch_names(default or "model", len(poses))
+        names = list(names)
+        with self.lock:
+            check_batch(names, poses, list(self._entities))
+            try:
+                homes = [
+                    self._attach(replace(loaded, spec=loaded.spec.copy()), n, p)
+                    for n, p in zip(names, poses, strict=True)
+                ]
+                placed, built = self._seed_batch(loaded, names, poses, homes, on_ground, joints)
+            except BaseException:
+                for n in names:
+                    spawn.remove_entity(self._spec, n)
+                raise
+            model, data, index = built
+            results = []
+            for n, (pose, state) in zip(names, placed, strict=True):
+                self._entities[n] = Entity(
+                    n, loaded.source, dict(args or {}), dict(package_paths or {}), pose,
+                    on_ground, state, loaded.report, loaded.xml, dict(joints or {}),
+                    loaded.description, sensors=loaded.sensors,
+                )  # fmt: skip
+                warnings = placement.start_warnings(model, data, index, n, pose.z)
+                results.append(
+                    SpawnResult(n, loaded.source, warnings, loaded.report, loaded.cached)
+                )
+            self._commit(self._spec, model, data, index)
+            return results
+
+    def _seed_batch(self, loaded, names, poses, homes, on_ground, joints):  # noqa: ANN001, ANN202
+        """One compile of the world with every instance attached; each seeded at rest."""
+        kept = [n for n in self._entities if n in self._index]
+        model, data, _ = self._rebuild(self._spec, None, loaded.source)
+        index = index_entities(model, kept + names)
+        starts: list[tuple[Pose, np.ndarray]] = []
+        for n, pose, home in zip(names, poses, homes, strict=True):
+            ix = index[n]
+            targets = posture.joint_targets(model, ix.joints, f"{n}/", joints or {}, n)
+            q = posture.apply_targets(spawn.initial_qpos(model, ix, home, pose), ix.qpos, targets)
+            if on_ground:  # a fixed base moves its frame: a recompile that keeps joint layouts
+                pose, q, (model, data, _) = self._ground(model, data, index, n, pose, q)
+                index = index_entities(model, kept + names)
+            starts.append((pose, q))
+        placed = []
+        for n, (pose, q) in zip(names, starts, strict=True):
+            state = rest_state(model, index[n], q)
+            write_state(data, index[n], state)
+            placed.append((pose, state))
+        return placed, (model, data, index)
