@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
+from twin_cli.cli.commands.validate_sweep import JobsOpt, RayOpt, SweepOpt, run_sweep
 from twin_cli.cli.options import (
     ArgOpt,
     JointOpt,
@@ -15,7 +16,6 @@ from twin_cli.cli.options import (
     joint_positions,
     source_inputs,
 )
-from twin_cli.cli.commands.validate_sweep import JobsOpt, RayOpt, SweepOpt, run_sweep
 
 ScenarioOpt = Annotated[
     list[str] | None,
