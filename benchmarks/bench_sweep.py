@@ -1,0 +1,43 @@
+"""Validation sweep throughput: 20 variants of the humanoid on `--jobs 1` and `--jobs 2`.
+
+Goal (issue 16): `--jobs 2` at least 1.7× faster than `--jobs 1` on 20 variants. Both runs
+include starting the pool's processes; each variant converts the robot and runs the checklist
+(less `realtime`, whose verdict depends on the machine's load). The two runs must also agree
+check for check: the sweep is deterministic whatever the worker count.
+"""
+
+from __future__ import annotations
+
+import os
+
+SWEEP = "mass_scale=0.8:1.2:20"
+SKIP = ["realtime"]
+
+
+def _results(run) -> list:
+    return [
+        [(r.check, r.status.value, r.measured, r.value) for r in variant.results]
+        for variant in run.runs
+    ]
+
+
+def run() -> dict:
+    """Figures: wall time [s] on 1 and 2 workers, their ratio, and whether the results agree."""
+    import scenarios
+    from twin_cli.validate.sweep import parse_axis, sweep
+
+    axes = [parse_axis(SWEEP)]
+    options = {"skip": SKIP}
+    one = sweep([str(scenarios.HUMANOID)], axes, options=options, jobs=1)
+    two = sweep([str(scenarios.HUMANOID)], axes, options=options, jobs=2)
+    return {
+        "sweep": SWEEP,
+        "variants": len(one.runs),
+        "jobs_1_s": round(one.seconds, 2),
+        "jobs_2_s": round(two.seconds, 2),
+        "speedup_jobs_2": round(one.seconds / two.seconds, 2),
+        "goal_speedup": 1.7,
+        "identical_results": _results(one) == _results(two),
+        "cores": os.cpu_count(),
+        "load_average_1min": round(os.getloadavg()[0], 2),
+    }
