@@ -20,6 +20,8 @@ from twin_cli.validate.sweep import Axis, Task, load_variant, parse_axis, run_ta
 
 HUMANOID = SCENARIO_DIR / "robots" / "humanoid.urdf.xacro"
 SLOPE = Path(__file__).parent / "scenarios" / "standing_slope.toml"
+INCLINE = Path(__file__).parent / "scenarios" / "incline_slope.toml"
+ONLY = ["friction_standing", "friction_incline"]
 TWIN = Path(sys.executable).parent / "twin"
 FOOT_MU = [round(0.1 * i, 12) for i in range(1, 11)]
 
@@ -40,16 +42,17 @@ def comparable(variants: list[dict]) -> list[dict]:
 
 
 def test_foot_mu_sweep_fails_below_tan_theta_on_a_pool_and_on_ray(tmp_path):
-    """Oracle: Coulomb. On a slope of θ (read from the scenario file) the held robot's feet stick
-    iff μ ≥ tan θ (0.213 here), so μ 0.1, 0.2 fail and 0.3..1.0 pass. The nearest grid values
-    are 0.09 below and 0.09 above tan θ: at μ = 0.2 Coulomb predicts ½·g(sin θ − μ cos θ)·t² =
-    135 mm of slip in 1.5 s, at μ = 0.3 none (MuJoCo's soft friction creeps 2.6 mm, under the
-    5 mm threshold)."""
-    theta = math.radians(load_scenario(SLOPE).world.incline_deg)
-    mu_critical = math.tan(theta)
+    """Oracle: Coulomb. On a slope of θ (read from each scenario file) the held robot's feet, and
+    each foot surface alone, stick iff μ ≥ tan θ (0.213 here), so μ 0.1, 0.2 fail and 0.3..1.0
+    pass. The nearest grid values are 0.09 below and 0.09 above tan θ: at μ = 0.2 Coulomb
+    predicts ½·g(sin θ − μ cos θ)·t² = 135 mm of slip in 1.5 s, at μ = 0.3 none (MuJoCo's soft
+    friction creeps 2.6 mm, under the 5 mm threshold)."""
+    for scenario in (SLOPE, INCLINE):
+        assert load_scenario(scenario).world.incline_deg == load_scenario(SLOPE).world.incline_deg
+    mu_critical = math.tan(math.radians(load_scenario(SLOPE).world.incline_deg))
     done = twin(
-        HUMANOID, "--sweep", "foot_mu=0.1:1.0:10", "--scenario", SLOPE,
-        "--only", "friction_standing", "--jobs", "2", "--json",
+        HUMANOID, "--sweep", "foot_mu=0.1:1.0:10", "--scenario", SLOPE, "--scenario", INCLINE,
+        "--only", ONLY[0], "--only", ONLY[1], "--jobs", "2", "--json",
         "--junit", tmp_path / "sweep.xml", "--markdown", tmp_path / "sweep.md",
         "--plots", tmp_path,
     )  # fmt: skip
@@ -57,16 +60,25 @@ def test_foot_mu_sweep_fails_below_tan_theta_on_a_pool_and_on_ray(tmp_path):
     pool = json.loads(done.stdout)
     assert [v["values"]["foot_mu"] for v in pool["variants"]] == pytest.approx(FOOT_MU)
     for v in pool["variants"]:
-        mu, (check,) = v["values"]["foot_mu"], v["checks"]
-        assert check["status"] == ("fail" if mu < mu_critical else "pass"), (mu, check)
-        margin = v["limits"]["friction_standing"] - check["value"]  # what the plot draws
-        assert (margin < 0) == (mu < mu_critical), (mu, margin)
+        mu, checks = v["values"]["foot_mu"], {c["check"]: c for c in v["checks"]}
+        assert sorted(checks) == sorted(ONLY)
+        for check in checks.values():
+            assert check["status"] == ("fail" if mu < mu_critical else "pass"), (mu, check)
+        margin = v["limits"]["friction_standing"] - checks["friction_standing"]["value"]
+        assert (margin < 0) == (mu < mu_critical), (mu, margin)  # what the plot draws
     # The reports: a JUnit case per variant × check, a matrix row per variant, the plot.
     cases = ET.parse(tmp_path / "sweep.xml").getroot().iter("testcase")
     failing = sorted(c.get("name") for c in cases if c.find("failure") is not None)
-    assert failing == [f"friction_standing (standing_slope) [foot_mu={m:g}]" for m in (0.1, 0.2)]
+    assert failing == sorted(
+        f"{check} ({scenario}) [foot_mu={m:g}]"
+        for check, scenario in (
+            ("friction_standing", "standing_slope"),
+            ("friction_incline", "incline_slope"),
+        )
+        for m in (0.1, 0.2)
+    )
     rows = [r for r in (tmp_path / "sweep.md").read_text().splitlines() if "foot_mu=" in r]
-    assert [("❌" in r) for r in rows] == [m < mu_critical for m in FOOT_MU]
+    assert [r.count("❌") for r in rows] == [2 * (m < mu_critical) for m in FOOT_MU]
     png = (tmp_path / "sweep_margins.png").read_bytes()
     assert png.startswith(b"\x89PNG") and len(png) > 10_000
 
@@ -76,7 +88,7 @@ def test_foot_mu_sweep_fails_below_tan_theta_on_a_pool_and_on_ray(tmp_path):
         on_ray = sweep(
             [str(HUMANOID)],
             [parse_axis("foot_mu=0.1:1.0:10")],
-            options={"scenarios": [str(SLOPE)], "only": ["friction_standing"]},
+            options={"scenarios": [str(SLOPE), str(INCLINE)], "only": ONLY},
             ray="auto",
         )
     finally:
