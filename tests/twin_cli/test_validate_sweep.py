@@ -178,3 +178,10 @@ def test_bad_sweep_input_exits_2_with_one_message(args, needle):
 def test_axis_values_include_both_ends():
     assert parse_axis("foot_mu=0.1:1.0:10") == Axis("foot_mu", tuple(FOOT_MU))
     assert parse_axis("gravity=9.81:9.81:1").values == (9.81,)
+
+
+def test_robot_that_does_not_convert_in_a_worker_exits_2_naming_it(tmp_path):
+    missing = tmp_path / "nope.urdf"
+    done = twin(missing, "--sweep", "foot_mu=0.1:1:2", "--only", "inertial", "--jobs", "1")
+    assert done.returncode == 2, (done.stdout, done.stderr)
+    assert str(missing) in done.stderr and "Traceback" not in done.stderr, done.stderr

@@ -27,6 +27,15 @@ class SweepError(TwinError):
         self.given = given
 
 
+class VariantError(TwinError):
+    """Bad input found inside a worker (a robot that does not convert, a bad start joint),
+    carried back as its message: the converter's errors take several constructor arguments
+    and would not survive pickling between processes."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message)
+
+
 @dataclass(frozen=True)
 class Axis:
     """One swept parameter: `values` from LO to HI, in the parameter's unit."""
@@ -136,7 +145,20 @@ class VariantRun:
 
 
 def run_task(task: Task) -> VariantRun:
-    """Convert one robot with one variant applied and run the planned checks (in a worker)."""
+    """Convert one robot with one variant applied and run the planned checks (in a worker).
+
+    Raises:
+        VariantError: the robot does not convert or a start posture is bad (exit 2).
+    """
+    from converters.errors import ConversionError
+
+    try:
+        return _run_task(task)
+    except (ConversionError, TwinError) as exc:
+        raise VariantError(str(exc)) from None
+
+
+def _run_task(task: Task) -> VariantRun:
     from twin_cli.validate.runner import check_start_postures, plan, run_check
     from twin_cli.validate.scenario import with_joints
     from twin_cli.validate.variants import apply_to_scenario, ground_friction

@@ -97,7 +97,8 @@ class _progress:
             if self.task is None:
                 self.task = self.bar.add_task("twin validate sweep", total=total)
             self.bar.update(self.task, completed=done)
-            self.bar.console.print(f"{run.robot} [{variant_name(run)}]: {verdict}")
+            line = f"{run.robot} [{variant_name(run)}]: {verdict}"
+            self.bar.console.print(line, markup=False, highlight=False)
         else:
             self.out.line(f"[{done}/{total}] {run.robot} {variant_name(run)}: {verdict}")
 
