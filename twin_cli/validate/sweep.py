@@ -238,6 +238,11 @@ def load_variant(path: str, values: Mapping[str, float], opts: Mapping):
     return robot_from_conversion(done, file, repair_inertia=repair)
 
 
+def _absolute(path: str) -> str:
+    """`path` made absolute when it names an existing file (a bundled scenario name stays)."""
+    return str(Path(path).resolve()) if Path(path).exists() else path
+
+
 @dataclass(frozen=True)
 class SweepRun:
     """Every robot × variant's results, in task order, and the sweep's wall time [s]."""
@@ -288,10 +293,10 @@ def sweep(
     from twin_cli.validate.runner import plan
 
     opts = dict(options or {})
-    plan(
-        opts.get("scenarios"), opts.get("only"), opts.get("skip")
-    )  # bad names fail before any work
-    tasks = [Task(str(r), v, opts) for r in robots for v in grid(axes)]
+    plan(opts.get("scenarios"), opts.get("only"), opts.get("skip"))  # bad names: before any work
+    # Workers (Ray's above all) do not share our working directory: give them absolute paths.
+    opts["scenarios"] = [_absolute(s) for s in opts.get("scenarios") or []] or None
+    tasks = [Task(_absolute(str(r)), v, opts) for r in robots for v in grid(axes)]
     start = time.perf_counter()
     done: list[VariantRun | None] = [None] * len(tasks)
     with open_executor(jobs=jobs, ray=ray) as executor:
