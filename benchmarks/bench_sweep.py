@@ -37,6 +37,10 @@ def run() -> dict:
         "jobs_2_s": round(two.seconds, 2),
         "speedup_jobs_2": round(one.seconds / two.seconds, 2),
         "goal_speedup": 1.7,
+        # Σ variant wall times / sweep wall time: how many variants ran at once on average
+        # (near 2.0 for 2 workers however loaded the machine is; the speed-up is not).
+        "concurrency_jobs_1": round(sum(r.seconds for r in one.runs) / one.seconds, 2),
+        "concurrency_jobs_2": round(sum(r.seconds for r in two.runs) / two.seconds, 2),
         "identical_results": _results(one) == _results(two),
         "cores": os.cpu_count(),
         "load_average_1min": round(os.getloadavg()[0], 2),
