@@ -9,6 +9,7 @@ cluster return identical results.
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -74,6 +75,8 @@ def parse_axis(text: str) -> Axis:
 
 def _check_range(text: str, param, lo: float, hi: float, n: int) -> None:
     given = f"--sweep {text}"
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise SweepError(given, "LO and HI must be finite numbers", "give finite values")
     if n < 1:
         raise SweepError(given, f"N = {n} values", "give N ≥ 1")
     if hi < lo:
