@@ -2,7 +2,8 @@
 
 `scenario` reads scenario files (TOML), `checks/` holds one function per check, `runner` builds
 the robot under test and runs each check in its own World, `report` renders the results
-(terminal, JUnit, JSON, Markdown, plots).
+(terminal, JUnit, JSON, Markdown, plots). `sweep` runs the checklist on every robot × parameter
+variant (`variants`) on a process pool or Ray (`executors`); `sweep_report` renders it.
 """
 
 from __future__ import annotations
@@ -14,8 +15,21 @@ from twin_cli.lazy import lazy_getattr
 if TYPE_CHECKING:
     from twin_cli.validate.runner import ValidationRun, validate
     from twin_cli.validate.scenario import Scenario, load_scenario
+    from twin_cli.validate.sweep import Axis, SweepError, SweepRun, VariantRun, parse_axis
+    from twin_cli.validate.variants import PARAMETERS
 
-__all__ = ["Scenario", "ValidationRun", "load_scenario", "validate"]
+__all__ = [
+    "PARAMETERS",
+    "Axis",
+    "Scenario",
+    "SweepError",
+    "SweepRun",
+    "ValidationRun",
+    "VariantRun",
+    "load_scenario",
+    "parse_axis",
+    "validate",
+]
 
 __getattr__ = lazy_getattr(
     "twin_cli.validate",
@@ -24,5 +38,11 @@ __getattr__ = lazy_getattr(
         "load_scenario": "twin_cli.validate.scenario",
         "ValidationRun": "twin_cli.validate.runner",
         "validate": "twin_cli.validate.runner",
+        "Axis": "twin_cli.validate.sweep",
+        "SweepError": "twin_cli.validate.sweep",
+        "SweepRun": "twin_cli.validate.sweep",
+        "VariantRun": "twin_cli.validate.sweep",
+        "parse_axis": "twin_cli.validate.sweep",
+        "PARAMETERS": "twin_cli.validate.variants",
     },
 )

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
+from twin_cli.cli.commands.validate_sweep import JobsOpt, RayOpt, SweepOpt, run_sweep
 from twin_cli.cli.options import (
     ArgOpt,
     JointOpt,
@@ -48,7 +49,9 @@ CollisionOpt = Annotated[
 
 
 def validate(
-    robot: Annotated[Path, typer.Argument(help="URDF, xacro, SDF or MJCF file of the robot.")],
+    robots: Annotated[
+        list[Path], typer.Argument(help="URDF, xacro, SDF or MJCF file(s) of the robot(s).")
+    ],
     arg: ArgOpt = None,
     package: PackageOpt = None,
     scenario: ScenarioOpt = None,
@@ -67,12 +70,41 @@ def validate(
             "--as-written", help="Apply what the URDF says where Gazebo's parser drops it."
         ),
     ] = False,
+    sweep: SweepOpt = None,
+    jobs: JobsOpt = None,
+    ray: RayOpt = None,
 ) -> None:
-    """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
+    """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input.
+
+    Several robots, --sweep, --jobs or --ray run every robot × variant in worker processes.
+    """
     from twin_cli.cli.output import Output
     from twin_cli.validate import report as render
     from twin_cli.validate.runner import validate as run_validation
 
+    if sweep or len(robots) > 1 or jobs is not None or ray is not None:
+        options = {
+            **source_inputs(arg, package),
+            "scenarios": scenario,
+            "only": only,
+            "skip": skip,
+            "repair_inertia": repair_inertia,
+            "collision": collision,
+            "joints": joint_positions(joint),
+            "as_written": as_written,
+        }
+        run_sweep(
+            robots,
+            sweep or [],
+            options,
+            jobs=jobs,
+            ray=ray,
+            json=json,
+            junit=junit,
+            markdown=markdown,
+            plots=plots,
+        )
+    robot = robots[0]
     run = run_validation(
         robot,
         **source_inputs(arg, package),

@@ -151,6 +151,7 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
             f"{name} slides {fmt_len(slid)} on a {math.degrees(theta_stick):.1f}° slope where "
             f"μ={mu:.3g} should hold it: the contact creeps; raise <kd> or check friction priority"
         )
+    hints += _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details)
     theta_slide = math.atan(th["slide_factor"] * mu)
     if theta_slide <= MAX_SLIDE_ANGLE:
         expected = 0.5 * g * (math.sin(theta_slide) - mu * math.cos(theta_slide)) * t * t
@@ -163,6 +164,24 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
                 "not min(μ); another surface's μ wins"
             )
     return hints, details
+
+
+def _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details) -> list[str]:
+    """A scenario with its own `incline_deg` asks whether the feet hold on that slope: Coulomb
+    says they do iff μ ≥ tan θ (what a sweep of foot μ finds). The bundled scenario is level
+    and asks nothing here."""
+    theta = math.radians(scenario.world.incline_deg)
+    if theta <= 0.0:
+        return []
+    slid = slide_on_slope(robot, spec, scenario, theta)
+    details.append(f"{name}: scenario slope {math.degrees(theta):.1f}° slides {fmt_len(slid)}")
+    if slid <= th["max_stick_slip_m"]:
+        return []
+    return [
+        f"{name} (μ={mu:.3g}) slides {fmt_len(slid)} on the scenario's "
+        f"{math.degrees(theta):.1f}° slope: Coulomb needs μ ≥ tan θ = {math.tan(theta):.3g}; "
+        "raise mu1/mu2 in its <gazebo> block"
+    ]
 
 
 def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
