@@ -238,3 +238,32 @@ def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
         world.step(1)
         vertical.append(suite.read(["imu"])["imu"].linear_acceleration[2])
     assert np.mean(vertical) == pytest.approx(_gravity(world), abs=0.02), "mean IMU z over 1 s"
+
+
+# ------------------------------------------------------------------------------------- stream
+def test_a_stream_captures_every_reading_at_the_sensors_rates(tmp_path: Path) -> None:
+    from twin_cli.sensors import SensorStream
+
+    world = _world_with(tmp_path, lidar_post(samples=31), "post")
+    world.spawn(_wall(2.0), name="wall")
+    box = imu_box(rate=200.0, stddev=0.02).replace("</robot>", STATIC)
+    world.spawn(write_urdf(tmp_path, box, "imu.urdf"), name="imu", pose=Pose(x=-3.0, z=0.1))
+    world.step(10)  # the box settles on its contacts' first steps
+    imu_stream = SensorStream(SensorSuite(world, "imu"))
+    scan_stream = SensorStream(SensorSuite(world, "post"))
+    start = world.data.time
+    world.step(1000)  # one call: 1 s of sim time
+    imus, scans = imu_stream.drain(), scan_stream.drain()
+    imu_stream.close()
+    scan_stream.close()
+    world.step(100)
+    assert not imu_stream.drain(), "closed: nothing more captured"
+    # 200 Hz over 1 s: one reading per 5 ms period, stamped at the period's end; 10 Hz: ten.
+    np.testing.assert_allclose([r.time for r in imus], start + 0.005 * np.arange(1, 201), atol=1e-9)
+    np.testing.assert_allclose([r.time for r in scans], start + 0.1 * np.arange(1, 11), atol=1e-9)
+    for scan in scans:
+        assert scan.ranges[len(scan.ranges) // 2] == pytest.approx(2.0, abs=1e-9)
+    # The static box: specific force +g on z, noise 0.02 m/s² per axis over 200 draws.
+    z = np.array([r.linear_acceleration[2] for r in imus])
+    assert abs(z.mean() - _gravity(world)) < 3 * 0.02 / math.sqrt(len(z)) + 1e-9
+    assert abs(z.std(ddof=1) - 0.02) < 3 * 0.02 / math.sqrt(2 * (len(z) - 1))

@@ -62,8 +62,8 @@ class ForceTorqueSensor:
         values = self.capture(data)
         return self.reading(values if values is not None else self.compute(model, data), time)
 
-    def reading(self, values: np.ndarray, time: float) -> WrenchReading:
-        """The reading of `values` (as `capture` returns them)."""
+    def reading(self, values: np.ndarray, time: float, *, noisy: bool = False) -> WrenchReading:
+        """The reading of `values` (as `capture` returns them; SDF's F/T noise is not read)."""
         return WrenchReading(
             self.spec.name,
             self.spec.type,

@@ -39,18 +39,23 @@ class ImuSensor:
         self.accel_noise = NoiseSampler(spec.linear_acceleration_noise, rng)
         self.site = -1
         self.native: slice | None = None
+        self._data: Any = None
+        self._view = np.zeros(0)
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         self.native = native_slice(model, self.entity, self.spec.site, NATIVE_PARTS["imu"])
+        self._data = None
 
     def capture(self, data: Any) -> np.ndarray | None:
         """The last step's (quat w x y z, gyro, specific force) in `sensordata`: a copy; None
         when MuJoCo has not computed them (no native sensors, or not stepped since built)."""
         if self.native is None:
             return None
-        values = data.sensordata[self.native].copy()
-        return values if values[:4].any() else None
+        if data is not self._data:  # a view per MjData: attribute access costs µs per call
+            self._data, self._view = data, data.sensordata[self.native]
+        values = self._view.copy()
+        return values if values[:4] @ values[:4] > 0.0 else None
 
     def read(self, model: Any, data: Any, time: float) -> ImuReading:
         """The reading of `data` (after forward dynamics and `mj_rnePostConstraint`)."""
@@ -69,11 +74,21 @@ class ImuSensor:
         out[4:7], out[7:10] = velocity[:3], acceleration[3:]
         return out
 
-    def reading(self, values: np.ndarray, time: float) -> ImuReading:
-        """The reading of `values` (as `capture` returns them), with the tags' noise."""
+    def noisy_batch(self, values: np.ndarray) -> np.ndarray:
+        """Rows of `capture` values (N×10) with the tags' noise drawn for all rows at once."""
+        out = values.copy()
+        out[:, 4:7] = self.gyro_noise.apply(values[:, 4:7])
+        out[:, 7:10] = self.accel_noise.apply(values[:, 7:10])
+        return out
+
+    def reading(self, values: np.ndarray, time: float, *, noisy: bool = True) -> ImuReading:
+        """The reading of `values` (as `capture` returns them), with the tags' noise unless
+        `noisy` is False (values from `noisy_batch`)."""
         w, x, y, z = values[:4].tolist()
-        gyro = self.gyro_noise.apply_one(values[4:7]).tolist()
-        accel = self.accel_noise.apply_one(values[7:10]).tolist()
+        gyro, accel = values[4:7], values[7:10]
+        if noisy:
+            gyro, accel = self.gyro_noise.apply_one(gyro), self.accel_noise.apply_one(accel)
+        gyro, accel = gyro.tolist(), accel.tolist()
         return ImuReading(
             self.spec.name,
             self.spec.type,
