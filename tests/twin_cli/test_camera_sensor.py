@@ -14,7 +14,6 @@ import math
 import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -47,7 +46,7 @@ try:
     mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8).close()
 except Exception as exc:
     print(json.dumps({"no_gl": str(exc).splitlines()[0]})); sys.exit(0)
-x, y, z, h = %r
+x, y, z, h = json.loads(sys.argv[2])
 world = World(WorldSettings(ground=False))
 world.spawn(sys.argv[1], name="post")
 box = mujoco.MjSpec(); box.modelname = "box"
@@ -55,21 +54,19 @@ box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y
                        rgba=[1, 0, 0, 1])
 world.spawn(box, name="box")
 readings = SensorSuite(world, "post").read()
-rgb = np.frombuffer(readings["cam"].data, np.uint8).reshape(%d, %d, 3)
-depth = np.frombuffer(readings["depth"].data, np.float32).reshape(%d, %d)
+rgb = np.frombuffer(readings["cam"].data, np.uint8).reshape(HEIGHT, WIDTH, 3)
+depth = np.frombuffer(readings["depth"].data, np.float32).reshape(HEIGHT, WIDTH)
 print(json.dumps({"rgb": rgb.tolist(), "depth": depth.tolist(),
                   "encodings": [readings["cam"].encoding, readings["depth"].encoding]}))
-""" % (BOX, H, W, H, W)
+""".replace("HEIGHT", str(H)).replace("WIDTH", str(W))
 
 
 @pytest.fixture(scope="module")
 def images(tmp_path_factory) -> dict:
     post = write_urdf(tmp_path_factory.mktemp("cam"), POST, "campost.urdf")
     env = {**os.environ, "MUJOCO_GL": "egl"}
-    done = subprocess.run(
-        [sys.executable, "-c", CHILD, str(post)], env=env, capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
+    command = [sys.executable, "-c", CHILD, str(post), json.dumps(BOX)]
+    done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     out = json.loads(done.stdout.strip().splitlines()[-1])
     if "no_gl" in out:
