@@ -267,3 +267,33 @@ def test_a_stream_captures_every_reading_at_the_sensors_rates(tmp_path: Path) ->
     z = np.array([r.linear_acceleration[2] for r in imus])
     assert abs(z.mean() - _gravity(world)) < 3 * 0.02 / math.sqrt(len(z)) + 1e-9
     assert abs(z.std(ddof=1) - 0.02) < 3 * 0.02 / math.sqrt(2 * (len(z) - 1))
+
+
+# ------------------------------------------------------------------------- SDF joint sensors
+HANGING_SDF = """<sdf version="1.7"><model name="hanging">
+  <link name="support"><pose>0 0 1 0 0 0</pose><inertial><mass>1</mass><inertia><ixx>0.01</ixx>
+    <iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>
+  <joint name="mount" type="fixed"><parent>world</parent><child>support</child></joint>
+  <link name="load"><pose>0 0 0.7 0 0 0</pose><inertial><pose>0 0 -0.1 0 0 0</pose>
+    <mass>{mass}</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+  </link>
+  <joint name="hook" type="prismatic"><parent>support</parent><child>load</child>
+    <axis><xyz>1 0 0</xyz><limit><lower>0</lower><upper>0</upper></limit></axis>
+    <sensor name="ft" type="force_torque"><update_rate>100</update_rate>
+      <force_torque><frame>child</frame><measure_direction>parent_to_child</measure_direction>
+      </force_torque></sensor></joint>
+</model></sdf>"""
+
+
+@pytest.mark.parametrize("mass", [0.5, 3.0])
+def test_sdf_joint_force_torque_sensor_reads_m_g(tmp_path: Path, mass: float) -> None:
+    path = tmp_path / "hanging.sdf"
+    path.write_text(HANGING_SDF.format(mass=mass))
+    world = World()
+    world.spawn(path, name="hang")
+    world.step(200)
+    suite = SensorSuite(world, "hang")
+    assert suite.names == ["ft"] and suite.specs["ft"].joint == "hook"
+    wrench = suite.read()["ft"]
+    np.testing.assert_allclose(wrench.force, [0, 0, mass * _gravity(world)], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(wrench.torque, 0.0, atol=1e-6)  # COM straight below the joint
