@@ -96,7 +96,8 @@ def test_robots_without_sensors_skip_the_sensor_checks_with_a_reason() -> None:
 
 
 def test_imu_check_fails_when_the_robot_is_not_at_rest(tmp_path: Path) -> None:
-    # The same IMU, pushed sideways through the settled half: the specific force is not Rᵀ·g.
+    # The same robot pushed with 60 N through the settled half rocks (~0.17 rad/s measured):
+    # the IMU is not at rest, and the check fails saying so.
     # (at = 0.5505 s, mid-step: ScenarioRun.run misses an action at an exact multiple of the
     # step once sim time has accumulated rounding; a bug of sim.py reported to the lead.)
     path = write_urdf(tmp_path, ROBOT, "sensed.urdf")

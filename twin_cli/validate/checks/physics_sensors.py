@@ -55,15 +55,19 @@ def _evaluated(run: ScenarioRun) -> Any:
 
 
 def check_sensor_imu(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
-    """IMU at rest: specific force Rᵀ·(−g) within `tol_m_s2`, angular velocity within
-    `max_rate_rad_s` (means over the settled second half)."""
+    """IMU at rest: mean specific force Rᵀ·(a − g) within `tol_m_s2`, angular velocity within
+    `max_rate_rad_s`, over the settled second half (sampled every step).
+
+    A robot "at rest" on chattering contacts still drifts a little; its mean acceleration over
+    the window, a = Δv/T of the sensor's site, is taken into the oracle, so the check judges
+    the sensor (frame, pose, gravity included), not how still the robot stands.
+    """
     imus = _of_type(robot, "imu")
     if not imus:
         return _skip("sensor_imu", "imu")
     run = ScenarioRun(robot, scenario)
     sensors = [_bound(run, s) for s in imus]
-    errors: dict[str, list[np.ndarray]] = {s.spec.name: [] for s in sensors}
-    rates: dict[str, list[np.ndarray]] = {s.spec.name: [] for s in sensors}
+    samples: dict[str, list[np.ndarray]] = {s.spec.name: [] for s in sensors}
     gravity = np.array(run.world.model.opt.gravity)
 
     def sample(r: ScenarioRun) -> None:
@@ -72,26 +76,38 @@ def check_sensor_imu(robot: RobotUnderTest, scenario: Scenario, th: dict[str, fl
         with r.world.lock:
             data = _evaluated(r)
             for sensor in sensors:
-                values = sensor.compute(r.world.model, data)
-                R = data.site_xmat[sensor.site].reshape(3, 3)
-                errors[sensor.spec.name].append(values[7:10] - R.T @ (-gravity))
-                rates[sensor.spec.name].append(values[4:7])
+                samples[sensor.spec.name].append(_imu_sample(r, sensor, data, gravity))
 
-    run.run(scenario.duration, sample, every=10)
+    run.run(scenario.duration, sample, every=1)
+    dt = float(run.world.model.opt.timestep)
     hints, worst = [], 0.0
-    for name in errors:
-        bias = float(np.linalg.norm(np.mean(errors[name], axis=0)))
-        spin = float(np.linalg.norm(np.mean(rates[name], axis=0)))
+    for name, rows in samples.items():
+        table = np.array(rows)  # per step: f − Rᵀ(−g) (3), gyro (3), R (9), site velocity (3)
+        mean_a = (table[-1, 15:18] - table[0, 15:18]) / (dt * (len(table) - 1))
+        R = table[:-1, 6:15].mean(axis=0).reshape(3, 3)
+        bias = float(np.linalg.norm(table[:-1, 0:3].mean(axis=0) - R.T @ mean_a))
+        spin = float(np.linalg.norm(table[:, 3:6].mean(axis=0)))
         worst = max(worst, bias)
         if bias > th["tol_m_s2"] or spin > th["max_rate_rad_s"]:
             hints.append(
-                f"IMU '{name}' at rest reads {bias:.3g} m/s² off Rᵀ·(0, 0, g) and "
+                f"IMU '{name}' at rest reads {bias:.3g} m/s² off Rᵀ·(a − g) and "
                 f"{spin:.3g} rad/s: check its <pose> and that its link is the one it moves with"
             )
     return judged(
         "sensor_imu", "physics", f"{worst:.3g} m/s² off gravity",
         f"≤ {th['tol_m_s2']:g} m/s²", hints,
     )  # fmt: skip
+
+
+def _imu_sample(run: ScenarioRun, sensor: Any, data: Any, gravity: np.ndarray) -> np.ndarray:
+    import mujoco
+
+    values = sensor.compute(run.world.model, data)
+    R = data.site_xmat[sensor.site].reshape(3, 3)
+    velocity = np.zeros(6)
+    site = mujoco.mjtObj.mjOBJ_SITE
+    mujoco.mj_objectVelocity(run.world.model, data, site, sensor.site, velocity, 0)
+    return np.concatenate([values[7:10] - R.T @ (-gravity), values[4:7], R.ravel(), velocity[3:]])
 
 
 def ray_box_distance(origin: np.ndarray, dirs: np.ndarray, centre, half, R) -> np.ndarray:
