@@ -14,6 +14,16 @@ from dataclasses import dataclass
 SITE_PREFIX = "sensor:"
 # SDF `<noise><type>` values twin simulates (noise.sdf); "none" draws nothing.
 NOISE_TYPES = ("none", "gaussian", "gaussian_quantized")
+# MuJoCo's own sensors (mjtSensor names) on the site of a sensor kind, by part: the built model
+# names them `sensor:<name>:<part>`, in this order, so their values are one slice of sensordata.
+NATIVE_PARTS: dict[str, tuple[tuple[str, str], ...]] = {
+    "imu": (
+        ("quat", "mjSENS_FRAMEQUAT"),
+        ("gyro", "mjSENS_GYRO"),
+        ("accel", "mjSENS_ACCELEROMETER"),
+    ),
+    "force_torque": (("force", "mjSENS_FORCE"), ("torque", "mjSENS_TORQUE")),
+}
 
 
 @dataclass(frozen=True)

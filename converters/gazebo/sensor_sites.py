@@ -17,6 +17,7 @@ import numpy as np
 from converters.description import RobotDescription
 from converters.description.gazebo import Blob
 from converters.description.sensors import (
+    NATIVE_PARTS,
     CameraSpec,
     ForceTorqueSpec,
     ImuSpec,
@@ -32,6 +33,7 @@ from converters.report import Report
 SITE_GROUP = 5  # the group of the builder's frame sites (lumped links, SDF frames)
 # Gazebo camera axes (x forward, y left, z up) in MuJoCo camera axes (x right, y up, z back).
 R_SENSOR_CAMERA = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+NATIVE_KIND = {ImuSpec: "imu", ForceTorqueSpec: "force_torque"}  # keys of NATIVE_PARTS
 
 
 def add_sensors(
@@ -127,6 +129,27 @@ def _add_site(
         aspect = sensor.height / max(1, sensor.width)
         fovy = math.degrees(2.0 * math.atan(math.tan(sensor.horizontal_fov / 2.0) * aspect))
         body.add_camera(name=sensor.site, pos=pos, quat=quat, fovy=fovy)
+    _add_native(spec, sensor)
+
+
+def _add_native(spec: Any, sensor: SensorSpec) -> None:
+    """MuJoCo's own sensors on the site, computed in C at every step (`sensor:<name>:<part>`).
+
+    A running world then reads an IMU or F/T sensor by copying `sensordata` (a few µs under
+    the world's lock) instead of evaluating the world's dynamics again per reading. MuJoCo's
+    accelerometer is the specific force a − g (+g up at rest) and its force/torque sensors are
+    the child body's interaction wrench at the site, in the site frame: what the twin sensors
+    report (`twin_cli.sensors.native`).
+    """
+    import mujoco
+
+    for part, kind in NATIVE_PARTS.get(NATIVE_KIND.get(type(sensor), ""), ()):
+        spec.add_sensor(
+            name=f"{sensor.site}:{part}",
+            type=getattr(mujoco.mjtSensor, kind),
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname=sensor.site,
+        )
 
 
 def robot_anchor(robot: RobotDescription, joint: str) -> tuple[float, float, float]:

@@ -11,7 +11,9 @@ from typing import Any
 import numpy as np
 
 from converters.description import WORLD_LINK, Dynamics, Joint, JointExtension, Limit, Mimic
-from converters.sdf.document import SdfContext
+from converters.description.gazebo import Blob
+from converters.gazebo.tags import to_xml
+from converters.sdf.document import SdfContext, line_of
 from converters.sdf.poses import MODEL_FRAME, PoseGraph, scoped
 
 # SDF's "no limit" sentinel: |lower|, |upper| at or beyond this are unlimited (SDF default 1e16).
@@ -169,4 +171,8 @@ def _extension(ctx: SdfContext, joint: Any, axis: Any, name: str) -> JointExtens
         for tag in ("erp", "cfm"):
             if limit.find(tag) is not None:
                 softness[f"stop_{tag}"] = ctx.number(limit, tag, 0.0)
-    return JointExtension(joint=name, **springs, **softness)  # type: ignore[arg-type]
+    sensors = tuple(  # force_torque sensors, at the joint (sdformat: pose in the joint frame)
+        Blob("sensor", s.get("name"), s.get("type"), to_xml(s), f"{ctx.source}:{line_of(s)}")
+        for s in joint.findall("sensor")
+    )
+    return JointExtension(joint=name, **springs, **softness, sensors=sensors)  # type: ignore[arg-type]

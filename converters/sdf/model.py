@@ -159,7 +159,7 @@ def _plugins(ctx: SdfContext, model: Any) -> list[Blob]:
 
 def _has_values(extension: JointExtension) -> bool:
     names = ("spring_stiffness", "spring_reference", "stop_erp", "stop_cfm")
-    return any(getattr(extension, n) is not None for n in names)
+    return bool(extension.sensors) or any(getattr(extension, n) is not None for n in names)
 
 
 def _report_ignored(ctx: SdfContext, model: Any) -> None:

@@ -238,3 +238,62 @@ def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
         world.step(1)
         vertical.append(suite.read(["imu"])["imu"].linear_acceleration[2])
     assert np.mean(vertical) == pytest.approx(_gravity(world), abs=0.02), "mean IMU z over 1 s"
+
+
+# ------------------------------------------------------------------------------------- stream
+def test_a_stream_captures_every_reading_at_the_sensors_rates(tmp_path: Path) -> None:
+    from twin_cli.sensors import SensorStream
+
+    world = _world_with(tmp_path, lidar_post(samples=31), "post")
+    world.spawn(_wall(2.0), name="wall")
+    box = imu_box(rate=200.0, stddev=0.02).replace("</robot>", STATIC)
+    world.spawn(write_urdf(tmp_path, box, "imu.urdf"), name="imu", pose=Pose(x=-3.0, z=0.1))
+    world.step(10)  # the box settles on its contacts' first steps
+    imu_stream = SensorStream(SensorSuite(world, "imu"))
+    scan_stream = SensorStream(SensorSuite(world, "post"))
+    start = world.data.time
+    world.step(1000)  # one call: 1 s of sim time
+    imus, scans = imu_stream.drain(), scan_stream.drain()
+    imu_stream.close()
+    scan_stream.close()
+    world.step(100)
+    assert not imu_stream.drain(), "closed: nothing more captured"
+    # 200 Hz over 1 s: one reading per 5 ms period, stamped at the period's end; 10 Hz: ten.
+    np.testing.assert_allclose([r.time for r in imus], start + 0.005 * np.arange(1, 201), atol=1e-9)
+    np.testing.assert_allclose([r.time for r in scans], start + 0.1 * np.arange(1, 11), atol=1e-9)
+    for scan in scans:
+        assert scan.ranges[len(scan.ranges) // 2] == pytest.approx(2.0, abs=1e-9)
+    # The static box: specific force +g on z, noise 0.02 m/s² per axis over 200 draws.
+    z = np.array([r.linear_acceleration[2] for r in imus])
+    assert abs(z.mean() - _gravity(world)) < 3 * 0.02 / math.sqrt(len(z)) + 1e-9
+    assert abs(z.std(ddof=1) - 0.02) < 3 * 0.02 / math.sqrt(2 * (len(z) - 1))
+
+
+# ------------------------------------------------------------------------- SDF joint sensors
+HANGING_SDF = """<sdf version="1.7"><model name="hanging">
+  <link name="support"><pose>0 0 1 0 0 0</pose><inertial><mass>1</mass><inertia><ixx>0.01</ixx>
+    <iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>
+  <joint name="mount" type="fixed"><parent>world</parent><child>support</child></joint>
+  <link name="load"><pose>0 0 0.7 0 0 0</pose><inertial><pose>0 0 -0.1 0 0 0</pose>
+    <mass>{mass}</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial>
+  </link>
+  <joint name="hook" type="prismatic"><parent>support</parent><child>load</child>
+    <axis><xyz>1 0 0</xyz><limit><lower>0</lower><upper>0</upper></limit></axis>
+    <sensor name="ft" type="force_torque"><update_rate>100</update_rate>
+      <force_torque><frame>child</frame><measure_direction>parent_to_child</measure_direction>
+      </force_torque></sensor></joint>
+</model></sdf>"""
+
+
+@pytest.mark.parametrize("mass", [0.5, 3.0])
+def test_sdf_joint_force_torque_sensor_reads_m_g(tmp_path: Path, mass: float) -> None:
+    path = tmp_path / "hanging.sdf"
+    path.write_text(HANGING_SDF.format(mass=mass))
+    world = World()
+    world.spawn(path, name="hang")
+    world.step(200)
+    suite = SensorSuite(world, "hang")
+    assert suite.names == ["ft"] and suite.specs["ft"].joint == "hook"
+    wrench = suite.read()["ft"]
+    np.testing.assert_allclose(wrench.force, [0, 0, mass * _gravity(world)], rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(wrench.torque, 0.0, atol=1e-6)  # COM straight below the joint

@@ -2,9 +2,10 @@
 
 A consumer of the world (like the recorder): it reads the engine's state under its lock and
 computes outside it; the world never imports it. Modules: `suite` (all sensors of an entity,
-update rates), `snapshot` (state copy and its dynamics), `imu`, `ray`, `contact`,
-`force_torque`, `camera` (one sensor type each), `noise` (Gazebo's Gaussian noise, seeded),
-`readings` (what each reports), `frames` (finding a sensor's elements by name).
+update rates), `stream` (every reading at the sensors' rates, for recorders), `snapshot`
+(state copy and its dynamics), `imu`, `ray`, `contact`, `force_torque`, `camera` (one sensor
+type each), `noise` (Gazebo's Gaussian noise, seeded), `readings` (what each reports),
+`frames` (finding a sensor's elements by name).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from twin_cli.sensors.readings import (
     ScanReading,
     WrenchReading,
 )
+from twin_cli.sensors.stream import SensorStream
 from twin_cli.sensors.suite import SensorSuite, describe_sensors
 
 __all__ = [
@@ -27,6 +29,7 @@ __all__ = [
     "ImuReading",
     "Reading",
     "ScanReading",
+    "SensorStream",
     "SensorSuite",
     "WrenchReading",
     "describe_sensors",

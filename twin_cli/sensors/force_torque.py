@@ -6,6 +6,11 @@ in world orientation. It is moved to the sensor's origin (τ_p = τ_c + (c − p
 Gazebo's default `child_to_parent` (what the child applies on the parent), and expressed in the
 child body, parent body or sensor frame as `<frame>` says. Under a static load of mass m hanging
 from the joint, `parent_to_child` reads +m·g upward.
+
+The converter adds MuJoCo's `force` and `torque` sensors on the site (on the child body): the
+same wrench, computed in C at every step, in the site frame about the site. A reading copies
+those six numbers and the rotation to the asked frame (the last step's, as Gazebo reports
+the last physics update); without them (or before the world stepped) it is computed here.
 """
 
 from __future__ import annotations
@@ -14,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from converters.description.sensors import ForceTorqueSpec
-from twin_cli.sensors.frames import body_id, site_id
+from converters.description.sensors import NATIVE_PARTS, ForceTorqueSpec
+from twin_cli.sensors.frames import body_id, native_slice, site_id
 from twin_cli.sensors.readings import WrenchReading
 
 
@@ -26,22 +31,46 @@ class ForceTorqueSensor:
         self.spec = spec
         self.entity = entity
         self.site = self.child = self.parent = -1
+        self.native: slice | None = None
+        self.sign = -1.0 if spec.measure_direction == "child_to_parent" else 1.0
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         self.child = body_id(model, self.entity, self.spec.child_body)
         self.parent = body_id(model, self.entity, self.spec.parent_body)
+        parts = NATIVE_PARTS["force_torque"]
+        self.native = native_slice(model, self.entity, self.spec.site, parts)
 
-    def read(self, model: Any, data: Any, time: float) -> WrenchReading:
+    def capture(self, data: Any) -> np.ndarray | None:
+        """(force, torque) of the last step in the asked frame and direction, from MuJoCo's
+        sensors; None when MuJoCo has not computed them (all zero: not stepped since built)."""
+        if self.native is None:
+            return None
+        site_wrench = data.sensordata[self.native]
+        if not site_wrench.any():
+            return None
+        R = self._frame(data).T @ data.site_xmat[self.site].reshape(3, 3)  # site → asked frame
+        return self.sign * np.concatenate([R @ site_wrench[:3], R @ site_wrench[3:]])
+
+    def compute(self, model: Any, data: Any) -> np.ndarray:
+        """What `capture` returns, computed from evaluated `data`."""
         force, torque = self.wrench_world(model, data)
         R = self._frame(data)
+        return np.concatenate([R.T @ force, R.T @ torque])
+
+    def read(self, model: Any, data: Any, time: float) -> WrenchReading:
+        values = self.capture(data)
+        return self.reading(values if values is not None else self.compute(model, data), time)
+
+    def reading(self, values: np.ndarray, time: float, *, noisy: bool = False) -> WrenchReading:
+        """The reading of `values` (as `capture` returns them; SDF's F/T noise is not read)."""
         return WrenchReading(
             self.spec.name,
             self.spec.type,
             time,
             self.spec.frame_id,
-            _vec(R.T @ force),
-            _vec(R.T @ torque),
+            _vec(values[:3]),
+            _vec(values[3:]),
             self.spec.frame,
             self.spec.measure_direction,
         )
@@ -53,8 +82,7 @@ class ForceTorqueSensor:
         centre = data.subtree_com[model.body_rootid[self.child]]
         point = data.site_xpos[self.site]
         torque = torque_c + np.cross(centre - point, force)
-        sign = -1.0 if self.spec.measure_direction == "child_to_parent" else 1.0
-        return sign * force, sign * torque
+        return self.sign * force, self.sign * torque
 
     def _frame(self, data: Any) -> np.ndarray:
         if self.spec.frame == "sensor":

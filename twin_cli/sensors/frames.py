@@ -36,3 +36,24 @@ def entity_bodies(model: Any, entity: str) -> frozenset[int]:
     """Ids of every body whose name starts with `<entity>/`."""
     prefix = f"{entity}/"
     return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
+
+
+def native_slice(
+    model: Any, entity: str, site: str, parts: tuple[tuple[str, str], ...]
+) -> slice | None:
+    """Where the MuJoCo sensors `<entity>/<site>:<part>` of one twin sensor sit in sensordata.
+
+    The converter adds them in `parts` order (`converters.description.sensors.NATIVE_PARTS`);
+    None when the model lacks one (a model built before they existed: computed instead).
+    """
+    kind = mujoco.mjtObj.mjOBJ_SENSOR
+    ids = [mujoco.mj_name2id(model, kind, f"{entity}/{site}:{part}") for part, _ in parts]
+    if not ids or min(ids) < 0:
+        return None
+    start = int(model.sensor_adr[ids[0]])
+    end = start
+    for i in ids:
+        if int(model.sensor_adr[i]) != end:
+            return None
+        end += int(model.sensor_dim[i])
+    return slice(start, end)

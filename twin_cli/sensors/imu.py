@@ -2,10 +2,16 @@
 
 A real accelerometer measures the specific force f = a − g (its proof mass is held against
 gravity), so an IMU lying still reads +9.81 m/s² up and one in free fall reads 0. MuJoCo's
-`cacc` starts from the world body's acceleration −g (`mj_rnePostConstraint`), so
-`mj_objectAcceleration` of the site is exactly a − g, including the centripetal term of the
-site's offset from the body; it is taken in the site frame (`flg_local`), as is the angular
-velocity. The orientation is the site's orientation in the world (ENU, as gz-sim reports it).
+`cacc` starts from the world body's acceleration −g (`mj_rnePostConstraint`), so its
+`accelerometer` sensor (and `mj_objectAcceleration` of the site) is exactly a − g, including
+the centripetal term of the site's offset from the body, in the site frame; so is its `gyro`.
+The orientation is the site's orientation in the world (ENU, as gz-sim reports it).
+
+The converter adds MuJoCo's `framequat`, `gyro` and `accelerometer` sensors on the site, so
+every physics step computes them in C (~1 µs for a humanoid world); a reading copies those ten
+numbers from `sensordata` (the values of the last step, as Gazebo's IMU reports the last
+physics update) and adds noise. A model without them (or a world not stepped since it was
+built) is evaluated on a snapshot instead, with the same functions MuJoCo uses.
 """
 
 from __future__ import annotations
@@ -15,10 +21,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from converters.description.sensors import ImuSpec
-from twin_cli.sensors.frames import site_id
+from converters.description.sensors import NATIVE_PARTS, ImuSpec
+from twin_cli.sensors.frames import native_slice, site_id
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import ImuReading
+
+IDENTITY = (0.0, 0.0, 0.0, 1.0)  # x y z w: what an IMU without orientation reports
 
 
 class ImuSensor:
@@ -30,31 +38,63 @@ class ImuSensor:
         self.gyro_noise = NoiseSampler(spec.angular_velocity_noise, rng)
         self.accel_noise = NoiseSampler(spec.linear_acceleration_noise, rng)
         self.site = -1
+        self.native: slice | None = None
+        self._data: Any = None
+        self._view = np.zeros(0)
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
+        self.native = native_slice(model, self.entity, self.spec.site, NATIVE_PARTS["imu"])
+        self._data = None
+
+    def capture(self, data: Any) -> np.ndarray | None:
+        """The last step's (quat w x y z, gyro, specific force) in `sensordata`: a copy; None
+        when MuJoCo has not computed them (no native sensors, or not stepped since built)."""
+        if self.native is None:
+            return None
+        if data is not self._data:  # a view per MjData: attribute access costs µs per call
+            self._data, self._view = data, data.sensordata[self.native]
+        values = self._view.copy()
+        return values if values[:4] @ values[:4] > 0.0 else None
 
     def read(self, model: Any, data: Any, time: float) -> ImuReading:
         """The reading of `data` (after forward dynamics and `mj_rnePostConstraint`)."""
-        velocity = np.zeros(6)
-        mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_SITE, self.site, velocity, 1)
-        acceleration = np.zeros(6)
-        mujoco.mj_objectAcceleration(
-            model, data, mujoco.mjtObj.mjOBJ_SITE, self.site, acceleration, 1
-        )
-        quat = np.zeros(4)
+        values = self.capture(data)
+        return self.reading(values if values is not None else self.compute(model, data), time)
+
+    def compute(self, model: Any, data: Any) -> np.ndarray:
+        """What the native sensors hold, computed from evaluated `data` (same 10 numbers)."""
+        out = np.zeros(10)
+        velocity, acceleration = np.zeros(6), np.zeros(6)
+        site = mujoco.mjtObj.mjOBJ_SITE
+        mujoco.mj_objectVelocity(model, data, site, self.site, velocity, 1)
+        mujoco.mj_objectAcceleration(model, data, site, self.site, acceleration, 1)
+        quat = out[:4]
         mujoco.mju_mat2Quat(quat, data.site_xmat[self.site])
-        w, x, y, z = quat.tolist()
+        out[4:7], out[7:10] = velocity[:3], acceleration[3:]
+        return out
+
+    def noisy_batch(self, values: np.ndarray) -> np.ndarray:
+        """Rows of `capture` values (N×10) with the tags' noise drawn for all rows at once."""
+        out = values.copy()
+        out[:, 4:7] = self.gyro_noise.apply(values[:, 4:7])
+        out[:, 7:10] = self.accel_noise.apply(values[:, 7:10])
+        return out
+
+    def reading(self, values: np.ndarray, time: float, *, noisy: bool = True) -> ImuReading:
+        """The reading of `values` (as `capture` returns them), with the tags' noise unless
+        `noisy` is False (values from `noisy_batch`)."""
+        w, x, y, z = values[:4].tolist()
+        gyro, accel = values[4:7], values[7:10]
+        if noisy:
+            gyro, accel = self.gyro_noise.apply_one(gyro), self.accel_noise.apply_one(accel)
+        gyro, accel = gyro.tolist(), accel.tolist()
         return ImuReading(
             self.spec.name,
             self.spec.type,
             time,
             self.spec.frame_id,
-            (x, y, z, w) if self.spec.enable_orientation else (0.0, 0.0, 0.0, 1.0),
-            _vec(self.gyro_noise.apply(velocity[:3])),
-            _vec(self.accel_noise.apply(acceleration[3:])),
+            (x, y, z, w) if self.spec.enable_orientation else IDENTITY,
+            (gyro[0], gyro[1], gyro[2]),
+            (accel[0], accel[1], accel[2]),
         )
-
-
-def _vec(v: np.ndarray) -> tuple[float, float, float]:
-    return (float(v[0]), float(v[1]), float(v[2]))

@@ -60,33 +60,37 @@ class RaySensor:
         self.site = self.body = -1
         self.own: frozenset[int] = frozenset()
         self.passive = np.zeros(0, bool)
+        self.skip = np.zeros(0, bool)  # by geom: the entity's own or non-colliding
+        horizontal, _ = ray_angles(spec)
+        self.angle_min, self.angle_max = float(horizontal[0]), float(horizontal[-1])
+        self.increment = float(horizontal[1] - horizontal[0]) if len(horizontal) > 1 else 0.0
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         self.body = body_id(model, self.entity, self.spec.body)
         self.own = entity_bodies(model, self.entity)
         self.passive = (model.geom_contype == 0) & (model.geom_conaffinity == 0)
+        own = np.isin(model.geom_bodyid, list(self.own))
+        self.skip = own | self.passive
 
     def read(self, model: Any, data: Any, time: float) -> ScanReading:
         ranges = self.ranges(model, data)
         hit = np.isfinite(ranges)
         noisy = np.clip(self.noise.apply(ranges[hit]), self.spec.range_min, self.spec.range_max)
         ranges[hit] = noisy
-        horizontal, _ = ray_angles(self.spec)
-        step = float(horizontal[1] - horizontal[0]) if len(horizontal) > 1 else 0.0
         rate = self.spec.update_rate
         return ScanReading(
             self.spec.name,
             self.spec.type,
             time,
             self.spec.frame_id,
-            float(horizontal[0]),
-            float(horizontal[-1]),
-            step,
+            self.angle_min,
+            self.angle_max,
+            self.increment,
             1.0 / rate if rate > 0 else model.opt.timestep,
             self.spec.range_min,
             self.spec.range_max,
-            tuple(float(r) for r in ranges),
+            tuple(ranges.tolist()),
             self.spec.vertical_rays,
         )
 
@@ -108,9 +112,7 @@ class RaySensor:
 
     def _skipped(self, model: Any, geoms: np.ndarray, dist: np.ndarray) -> np.ndarray:
         hit = geoms >= 0
-        ids = np.where(hit, geoms, 0)
-        own = np.isin(model.geom_bodyid[ids], list(self.own))
-        return hit & (own | self.passive[ids] | (dist < self.spec.range_min))
+        return hit & (self.skip[np.where(hit, geoms, 0)] | (dist < self.spec.range_min))
 
     def _recast(
         self, model: Any, data: Any, origin: np.ndarray, direction: np.ndarray, t: float, geom: int

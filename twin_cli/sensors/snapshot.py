@@ -67,6 +67,7 @@ class Evaluator:
         mujoco.mj_setState(self.model, self.data, snapshot.state, STATE)
         if not dynamics:
             mujoco.mj_kinematics(self.model, self.data)
+            mujoco.mj_camlight(self.model, self.data)  # cameras' poses: not in mj_kinematics
             return self.data
         mujoco.mj_forward(self.model, self.data)
         mujoco.mj_rnePostConstraint(self.model, self.data)

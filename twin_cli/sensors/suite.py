@@ -1,11 +1,12 @@
 """All sensors of one entity, read from a running world at their own update rates.
 
-`SensorSuite.read` copies the world's state under its lock once (`snapshot.take`), and only if
-some asked-for sensor is due evaluates that state's dynamics on scratch data and computes the
-due sensors; the others return their last reading. A sensor of rate r [Hz] is due once per
-period 1/r of sim time, aligned to multiples of the period as Gazebo's sensor manager updates
-them (rate 0: every physics step); a clock that went back (reset) makes every sensor due.
-Readers therefore cost the loop one state copy per request, never a step of Python.
+`SensorSuite.read` holds the world's lock once, for copies only: the `sensordata` of the due
+sensors MuJoCo computes at every step (IMU, force/torque: see `imu`), and, only if some other
+asked-for sensor is due (lidar, contact, camera), the world's state, which it evaluates outside
+the lock on scratch data; sensors not due return their last reading. A sensor of rate r [Hz]
+is due once per period 1/r of sim time, aligned to multiples of the period as Gazebo's sensor
+manager updates them (rate 0: every physics step); a clock that went back (reset) makes every
+sensor due. Readers therefore cost the loop a few copies per request, never a step of Python.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from typing import Any
+
+import mujoco
+import numpy as np
 
 from converters.description.sensors import (
     CameraSpec,
@@ -22,7 +26,7 @@ from converters.description.sensors import (
     RaySpec,
     SensorSpec,
 )
-from twin_cli.errors import PartNotFoundError
+from twin_cli.errors import EntityNotFoundError, PartNotFoundError
 from twin_cli.sensors.camera import CameraSensor
 from twin_cli.sensors.contact import ContactSensor
 from twin_cli.sensors.force_torque import ForceTorqueSensor
@@ -30,7 +34,7 @@ from twin_cli.sensors.imu import ImuSensor
 from twin_cli.sensors.noise import sensor_rng
 from twin_cli.sensors.ray import RaySensor
 from twin_cli.sensors.readings import Reading
-from twin_cli.sensors.snapshot import Evaluator, Snapshot, take
+from twin_cli.sensors.snapshot import STATE, Evaluator, Snapshot, take
 
 SENSOR_TYPES: dict[type, Any] = {
     ImuSpec: ImuSensor,
@@ -82,36 +86,67 @@ class SensorSuite:
             EntityNotFoundError: the entity was deleted.
             PartNotFoundError: a name that is not one of the entity's sensors (lists them).
         """
-        snapshot = take(self.world, self.entity)
-        if snapshot.entity is not self._record:  # deleted and spawned again, or loaded
-            self._build(snapshot.entity)
-        wanted = list(self.specs) if names is None else list(names)
-        for name in wanted:
-            if name not in self.specs:
-                raise PartNotFoundError(self.entity, "sensor", name, list(self.specs))
-        due = [n for n in wanted if self._due(n, snapshot)]
-        if due:
-            self._refresh(due, snapshot)
+        with self.world.lock:  # held for a few µs: copies, no physics
+            time, model, record = float(self.world.data.time), self.world.model, self._entity()
+            if record is not self._record:  # deleted and spawned again, or loaded
+                self._build(record)
+            wanted = list(self.specs) if names is None else list(names)
+            for name in wanted:
+                if name not in self.specs:
+                    raise PartNotFoundError(self.entity, "sensor", name, list(self.specs))
+            due = [n for n in wanted if self._due(n, time, model.opt.timestep)]
+            if model is not self._model:
+                self._bind(model)
+            captured = {n: self._capture(n) for n in due}
+            rest = [n for n in due if captured[n] is None]
+            snapshot = self._snapshot(time, model, record) if rest else None
+        for name, values in captured.items():
+            if values is not None:
+                self._store(name, self._sensors[name].reading(values, time), time, model)
+        if snapshot is not None:
+            self._refresh(rest, snapshot)
         return {n: self._readings[n] for n in wanted}
 
-    def _due(self, name: str, snapshot: Snapshot) -> bool:
-        slot = period_slot(snapshot.time, self.specs[name].update_rate, snapshot.model.opt.timestep)
+    def _entity(self) -> Any:
+        """The entity's record (the world's; read-only); call with the lock held."""
+        record = self.world._entities.get(self.entity)
+        if record is None:
+            raise EntityNotFoundError(self.entity, list(self.world._entities))
+        return record
+
+    def _bind(self, model: Any) -> None:
+        for sensor in self._sensors.values():
+            sensor.bind(model)
+        self._model = model
+
+    def _capture(self, name: str) -> Any:
+        """The last step's values of a sensor MuJoCo computes (IMU, F/T), else None."""
+        capture = getattr(self._sensors[name], "capture", None)
+        return None if capture is None else capture(self.world.data)
+
+    def _snapshot(self, time: float, model: Any, record: Any) -> Snapshot:
+        state = np.empty(mujoco.mj_stateSize(model, STATE))
+        mujoco.mj_getState(model, self.world.data, state, STATE)
+        return Snapshot(time, model, state, record)
+
+    def _due(self, name: str, time: float, timestep: float) -> bool:
+        slot = period_slot(time, self.specs[name].update_rate, timestep)
         return name not in self._readings or slot != self._slots.get(name)
+
+    def _store(self, name: str, reading: Reading, time: float, model: Any) -> None:
+        self._readings[name] = reading
+        rate = self.specs[name].update_rate
+        self._slots[name] = period_slot(time, rate, model.opt.timestep)
 
     def _refresh(self, due: list[str], snapshot: Snapshot) -> None:
         # Rays and cameras need poses only (mj_kinematics, a few µs); the others need the
-        # forward dynamics of the whole world (measured: ~60 µs with a humanoid in it).
+        # forward dynamics of the whole world (measured: ~30 µs with a humanoid in it).
         dynamics = any(not isinstance(self.specs[n], KINEMATIC) for n in due)
         data = self._evaluator.evaluate(snapshot, dynamics=dynamics)
         model = snapshot.model
-        if model is not self._model:
-            for sensor in self._sensors.values():
-                sensor.bind(model)
-            self._model = model
-        timestep = model.opt.timestep
         for name in due:
-            self._readings[name] = self._sensors[name].read(model, data, snapshot.time)
-            self._slots[name] = period_slot(snapshot.time, self.specs[name].update_rate, timestep)
+            reading = self._sensors[name].read(model, data, snapshot.time)
+            self._store(name, reading, snapshot.time, model)
 
 
 def describe_sensors(specs: Sequence[SensorSpec]) -> list[dict[str, Any]]:

@@ -93,7 +93,10 @@ def robot_from_conversion(done, path: str | Path, *, repair_inertia: bool) -> Ro
     """The robot under test from a `converters.Conversion` (spec, report, provenance)."""
     body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
     joints = tuple(_declared(j) for j in done.description.joints)
-    return _robot(done.spec, done.report, Path(path), repair_inertia, body_links, joints)
+    from dataclasses import replace
+
+    robot = _robot(done.spec, done.report, Path(path), repair_inertia, body_links, joints)
+    return replace(robot, sensors=tuple(getattr(done, "sensors", ())))
 
 
 def _declared(joint: Joint) -> DeclaredJoint:

@@ -18,6 +18,7 @@ from twin_cli.validate.checks import (
     physics_dynamics,
     physics_friction,
     physics_gravity,
+    physics_sensors,
 )
 from twin_cli.validate.checks.base import CheckResult, RobotUnderTest, Series, Status
 
@@ -111,6 +112,17 @@ CHECKS: dict[str, Check] = {
             max_spin_rad_s=100.0,
         ),
         _check("realtime", "physics", physics_dynamics.check_realtime, min_factor=0.8),
+        _check(
+            "sensor_imu",
+            "physics",
+            physics_sensors.check_sensor_imu,
+            tol_m_s2=0.05,
+            max_rate_rad_s=0.01,
+        ),
+        _check("sensor_lidar", "physics", physics_sensors.check_sensor_lidar, tol_m=0.001),
+        _check(
+            "sensor_contact", "physics", physics_sensors.check_sensor_contact, max_wrong_samples=0
+        ),
     )
 }
 

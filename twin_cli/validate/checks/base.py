@@ -103,6 +103,7 @@ class RobotUnderTest:
     repair_inertia: bool = False
     body_links: dict[str, str] = field(default_factory=dict)
     declared_joints: tuple[DeclaredJoint, ...] = ()
+    sensors: tuple = ()  # the converter's Gazebo sensors (converters.description.sensors)
 
     def link_of_body(self, body: str) -> str:
         """The URDF link name for a body name (bodies are named after links)."""

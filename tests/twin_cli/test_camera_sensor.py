@@ -1,0 +1,107 @@
+"""Camera and depth sensors rendered offscreen (MUJOCO_GL=egl) against a pinhole projection.
+
+MuJoCo picks its GL backend at import, so the rendering runs in a child Python with
+MUJOCO_GL=egl; without an EGL here the test skips saying so (CI installs Mesa's EGL).
+Oracle: a red box 2 m ahead and 0.3 m to the left of a camera with horizontal field of view
+1.0 rad projects, by the pinhole model (f = (W/2)/tan(hfov/2) px), to a known pixel rectangle;
+a depth camera reads the distance from the camera to the box's near face along its view axis.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from models import write_urdf
+
+W, H, HFOV = 64, 48, 1.0  # [px], [px], [rad]
+CAM_Z = 0.5  # [m] camera height
+BOX = (2.0, 0.3, CAM_Z, 0.1)  # centre x, y, z and half size [m]
+
+POST = f"""<robot name="campost">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <gazebo><static>true</static></gazebo>
+  <gazebo reference="base">
+  <sensor type="camera" name="cam"><pose>0 0 {CAM_Z} 0 0 0</pose><update_rate>30</update_rate>
+    <camera><horizontal_fov>{HFOV}</horizontal_fov><image><width>{W}</width>
+    <height>{H}</height></image><clip><near>0.05</near><far>50</far></clip></camera></sensor>
+  <sensor type="depth" name="depth"><pose>0 0 {CAM_Z} 0 0 0</pose><update_rate>30</update_rate>
+    <camera><horizontal_fov>{HFOV}</horizontal_fov><image><width>{W}</width>
+    <height>{H}</height></image><clip><near>0.05</near><far>50</far></clip></camera></sensor>
+  </gazebo>
+</robot>"""
+
+CHILD = """
+import json, sys
+import mujoco, numpy as np
+from twin_cli.sensors import SensorSuite
+from twin_cli.world import World, WorldSettings
+try:
+    mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8).close()
+except Exception as exc:
+    print(json.dumps({"no_gl": str(exc).splitlines()[0]})); sys.exit(0)
+x, y, z, h = json.loads(sys.argv[2])
+world = World(WorldSettings(ground=False))
+world.spawn(sys.argv[1], name="post")
+box = mujoco.MjSpec(); box.modelname = "box"
+box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y, z],
+                       rgba=[1, 0, 0, 1])
+world.spawn(box, name="box")
+readings = SensorSuite(world, "post").read()
+rgb = np.frombuffer(readings["cam"].data, np.uint8).reshape(HEIGHT, WIDTH, 3)
+depth = np.frombuffer(readings["depth"].data, np.float32).reshape(HEIGHT, WIDTH)
+print(json.dumps({"rgb": rgb.tolist(), "depth": depth.tolist(),
+                  "encodings": [readings["cam"].encoding, readings["depth"].encoding]}))
+""".replace("HEIGHT", str(H)).replace("WIDTH", str(W))
+
+
+@pytest.fixture(scope="module")
+def images(tmp_path_factory) -> dict:
+    post = write_urdf(tmp_path_factory.mktemp("cam"), POST, "campost.urdf")
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    command = [sys.executable, "-c", CHILD, str(post), json.dumps(BOX)]
+    done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout.strip().splitlines()[-1])
+    if "no_gl" in out:
+        pytest.skip(f"no offscreen EGL here ({out['no_gl']}); install libegl-mesa0")
+    return out
+
+
+def _projection() -> tuple[float, float, float]:
+    """Pixel column and row of the box's near-face centre, and its half width [px]."""
+    f = (W / 2) / math.tan(HFOV / 2)
+    x, y, _, h = BOX
+    near = x - h
+    u = W / 2 - f * y / near  # image x grows to the camera's right (−y)
+    return u, H / 2, f * h / near
+
+
+def test_camera_sees_the_red_box_where_the_pinhole_projection_puts_it(images) -> None:
+    rgb = np.array(images["rgb"], np.float64)
+    assert images["encodings"] == ["rgb8", "32FC1"]
+    u, v, half = _projection()
+    red = (rgb[..., 0] > 2 * rgb[..., 1] + 20) & (rgb[..., 0] > 2 * rgb[..., 2] + 20)
+    rows, cols = np.nonzero(red)
+    assert len(cols), "the box is in view"
+    # The red region's centre and extent match the projection within 1.5 px (pixel rounding,
+    # and the box's side faces, seen obliquely, add under 1 px here).
+    assert cols.mean() == pytest.approx(u - 0.5, abs=1.5), (cols.mean(), u)
+    assert rows.mean() == pytest.approx(v - 0.5, abs=1.5), (rows.mean(), v)
+    assert cols.max() - cols.min() + 1 == pytest.approx(2 * half, abs=2.0)
+    assert not red[:, W // 2 :].any(), "nothing red in the right half (the box is to the left)"
+
+
+def test_depth_camera_reads_the_distance_to_the_near_face(images) -> None:
+    depth = np.array(images["depth"])
+    u, v, _ = _projection()
+    x, _, _, h = BOX
+    centre = depth[int(v), int(u)]
+    assert centre == pytest.approx(x - h, abs=0.01), "metres along the view axis to the face"
+    assert depth[int(v), 2] > 10.0, "nothing to the right within range: far background"
