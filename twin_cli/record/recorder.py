@@ -41,6 +41,8 @@ class RecordingStatus:
     Attributes:
         active: still sampling; samples: samples written; start, end: their sim times [s].
         error: why the worker stopped early, or None.
+        blocked_s: wall time [s] the stepping thread waited for the encoder (its ring was
+            full); waits: how many times. No sample is ever dropped from a bag.
     """
 
     active: bool
@@ -48,6 +50,8 @@ class RecordingStatus:
     start: float | None
     end: float | None
     error: str | None
+    blocked_s: float = 0.0
+    waits: int = 0
 
 
 def check_rate(rate: float) -> float:
@@ -179,15 +183,10 @@ class Recording:
             self._close_sinks()
 
     def _publish(self, sample: Sample, layout: Layout | None, kinematics: Kinematics) -> Layout:
-        if not sample.finite():
-            return layout
-        if sample.layout is not layout:
-            layout = sample.layout
-            self._relayout(layout, sample.time)
-        xpos, xquat = kinematics.poses(sample)
-        for message in live_messages(sample, xpos, xquat):
-            self._emit(message)
-        self._count(sample.time)
+        sink = _Fanout(self._sinks)
+        if publish_sample(sample, kinematics, sink, new_layout=sample.layout is not layout):
+            self._count(sample.time)
+            return sample.layout
         return layout
 
     def _next_newest(self) -> Sample | None:
@@ -198,17 +197,6 @@ class Recording:
             sample, self._newest = self._newest, None
             self._busy = sample is not None
         return sample
-
-    def _relayout(self, layout: Layout, time: float) -> None:
-        names = topics(layout)
-        for sink in self._sinks:
-            sink.set_topics(names)
-        for message in latched_messages(layout, time):
-            self._emit(message)
-
-    def _emit(self, message: Message) -> None:
-        for sink in self._sinks:
-            sink.write(message)
 
     def _count(self, time: float) -> None:
         self._samples += 1
@@ -223,6 +211,36 @@ class Recording:
             except Exception as exc:
                 log.exception("closing %s failed", sink)
                 self._error = self._error or f"{type(exc).__name__}: {exc}"
+
+
+class _Fanout:
+    """Several sinks as one."""
+
+    def __init__(self, sinks: Sequence[Sink]) -> None:
+        self._sinks = sinks
+
+    def set_topics(self, topics: list[Topic]) -> None:
+        for sink in self._sinks:
+            sink.set_topics(topics)
+
+    def write(self, message: Message) -> None:
+        for sink in self._sinks:
+            sink.write(message)
+
+
+def publish_sample(sample: Sample, kinematics: Kinematics, sink: Any, *, new_layout: bool) -> bool:
+    """Hands one sample's messages to `sink` (its topics and latched messages first when the
+    layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
+    if not sample.finite():
+        return False
+    if new_layout:
+        sink.set_topics(topics(sample.layout))
+        for message in latched_messages(sample.layout, sample.time):
+            sink.write(message)
+    xpos, xquat = kinematics.poses(sample)
+    for message in live_messages(sample, xpos, xquat):
+        sink.write(message)
+    return True
 
 
 class BagSink:

@@ -12,8 +12,9 @@ from dataclasses import asdict
 from typing import Any
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.record.bag_recording import BagRecording
 from twin_cli.record.foxglove import LiveStream
-from twin_cli.record.recorder import BagSink, Recording
+from twin_cli.record.recorder import Recording
 
 
 class Consumers:
@@ -21,7 +22,7 @@ class Consumers:
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self.recording: Recording | None = None
+        self.recording: BagRecording | None = None
         self.recording_path: str | None = None
         self.live: tuple[Recording, LiveStream] | None = None
 
@@ -49,14 +50,7 @@ class Consumers:
                 )
             if self.recording is not None:
                 self.recording.stop()
-            sink = BagSink(path)
-            try:
-                recording = Recording(
-                    world, [sink], rate=rate, entities=entities, duration=duration
-                )
-            except BaseException:
-                sink.close()
-                raise
+            recording = BagRecording(world, path, rate=rate, entities=entities, duration=duration)
             self.recording, self.recording_path = recording.start(), path
             return self.record_status()
 
