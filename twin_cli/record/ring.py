@@ -57,50 +57,60 @@ def views(memory: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 class RingWriter:
-    """The stepping thread's side: copies one state into the next record."""
+    """The stepping thread's side: copies one state into the next record (~3 µs: one
+    `np.concatenate` into the ring; the read position is re-read only when room runs short)."""
 
     def __init__(self, data: np.ndarray, header: np.ndarray, alive: Any) -> None:
         """Args: data, header: ring views; alive: () -> bool, whether the reader still runs."""
         self._data, self._header, self._alive = data, header, alive
+        self._write = int(header[WRITE])  # only this side writes it: a Python mirror
+        self._limit = int(header[READ]) + data.size  # write may grow to here without a look
+        self._shape: tuple[int, int, int] | None = None
+        self._length = 0
         self.blocked_s = 0.0  # [s] waited for room (the reader fell behind)
         self.waits = 0
 
     def put(self, epoch: int, d: Any) -> bool:
         """Writes MjData `d`'s state as a record of `epoch`; False if the reader is gone."""
-        parts = (d.qpos, d.qvel, d.qfrc_actuator, d.mocap_pos.ravel(), d.mocap_quat.ravel())
-        length = 3 + sum(p.size for p in parts)
-        capacity = self._data.size
-        write = int(self._header[WRITE])
-        pos = write % capacity
+        shape = (d.qpos.size, d.qvel.size, d.mocap_pos.size)
+        if shape != self._shape:
+            self._shape, self._length = shape, 3 + shape[0] + 2 * shape[1] + shape[2] * 7 // 3
+        length, capacity = self._length, self._data.size
+        pos = self._write % capacity
         if pos + length > capacity:
-            if not self._room(write, capacity - pos):
+            if not self._room(capacity - pos):
                 return False
             self._data[pos] = WRAP
-            write += capacity - pos
-            self._header[WRITE] = write
+            self._write += capacity - pos
+            self._header[WRITE] = self._write
             pos = 0
-        if not self._room(write, length):
+        if not self._room(length):
             return False
         buf = self._data
         buf[pos], buf[pos + 1], buf[pos + 2] = length, epoch, d.time
-        at = pos + 3
-        for p in parts:
-            buf[at : at + p.size] = p
-            at += p.size
-        self._header[WRITE] = write + length
+        np.concatenate(
+            (d.qpos, d.qvel, d.qfrc_actuator, d.mocap_pos.ravel(), d.mocap_quat.ravel()),
+            out=buf[pos + 3 : pos + length],
+        )
+        self._write += length
+        self._header[WRITE] = self._write
         return True
 
-    def _room(self, write: int, needed: int) -> bool:
+    def _room(self, needed: int) -> bool:
+        if self._write + needed <= self._limit:
+            return True
         capacity = self._data.size
-        if write + needed - int(self._header[READ]) <= capacity:
+        self._limit = int(self._header[READ]) + capacity
+        if self._write + needed <= self._limit:
             return True
         start = time.perf_counter()
         self.waits += 1
         try:
-            while write + needed - int(self._header[READ]) > capacity:
+            while self._write + needed > self._limit:
                 if not self._alive():
                     return False
                 time.sleep(WAIT_S)
+                self._limit = int(self._header[READ]) + capacity
         finally:
             self.blocked_s += time.perf_counter() - start
         return True
