@@ -177,3 +177,54 @@ def test_foxglove_clients_receive_the_worlds_state_and_new_entities(tmp_path, se
     _, tf = got["/tf"][-1]
     assert ("world", "h/torso") in {(t.header.frame_id, t.child_frame_id) for t in tf.transforms}
     assert {"/h2/joint_states", "/h2/robot_description", "/h2/odom"} <= set(session["channels"])
+
+
+def _paused_session(port: int) -> dict:
+    """Subscribe to /clock and /h/joint_states of a paused world that is never stepped."""
+    import websockets
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+
+    async def run() -> dict:
+        async with websockets.connect(
+            f"ws://127.0.0.1:{port}", subprotocols=FOXGLOVE_SUBPROTOCOLS
+        ) as ws:
+            channels: dict[str, dict] = {}
+            got: dict[str, list] = {}
+            subscribed: dict[int, str] = {}
+            wanted = ("/clock", "/h/joint_states", "/tf_static")
+            deadline = time.monotonic() + 20.0
+            while not all(got.get(t) for t in wanted):
+                frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                if isinstance(frame, str):
+                    op = json.loads(frame)
+                    if op["op"] == "advertise":
+                        channels.update({c["topic"]: c for c in op["channels"]})
+                        if set(wanted) <= set(channels) and not subscribed:
+                            subs = []
+                            for k, topic in enumerate(wanted, start=1):
+                                subscribed[k] = topic
+                                subs.append({"id": k, "channelId": channels[topic]["id"]})
+                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                elif frame[0] == MESSAGE_DATA:
+                    sub, stamp = struct.unpack_from("<IQ", frame, 1)
+                    topic = subscribed[sub]
+                    message = store.deserialize_cdr(frame[13:], channels[topic]["schemaName"])
+                    got.setdefault(topic, []).append((stamp, message))
+            return got
+
+    return asyncio.run(run())
+
+
+def test_a_paused_world_still_shows_its_state_to_a_new_foxglove_client(tmp_path, serve_world):
+    port = free_port()
+    with serve_world(tmp_path, "foxpause", "--paused", "--foxglove", str(port)) as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        got = _paused_session(port)  # the world never steps
+        joints = client.joints("h")
+    stamp, clock = got["/clock"][-1]
+    assert stamp == 0 and seconds(clock.clock) == 0.0, "sim time of the paused world"
+    _, message = got["/h/joint_states"][-1]
+    assert np.array_equal(message.position, [j["position"] for j in joints]), "its state"
+    assert got["/tf_static"], "latched topics are sent to the new subscriber"

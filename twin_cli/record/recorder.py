@@ -21,6 +21,7 @@ from twin_cli.record.sampler import Kinematics, Sample, Sampler
 from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
 
 log = logging.getLogger("twin.record")
+HEARTBEAT_S = 0.5  # [s] wall: how often a live view republishes a world that is not stepping
 MAX_RATE = 1000.0  # [Hz] of sim time; above the world's step rate a sample is taken every step
 
 
@@ -171,7 +172,7 @@ class Recording:
     def _work(self) -> None:
         kinematics, layout = Kinematics(), None
         try:
-            while (sample := self._queue.get()) is not None:
+            while (sample := self._next()) is not None:
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)
                     sample = self._next_newest()
@@ -188,6 +189,18 @@ class Recording:
             self._count(sample.time)
             return sample.layout
         return layout
+
+    def _next(self) -> Sample | None:
+        """The next queued sample; a live view of a world that does not step (paused) gets the
+        current state again every HEARTBEAT_S, so a viewer that connects sees the robot."""
+        if not self._latest_only:
+            return self._queue.get()
+        while True:
+            try:
+                return self._queue.get(timeout=HEARTBEAT_S)
+            except queue.Empty:
+                with self._world.lock:
+                    self._capture()
 
     def _next_newest(self) -> Sample | None:
         """latest_only: the newest sample kept while busy, or None (and the worker is idle)."""
