@@ -228,3 +228,28 @@ def test_a_paused_world_still_shows_its_state_to_a_new_foxglove_client(tmp_path,
     _, message = got["/h/joint_states"][-1]
     assert np.array_equal(message.position, [j["position"] for j in joints]), "its state"
     assert got["/tf_static"], "latched topics are sent to the new subscriber"
+
+
+def test_twin_load_moves_a_recording_or_says_it_stopped(tmp_path, serve_world):
+    out = tmp_path / "moved.mcap"
+    with serve_world(tmp_path, "recload", "--paused") as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        client.step(200)
+        client.save(tmp_path / "with_h.json")  # t = 0.2 s
+        client.delete("h")
+        client.spawn(str(HUMANOID), name="g", pose={"z": 1.0})
+        client.save(tmp_path / "without_h.json")
+        client.load(tmp_path / "with_h.json")
+        client.request("POST", "/record", body={"path": str(out), "entities": ["h"]})
+        client.step(100)  # 0.2 → 0.3 s
+        moved = twin("load", str(tmp_path / "with_h.json"), world="recload")
+        client.step(50)  # 0.2 → 0.25 s in the loaded world
+        stopped = twin("load", str(tmp_path / "without_h.json"), world="recload")
+        status = client.request("GET", "/record")
+    assert moved.returncode == 0 and "recording moved" in moved.stderr, moved.stderr
+    assert "recording stopped: Entity [h] does not exist" in stopped.stderr, stopped.stderr
+    assert status["active"] is False and status["error"] is None, status
+    clock = [round(seconds(m.clock), 9) for _, m in read_bag(out)["/clock"]]
+    first = [round(0.2 + 0.01 * k, 9) for k in range(11)]
+    # rosbags yields messages in log-time order: the loaded world's clock restarted at 0.2 s.
+    assert clock == sorted(first + [round(0.2 + 0.01 * k, 9) for k in range(6)]), clock

@@ -305,7 +305,10 @@ def save(*, file: Path, world: str) -> None:
 
 def load(*, file: Path, world: str) -> None:
     with _connect(world) as c:
-        c.load(file)
+        reply = c.load(file)
+    for consumer in ("recording", "foxglove"):  # a running recording follows, or says it stopped
+        if isinstance(reply, dict) and consumer in reply:
+            sys.stderr.write(f"twin: {consumer} {reply[consumer]}\n")
 
 
 def logs(*, lines: int | None, world: str) -> None:

@@ -19,6 +19,7 @@ from typing import Any
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.record import ring
+from twin_cli.record.follow import Follows
 from twin_cli.record.mcap_writer import open_output
 from twin_cli.record.recorder import RecordingStatus, check_rate
 from twin_cli.record.sampler import Sampler
@@ -28,7 +29,7 @@ RING_BYTES = 32 << 20  # [B] ~40 s of a humanoid at 1,000 samples per wall secon
 START_TIMEOUT_S = 60.0  # [s] for the encoder's answer when stopping (imports on a loaded host)
 
 
-class BagRecording:
+class BagRecording(Follows):
     """Samples `world` at `rate` [Hz] of sim time into the MCAP file `path` until stopped."""
 
     def __init__(
@@ -54,6 +55,7 @@ class BagRecording:
         if duration is not None and not (math.isfinite(duration) and duration > 0):
             raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
         self._sampler = Sampler(world, entities, descriptions)  # checks the names
+        self._entities, self._descriptions = tuple(entities), descriptions
         open_output(path, overwrite=overwrite).close()  # the errors, here and now
         self.path = Path(path).expanduser()
         self._world, self._duration = world, duration

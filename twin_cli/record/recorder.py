@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
 from twin_cli.record.sampler import Kinematics, Sample, Sampler
 from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
@@ -68,7 +69,7 @@ def check_rate(rate: float) -> float:
     return rate
 
 
-class Recording:
+class Recording(Follows):
     """Samples `world` at `rate` [Hz] of sim time into `sinks` until `stop` (or `duration`)."""
 
     def __init__(
@@ -100,6 +101,7 @@ class Recording:
             raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
         self._world = world
         self._sampler = Sampler(world, entities, descriptions)
+        self._entities, self._descriptions = tuple(entities), descriptions
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
-from twin_cli.errors import InvalidRequestError
+from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.record.bag_recording import BagRecording
 from twin_cli.record.foxglove import LiveStream
 from twin_cli.record.recorder import Recording
@@ -98,6 +98,26 @@ class Consumers:
             recording.stop()
             self.live = None
             return {"stopped": live.port}
+
+    def follow(self, world: Any) -> dict:
+        """Moves the recording and the live stream to `world` (the server loaded a new one).
+
+        Returns what happened to each, for the `/load` reply: "moved", or "stopped: <why>"
+        (a recorded entity is not in the new world; the file is closed and complete).
+        """
+        out = {}
+        with self._lock:
+            if self.recording is not None and self.recording.status().active:
+                try:
+                    self.recording.retarget(world)
+                    out["recording"] = "moved"
+                except TwinError as exc:
+                    self.recording.stop()
+                    out["recording"] = f"stopped: {exc}"
+            if self.live is not None:
+                self.live[0].retarget(world)
+                out["foxglove"] = "moved"
+        return out
 
     def close(self) -> None:
         """Stops both (server shutdown): the recording's file gets its summary."""

@@ -1,0 +1,41 @@
+"""Moving a running recording or live stream to another world (`twin load` swaps the world).
+
+A mixin of `Recording` and `BagRecording`: both sample `self._world` through an observer and a
+`Sampler`. The samples of the new world go on in the same file or stream; the layout changes
+(a new model), so topics and latched messages are sent again. Sim time continues from the
+loaded world's clock, which may be earlier than the last sample's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from twin_cli.record.sampler import Sampler
+
+
+class Follows:
+    """`retarget`: observe another world from now on (mixin; see module docstring)."""
+
+    def retarget(self, world: Any) -> None:
+        """Samples `world` instead of the current one, starting with a sample now.
+
+        Raises:
+            EntityNotFoundError: a recorded entity is not in `world` (the recording is unchanged).
+        """
+        sampler = Sampler(world, self._entities, self._descriptions)
+        old = self._world
+        if self._handle is not None:
+            old.remove_observer(self._handle)
+            self._handle = None
+        with old.lock:
+            old_time = float(old.data.time)
+        self._world, self._sampler, self._model = world, sampler, None
+        if self._done.is_set():
+            return
+        with world.lock:
+            now = float(world.data.time)
+            if self._until is not None:
+                self._until = now + max(0.0, self._until - old_time)
+            self._capture()
+            if not self._done.is_set():
+                self._handle = world.add_observer(self._capture, self.rate)
