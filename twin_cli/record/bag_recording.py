@@ -23,6 +23,7 @@ from twin_cli.record.follow import Follows
 from twin_cli.record.mcap_writer import open_output
 from twin_cli.record.recorder import RecordingStatus, check_rate
 from twin_cli.record.sampler import Sampler
+from twin_cli.record.sensor_feed import SensorFeed
 from twin_cli.world.observers import world_view
 
 RING_BYTES = 32 << 20  # [B] ~40 s of a humanoid at 1,000 samples per wall second
@@ -66,6 +67,8 @@ class BagRecording(Follows):
         self._process: subprocess.Popen | None = None
         self._writer = ring.RingWriter(data, self._header, self._alive)
         self._model: Any = None
+        self._feed = SensorFeed(world, entities)
+        self._sensor_handle: int | None = None
         self._epoch = -1
         self._until: float | None = None
         self._handle: int | None = None
@@ -88,7 +91,14 @@ class BagRecording(Follows):
             self._capture()
             if not self._done.is_set():
                 self._handle = self._world.add_observer(self._capture, self.rate)
+        self._follow_sensors(self._world)
         return self
+
+    def retarget(self, world: Any) -> None:
+        """As `Follows.retarget`, and the sensors follow too."""
+        super().retarget(world)
+        self._feed = SensorFeed(world, self._entities)
+        self._follow_sensors(world)
 
     def capture_now(self) -> None:
         """Takes one sample now (for callers that step the world themselves)."""
@@ -142,6 +152,25 @@ class BagRecording(Follows):
         if self._until is not None and float(world.data.time) >= self._until - 1e-9:
             self._finish_sampling()
 
+    def _follow_sensors(self, world: Any) -> None:
+        """Observes `world` at its fastest sensor's rate (no sensors: not at all)."""
+        if self._sensor_handle is not None:
+            self._sensor_world.remove_observer(self._sensor_handle)
+            self._sensor_handle = None
+        rate = self._feed.rate()
+        if rate > 0 and not self._done.is_set():
+            with world.lock:
+                self._capture_sensors()
+                self._sensor_world = world
+                self._sensor_handle = world.add_observer(self._capture_sensors, rate)
+
+    def _capture_sensors(self) -> None:
+        if self._done.is_set():
+            return
+        readings = self._feed.fresh()
+        if readings:
+            self._conn.send(("readings", readings))
+
     def _send_layout(self) -> None:
         view = world_view(self._world)
         index, descriptions = self._sampler.selection(view)
@@ -155,6 +184,8 @@ class BagRecording(Follows):
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
+        if self._sensor_handle is not None:
+            self._sensor_world.remove_observer(self._sensor_handle)
 
     def _await_ready(self) -> None:
         """Waits for the encoder's imports (its first second), so samples start flowing."""

@@ -41,17 +41,16 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
     try:
         stop = None
         while True:
+            stop = encoder.poll(conn)  # layouts, sensor readings, stop
             records = ring.read_records(buf, head, BATCH)
             for record in records:
                 encoder.encode(record, conn)
             head[ring.SAMPLES] = encoder.samples
             if records:
                 continue
-            if stop is not None:
+            if stop is not None and not conn_pending(conn):
                 break
-            stop = encoder.poll(conn)
-            if stop is None:
-                time.sleep(IDLE_S)
+            time.sleep(IDLE_S)
     except Exception as exc:  # disk full...: report it to the parent
         error = f"{type(exc).__name__}: {exc}"
     finally:
@@ -95,6 +94,12 @@ class _Encoder:
         if message[0] == "layout":
             _, epoch, model, index, descriptions = message
             self._layouts[epoch] = make_layout(model, index, descriptions)
+        elif message[0] == "readings":
+            from twin_cli.record.sensor_messages import sensor_message
+
+            for topic, reading in message[1]:
+                self.writer.set_topics([topic])
+                self.writer.write(sensor_message(topic, reading))
         elif message[0] == "stop":
             self._stop = message[1]
 
@@ -117,6 +122,14 @@ class _Encoder:
     def close(self, figures: dict) -> None:
         self.writer.writer.custom_data = {k: str(v) for k, v in figures.items()}
         self.writer.close()
+
+
+def conn_pending(conn: Any) -> bool:
+    """Whether the parent sent something not yet taken (False once the pipe is closed)."""
+    try:
+        return bool(conn.poll())
+    except (EOFError, OSError):
+        return False
 
 
 def _sample(record: Any, layout: Any) -> Any:
