@@ -79,3 +79,23 @@ def test_sensor_topics_carry_the_worlds_readings_at_their_rates(tmp_path):
         assert [s.collision2_name for s in m.states] == [c.collision2 for c in want.states]
         f = m.states[0].total_wrench.force
         assert (f.x, f.y, f.z) == tuple(want.states[0].force)
+
+
+def test_the_live_streams_worker_publishes_sensor_topics_too(tmp_path):
+    """`Recording` (the worker thread behind the Foxglove stream) with a bag sink: the same
+    sensor topics, announced with the others, at the sensor's rate."""
+    from twin_cli.record import BagSink, Recording
+
+    world = World()
+    world.spawn(write_urdf(tmp_path, imu_box(rate=IMU_RATE), "imu.urdf"), name="imu")
+    path = tmp_path / "live.mcap"
+    recording = Recording(world, [BagSink(path)], rate=30.0).start()
+    first = SensorSuite(world, "imu").read()["imu"]
+    world.step(100)
+    assert recording.stop().error is None
+    bag = read_bag(path)
+    stamps = [seconds(m.header.stamp) for _, m in bag["/imu/imu"]]
+    assert np.allclose(np.diff(stamps), 1 / IMU_RATE, atol=1e-9) and len(stamps) == 21
+    a = bag["/imu/imu"][0][1].linear_acceleration
+    assert (a.x, a.y, a.z) == tuple(first.linear_acceleration)
+    assert "/imu/joint_states" in bag, "the world's topics stay announced"

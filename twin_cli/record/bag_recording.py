@@ -94,12 +94,6 @@ class BagRecording(Follows):
         self._follow_sensors(self._world)
         return self
 
-    def retarget(self, world: Any) -> None:
-        """As `Follows.retarget`, and the sensors follow too."""
-        super().retarget(world)
-        self._feed = SensorFeed(world, self._entities)
-        self._follow_sensors(world)
-
     def capture_now(self) -> None:
         """Takes one sample now (for callers that step the world themselves)."""
         with self._world.lock:
@@ -152,18 +146,6 @@ class BagRecording(Follows):
         if self._until is not None and float(world.data.time) >= self._until - 1e-9:
             self._finish_sampling()
 
-    def _follow_sensors(self, world: Any) -> None:
-        """Observes `world` at its fastest sensor's rate (no sensors: not at all)."""
-        if self._sensor_handle is not None:
-            self._sensor_world.remove_observer(self._sensor_handle)
-            self._sensor_handle = None
-        rate = self._feed.rate()
-        if rate > 0 and not self._done.is_set():
-            with world.lock:
-                self._capture_sensors()
-                self._sensor_world = world
-                self._sensor_handle = world.add_observer(self._capture_sensors, rate)
-
     def _capture_sensors(self) -> None:
         if self._done.is_set():
             return
@@ -184,8 +166,7 @@ class BagRecording(Follows):
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
-        if self._sensor_handle is not None:
-            self._sensor_world.remove_observer(self._sensor_handle)
+        self._stop_sensors()
 
     def _await_ready(self) -> None:
         """Waits for the encoder's imports (its first second), so samples start flowing."""

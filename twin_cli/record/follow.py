@@ -11,10 +11,12 @@ from __future__ import annotations
 from typing import Any
 
 from twin_cli.record.sampler import Sampler
+from twin_cli.record.sensor_feed import SensorFeed
 
 
 class Follows:
-    """`retarget`: observe another world from now on (mixin; see module docstring)."""
+    """`retarget`: observe another world from now on (mixin; see module docstring); and the
+    sensor observer both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
 
     def retarget(self, world: Any) -> None:
         """Samples `world` instead of the current one, starting with a sample now.
@@ -39,3 +41,20 @@ class Follows:
             self._capture()
             if not self._done.is_set():
                 self._handle = world.add_observer(self._capture, self.rate)
+        self._feed = SensorFeed(world, self._entities)
+        self._follow_sensors(world)
+
+    def _follow_sensors(self, world: Any) -> None:
+        """Observes `world` at its fastest sensor's rate (no sensors: not at all)."""
+        self._stop_sensors()
+        rate = self._feed.rate()
+        if rate > 0 and not self._done.is_set():
+            with world.lock:
+                self._capture_sensors()
+                self._sensor_world = world
+                self._sensor_handle = world.add_observer(self._capture_sensors, rate)
+
+    def _stop_sensors(self) -> None:
+        if getattr(self, "_sensor_handle", None) is not None:
+            self._sensor_world.remove_observer(self._sensor_handle)
+            self._sensor_handle = None

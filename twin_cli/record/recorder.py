@@ -19,6 +19,8 @@ from twin_cli.errors import InvalidRequestError
 from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
 from twin_cli.record.sampler import Kinematics, Sample, Sampler
+from twin_cli.record.sensor_feed import SensorFeed
+from twin_cli.record.sensor_messages import sensor_message
 from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
 
 log = logging.getLogger("twin.record")
@@ -105,7 +107,7 @@ class Recording(Follows):
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
-        self._queue: queue.SimpleQueue[Sample | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Sample | list | None] = queue.SimpleQueue()
         self._handle: int | None = None
         self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
         self._busy, self._newest = False, None
@@ -114,6 +116,9 @@ class Recording(Follows):
         self._samples, self._span = 0, [None, None]
         self._error: str | None = None
         self._worker = threading.Thread(target=self._work, name="twin-record", daemon=True)
+        self._feed = SensorFeed(world, entities)
+        self._sensor_topics: dict[str, Topic] = {}  # worker thread: sensor topics seen so far
+        self._layout_topics: list[Topic] = []
 
     # ------------------------------------------------------------ control (any thread)
     def start(self) -> Recording:
@@ -125,6 +130,7 @@ class Recording(Follows):
             self._capture()
             if not self._done.is_set() and hasattr(self._world, "add_observer"):
                 self._handle = self._world.add_observer(self._capture, self.rate)
+        self._follow_sensors(self._world)
         return self
 
     def capture_now(self) -> None:
@@ -162,12 +168,20 @@ class Recording(Follows):
         if self._until is not None and sample.time >= self._until - 1e-9:
             self._finish_sampling()
 
+    def _capture_sensors(self) -> None:
+        if self._done.is_set():
+            return
+        readings = self._feed.fresh()
+        if readings and not (self._latest_only and self._busy):  # a busy live view skips them
+            self._queue.put(readings)
+
     def _finish_sampling(self) -> None:
         if self._done.is_set():
             return
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
+        self._stop_sensors()
         self._queue.put(None)
 
     # ------------------------------------------------------------ worker thread
@@ -175,6 +189,9 @@ class Recording(Follows):
         kinematics, layout = Kinematics(), None
         try:
             while (sample := self._next()) is not None:
+                if isinstance(sample, list):
+                    self._publish_readings(sample)
+                    continue
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)
                     sample = self._next_newest()
@@ -187,10 +204,24 @@ class Recording(Follows):
 
     def _publish(self, sample: Sample, layout: Layout | None, kinematics: Kinematics) -> Layout:
         sink = _Fanout(self._sinks)
-        if publish_sample(sample, kinematics, sink, new_layout=sample.layout is not layout):
+        if sample.layout is not layout:
+            self._layout_topics = topics(sample.layout)
+        extra = list(self._sensor_topics.values())
+        new = sample.layout is not layout
+        if publish_sample(sample, kinematics, sink, new_layout=new, extra_topics=extra):
             self._count(sample.time)
             return sample.layout
         return layout
+
+    def _publish_readings(self, readings: list) -> None:
+        """Sensor messages; a new sensor topic is announced with all the others (a live sink
+        closes channels that a topic list leaves out)."""
+        sink = _Fanout(self._sinks)
+        if any(t.name not in self._sensor_topics for t, _ in readings):
+            self._sensor_topics.update({t.name: t for t, _ in readings})
+            sink.set_topics(self._layout_topics + list(self._sensor_topics.values()))
+        for topic, reading in readings:
+            sink.write(sensor_message(topic, reading))
 
     def _next(self) -> Sample | None:
         """The next queued sample; a live view of a world that does not step (paused) gets the
@@ -243,13 +274,20 @@ class _Fanout:
             sink.write(message)
 
 
-def publish_sample(sample: Sample, kinematics: Kinematics, sink: Any, *, new_layout: bool) -> bool:
+def publish_sample(
+    sample: Sample,
+    kinematics: Kinematics,
+    sink: Any,
+    *,
+    new_layout: bool,
+    extra_topics: Sequence[Topic] = (),
+) -> bool:
     """Hands one sample's messages to `sink` (its topics and latched messages first when the
     layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
     if not sample.finite():
         return False
     if new_layout:
-        sink.set_topics(topics(sample.layout))
+        sink.set_topics(topics(sample.layout) + list(extra_topics))
         for message in latched_messages(sample.layout, sample.time):
             sink.write(message)
     xpos, xquat = kinematics.poses(sample)

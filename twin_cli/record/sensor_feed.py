@@ -12,11 +12,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from twin_cli.record.recorder import MAX_RATE
 from twin_cli.record.sensor_messages import sensor_topic
 from twin_cli.record.topics import Topic
 from twin_cli.sensors import Reading, SensorSuite
 from twin_cli.world.observers import world_view
+
+MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
 
 
 class SensorFeed:
