@@ -39,7 +39,9 @@ def _world(rate: float = 0.0) -> World:
 def _recorder(world: World, out: Path, kind: str):  # noqa: ANN202
     if kind == "thread":  # before: encoded in a thread of the loop's process
         return Recording(world, [BagSink(out)], rate=RATE).start()
-    return BagRecording(world, out, rate=RATE).start()  # encoder process (waits for it)
+    recording = BagRecording(world, out, rate=RATE).start()  # encoder process
+    recording.ready()  # the steady state: not the encoder's imports
+    return recording
 
 
 def _window(world: World, out: Path | None, kind: str = "process") -> tuple[float, float]:

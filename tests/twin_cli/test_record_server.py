@@ -78,7 +78,12 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
     with serve_world(tmp_path, "reckill") as (client, proc):
         client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
         client.request("POST", "/record", body={"path": str(out), "rate": 100})
-        time.sleep(3.0)  # > FLUSH_PERIOD_S: at least one chunk reached the OS
+        deadline = time.monotonic() + 60.0  # the encoder starts in ~1 s, more under load
+        while time.monotonic() < deadline and (not out.exists() or out.stat().st_size < 50_000):
+            time.sleep(0.2)
+        time.sleep(1.5)  # > FLUSH_PERIOD_S: more chunks reach the OS
+        for child in _children(proc.pid):  # the encoder process first, as a kill -9 of all
+            os.kill(child, signal.SIGKILL)
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait()
     schemas, channels, stamps = {}, {}, []
@@ -100,6 +105,14 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
             pass  # the cut: the chunk being written when the process died
     assert len(stamps) >= 50, f"{len(stamps)} /clock messages survived"
     assert np.all(np.diff(stamps) == 10_000_000), "consecutive 100 Hz samples up to the cut"
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids of `pid`'s children (Linux /proc)."""
+    out = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        out += [int(c) for c in (task / "children").read_text().split()]
+    return out
 
 
 def _foxglove_session(port: int, client, steps: int) -> dict:

@@ -75,6 +75,7 @@ class BagRecording(Follows):
         self._done = threading.Event()
         self._error: str | None = None
         self._closed = False
+        self._started = False
 
     # ------------------------------------------------------------ control (any thread)
     def start(self) -> BagRecording:
@@ -84,7 +85,6 @@ class BagRecording(Follows):
         self._process = subprocess.Popen(command, pass_fds=fds, stdin=subprocess.DEVNULL)
         os.close(self._ring_fd)
         self._child.close()
-        self._await_ready()
         with self._world.lock:
             now = float(self._world.data.time)
             self._until = None if self._duration is None else now + self._duration
@@ -107,9 +107,11 @@ class BagRecording(Follows):
             figures = {"blocked_s": round(self._writer.blocked_s, 6), "waits": self._writer.waits}
             try:
                 self._conn.send(("stop", figures))
-                if self._conn.poll(START_TIMEOUT_S + self._backlog_s()):
-                    _, error = self._conn.recv()
+                while self._conn.poll(START_TIMEOUT_S + self._backlog_s()):
+                    kind, error = self._conn.recv()
                     self._error = self._error or error
+                    if kind == "done":
+                        break
             except (EOFError, OSError):
                 self._error = self._error or "the encoder process ended unexpectedly"
             self._end_process()
@@ -168,17 +170,17 @@ class BagRecording(Follows):
             self._world.remove_observer(self._handle)
         self._stop_sensors()
 
-    def _await_ready(self) -> None:
-        """Waits for the encoder's imports (its first second), so samples start flowing."""
-        if not self._conn.poll(START_TIMEOUT_S):
-            self._error = "the encoder process did not start"
-            return
-        try:
-            kind, error = self._conn.recv()
-        except (EOFError, OSError):
-            kind, error = "done", "the encoder process ended at start"
-        if kind != "ready":
-            self._error = error
+    def ready(self, timeout: float = START_TIMEOUT_S) -> bool:
+        """Waits until the encoder has started (its imports take about a second; samples wait
+        in the ring meanwhile). For benchmarks, which time the steady state."""
+        if self._started:
+            return True
+        if not self._conn.poll(timeout):
+            return False
+        kind, error = self._conn.recv()
+        self._started = kind == "ready"
+        self._error = self._error or error
+        return self._started
 
     def _alive(self) -> bool:
         return self._process is not None and self._process.poll() is None

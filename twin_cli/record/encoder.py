@@ -16,7 +16,7 @@ import time
 from typing import Any
 
 IDLE_S = 0.002  # [s] poll period when the ring is empty
-BATCH = 256  # records taken from the ring at a time
+BATCH = 32  # records taken from the ring between looks at the pipe (sensor readings)
 
 
 def main(argv: list[str]) -> None:
