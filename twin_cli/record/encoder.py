@@ -12,9 +12,11 @@ closed. A parent that dies closes the pipe: the file is finished with what was w
 
 from __future__ import annotations
 
+import os
 import time
 from typing import Any
 
+NICE = 10  # added niceness of the encoder process
 IDLE_S = 0.002  # [s] poll period when the ring is empty
 BATCH = 32  # records taken from the ring between looks at the pipe (sensor readings)
 
@@ -26,6 +28,9 @@ def main(argv: list[str]) -> None:
     from twin_cli.record import ring
 
     ring_fd, pipe_fd, path = int(argv[0]), int(argv[1]), argv[2]
+    # Below the loop's priority: on a busy machine the loop keeps its CPU and the encoder works
+    # in the gaps; the ring holds the backlog (the loop waits, measured, only when it is full).
+    os.nice(NICE)
     encode_main(ring.attach(ring_fd), Connection(pipe_fd), path)
 
 
