@@ -10,7 +10,7 @@ import pytest
 from record_helpers import compose_links, pose_error, read_bag, seconds
 
 from twin_cli.errors import EntityNotFoundError, InvalidRequestError, RequestError
-from twin_cli.record import BagSink, Recording
+from twin_cli.record import BagRecording, BagSink, Recording
 from twin_cli.world import Pose, World
 
 HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
@@ -28,7 +28,7 @@ def falling(tmp_path_factory) -> tuple[Path, dict[float, dict], dict[float, list
     world = World()
     world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
     path = tmp_path_factory.mktemp("rec") / "fall.mcap"
-    recording = Recording(world, [BagSink(path)], rate=RATE).start()
+    recording = BagRecording(world, path, rate=RATE).start()  # encoded in another process
     links, joints = {0.0: world.link_poses("h")}, {0.0: world.joint_states("h")}
     for _ in range(SAMPLES):
         world.step(STEPS_PER_SAMPLE)
@@ -165,3 +165,30 @@ def test_observers_fire_on_the_rate_grid_across_batch_sizes():
         expected = [round(0.01 * k, 12) for k in range(1, len(seen) + 1)]
         assert seen == pytest.approx(expected, abs=1e-12), f"batch {batch}"
         assert len(seen) == (1000 // batch) * batch // 10
+
+
+def test_a_full_ring_makes_the_loop_wait_and_says_so_and_a_spawn_changes_the_layout(tmp_path):
+    """A ring of ~12 samples: the loop outruns the encoder, waits, loses nothing, and the wait is
+    in the status and in the bag's rosbag2 metadata; a spawn mid-recording adds its topics."""
+    import yaml
+    from mcap.reader import make_reader
+
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    path = tmp_path / "small.mcap"
+    recording = BagRecording(world, path, rate=RATE, ring_bytes=8 * 1000).start()
+    world.step(1000)  # 100 samples in one batch, far faster than they are encoded
+    world.spawn(HUMANOID, name="h2", pose=Pose(x=2.0, z=1.0))
+    world.step(1000)
+    status = recording.stop()
+    assert status.error is None and status.samples == 201, status
+    assert status.waits > 0 and status.blocked_s > 0.0, "the full ring was waited for"
+    bag = read_bag(path)
+    clock = np.array([seconds(m.clock) for _, m in bag["/clock"]])
+    assert np.allclose(np.diff(clock), 1.0 / RATE, atol=1e-9), "no sample lost"
+    assert len(bag["/h2/joint_states"]) == 100, "the spawned entity from its first sample on"
+    assert len(bag["/h2/robot_description"]) == 1
+    with path.open("rb") as stream:
+        (meta,) = [m for m in make_reader(stream).iter_metadata() if m.name == "rosbag2"]
+    custom = yaml.safe_load(meta.metadata["serialized_metadata"])["custom_data"]
+    assert int(custom["waits"]) == status.waits and float(custom["blocked_s"]) > 0.0

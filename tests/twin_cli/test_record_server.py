@@ -78,7 +78,12 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
     with serve_world(tmp_path, "reckill") as (client, proc):
         client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
         client.request("POST", "/record", body={"path": str(out), "rate": 100})
-        time.sleep(3.0)  # > FLUSH_PERIOD_S: at least one chunk reached the OS
+        deadline = time.monotonic() + 60.0  # the encoder starts in ~1 s, more under load
+        while time.monotonic() < deadline and (not out.exists() or out.stat().st_size < 50_000):
+            time.sleep(0.2)
+        time.sleep(1.5)  # > FLUSH_PERIOD_S: more chunks reach the OS
+        for child in _children(proc.pid):  # the encoder process first, as a kill -9 of all
+            os.kill(child, signal.SIGKILL)
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait()
     schemas, channels, stamps = {}, {}, []
@@ -100,6 +105,14 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
             pass  # the cut: the chunk being written when the process died
     assert len(stamps) >= 50, f"{len(stamps)} /clock messages survived"
     assert np.all(np.diff(stamps) == 10_000_000), "consecutive 100 Hz samples up to the cut"
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids of `pid`'s children (Linux /proc)."""
+    out = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        out += [int(c) for c in (task / "children").read_text().split()]
+    return out
 
 
 def _foxglove_session(port: int, client, steps: int) -> dict:
@@ -167,11 +180,89 @@ def test_foxglove_clients_receive_the_worlds_state_and_new_entities(tmp_path, se
         client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
         session = _foxglove_session(port, client, steps=300)
     got, joints = session["got"], session["joints"]
-    stamp, message = got["/h/joint_states"][-1]
-    assert stamp == 300_000_000, "stamped with sim time (paused world stepped 300 × 1 ms)"
+    # The last message before the spawn (later ones may arrive while the spawn's channels do).
+    at_300 = [m for stamp, m in got["/h/joint_states"] if stamp == 300_000_000]
+    assert at_300, "stamped with sim time (paused world stepped 300 × 1 ms)"
+    message = at_300[-1]
     assert list(message.name) == [j["name"] for j in joints]
     assert np.array_equal(message.position, [j["position"] for j in joints]), "positions"
     assert np.array_equal(message.velocity, [j["velocity"] for j in joints]), "velocities"
     _, tf = got["/tf"][-1]
     assert ("world", "h/torso") in {(t.header.frame_id, t.child_frame_id) for t in tf.transforms}
     assert {"/h2/joint_states", "/h2/robot_description", "/h2/odom"} <= set(session["channels"])
+
+
+def _paused_session(port: int) -> dict:
+    """Subscribe to /clock and /h/joint_states of a paused world that is never stepped."""
+    import websockets
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+
+    async def run() -> dict:
+        async with websockets.connect(
+            f"ws://127.0.0.1:{port}", subprotocols=FOXGLOVE_SUBPROTOCOLS
+        ) as ws:
+            channels: dict[str, dict] = {}
+            got: dict[str, list] = {}
+            subscribed: dict[int, str] = {}
+            wanted = ("/clock", "/h/joint_states", "/tf_static")
+            deadline = time.monotonic() + 20.0
+            while not all(got.get(t) for t in wanted):
+                frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                if isinstance(frame, str):
+                    op = json.loads(frame)
+                    if op["op"] == "advertise":
+                        channels.update({c["topic"]: c for c in op["channels"]})
+                        if set(wanted) <= set(channels) and not subscribed:
+                            subs = []
+                            for k, topic in enumerate(wanted, start=1):
+                                subscribed[k] = topic
+                                subs.append({"id": k, "channelId": channels[topic]["id"]})
+                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                elif frame[0] == MESSAGE_DATA:
+                    sub, stamp = struct.unpack_from("<IQ", frame, 1)
+                    topic = subscribed[sub]
+                    message = store.deserialize_cdr(frame[13:], channels[topic]["schemaName"])
+                    got.setdefault(topic, []).append((stamp, message))
+            return got
+
+    return asyncio.run(run())
+
+
+def test_a_paused_world_still_shows_its_state_to_a_new_foxglove_client(tmp_path, serve_world):
+    port = free_port()
+    with serve_world(tmp_path, "foxpause", "--paused", "--foxglove", str(port)) as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        got = _paused_session(port)  # the world never steps
+        joints = client.joints("h")
+    stamp, clock = got["/clock"][-1]
+    assert stamp == 0 and seconds(clock.clock) == 0.0, "sim time of the paused world"
+    _, message = got["/h/joint_states"][-1]
+    assert np.array_equal(message.position, [j["position"] for j in joints]), "its state"
+    assert got["/tf_static"], "latched topics are sent to the new subscriber"
+
+
+def test_twin_load_moves_a_recording_or_says_it_stopped(tmp_path, serve_world):
+    out = tmp_path / "moved.mcap"
+    with serve_world(tmp_path, "recload", "--paused") as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        client.step(200)
+        client.save(tmp_path / "with_h.json")  # t = 0.2 s
+        client.delete("h")
+        client.spawn(str(HUMANOID), name="g", pose={"z": 1.0})
+        client.save(tmp_path / "without_h.json")
+        client.load(tmp_path / "with_h.json")
+        client.request("POST", "/record", body={"path": str(out), "entities": ["h"]})
+        client.step(100)  # 0.2 → 0.3 s
+        moved = twin("load", str(tmp_path / "with_h.json"), world="recload")
+        client.step(50)  # 0.2 → 0.25 s in the loaded world
+        stopped = twin("load", str(tmp_path / "without_h.json"), world="recload")
+        status = client.request("GET", "/record")
+    assert moved.returncode == 0 and "recording moved" in moved.stderr, moved.stderr
+    assert "recording stopped: Entity [h] does not exist" in stopped.stderr, stopped.stderr
+    assert status["active"] is False and status["error"] is None, status
+    clock = [round(seconds(m.clock), 9) for _, m in read_bag(out)["/clock"]]
+    first = [round(0.2 + 0.01 * k, 9) for k in range(11)]
+    # rosbags yields messages in log-time order: the loaded world's clock restarted at 0.2 s.
+    assert clock == sorted(first + [round(0.2 + 0.01 * k, 9) for k in range(6)]), clock

@@ -415,9 +415,11 @@ def load(*, file: Path | None, world: str, last: bool = False) -> None:
         sys.stderr.write(f"{line}\n")
 
     with _connect(world, start=True, serve_args=(path,), announce=announce) as c:
-        if not any("started world" in line for line in started):
-            c.load(path)
+        reply = None if any("started world" in line for line in started) else c.load(path)
     sys.stderr.write(f"twin: world [{world}] loaded from {path}\n")
+    for consumer in ("recording", "foxglove"):  # a running recording follows, or says it stopped
+        if isinstance(reply, dict) and consumer in reply:
+            sys.stderr.write(f"twin: {consumer} {reply[consumer]}\n")
 
 
 def _last_autosave(world: str) -> Path:

@@ -5,14 +5,25 @@ A consumer of the world (design.md §7): it observes the stepping loop at its ow
 world never imports this package. Modules: `layout` (frames and joints per entity), `sampler`
 (the copy, the kinematics), `topics` (the ROS topics and messages), `messages` (types and CDR,
 rosbags), `mcap_writer` (rosbag2 MCAP files), `foxglove` (the live server), `recorder` (the
-worker that ties them).
+worker thread that ties them, for live sinks), `ring`, `encoder`, `bag_recording` (a bag
+recording whose encoding runs in another process, fed through shared memory).
 """
 
 from __future__ import annotations
 
+from twin_cli.record.bag_recording import BagRecording
 from twin_cli.record.foxglove import LiveStream
 from twin_cli.record.mcap_writer import BagWriter
 from twin_cli.record.recorder import BagSink, Recording, RecordingStatus
 from twin_cli.record.topics import Message, Topic
 
-__all__ = ["BagSink", "BagWriter", "LiveStream", "Message", "Recording", "RecordingStatus", "Topic"]
+__all__ = [
+    "BagRecording",
+    "BagSink",
+    "BagWriter",
+    "LiveStream",
+    "Message",
+    "Recording",
+    "RecordingStatus",
+    "Topic",
+]

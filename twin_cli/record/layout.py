@@ -38,6 +38,7 @@ class EntityLayout:
         joint_ids: their joint ids.
         free_qpos, free_dof: the root free joint's qpos and dof addresses, or -1 (fixed base).
         description: URDF text for `/<entity>/robot_description`, or None.
+        ball_joints: positions in `joint_ids` of ball joints (JointState: angle and speed).
     """
 
     name: str
@@ -51,6 +52,7 @@ class EntityLayout:
     free_qpos: int
     free_dof: int
     description: str | None
+    ball_joints: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -102,6 +104,7 @@ def entity_layout(
         free_qpos=ix.free_qpos,
         free_dof=int(model.jnt_dofadr[free[0]]) if free else -1,
         description=description,
+        ball_joints=tuple(k for k, j in enumerate(joints) if is_ball(model, j)),
     )
 
 

@@ -86,6 +86,7 @@ class BagWriter:
         self._counts: dict[str, int] = {}
         self._span = [2**63 - 1, 0]  # first and last log time [ns]
         self._flushed = time.monotonic()
+        self.custom_data: dict[str, str] = {}  # rosbag2 metadata's custom_data (figures)
 
     def add_topic(self, topic: Topic) -> None:
         """Registers a topic (its schema first) unless known."""
@@ -174,7 +175,7 @@ class BagWriter:
                     "message_count": self.message_count,
                 }
             ],
-            "custom_data": {},
+            "custom_data": dict(self.custom_data),
             "ros_distro": ros.DISTRO,
         }
         return yaml.safe_dump(info, sort_keys=False)

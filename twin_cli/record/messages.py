@@ -39,7 +39,11 @@ def typestore() -> Any:
     """rosbags' typestore of the ROS 2 distribution twin writes for (built once, ~0.1 s)."""
     from rosbags.typesys import Stores, get_typestore
 
-    return get_typestore(Stores.ROS2_JAZZY)
+    from twin_cli.record.sensor_messages import register_contact_types
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    register_contact_types(store)  # gazebo_msgs, for contact sensors
+    return store
 
 
 @cache

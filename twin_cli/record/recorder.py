@@ -16,11 +16,15 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
 from twin_cli.record.sampler import Kinematics, Sample, Sampler
+from twin_cli.record.sensor_feed import SensorFeed
+from twin_cli.record.sensor_messages import sensor_message
 from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
 
 log = logging.getLogger("twin.record")
+HEARTBEAT_S = 0.5  # [s] wall: how often a live view republishes a world that is not stepping
 MAX_RATE = 1000.0  # [Hz] of sim time; above the world's step rate a sample is taken every step
 
 
@@ -41,6 +45,8 @@ class RecordingStatus:
     Attributes:
         active: still sampling; samples: samples written; start, end: their sim times [s].
         error: why the worker stopped early, or None.
+        blocked_s: wall time [s] the stepping thread waited for the encoder (its ring was
+            full); waits: how many times. No sample is ever dropped from a bag.
     """
 
     active: bool
@@ -48,6 +54,8 @@ class RecordingStatus:
     start: float | None
     end: float | None
     error: str | None
+    blocked_s: float = 0.0
+    waits: int = 0
 
 
 def check_rate(rate: float) -> float:
@@ -63,7 +71,7 @@ def check_rate(rate: float) -> float:
     return rate
 
 
-class Recording:
+class Recording(Follows):
     """Samples `world` at `rate` [Hz] of sim time into `sinks` until `stop` (or `duration`)."""
 
     def __init__(
@@ -95,10 +103,11 @@ class Recording:
             raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
         self._world = world
         self._sampler = Sampler(world, entities, descriptions)
+        self._entities, self._descriptions = tuple(entities), descriptions
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
-        self._queue: queue.SimpleQueue[Sample | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Sample | list | None] = queue.SimpleQueue()
         self._handle: int | None = None
         self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
         self._busy, self._newest = False, None
@@ -107,6 +116,9 @@ class Recording:
         self._samples, self._span = 0, [None, None]
         self._error: str | None = None
         self._worker = threading.Thread(target=self._work, name="twin-record", daemon=True)
+        self._feed = SensorFeed(world, entities)
+        self._sensor_topics: dict[str, Topic] = {}  # worker thread: sensor topics seen so far
+        self._layout_topics: list[Topic] = []
 
     # ------------------------------------------------------------ control (any thread)
     def start(self) -> Recording:
@@ -118,6 +130,7 @@ class Recording:
             self._capture()
             if not self._done.is_set() and hasattr(self._world, "add_observer"):
                 self._handle = self._world.add_observer(self._capture, self.rate)
+        self._follow_sensors(self._world)
         return self
 
     def capture_now(self) -> None:
@@ -155,19 +168,30 @@ class Recording:
         if self._until is not None and sample.time >= self._until - 1e-9:
             self._finish_sampling()
 
+    def _capture_sensors(self) -> None:
+        if self._done.is_set():
+            return
+        readings = self._feed.fresh()
+        if readings and not (self._latest_only and self._busy):  # a busy live view skips them
+            self._queue.put(readings)
+
     def _finish_sampling(self) -> None:
         if self._done.is_set():
             return
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
+        self._stop_sensors()
         self._queue.put(None)
 
     # ------------------------------------------------------------ worker thread
     def _work(self) -> None:
         kinematics, layout = Kinematics(), None
         try:
-            while (sample := self._queue.get()) is not None:
+            while (sample := self._next()) is not None:
+                if isinstance(sample, list):
+                    self._publish_readings(sample)
+                    continue
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)
                     sample = self._next_newest()
@@ -179,16 +203,37 @@ class Recording:
             self._close_sinks()
 
     def _publish(self, sample: Sample, layout: Layout | None, kinematics: Kinematics) -> Layout:
-        if not sample.finite():
-            return layout
+        sink = _Fanout(self._sinks)
         if sample.layout is not layout:
-            layout = sample.layout
-            self._relayout(layout, sample.time)
-        xpos, xquat = kinematics.poses(sample)
-        for message in live_messages(sample, xpos, xquat):
-            self._emit(message)
-        self._count(sample.time)
+            self._layout_topics = topics(sample.layout)
+        extra = list(self._sensor_topics.values())
+        new = sample.layout is not layout
+        if publish_sample(sample, kinematics, sink, new_layout=new, extra_topics=extra):
+            self._count(sample.time)
+            return sample.layout
         return layout
+
+    def _publish_readings(self, readings: list) -> None:
+        """Sensor messages; a new sensor topic is announced with all the others (a live sink
+        closes channels that a topic list leaves out)."""
+        sink = _Fanout(self._sinks)
+        if any(t.name not in self._sensor_topics for t, _ in readings):
+            self._sensor_topics.update({t.name: t for t, _ in readings})
+            sink.set_topics(self._layout_topics + list(self._sensor_topics.values()))
+        for topic, reading in readings:
+            sink.write(sensor_message(topic, reading))
+
+    def _next(self) -> Sample | None:
+        """The next queued sample; a live view of a world that does not step (paused) gets the
+        current state again every HEARTBEAT_S, so a viewer that connects sees the robot."""
+        if not self._latest_only:
+            return self._queue.get()
+        while True:
+            try:
+                return self._queue.get(timeout=HEARTBEAT_S)
+            except queue.Empty:
+                with self._world.lock:
+                    self._capture()
 
     def _next_newest(self) -> Sample | None:
         """latest_only: the newest sample kept while busy, or None (and the worker is idle)."""
@@ -198,17 +243,6 @@ class Recording:
             sample, self._newest = self._newest, None
             self._busy = sample is not None
         return sample
-
-    def _relayout(self, layout: Layout, time: float) -> None:
-        names = topics(layout)
-        for sink in self._sinks:
-            sink.set_topics(names)
-        for message in latched_messages(layout, time):
-            self._emit(message)
-
-    def _emit(self, message: Message) -> None:
-        for sink in self._sinks:
-            sink.write(message)
 
     def _count(self, time: float) -> None:
         self._samples += 1
@@ -223,6 +257,43 @@ class Recording:
             except Exception as exc:
                 log.exception("closing %s failed", sink)
                 self._error = self._error or f"{type(exc).__name__}: {exc}"
+
+
+class _Fanout:
+    """Several sinks as one."""
+
+    def __init__(self, sinks: Sequence[Sink]) -> None:
+        self._sinks = sinks
+
+    def set_topics(self, topics: list[Topic]) -> None:
+        for sink in self._sinks:
+            sink.set_topics(topics)
+
+    def write(self, message: Message) -> None:
+        for sink in self._sinks:
+            sink.write(message)
+
+
+def publish_sample(
+    sample: Sample,
+    kinematics: Kinematics,
+    sink: Any,
+    *,
+    new_layout: bool,
+    extra_topics: Sequence[Topic] = (),
+) -> bool:
+    """Hands one sample's messages to `sink` (its topics and latched messages first when the
+    layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
+    if not sample.finite():
+        return False
+    if new_layout:
+        sink.set_topics(topics(sample.layout) + list(extra_topics))
+        for message in latched_messages(sample.layout, sample.time):
+            sink.write(message)
+    xpos, xquat = kinematics.poses(sample)
+    for message in live_messages(sample, xpos, xquat):
+        sink.write(message)
+    return True
 
 
 class BagSink:

@@ -88,12 +88,15 @@ class Sampler:
             d.mocap_quat.copy(),
         )
 
-    def _relayout(self) -> None:
-        view = world_view(self._world)
+    def selection(self, view: Any) -> tuple[dict, dict]:
+        """The observed entities' index (name → EntityIndex) and URDF texts in `view`."""
         names = self._names or tuple(view.index)
         index = {n: view.index[n] for n in names if n in view.index}
-        descriptions = {**view.descriptions, **self._descriptions}
-        self._layout = make_layout(view.model, index, descriptions)
+        return index, {**view.descriptions, **self._descriptions}
+
+    def _relayout(self) -> None:
+        view = world_view(self._world)
+        self._layout = make_layout(view.model, *self.selection(view))
         self._model = view.model
 
 

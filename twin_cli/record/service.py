@@ -11,9 +11,10 @@ from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
-from twin_cli.errors import InvalidRequestError
+from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.record.bag_recording import BagRecording
 from twin_cli.record.foxglove import LiveStream
-from twin_cli.record.recorder import BagSink, Recording
+from twin_cli.record.recorder import Recording
 
 
 class Consumers:
@@ -21,7 +22,7 @@ class Consumers:
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self.recording: Recording | None = None
+        self.recording: BagRecording | None = None
         self.recording_path: str | None = None
         self.live: tuple[Recording, LiveStream] | None = None
 
@@ -49,14 +50,7 @@ class Consumers:
                 )
             if self.recording is not None:
                 self.recording.stop()
-            sink = BagSink(path)
-            try:
-                recording = Recording(
-                    world, [sink], rate=rate, entities=entities, duration=duration
-                )
-            except BaseException:
-                sink.close()
-                raise
+            recording = BagRecording(world, path, rate=rate, entities=entities, duration=duration)
             self.recording, self.recording_path = recording.start(), path
             return self.record_status()
 
@@ -104,6 +98,26 @@ class Consumers:
             recording.stop()
             self.live = None
             return {"stopped": live.port}
+
+    def follow(self, world: Any) -> dict:
+        """Moves the recording and the live stream to `world` (the server loaded a new one).
+
+        Returns what happened to each, for the `/load` reply: "moved", or "stopped: <why>"
+        (a recorded entity is not in the new world; the file is closed and complete).
+        """
+        out = {}
+        with self._lock:
+            if self.recording is not None and self.recording.status().active:
+                try:
+                    self.recording.retarget(world)
+                    out["recording"] = "moved"
+                except TwinError as exc:
+                    self.recording.stop()
+                    out["recording"] = f"stopped: {exc}"
+            if self.live is not None:
+                self.live[0].retarget(world)
+                out["foxglove"] = "moved"
+        return out
 
     def close(self) -> None:
         """Stops both (server shutdown): the recording's file gets its summary."""

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from twin_cli.record import messages as ros
-from twin_cli.record.layout import WORLD_FRAME, EntityLayout, Layout, is_ball
+from twin_cli.record.layout import WORLD_FRAME, EntityLayout, Layout
 from twin_cli.record.sampler import Sample
 
 
@@ -131,11 +131,10 @@ def _joint_states(sample: Sample, e: EntityLayout) -> Message:
     qa, da = model.jnt_qposadr[e.joint_ids], model.jnt_dofadr[e.joint_ids]
     position, velocity = sample.qpos[qa].copy(), sample.qvel[da].copy()
     effort = sample.qfrc_actuator[da].copy()
-    for k, j in enumerate(e.joint_ids):
-        if is_ball(model, j):  # as World.joint_states: rotation angle and angular speed
-            position[k] = 2.0 * np.arccos(min(1.0, abs(float(sample.qpos[qa[k]]))))
-            velocity[k] = np.linalg.norm(sample.qvel[da[k] : da[k] + 3])
-            effort[k] = 0.0
+    for k in e.ball_joints:  # as World.joint_states: rotation angle and angular speed
+        position[k] = 2.0 * np.arccos(min(1.0, abs(float(sample.qpos[qa[k]]))))
+        velocity[k] = np.linalg.norm(sample.qvel[da[k] : da[k] + 3])
+        effort[k] = 0.0
     message = T[ros.JOINT_STATE](
         header=_header(sample.time, ""),
         name=list(e.joint_names),
@@ -211,5 +210,12 @@ def _quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Row-wise rotation of (n×3) vectors by (n×4) unit quaternions w,x,y,z."""
     w, u = q[:, :1], q[:, 1:]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    t = 2.0 * _cross(u, v)
+    return v + w * t + _cross(u, t)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (n×3) arrays (np.cross costs ~10 µs of checks per call)."""
+    ax, ay, az = a[:, 0], a[:, 1], a[:, 2]
+    bx, by, bz = b[:, 0], b[:, 1], b[:, 2]
+    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=1)

@@ -248,7 +248,9 @@ def load(body: PathBody, request: Request) -> dict:
     new_world = load_world(body.path, name=request.app.state.world_name)
     request.app.state.holder.replace(new_world)
     log.info("loaded world from %s", body.path)
-    return {"loaded": body.path, "entities": [e.name for e in new_world.entities()]}
+    consumers = getattr(request.app.state, "consumers", None)  # recording, Foxglove stream
+    followed = consumers.follow(new_world) if consumers is not None else {}
+    return {"loaded": body.path, "entities": [e.name for e in new_world.entities()], **followed}
 
 
 @router.post("/shutdown")

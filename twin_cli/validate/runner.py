@@ -167,12 +167,16 @@ def _validate_scenario(sc: Scenario) -> None:
 
 def run_check(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> CheckResult:
     """Run one scenario's check; an unexpected error becomes a failed result naming it."""
+    from twin_cli.validate.recording import finish
+
     check = CHECKS[sc.check]
     thresholds = {**check.defaults, **sc.thresholds}
     start = time.perf_counter()
     try:
         outcome = check.run(robot, sc, thresholds)
+        finish()
     except Exception as exc:  # noqa: BLE001 - one broken check must not hide the others
+        finish()
         if debug:
             raise
         outcome = result(
@@ -206,6 +210,7 @@ def validate(
     joints: dict[str, float] | None = None,
     debug: bool = False,
     as_written: bool = False,
+    record: Path | None = None,
 ) -> ValidationRun:
     """Validate one robot: convert it, run the planned checks, return every result.
 
@@ -221,7 +226,10 @@ def validate(
             `[robot] joints`; what a scenario's `[hold]` holds.
         debug: re-raise errors inside checks instead of reporting them as failures.
         as_written: apply what a URDF says where Gazebo's parser drops it.
+        record: a folder for one rosbag2 MCAP file per physics scenario run (None: none).
     """
+    from twin_cli.validate.recording import recording_into
+
     start = time.perf_counter()
     todo = [with_joints(sc, joints or {}) for sc in plan(scenarios, only, skip)]
     robot = load_robot(
@@ -233,7 +241,8 @@ def validate(
         as_written=as_written,
     )
     check_start_postures(robot, todo, joints or {})
-    results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
+    with recording_into(record):
+        results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
     return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)
 
 

@@ -39,6 +39,10 @@ RepairOpt = Annotated[
     ),
 ]
 
+RecordOpt = Annotated[
+    Path | None,
+    typer.Option("--record", help="Keep one rosbag2 MCAP file per physics scenario in DIR."),
+]
 CollisionOpt = Annotated[
     str | None,
     typer.Option(
@@ -73,6 +77,7 @@ def validate(
     sweep: SweepOpt = None,
     jobs: JobsOpt = None,
     ray: RayOpt = None,
+    record: RecordOpt = None,
 ) -> None:
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input.
 
@@ -115,6 +120,7 @@ def validate(
         collision=collision,
         joints=joint_positions(joint),
         as_written=as_written,
+        record=record,
     )
     out = Output(json)
     if json:
@@ -128,6 +134,11 @@ def validate(
     if plots:
         for path in render.write_plots(run, plots):
             out.line(f"plot: {path}")
+    if record and not json:
+        from twin_cli.validate.recording import written
+
+        for path in written:
+            out.line(f"recording: {path}")
     raise typer.Exit(0 if run.passed else 1)
 
 

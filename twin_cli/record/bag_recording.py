@@ -1,0 +1,210 @@
+"""A rosbag2 MCAP recording whose encoding runs in another process (see `ring`, `encoder`).
+
+The stepping thread's share per sample is one copy of qpos, qvel, qfrc_actuator and the mocap
+poses into shared memory (a few µs); the encoder process builds and writes the messages. The
+interface is `Recording`'s: `start`, `stop`, `wait`, `status`, `capture_now`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from twin_cli.errors import InvalidRequestError
+from twin_cli.record import ring
+from twin_cli.record.follow import Follows
+from twin_cli.record.mcap_writer import open_output
+from twin_cli.record.recorder import RecordingStatus, check_rate
+from twin_cli.record.sampler import Sampler
+from twin_cli.record.sensor_feed import SensorFeed
+from twin_cli.world.observers import world_view
+
+RING_BYTES = 32 << 20  # [B] ~40 s of a humanoid at 1,000 samples per wall second
+START_TIMEOUT_S = 60.0  # [s] for the encoder's answer when stopping (imports on a loaded host)
+
+
+class BagRecording(Follows):
+    """Samples `world` at `rate` [Hz] of sim time into the MCAP file `path` until stopped."""
+
+    def __init__(
+        self,
+        world: Any,
+        path: str | Path,
+        *,
+        rate: float = 100.0,
+        entities: Sequence[str] = (),
+        descriptions: dict[str, str] | None = None,
+        duration: float | None = None,
+        overwrite: bool = False,
+        ring_bytes: int = RING_BYTES,
+    ) -> None:
+        """Args: as `Recording`, with the output file instead of sinks; `ring_bytes` [B] is the
+        shared buffer between the loop and the encoder (when full, the loop waits for it).
+
+        Raises:
+            RequestError: the file exists or cannot be written.
+            EntityNotFoundError, InvalidRequestError: unknown entity, bad rate or duration.
+        """
+        self.rate = check_rate(rate)
+        if duration is not None and not (math.isfinite(duration) and duration > 0):
+            raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
+        self._sampler = Sampler(world, entities, descriptions)  # checks the names
+        self._entities, self._descriptions = tuple(entities), descriptions
+        open_output(path, overwrite=overwrite).close()  # the errors, here and now
+        self.path = Path(path).expanduser()
+        self._world, self._duration = world, duration
+        fd, self._memory = ring.allocate(ring_bytes // 8)
+        data, self._header, self._span = ring.views(self._memory)
+        self._conn, self._child = _pipe()
+        self._ring_fd = fd
+        self._process: subprocess.Popen | None = None
+        self._writer = ring.RingWriter(data, self._header, self._alive)
+        self._model: Any = None
+        self._feed = SensorFeed(world, entities)
+        self._sensor_handle: int | None = None
+        self._epoch = -1
+        self._until: float | None = None
+        self._handle: int | None = None
+        self._done = threading.Event()
+        self._error: str | None = None
+        self._closed = False
+        self._started = False
+
+    # ------------------------------------------------------------ control (any thread)
+    def start(self) -> BagRecording:
+        """Starts the encoder, takes the first sample now and follows the world's stepping."""
+        fds = (self._ring_fd, self._child.fileno())
+        command = [sys.executable, "-m", "twin_cli.record.encoder", *map(str, fds), str(self.path)]
+        self._process = subprocess.Popen(command, pass_fds=fds, stdin=subprocess.DEVNULL)
+        os.close(self._ring_fd)
+        self._child.close()
+        with self._world.lock:
+            now = float(self._world.data.time)
+            self._until = None if self._duration is None else now + self._duration
+            self._capture()
+            if not self._done.is_set():
+                self._handle = self._world.add_observer(self._capture, self.rate)
+        self._follow_sensors(self._world)
+        return self
+
+    def capture_now(self) -> None:
+        """Takes one sample now (for callers that step the world themselves)."""
+        with self._world.lock:
+            self._capture()
+
+    def stop(self) -> RecordingStatus:
+        """Stops sampling, lets the encoder write what is queued and close the file."""
+        self._finish_sampling()
+        if not self._closed:
+            self._closed = True
+            figures = {"blocked_s": round(self._writer.blocked_s, 6), "waits": self._writer.waits}
+            try:
+                self._conn.send(("stop", figures))
+                while self._conn.poll(START_TIMEOUT_S + self._backlog_s()):
+                    kind, error = self._conn.recv()
+                    self._error = self._error or error
+                    if kind == "done":
+                        break
+            except (EOFError, OSError):
+                self._error = self._error or "the encoder process ended unexpectedly"
+            self._end_process()
+        return self.status()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Waits until the duration is over (or `stop`); True when sampling has ended."""
+        return self._done.wait(timeout)
+
+    def status(self) -> RecordingStatus:
+        samples = int(self._header[ring.SAMPLES])
+        start, end = (float(self._span[0]), float(self._span[1])) if samples else (None, None)
+        return RecordingStatus(
+            not self._done.is_set(),
+            samples,
+            start,
+            end,
+            self._error,
+            self._writer.blocked_s,
+            self._writer.waits,
+        )
+
+    # ------------------------------------------------------------ stepping thread (lock held)
+    def _capture(self) -> None:
+        if self._done.is_set():
+            return
+        world = self._world
+        if world.model is not self._model:
+            self._send_layout()
+        if not self._writer.put(self._epoch, world.data):
+            self._error = "the encoder process ended; the recording stopped"
+            self._finish_sampling()
+            return
+        if self._until is not None and float(world.data.time) >= self._until - 1e-9:
+            self._finish_sampling()
+
+    def _capture_sensors(self) -> None:
+        if self._done.is_set():
+            return
+        readings = self._feed.fresh()
+        if readings:
+            self._conn.send(("readings", readings))
+
+    def _send_layout(self) -> None:
+        view = world_view(self._world)
+        index, descriptions = self._sampler.selection(view)
+        self._epoch += 1
+        self._conn.send(("layout", self._epoch, view.model, index, descriptions))
+        self._model = view.model
+
+    def _finish_sampling(self) -> None:
+        if self._done.is_set():
+            return
+        self._done.set()
+        if self._handle is not None:
+            self._world.remove_observer(self._handle)
+        self._stop_sensors()
+
+    def ready(self, timeout: float = START_TIMEOUT_S) -> bool:
+        """Waits until the encoder has started (its imports take about a second; samples wait
+        in the ring meanwhile). For benchmarks, which time the steady state."""
+        if self._started:
+            return True
+        if not self._conn.poll(timeout):
+            return False
+        kind, error = self._conn.recv()
+        self._started = kind == "ready"
+        self._error = self._error or error
+        return self._started
+
+    def _alive(self) -> bool:
+        return self._process is not None and self._process.poll() is None
+
+    def _end_process(self) -> None:
+        self._conn.close()
+        if self._process is None:
+            return
+        try:
+            self._process.wait(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            self._process.kill()
+            self._process.wait()
+            self._error = self._error or "the encoder process did not finish"
+
+    def _backlog_s(self) -> float:
+        """A generous bound [s] on the time to encode what is still in the ring."""
+        backlog = int(self._header[ring.WRITE] - self._header[ring.READ])
+        return backlog / 100.0 * 1e-3 * 10  # ~100 doubles a sample, ≥ 100 samples/s
+
+
+def _pipe() -> tuple[Any, Any]:
+    """Both ends of a duplex message pipe (the child's end is inherited by descriptor)."""
+    from multiprocessing.connection import Connection
+
+    ours, theirs = socket.socketpair()
+    return Connection(ours.detach()), Connection(theirs.detach())

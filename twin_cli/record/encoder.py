@@ -1,0 +1,159 @@
+"""The encoder process of a bag recording: raw records from the ring → ROS messages → MCAP.
+
+Runs in its own interpreter (a fresh `python -m`, so the server's threads are not forked and
+no script is re-imported), so
+computing link poses (`mj_kinematics` on its own MjData), building messages and CDR-encoding
+them (rosbags) and writing chunks (mcap) never hold the stepping loop's GIL. The parent sends
+each layout (compiled model, entity index, URDF texts; MjModel pickles) over a pipe before the
+first record of that layout, tagged with an epoch that every record carries; then "stop" with
+its figures (time the writer waited for room), after which the ring is drained and the file
+closed. A parent that dies closes the pipe: the file is finished with what was written.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from typing import Any
+
+NICE = 10  # added niceness of the encoder process
+IDLE_S = 0.002  # [s] poll period when the ring is empty
+BATCH = 32  # records taken from the ring between looks at the pipe (sensor readings)
+
+
+def main(argv: list[str]) -> None:
+    """`python -m twin_cli.record.encoder RING_FD PIPE_FD OUT.mcap` (started by BagRecording)."""
+    from multiprocessing.connection import Connection
+
+    from twin_cli.record import ring
+
+    ring_fd, pipe_fd, path = int(argv[0]), int(argv[1]), argv[2]
+    # Below the loop's priority: on a busy machine the loop keeps its CPU and the encoder works
+    # in the gaps; the ring holds the backlog (the loop waits, measured, only when it is full).
+    os.nice(NICE)
+    encode_main(ring.attach(ring_fd), Connection(pipe_fd), path)
+
+
+def encode_main(memory: Any, conn: Any, path: str) -> None:
+    """Encodes until told to stop (or the parent is gone)."""
+    from twin_cli.record import ring
+    from twin_cli.record.recorder import BagSink
+
+    buf, head, times = ring.views(memory)
+    encoder = _Encoder(BagSink(path, overwrite=True), times)
+    conn.send(("ready", None))
+    error = None
+    try:
+        stop = None
+        while True:
+            stop = encoder.poll(conn)  # layouts, sensor readings, stop
+            records = ring.read_records(buf, head, BATCH)
+            for record in records:
+                encoder.encode(record, conn)
+            head[ring.SAMPLES] = encoder.samples
+            if records:
+                continue
+            if stop is not None and not conn_pending(conn):
+                break
+            time.sleep(IDLE_S)
+    except Exception as exc:  # disk full...: report it to the parent
+        error = f"{type(exc).__name__}: {exc}"
+    finally:
+        try:
+            encoder.close(stop if isinstance(stop, dict) else {})
+        except Exception as exc:
+            error = error or f"{type(exc).__name__}: {exc}"
+        head[ring.DONE] = 1
+        try:
+            conn.send(("done", error))
+        except OSError:
+            pass
+
+
+class _Encoder:
+    """Turns records into messages with the layouts the parent sent."""
+
+    def __init__(self, writer: Any, times: Any) -> None:
+        from twin_cli.record.sampler import Kinematics
+
+        self.writer = writer
+        self.times = times
+        self.samples = 0
+        self._layouts: dict[int, Any] = {}
+        self._epoch = -1
+        self._kinematics = Kinematics()
+        self._stop: dict | None = None
+
+    def poll(self, conn: Any) -> dict | None:
+        """Takes waiting control messages; the stop figures once the parent said stop."""
+        try:
+            while self._stop is None and conn.poll():
+                self._take(conn.recv())
+        except (EOFError, OSError):  # the parent is gone: finish the file
+            self._stop = self._stop or {"parent": "gone"}
+        return self._stop
+
+    def _take(self, message: tuple) -> None:
+        from twin_cli.record.layout import make_layout
+
+        if message[0] == "layout":
+            _, epoch, model, index, descriptions = message
+            self._layouts[epoch] = make_layout(model, index, descriptions)
+        elif message[0] == "readings":
+            from twin_cli.record.sensor_messages import sensor_message
+
+            for topic, reading in message[1]:
+                self.writer.set_topics([topic])
+                self.writer.write(sensor_message(topic, reading))
+        elif message[0] == "stop":
+            self._stop = message[1]
+
+    def encode(self, record: Any, conn: Any) -> None:
+        from twin_cli.record.recorder import publish_sample
+
+        epoch = int(record[1])
+        while epoch not in self._layouts:
+            self._take(conn.recv())
+        layout = self._layouts[epoch]
+        sample = _sample(record, layout)
+        new = epoch != self._epoch
+        self._epoch = epoch
+        if publish_sample(sample, self._kinematics, self.writer, new_layout=new):
+            if self.samples == 0:
+                self.times[0] = sample.time
+            self.times[1] = sample.time
+            self.samples += 1
+
+    def close(self, figures: dict) -> None:
+        self.writer.writer.custom_data = {k: str(v) for k, v in figures.items()}
+        self.writer.close()
+
+
+def conn_pending(conn: Any) -> bool:
+    """Whether the parent sent something not yet taken (False once the pipe is closed)."""
+    try:
+        return bool(conn.poll())
+    except (EOFError, OSError):
+        return False
+
+
+def _sample(record: Any, layout: Any) -> Any:
+    """The `Sample` a record holds (views into the record's copy)."""
+    from twin_cli.record.sampler import Sample
+
+    m = layout.model
+    sizes = (m.nq, m.nv, m.nv, 3 * m.nmocap, 4 * m.nmocap)
+    parts, at = [], 3
+    for n in sizes:
+        parts.append(record[at : at + n])
+        at += n
+    qpos, qvel, qfrc, mpos, mquat = parts
+    return Sample(
+        float(record[2]), layout, qpos, qvel, qfrc, mpos.reshape(-1, 3), mquat.reshape(-1, 4)
+    )
+
+
+if __name__ == "__main__":
+    import sys
+
+    main(sys.argv[1:])

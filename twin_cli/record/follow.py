@@ -1,0 +1,60 @@
+"""Moving a running recording or live stream to another world (`twin load` swaps the world).
+
+A mixin of `Recording` and `BagRecording`: both sample `self._world` through an observer and a
+`Sampler`. The samples of the new world go on in the same file or stream; the layout changes
+(a new model), so topics and latched messages are sent again. Sim time continues from the
+loaded world's clock, which may be earlier than the last sample's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from twin_cli.record.sampler import Sampler
+from twin_cli.record.sensor_feed import SensorFeed
+
+
+class Follows:
+    """`retarget`: observe another world from now on (mixin; see module docstring); and the
+    sensor observer both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
+
+    def retarget(self, world: Any) -> None:
+        """Samples `world` instead of the current one, starting with a sample now.
+
+        Raises:
+            EntityNotFoundError: a recorded entity is not in `world` (the recording is unchanged).
+        """
+        sampler = Sampler(world, self._entities, self._descriptions)
+        old = self._world
+        if self._handle is not None:
+            old.remove_observer(self._handle)
+            self._handle = None
+        with old.lock:
+            old_time = float(old.data.time)
+        self._world, self._sampler, self._model = world, sampler, None
+        if self._done.is_set():
+            return
+        with world.lock:
+            now = float(world.data.time)
+            if self._until is not None:
+                self._until = now + max(0.0, self._until - old_time)
+            self._capture()
+            if not self._done.is_set():
+                self._handle = world.add_observer(self._capture, self.rate)
+        self._feed = SensorFeed(world, self._entities)
+        self._follow_sensors(world)
+
+    def _follow_sensors(self, world: Any) -> None:
+        """Observes `world` at its fastest sensor's rate (no sensors: not at all)."""
+        self._stop_sensors()
+        rate = self._feed.rate()
+        if rate > 0 and not self._done.is_set():
+            with world.lock:
+                self._capture_sensors()
+                self._sensor_world = world
+                self._sensor_handle = world.add_observer(self._capture_sensors, rate)
+
+    def _stop_sensors(self) -> None:
+        if getattr(self, "_sensor_handle", None) is not None:
+            self._sensor_world.remove_observer(self._sensor_handle)
+            self._sensor_handle = None

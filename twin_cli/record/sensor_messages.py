@@ -1,0 +1,126 @@
+"""Sensor readings (`twin_cli.sensors`) as the ROS messages gazebo_ros sensor plugins publish.
+
+IMU → sensor_msgs/Imu, ray → sensor_msgs/LaserScan (one row: the first vertical row), force/torque
+→ geometry_msgs/WrenchStamped, contact/bumper → gazebo_msgs/ContactsState. rosbags ships no
+gazebo_msgs (Gazebo classic's package is not part of any ROS 2 distribution it carries), so the
+two contact types are registered in its typestore from their definitions below (the
+interface of gazebo_ros_bumper); the bag stores the definitions with the messages, so every
+reader decodes them. Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from twin_cli.record import messages as ros
+from twin_cli.record.topics import Message, Topic
+from twin_cli.sensors import ContactReading, ImuReading, Reading, ScanReading, WrenchReading
+
+IMU = "sensor_msgs/msg/Imu"
+SCAN = "sensor_msgs/msg/LaserScan"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+CONTACTS = "gazebo_msgs/msg/ContactsState"
+CONTACT_DEFINITIONS = {
+    "gazebo_msgs/msg/ContactState": """string info
+string collision1_name
+string collision2_name
+geometry_msgs/Wrench[] wrenches
+geometry_msgs/Wrench total_wrench
+geometry_msgs/Vector3[] contact_positions
+geometry_msgs/Vector3[] contact_normals
+float64[] depths
+""",
+    CONTACTS: """std_msgs/Header header
+gazebo_msgs/ContactState[] states
+""",
+}
+TYPES = {ImuReading: IMU, ScanReading: SCAN, WrenchReading: WRENCH, ContactReading: CONTACTS}
+_UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
+
+
+def register_contact_types(store: Any) -> None:
+    """Adds gazebo_msgs' ContactState and ContactsState to a rosbags typestore (idempotent)."""
+    if CONTACTS in store.types:
+        return
+    from rosbags.typesys import get_types_from_msg
+
+    types: dict = {}
+    for name, text in CONTACT_DEFINITIONS.items():
+        types.update(get_types_from_msg(text, name))
+    store.register(types)
+
+
+def sensor_topic(entity: str, name: str, topic: str, reading: Reading) -> Topic | None:
+    """The topic of one sensor's readings (None: a kind not published, e.g. camera images)."""
+    kind = TYPES.get(type(reading))
+    if kind is None:
+        return None
+    return Topic(f"/{entity}/{(topic or name).strip('/')}", kind)
+
+
+def sensor_message(topic: Topic, reading: Reading) -> Message:
+    """The ROS message of `reading` on `topic`, stamped with its sim time."""
+    T = ros.types()
+    header = T["std_msgs/msg/Header"](stamp=ros.stamp(reading.time), frame_id=reading.frame_id)
+    build = {IMU: _imu, SCAN: _scan, WRENCH: _wrench, CONTACTS: _contacts}[topic.type]
+    return Message(topic.name, topic.type, reading.time, build(T, header, reading))
+
+
+def _vector(T: Any, v: Any) -> Any:
+    return T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def _imu(T: Any, header: Any, r: ImuReading) -> Any:
+    x, y, z, w = (float(c) for c in r.orientation)
+    return T[IMU](
+        header=header,
+        orientation=T["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
+        orientation_covariance=_UNKNOWN_COVARIANCE,
+        angular_velocity=_vector(T, r.angular_velocity),
+        angular_velocity_covariance=_UNKNOWN_COVARIANCE,
+        linear_acceleration=_vector(T, r.linear_acceleration),
+        linear_acceleration_covariance=_UNKNOWN_COVARIANCE,
+    )
+
+
+def _scan(T: Any, header: Any, r: ScanReading) -> Any:
+    row = len(r.ranges) // max(1, r.vertical_count)
+    return T[SCAN](
+        header=header,
+        angle_min=r.angle_min,
+        angle_max=r.angle_max,
+        angle_increment=r.angle_increment,
+        time_increment=0.0,
+        scan_time=r.scan_time,
+        range_min=r.range_min,
+        range_max=r.range_max,
+        ranges=np.asarray(r.ranges[:row], dtype=np.float32),
+        intensities=np.zeros(0, dtype=np.float32),
+    )
+
+
+def _wrench(T: Any, header: Any, r: WrenchReading) -> Any:
+    wrench = T["geometry_msgs/msg/Wrench"](force=_vector(T, r.force), torque=_vector(T, r.torque))
+    return T[WRENCH](header=header, wrench=wrench)
+
+
+def _contacts(T: Any, header: Any, r: ContactReading) -> Any:
+    zero = (0.0, 0.0, 0.0)
+    states = []
+    for c in r.states:
+        wrench = T["geometry_msgs/msg/Wrench"](force=_vector(T, c.force), torque=_vector(T, zero))
+        states.append(
+            T["gazebo_msgs/msg/ContactState"](
+                info=f"{c.collision1} touches {c.collision2}",
+                collision1_name=c.collision1,
+                collision2_name=c.collision2,
+                wrenches=[wrench],
+                total_wrench=wrench,
+                contact_positions=[_vector(T, c.position)],
+                contact_normals=[_vector(T, c.normal)],
+                depths=np.array([c.depth]),
+            )
+        )
+    return T[CONTACTS](header=header, states=states)
