@@ -126,7 +126,7 @@ def _apply_effort(
         model.actuator_biastype[a] = _NONE
         data.ctrl[a] = u
         return
-    full = cmd.effort if math.isfinite(cmd.effort) else abs(cmd.target)
+    full = abs(cmd.target)  # the band is VELOCITY_BAND·v wide whatever the effort
     gain = max(full, 1e-9) / (VELOCITY_BAND * v) / gear
     model.actuator_biastype[a] = _AFFINE
     model.actuator_gainprm[a, 0] = gain
