@@ -154,3 +154,66 @@ def test_ur5e_reaches_half_a_radian_on_every_joint_within_2_s_and_holds_1_mrad(t
     over = {n: round(r, 4) for n, r in worst.items() if r > 1.0}
     assert not over, f"peak speed / velocity limit above 1: {over}"
     assert sum(w.number for w in world.data.warning) == 0, "MuJoCo warnings"
+
+
+TRAJECTORY = """joint_names: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint]
+points:
+  - {positions: [0.2, -0.2, 0.3], time_from_start: {sec: 0, nanosec: 500000000}}
+  - {positions: [0.4, -0.4, 0.6], velocities: [0.2, -0.2, 0.3], time_from_start: 1.0}
+  - {positions: [0.5, -0.5, 0.8], velocities: [0.0, 0.0, 0.0], time_from_start: 1.5}
+  - {positions: [0.3, -0.3, 0.5], time_from_start: 2.0}
+  - {positions: [0.0, 0.0, 0.0], time_from_start: 2.5}
+"""
+
+
+@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
+def test_ur5e_follows_a_five_point_trajectory_with_a_bounded_tracking_error(tmp_path):
+    from twin_cli.control import follow_trajectory, read_trajectory, sample, tracking_report
+
+    world = World()
+    world.spawn(ur5e_fixed(tmp_path), name="ur", pose=Pose(z=1.0))
+    trajectory = read_trajectory(TRAJECTORY, "five.yaml")
+    follow_trajectory(world, "ur", trajectory)
+    own_worst = 0.0  # the test's own measurement against the interpolated reference
+    for _ in range(260):  # 2.6 s
+        world.step(10)
+        t = float(world.data.time)
+        reference, _ = sample(trajectory, (0.0, 0.0, 0.0), t)
+        q = {s.name: s.position for s in world.joint_states("ur")}
+        errors = [abs(q[n] - r) for n, r in zip(trajectory.joint_names, reference, strict=True)]
+        own_worst = max(own_worst, *errors)
+    report = tracking_report(world, "ur")
+    assert report is not None and not report["active"], "the follower finished at 2.5 s"
+    assert set(report["final_error"]) == set(trajectory.joint_names)
+    assert max(report["max_error"].values()) < 0.02, f"max tracking error {report['max_error']}"
+    assert max(report["final_error"].values()) < 5e-3, f"final error {report['final_error']}"
+    world.step(400)  # then the last point is held
+    settled = {
+        s.name: abs(s.position) for s in world.joint_states("ur") if s.name in report["max_error"]
+    }
+    assert max(settled.values()) < 1e-3, f"|q - last point| 0.4 s after the end: {settled}"
+    assert own_worst < 0.03, f"worst error against the spline reference {own_worst:.4f} rad"
+    assert sum(w.number for w in world.data.warning) == 0, "MuJoCo warnings"
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("joint_names: [spin]\npoints:\n  - {positions: [0.1]}\n", "no time_from_start"),
+        (
+            "joint_names: [slide]\npoints:\n  - {positions: [0.1], time_from_start: 1}\n"
+            "  - {positions: [0.2], time_from_start: 1}\n",
+            "not after 1 s",
+        ),
+        ("joint_names: [elbow]\npoints:\n  - {positions: [0.1], time_from_start: 1}\n", "elbow"),
+        ("joint_names: [slide]\npoints:\n  - {positions: [0.29], time_from_start: 1}\n", "0.29"),
+        ("time_from_start,slide\n1,0.1\n,0.2\n", "no time_from_start"),
+    ],
+)
+def test_malformed_trajectory_is_refused_and_leaves_the_world_unchanged(rig, text, words):
+    from twin_cli.control import follow_trajectory, read_trajectory
+
+    name = "bad.csv" if text.startswith("time_from_start") else "bad.yaml"
+    with pytest.raises((InvalidRequestError, PartNotFoundError), match=re.escape(words)):
+        follow_trajectory(rig, "rig", read_trajectory(text, name))
+    assert rig._commands == {} and not rig._observers, "no command or controller was kept"
