@@ -167,3 +167,34 @@ def _check_command(joint: str, mode: str, value: float) -> None:
         raise InvalidRequestError(
             f"command value for joint [{joint}]", f"{value} is not finite", "give a finite number"
         )
+
+
+def joint_commands(world: object, name: str) -> dict[str, dict]:
+    """Each actuated joint's mode, target, gains and limits (`twin joints`); lock held by caller.
+
+    Joints without a command report mode "none" (zero effort), with the modes they offer.
+    """
+    model, ix = world.model, world._require(name)
+    out = {}
+    for a in ix.actuators:
+        key = element_names(model, model.name_actuatoradr[[a]])[0]
+        j = int(model.actuator_trnid[a][0])
+        joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
+        limits = joint_control.limits_of(model, name, joint)
+        cmd = world._commands.get(key)
+        out[joint] = {
+            "mode": cmd.mode if cmd else "none",
+            "target": cmd.target if cmd else None,
+            "modes": list(limits.modes),
+            "source": limits.source,
+            "kp": cmd.kp if cmd else None,
+            "kv": cmd.kv if cmd else None,
+            "rule": cmd.rule if cmd else "",
+            "velocity_limit": _finite(limits.velocity),
+            "effort_limit": _finite(cmd.effort if cmd else control.effort_limit(model, int(a))),
+        }
+    return out
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
