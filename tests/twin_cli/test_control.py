@@ -7,43 +7,11 @@ import re
 
 import pytest
 from corpus_registry import CORPUS, package_paths
+from models import CONTROL_RIG as WHEEL_URDF
 from models import write_urdf
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import Pose, World, WorldSettings
-
-
-def _inertial(mass: float, moment: float) -> str:
-    return (
-        f'<inertial><mass value="{mass}"/><inertia ixx="{moment}" iyy="{moment}" '
-        f'izz="{moment}" ixy="0" ixz="0" iyz="0"/></inertial>'
-    )
-
-
-# A fixed rig: a disc on a continuous joint (effort 2 N m, 3 rad/s, effort and velocity
-# interfaces) and a slider (range -0.2..0.3 m, 0.5 m/s, a position interface bounded -0.1..0.25).
-WHEEL_URDF = f"""<robot name="wheel">
-  <link name="world"/>
-  <link name="base">{_inertial(1, 1)}</link>
-  <link name="disc">{_inertial(1, 0.01)}</link>
-  <link name="slider">{_inertial(0.5, 0.001)}</link>
-  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
-  <joint name="spin" type="continuous"><parent link="base"/><child link="disc"/>
-    <axis xyz="0 0 1"/><limit effort="2" velocity="3"/></joint>
-  <joint name="slide" type="prismatic"><parent link="base"/><child link="slider"/>
-    <axis xyz="1 0 0"/><limit lower="-0.2" upper="0.3" effort="50" velocity="0.5"/></joint>
-  <ros2_control name="rig" type="system">
-    <joint name="spin">
-      <command_interface name="effort"/><command_interface name="velocity"/>
-    </joint>
-    <joint name="slide">
-      <command_interface name="position">
-        <param name="min">-0.1</param><param name="max">0.25</param>
-      </command_interface>
-    </joint>
-  </ros2_control>
-</robot>
-"""
 
 
 @pytest.fixture

@@ -18,6 +18,7 @@ from twin_cli.cli.options import JsonOpt, WorldOpt
 from twin_cli.cli.output import Output
 
 POLL_S = 0.1  # [s] wall time between trajectory status requests
+MODES = ("position", "velocity", "effort")
 
 
 def parse_targets(pairs: list[str]) -> dict[str, float]:
@@ -53,8 +54,11 @@ def command(
     json: JsonOpt = False,
 ) -> None:
     """Hold joint targets until changed (position, velocity or effort command interfaces)."""
+    from twin_cli.errors import InvalidRequestError
     from twin_cli.server.client import connect
 
+    if mode not in MODES:
+        raise InvalidRequestError(f"--mode [{mode}]", "unknown", f"use one of {', '.join(MODES)}")
     parsed = parse_targets(targets)
     with connect(world) as client:
         done = client.command_joints(entity, parsed, mode)
