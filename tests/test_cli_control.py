@@ -74,3 +74,15 @@ def test_trajectory_is_followed_and_bad_files_exit_2(rig):
     done = t("trajectory", "rig", str(bad), check=False)
     assert done.returncode == 2 and "not after 1 s" in done.stderr, done.stderr
     assert _joints(t) == before, "a refused trajectory leaves the world unchanged"
+
+
+def test_command_and_trajectory_import_no_physics(rig):
+    from test_lazy_imports import HEAVY, _imported
+
+    t, tmp_path = rig
+    path = tmp_path / "one.csv"
+    path.write_text("time_from_start,slide\n0.01,0.0\n")
+    for args in (["command", "rig", "slide=0.1"], ["trajectory", "rig", str(path), "--no-wait"]):
+        proc, modules = _imported(args, t.env)
+        assert proc.returncode == 0, f"twin {args}: {proc.stderr[-500:]}"
+        assert not modules & set(HEAVY), f"twin {args} imported {modules & set(HEAVY)}"
