@@ -66,6 +66,7 @@ class TrajectoryFollower:
             self.keys = [c.actuator for c in commands]
             self.qpos = [world.model.joint(f"{entity}/{j}").qposadr[0] for j in self.start_names]
             self.t0 = float(world.data.time)
+            self._model, self._ids, self._last = None, None, None
             self.handle = world.add_observer(self._update, rate)
 
     @property
@@ -74,10 +75,6 @@ class TrajectoryFollower:
 
     def _update(self) -> None:
         """One controller update (the world's lock is held): measure, then command."""
-        import mujoco
-
-        from twin_cli.world import actuation
-
         world = self.world
         t = float(world.data.time) - self.t0
         if t < -1e-9 or any(k not in world._commands for k in self.keys):
@@ -91,18 +88,45 @@ class TrajectoryFollower:
                 self.report.final_error[name] = error
         self.report.elapsed = t
         nxt, speed = sample(self.trajectory, self.start, t + 1.0 / UPDATE_RATE)
-        for key, p, v in zip(self.keys, nxt, speed, strict=True):
-            a = mujoco.mj_name2id(world.model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
-            cmd = replace(world._commands[key], target=p, feedforward=v)
-            actuation.apply_command(world.model, world.data, a, cmd)
-            world._commands[key] = cmd
+        self._write(nxt, speed)
         if t >= self.trajectory.duration - 1e-9:
             self.stop()
+
+    def _write(self, positions: tuple[float, ...], speeds: tuple[float, ...]) -> None:
+        """Moves each position servo's target and damping reference: ctrl and the bias constant.
+
+        Only those two numbers change (see actuation.apply_command), written as arrays; actuator
+        ids and gains are looked up again after a recompile. The world's command records get the
+        last reference when the follower stops.
+        """
+        import numpy as np
+
+        world = self.world
+        if self._model is not world.model:
+            self._model = world.model
+            self._ids = np.array([world.model.actuator(k).id for k in self.keys])
+            commands = [world._commands[k] for k in self.keys]
+            gear = np.abs(world.model.actuator_gear[self._ids, 0])
+            gear[gear == 0] = 1.0
+            self._kv = np.array([c.kv for c in commands]) / gear
+            self._hold = np.array([c.hold for c in commands]) / gear
+        world.data.ctrl[self._ids] = positions
+        world.model.actuator_biasprm[self._ids, 0] = self._kv * np.array(speeds) + self._hold
+        self._last = (positions, speeds)
+
+    def _record_last(self) -> None:
+        positions, speeds = self._last
+        for key, p, v in zip(self.keys, positions, speeds, strict=True):
+            if key in self.world._commands:
+                cmd = self.world._commands[key]
+                self.world._commands[key] = replace(cmd, target=p, feedforward=v)
 
     def stop(self) -> None:
         """Stops updating; the joints keep their last target."""
         self.report.active = False
         self.world.remove_observer(self.handle)
+        if self._last is not None:
+            self._record_last()
 
 
 def _check_points(world: Any, entity: str, trajectory: Trajectory) -> None:
