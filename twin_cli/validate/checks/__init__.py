@@ -18,6 +18,7 @@ from twin_cli.validate.checks import (
     physics_dynamics,
     physics_friction,
     physics_gravity,
+    physics_tracking,
 )
 from twin_cli.validate.checks.base import CheckResult, RobotUnderTest, Series, Status
 
@@ -111,6 +112,14 @@ CHECKS: dict[str, Check] = {
             max_spin_rad_s=100.0,
         ),
         _check("realtime", "physics", physics_dynamics.check_realtime, min_factor=0.8),
+        _check(
+            "tracking",
+            "physics",
+            physics_tracking.check_tracking,
+            max_settle_s=1.0,
+            max_sine_error_fraction=0.2,
+            max_speed_ratio=1.05,
+        ),
     )
 }
 
