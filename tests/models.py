@@ -227,3 +227,36 @@ def mjcf_stiff_spring(name: str = "spring") -> str:
   <body name="bob"><joint name="spring" type="hinge" axis="0 0 1" stiffness="1e9" springref="1"/>
     <geom type="sphere" size="0.01" mass="1e-4" contype="0" conaffinity="0"/></body>
 </body></worldbody></mujoco>"""
+
+
+def _control_inertial(mass: float, moment: float) -> str:
+    return (
+        f'<inertial><mass value="{mass}"/><inertia ixx="{moment}" iyy="{moment}" '
+        f'izz="{moment}" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+
+
+# A fixed rig: a disc on a continuous joint (effort 2 N m, 3 rad/s, effort and velocity
+# interfaces) and a slider (range -0.2..0.3 m, 0.5 m/s, a position interface bounded -0.1..0.25).
+CONTROL_RIG = f"""<robot name="wheel">
+  <link name="world"/>
+  <link name="base">{_control_inertial(1, 1)}</link>
+  <link name="disc">{_control_inertial(1, 0.01)}</link>
+  <link name="slider">{_control_inertial(0.5, 0.001)}</link>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <joint name="spin" type="continuous"><parent link="base"/><child link="disc"/>
+    <axis xyz="0 0 1"/><limit effort="2" velocity="3"/></joint>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="slider"/>
+    <axis xyz="1 0 0"/><limit lower="-0.2" upper="0.3" effort="50" velocity="0.5"/></joint>
+  <ros2_control name="rig" type="system">
+    <joint name="spin">
+      <command_interface name="effort"/><command_interface name="velocity"/>
+    </joint>
+    <joint name="slide">
+      <command_interface name="position">
+        <param name="min">-0.1</param><param name="max">0.25</param>
+      </command_interface>
+    </joint>
+  </ros2_control>
+</robot>
+"""

@@ -7,6 +7,14 @@ and placed models. Nothing here knows a file format.
 
 from __future__ import annotations
 
+from converters.description.control import (
+    CONTROL_PLUGINS,
+    HARDWARE_INTERFACES,
+    MODES,
+    CommandInterface,
+    JointControl,
+    PidGains,
+)
 from converters.description.gazebo import (
     Blob,
     GazeboExtensions,
@@ -36,6 +44,12 @@ from converters.description.robot import (
 from converters.description.world import Light, PlacedModel, WorldDescription
 
 __all__ = [
+    "CONTROL_PLUGINS",
+    "HARDWARE_INTERFACES",
+    "MODES",
+    "CommandInterface",
+    "JointControl",
+    "PidGains",
     "JOINT_TYPES",
     "SHAPES",
     "WORLD_LINK",

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from converters.description.control import JointControl
 from converters.description.gazebo import GazeboExtensions
 
 # A link of this name is the world itself: a joint to it fixes (or moves) the model against the
@@ -185,6 +186,7 @@ class RobotDescription:
         frames: named frames fixed to links (SDF `<frame>`).
         model_frame_site: mark the model frame with a `__model__` site when it is not the root
             link's frame (SDF), so a running world can report the model's pose as Gazebo does.
+        controls: the command interfaces each `<ros2_control>`/`<transmission>` joint declares.
     """
 
     name: str
@@ -198,6 +200,7 @@ class RobotDescription:
     base_pose: np.ndarray = field(default_factory=identity)
     frames: tuple[Frame, ...] = ()
     model_frame_site: bool = False
+    controls: tuple[JointControl, ...] = ()
 
     def link(self, name: str) -> Link:
         """The link called `name` (KeyError when there is none)."""

@@ -40,10 +40,10 @@ def add_motors(spec: object, joints: list[Joint], report: Report) -> None:
 
     limited = [j.name for j in joints if j.limit is not None and (j.limit.velocity or 0) > 0]
     if limited:
-        report.ignored(
+        report.mapped(
             "joint velocity limits",
-            f"<limit velocity> on {len(limited)} actuated joint(s) is not enforced: Gazebo zeroes "
-            "a motor's effort past it, a MuJoCo motor has no velocity-dependent clamp",
+            f"<limit velocity> of {len(limited)} actuated joint(s) kept for the world's commands "
+            "(Gazebo's rule in effort mode; position and velocity servos stay below it)",
         )
     for joint in joints:
         effort = _effort(joint)

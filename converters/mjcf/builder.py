@@ -15,6 +15,7 @@ from converters.description import RobotDescription
 from converters.mjcf import inertia as inr
 from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
 from converters.mjcf.bodies import body_inertias
+from converters.mjcf.control_data import add_control_data
 from converters.mjcf.geometry import GeomPlan, plan_geoms
 from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joints
 from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
@@ -100,7 +101,9 @@ def build_spec(
     bodies, joints = _add_bodies(spec, plan, inertias, report, provenance)
     _add_sites(bodies, plan, robot)
     _add_geoms(spec, bodies, geoms, options.collision, report, provenance)
-    add_motors(spec, actuated_joints(robot, report), report)
+    actuated = actuated_joints(robot, report)
+    add_motors(spec, actuated, report)
+    add_control_data(spec, actuated, {a.name for a in spec.actuators}, robot, report)
     add_mimics(spec, robot, report)
     spec.add_key(name=HOME_KEY, qpos=_home(joints, robot))
     _summarise(plan, inertias, geoms, report)

@@ -47,7 +47,8 @@ def restore_precision(xml: str, spec: Any) -> str:
     """`xml` (from `spec.to_xml()`) with every recognised number at full double precision."""
     from lxml import etree
 
-    root = etree.fromstring(xml.encode())
+    # Keep CDATA: MuJoCo writes custom <text> data as a CDATA section and reads no plain text.
+    root = etree.fromstring(xml.encode(), etree.XMLParser(strip_cdata=False))
     for element in root.iter():
         if not isinstance(element.tag, str):
             continue

@@ -31,6 +31,7 @@ from converters.description.transforms import pose_matrix
 from converters.errors import URDFStructureError
 from converters.gazebo.blocks import parse_gazebo
 from converters.resources.packages import PackageResolver
+from converters.urdf.control import read_controls
 from converters.urdf.xml_checks import check_kinds, check_numbers, check_tree, parse_xml
 
 # Joint children that only ROS controllers read; reported as ignored by the builder.
@@ -85,6 +86,7 @@ def parse_urdf(
         gazebo=gazebo,
         actuated=_named_joints(root, ("transmission", "ros2_control")),
         text=text,
+        controls=read_controls(root, source),
     )
 
 

@@ -247,14 +247,21 @@ def pose(
 def joints(*, name: str, world: str, json: bool) -> None:
     with _connect(world) as c:
         rows = c.joints(name)
+        control = {j["name"]: j for j in c.joint_control(name)}
+    for row in rows:  # each actuated joint's command: mode ("none": zero effort) and target
+        extra = control.get(row["name"], {})
+        row.update(mode=extra.get("mode"), target=extra.get("target"), modes=extra.get("modes"))
     out = Output(json)
     if json:
         out.data(rows)
         return
     out.table(
         f"joints of {name}",
-        ["joint", "position", "velocity", "effort"],
-        [[j["name"], j["position"], j["velocity"], j["effort"]] for j in rows],
+        ["joint", "mode", "target", "position", "velocity", "effort"],
+        [
+            [j["name"], j["mode"] or "-", j["target"], j["position"], j["velocity"], j["effort"]]
+            for j in rows
+        ],
     )
 
 

@@ -250,6 +250,20 @@ class Client:
     def joints(self, name: str) -> list[dict]:
         return self.request("GET", f"/entities/{_seg(name)}/joints")
 
+    def command_joints(self, name: str, targets: dict[str, float], mode: str) -> dict:
+        body = {"mode": mode, "targets": targets}
+        return self.request("POST", f"/entities/{_seg(name)}/commands", body=body)
+
+    def joint_control(self, name: str) -> list[dict]:
+        return self.request("GET", f"/entities/{_seg(name)}/control")
+
+    def trajectory(self, name: str, trajectory: dict, rate: float = 100.0) -> dict:
+        body = {**trajectory, "rate": rate}
+        return self.request("POST", f"/entities/{_seg(name)}/trajectory", body=body)
+
+    def trajectory_status(self, name: str) -> dict:
+        return self.request("GET", f"/entities/{_seg(name)}/trajectory")
+
     def links(self, name: str) -> dict:
         return self.request("GET", f"/entities/{_seg(name)}/links")
 

@@ -17,10 +17,7 @@ import mujoco
 import numpy as np
 
 MODES = ("position", "velocity", "effort")
-FULL_EFFORT_ERROR = 0.1  # [rad or m] position error at which the PD reaches full effort
-FULL_EFFORT_SPEED = 1.0  # [rad/s or m/s] velocity error at which the servo reaches full effort
-MAX_OMEGA_DT = 0.5  # ω·dt cap on the position servo's natural frequency (explicit stiffness)
-UNLIMITED_OMEGA = 30.0  # [rad/s] servo natural frequency for a joint without effort limit
+VELOCITY_BAND = 0.01  # fraction of the velocity limit over which Gazebo's rule fades the effort
 GAZEBO_STEP = 0.001  # [s] dampingFactor is the velocity fraction lost per Gazebo step
 _AFFINE = mujoco.mjtBias.mjBIAS_AFFINE
 _NONE = mujoco.mjtBias.mjBIAS_NONE
@@ -34,9 +31,14 @@ class JointCommand:
     Attributes:
         actuator: full actuator name ("<entity>/<joint>'s motor").
         mode: "position" | "velocity" | "effort".
-        target: clipped target [rad, m, rad/s, m/s, N m or N].
+        target: target [rad, m, rad/s, m/s, N m or N].
         kp: stiffness [N m/rad or N/m] (position mode); kv: damping [N m s/rad or N s/m].
         effort: the joint's effort limit [N m or N] (inf when unlimited).
+        velocity_limit: the joint's velocity limit [rad/s or m/s] (inf when none).
+        feedforward: velocity the position servo's damping tracks [rad/s or m/s] (trajectories).
+        rule: where the gains came from (`twin joints` shows it).
+        hold: constant force [N m or N] the position servo adds: the gravity load of the target
+            posture (fixed-base entities).
     """
 
     actuator: str
@@ -45,6 +47,10 @@ class JointCommand:
     kp: float
     kv: float
     effort: float
+    velocity_limit: float = math.inf
+    feedforward: float = 0.0
+    rule: str = ""
+    hold: float = 0.0
 
 
 def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
@@ -59,20 +65,11 @@ def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
 
 
 def servo_gains(mode: str, effort: float, inertia: float, timestep: float) -> tuple[float, float]:
-    """PD gains (kp, kv) for a joint of effective inertia `inertia` [kg m² or kg].
+    """PD gains (kp, kv) of a joint without control record or velocity limit (see joint_control)."""
+    from twin_cli.world.joint_control import JointLimits, servo_rule
 
-    kp reaches full effort at FULL_EFFORT_ERROR, capped so the servo's natural frequency
-    ω = √(kp/I) keeps ω·dt ≤ MAX_OMEGA_DT; kv damps it critically (2√(kp·I)). Velocity mode
-    reaches full effort at FULL_EFFORT_SPEED.
-    """
-    if mode == "effort":
-        return 0.0, 0.0
-    if mode == "velocity":
-        kv = effort / FULL_EFFORT_SPEED if math.isfinite(effort) else inertia * UNLIMITED_OMEGA
-        return 0.0, kv
-    kp = effort / FULL_EFFORT_ERROR if math.isfinite(effort) else inertia * UNLIMITED_OMEGA**2
-    kp = min(kp, inertia * (MAX_OMEGA_DT / timestep) ** 2)
-    return kp, 2.0 * math.sqrt(kp * inertia)
+    kp, kv, _ = servo_rule(mode, JointLimits(), effort, inertia, timestep, 0.0)
+    return kp, kv
 
 
 def clip_target(model: mujoco.MjModel, joint: int, mode: str, value: float, effort: float) -> float:
@@ -86,7 +83,18 @@ def clip_target(model: mujoco.MjModel, joint: int, mode: str, value: float, effo
 
 
 def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
-    """Writes `cmd` into actuator `a` of `model` (gains, ranges) and `data.ctrl`."""
+    """Writes `cmd` into actuator `a` of `model` (gains, bias, force range) and `data.ctrl`.
+
+    Everything then runs inside mj_step, with no Python per step:
+    - position: force = kp·(target − q) + kv·(feedforward − q̇) + hold, within ±effort;
+    - velocity: force = kv·(target − q̇), within ±effort;
+    - effort u with a velocity limit v: Gazebo zeroes the effort while |q̇| > v in u's direction
+      (Joint::CheckAndTruncateForce). Here the actuator is a velocity servo towards sign(u)·v
+      with a gain reaching full effort within VELOCITY_BAND·v, and force range
+      [min(0, u), max(0, u)]: force = u while q̇ ≤ v·(1 − VELOCITY_BAND), falls linearly to 0 at
+      v and stays 0 beyond (the servo's pull reverses sign and the range clips it to 0).
+      implicitfast integrates the gain's velocity term implicitly, so it is stable at any gain.
+    """
     gear = abs(model.actuator_gear[a][0]) or 1.0
     limit = cmd.effort / gear
     model.actuator_gaintype[a] = _FIXED
@@ -96,18 +104,36 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
     model.actuator_forcelimited[a] = int(math.isfinite(limit))
     model.actuator_forcerange[a] = (-limit, limit) if math.isfinite(limit) else (0.0, 0.0)
     if cmd.mode == "effort":
-        model.actuator_gainprm[a, 0] = 1.0
-        model.actuator_biastype[a] = _NONE
-        data.ctrl[a] = cmd.target / gear
+        _apply_effort(model, data, a, cmd, gear)
         return
     model.actuator_biastype[a] = _AFFINE
     if cmd.mode == "position":
         model.actuator_gainprm[a, 0] = cmd.kp / gear
+        model.actuator_biasprm[a, 0] = (cmd.kv * cmd.feedforward + cmd.hold) / gear
         model.actuator_biasprm[a, 1] = -cmd.kp / gear
     else:
         model.actuator_gainprm[a, 0] = cmd.kv / gear
     model.actuator_biasprm[a, 2] = -cmd.kv / gear
     data.ctrl[a] = cmd.target
+
+
+def _apply_effort(
+    model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand, gear: float
+) -> None:
+    u, v = cmd.target / gear, cmd.velocity_limit
+    if not math.isfinite(v):
+        model.actuator_gainprm[a, 0] = 1.0
+        model.actuator_biastype[a] = _NONE
+        data.ctrl[a] = u
+        return
+    full = abs(cmd.target)  # the band is VELOCITY_BAND·v wide whatever the effort
+    gain = max(full, 1e-9) / (VELOCITY_BAND * v) / gear
+    model.actuator_biastype[a] = _AFFINE
+    model.actuator_gainprm[a, 0] = gain
+    model.actuator_biasprm[a, 2] = -gain
+    model.actuator_forcelimited[a] = 1
+    model.actuator_forcerange[a] = (min(0.0, u), max(0.0, u))
+    data.ctrl[a] = math.copysign(v, u)
 
 
 @dataclass(frozen=True)

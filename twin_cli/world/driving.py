@@ -12,6 +12,7 @@ import mujoco
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import actuation as control
+from twin_cli.world import joint_control
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.values import finite_vector
 
@@ -59,22 +60,80 @@ class EntityControl:
     def command(self, name: str, joint: str, *, mode: str, value: float) -> None:
         """Sets a joint's target: "position" [rad|m], "velocity" [rad/s|m/s] or "effort" [N m|N].
 
-        Targets are clipped to the joint's range (position) and effort limit (effort); the
-        position and velocity servos never exceed the effort limit (see twin_cli.world.actuation).
+        Targets are clipped to what the joint allows (its range, velocity and effort limits and
+        its interface's min/max); `command_joints` refuses them instead. The position and
+        velocity servos never exceed the effort limit (see twin_cli.world.actuation).
+
+        Raises:
+            InvalidRequestError: unknown mode, or one the joint's control tags do not offer.
         """
-        _check_command(joint, mode, value)
+        self.command_joints(name, {joint: value}, mode=mode, clip=True)
+
+    def command_joints(
+        self, name: str, targets: dict[str, float], *, mode: str, clip: bool = False
+    ) -> list[control.JointCommand]:
+        """Sets several joints' targets at once, all or none (`twin command`).
+
+        Raises:
+            EntityNotFoundError, PartNotFoundError: unknown entity or actuated joint.
+            InvalidRequestError: unknown mode, a mode the joint does not offer, or (unless
+                `clip`) a value outside the interface's min/max or the joint's limits. On any
+                error no command changes.
+        """
+        for joint, value in targets.items():
+            _check_command(joint, mode, value)
         with self.lock:
             ix = self._require(name)
-            a, j = self._motor_of(name, ix, joint)
-            key = element_names(self.model, self.model.name_actuatoradr[[a]])[0]
-            old = self._commands.get(key)
-            effort = old.effort if old else control.effort_limit(self.model, a)
-            inertia = float(self.model.dof_M0[self.model.jnt_dofadr[j]])
-            kp, kv = control.servo_gains(mode, effort, inertia, self.model.opt.timestep)
-            target = control.clip_target(self.model, j, mode, value, effort)
-            cmd = control.JointCommand(key, mode, target, kp, kv, effort)
-            control.apply_command(self.model, self.data, a, cmd)
-            self._commands[key] = cmd
+            checked = [self._checked(name, ix, j, mode, v, clip) for j, v in targets.items()]
+            positions = {
+                int(self.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
+            }
+            loads = joint_control.posture_loads(self.model, self.data, positions)
+            return [self._set_command(c, loads, ix.free_qpos < 0) for c in checked]
+
+    def _checked(
+        self, name: str, ix: EntityIndex, joint: str, mode: str, value: float, clip: bool
+    ) -> tuple:
+        a, j = self._motor_of(name, ix, joint)
+        limits = joint_control.limits_of(self.model, name, joint)
+        if mode not in limits.modes:
+            raise InvalidRequestError(
+                f"command mode [{mode}] of joint [{joint}] of [{name}]",
+                f"its {limits.source} tags offer only {', '.join(limits.modes)}",
+                f"use --mode {limits.modes[0]}",
+            )
+        key = element_names(self.model, self.model.name_actuatoradr[[a]])[0]
+        old = self._commands.get(key)
+        effort = old.effort if old else control.effort_limit(self.model, a)
+        low, high = joint_control.allowed_range(self.model, j, mode, limits, effort)
+        if clip:
+            value = min(max(value, low), high)
+        elif not low <= value <= high:
+            raise InvalidRequestError(
+                f"{mode} command for joint [{joint}] of [{name}]",
+                f"{value:g} is outside [{low:g}, {high:g}] (interface min/max, joint limits)",
+                "give a value inside that range",
+            )
+        return key, a, j, mode, float(value), effort, limits
+
+    def _set_command(self, checked: tuple, loads: tuple, fixed: bool) -> control.JointCommand:
+        """Writes one checked command; a fixed-base position servo holds its target's load."""
+        key, a, j, mode, value, effort, limits = checked
+        inertia, load = loads
+        dof = int(self.model.jnt_dofadr[j])
+        hold = float(load[dof]) if fixed and mode == "position" else 0.0
+        step = abs(value - float(self.data.qpos[self.model.jnt_qposadr[j]]))
+        kp, kv, rule = joint_control.servo_rule(
+            mode, limits, effort, float(inertia[dof]), self.model.opt.timestep, step
+        )
+        if math.isfinite(effort):
+            hold = min(max(hold, -effort), effort)
+        cmd = control.JointCommand(
+            key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold
+        )
+        control.apply_command(self.model, self.data, a, cmd)
+        self._commands[key] = cmd
+        return cmd
 
     def _motor_of(self, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:
         m = self.model
@@ -108,3 +167,34 @@ def _check_command(joint: str, mode: str, value: float) -> None:
         raise InvalidRequestError(
             f"command value for joint [{joint}]", f"{value} is not finite", "give a finite number"
         )
+
+
+def joint_commands(world: object, name: str) -> dict[str, dict]:
+    """Each actuated joint's mode, target, gains and limits (`twin joints`); lock held by caller.
+
+    Joints without a command report mode "none" (zero effort), with the modes they offer.
+    """
+    model, ix = world.model, world._require(name)
+    out = {}
+    for a in ix.actuators:
+        key = element_names(model, model.name_actuatoradr[[a]])[0]
+        j = int(model.actuator_trnid[a][0])
+        joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
+        limits = joint_control.limits_of(model, name, joint)
+        cmd = world._commands.get(key)
+        out[joint] = {
+            "mode": cmd.mode if cmd else "none",
+            "target": cmd.target if cmd else None,
+            "modes": list(limits.modes),
+            "source": limits.source,
+            "kp": cmd.kp if cmd else None,
+            "kv": cmd.kv if cmd else None,
+            "rule": cmd.rule if cmd else "",
+            "velocity_limit": _finite(limits.velocity),
+            "effort_limit": _finite(cmd.effort if cmd else control.effort_limit(model, int(a))),
+        }
+    return out
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None

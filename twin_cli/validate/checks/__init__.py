@@ -19,6 +19,7 @@ from twin_cli.validate.checks import (
     physics_friction,
     physics_gravity,
     physics_sensors,
+    physics_tracking,
 )
 from twin_cli.validate.checks.base import CheckResult, RobotUnderTest, Series, Status
 
@@ -122,6 +123,14 @@ CHECKS: dict[str, Check] = {
         _check("sensor_lidar", "physics", physics_sensors.check_sensor_lidar, tol_m=0.001),
         _check(
             "sensor_contact", "physics", physics_sensors.check_sensor_contact, max_wrong_samples=0
+        ),
+        _check(
+            "tracking",
+            "physics",
+            physics_tracking.check_tracking,
+            max_settle_s=1.0,
+            max_sine_error_fraction=0.2,
+            max_speed_ratio=1.05,
         ),
     )
 }

@@ -1,0 +1,67 @@
+"""Each motor's command modes and limits → a custom text `control:<joint>` the world reads.
+
+A MuJoCo motor knows its effort limit (ctrlrange = forcerange = ±effort) but not the joint's
+velocity limit, the modes its `<ros2_control>`/`<transmission>` tags allow, their `min`/`max`
+bounds or their PID gains. The world needs them at command time to write the actuator's gain,
+bias and force range (twin_cli.world.actuation), so they travel in the model as one JSON text per
+motor; attaching an entity prefixes the name (`<entity>/control:<joint>`) like any element.
+"""
+
+from __future__ import annotations
+
+import json
+
+from converters.description import CONTROL_PLUGINS, MODES, Joint, JointControl, RobotDescription
+from converters.report import Report
+
+TEXT_PREFIX = "control:"
+
+
+def control_record(joint: Joint, control: JointControl | None, enabled: str | None) -> dict:
+    """The JSON-able record of one motor's modes, bounds, gains and velocity limit."""
+    velocity = joint.limit.velocity if joint.limit else None
+    if control is None or not control.interfaces:
+        return {"modes": list(MODES), "source": "default", "velocity_limit": velocity}
+    bounds = {
+        i.mode: [i.minimum, i.maximum]
+        for i in control.interfaces
+        if i.minimum is not None or i.maximum is not None
+    }
+    gains = {mode: [g.kp, g.ki, g.kd] for mode, g in control.gains}
+    return {
+        "modes": list(control.modes),
+        "source": control.source,
+        "where": control.where,
+        "bounds": bounds,
+        "pid": gains,
+        "velocity_limit": velocity,
+        "plugin": enabled,
+    }
+
+
+def add_control_data(
+    spec: object, joints: list[Joint], motors: set[str], robot: RobotDescription, report: Report
+) -> None:
+    """One `control:<joint>` text per motor, and a report line saying which rule applies."""
+    controls = {c.joint: c for c in robot.controls}
+    plugins = [p.kind for p in robot.gazebo.plugins if p.kind in CONTROL_PLUGINS]
+    enabled = plugins[0] if plugins else None
+    for joint in joints:
+        if joint.name not in motors:
+            continue
+        record = control_record(joint, controls.get(joint.name), enabled)
+        spec.add_text(name=TEXT_PREFIX + joint.name, data=json.dumps(record))
+        report.mapped(f"joint '{joint.name}' command modes", _rule_text(record))
+
+
+def _rule_text(record: dict) -> str:
+    modes = "/".join(record["modes"])
+    if record["source"] == "default":
+        return f"{modes} (no control tag); servo gains from the reflected inertia"
+    gains = ", ".join(
+        f"{mode} PID kp={g[0]:g} kd={g[2]:g}" + (f" (ki={g[1]:g} not run)" if g[1] else "")
+        for mode, g in record["pid"].items()
+    )
+    rule = gains or "servo gains from the reflected inertia"
+    plugin = record["plugin"] or "no gazebo_ros(2)_control plugin: Gazebo would not drive it"
+    return f"{modes} from {record['where']}; {rule}; {plugin}"

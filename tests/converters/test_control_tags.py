@@ -1,0 +1,89 @@
+"""`<ros2_control>` and `<transmission>` tags → command modes, bounds and gains, per form."""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import pytest
+from models import write_urdf
+
+from converters import convert
+
+LINKS = """<link name="base"><inertial><mass value="1"/>
+<inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>""" + "".join(
+    f"""<link name="l{i}"><inertial><mass value="1"/>
+<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j{i}" type="revolute"><parent link="base"/><child link="l{i}"/>
+<limit lower="-1" upper="1" effort="10" velocity="2"/></joint>"""
+    for i in range(3)
+)
+
+
+def _records(tmp_path, tags: str) -> dict[str, dict]:
+    spec, _ = convert(write_urdf(tmp_path, f'<robot name="r">{LINKS}{tags}</robot>'))
+    model = spec.compile()
+    out = {}
+    for t in range(model.ntext):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_TEXT, t)
+        start = model.text_adr[t]
+        out[name.removeprefix("control:")] = json.loads(
+            bytes(model.text_data[start : start + model.text_size[t] - 1]).decode()
+        )
+    return out
+
+
+def _transmission(joint: str, interface: str, on_actuator: bool = False) -> str:
+    hw = f"<hardwareInterface>{interface}</hardwareInterface>"
+    return (
+        f'<transmission name="t_{joint}"><type>transmission_interface/SimpleTransmission</type>'
+        f'<joint name="{joint}">{"" if on_actuator else hw}</joint>'
+        f'<actuator name="m_{joint}">{hw if on_actuator else ""}</actuator></transmission>'
+    )
+
+
+@pytest.mark.parametrize(
+    ("interface", "on_actuator", "mode"),
+    [
+        ("hardware_interface/EffortJointInterface", False, "effort"),
+        ("PositionJointInterface", False, "position"),  # hyq writes it without the prefix
+        ("hardware_interface/VelocityJointInterface", True, "velocity"),  # deprecated place
+    ],
+)
+def test_transmission_hardware_interface_is_the_joints_one_mode(
+    tmp_path, interface, on_actuator, mode
+):
+    records = _records(tmp_path, _transmission("j0", interface, on_actuator))
+    assert records["j0"]["modes"] == [mode] and records["j0"]["source"] == "transmission"
+    assert records["j0"]["velocity_limit"] == 2.0, "the joint's velocity limit travels along"
+    assert set(records) == {"j0"}, "only the transmission's joint gets a motor"
+
+
+def test_ros2_control_interfaces_bounds_and_pid_gains(tmp_path):
+    tags = """<ros2_control name="arm" type="system"><hardware><plugin>x</plugin></hardware>
+      <joint name="j0"><command_interface name="position">
+        <param name="min">-0.5</param><param name="max">0.7</param></command_interface>
+        <command_interface name="velocity"/><state_interface name="position"/></joint>
+      <joint name="j1"><param name="pos_kp">120</param><param name="pos_kd">4</param>
+        <param name="pos_ki">1</param><command_interface name="position_pid"/></joint>
+      <joint name="j2"><command_interface name="acceleration"/></joint>
+    </ros2_control>"""
+    records = _records(tmp_path, tags)
+    assert records["j0"]["modes"] == ["position", "velocity"]
+    assert records["j0"]["bounds"] == {"position": [-0.5, 0.7]}
+    assert records["j1"]["modes"] == ["position"] and records["j1"]["pid"] == {
+        "position": [120.0, 1.0, 4.0]
+    }
+    assert records["j2"]["modes"] == ["position", "velocity", "effort"], (
+        "a joint without a command interface twin can drive keeps every mode"
+    )
+
+
+def test_a_bad_number_in_a_param_names_the_joint(tmp_path):
+    from converters.errors import ConversionError
+
+    tags = """<ros2_control name="arm" type="system"><joint name="j0">
+      <command_interface name="position"><param name="min">low</param></command_interface>
+    </joint></ros2_control>"""
+    with pytest.raises(ConversionError, match="joint 'j0'.*min.*'low' is not a number"):
+        _records(tmp_path, tags)

@@ -1,0 +1,187 @@
+"""Joint commands with Gazebo's limits in motion: real worlds and corpus robots, measured."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+from corpus_registry import CORPUS, package_paths
+from models import CONTROL_RIG as WHEEL_URDF
+from models import write_urdf
+
+from twin_cli.errors import InvalidRequestError, PartNotFoundError
+from twin_cli.world import Pose, World, WorldSettings
+
+
+@pytest.fixture
+def rig(tmp_path) -> World:
+    from converters import convert
+
+    spec, _ = convert(write_urdf(tmp_path, WHEEL_URDF))
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
+    world.spawn(spec, name="rig", pose=Pose(z=1.0))
+    return world
+
+
+def test_full_effort_settles_at_the_velocity_limit_as_gazebo_zeroes_effort_beyond_it(rig):
+    # Gazebo (Joint::CheckAndTruncateForce): effort zeroed while |v| > v_max in its direction.
+    # A 2 N m drive on 0.01 kg m² would reach 200 rad/s in 1 s without the rule.
+    rig.command_joints("rig", {"spin": 2.0}, mode="effort")
+    peak = 0.0
+    for _ in range(100):
+        rig.step(10)
+        peak = max(peak, rig.joint_states("rig")[0].velocity)
+    speed = rig.joint_states("rig")[0].velocity
+    assert speed == pytest.approx(3.0, rel=0.05), f"settled speed {speed:.4f} rad/s (limit 3)"
+    assert peak <= 3.0 * 1.0001, f"peak speed {peak:.5f} rad/s above the 3 rad/s limit"
+    # Reversed effort is never zeroed: it brakes at the full 2 N m (0.01 kg m² → 200 rad/s²).
+    rig.command_joints("rig", {"spin": -2.0}, mode="effort")
+    rig.step(5)
+    accel = (rig.joint_states("rig")[0].velocity - speed) / 0.005
+    assert accel == pytest.approx(-200.0, rel=0.02), f"braking {accel:.1f} rad/s² (expect -200)"
+
+
+def test_a_mode_the_tags_do_not_offer_or_a_value_outside_the_interface_is_refused(rig):
+    before = rig.data.ctrl.copy(), rig.model.actuator_gainprm.copy()
+    bad = [
+        ({"slide": 0.0}, "velocity", "offer only position"),
+        ({"slide": 0.28}, "position", "outside [-0.1, 0.25]"),  # interface max below the range
+        ({"spin": 3.5}, "velocity", "outside [-3, 3]"),  # the joint's velocity limit
+        ({"spin": 1.0, "slide": 9.0}, "effort", "offer only position"),
+        ({"spin": 2.5}, "effort", "outside [-2, 2]"),
+    ]
+    for targets, mode, words in bad:
+        with pytest.raises(InvalidRequestError, match=re.escape(words)):
+            rig.command_joints("rig", targets, mode=mode)
+    with pytest.raises(PartNotFoundError, match="spin"):  # lists the actuated joints
+        rig.command_joints("rig", {"elbow": 0.0}, mode="effort")
+    assert (rig.data.ctrl == before[0]).all() and (rig.model.actuator_gainprm == before[1]).all()
+    assert rig._commands == {}, "no command was kept after refused requests"
+
+
+def test_position_interface_servo_reaches_its_target_below_the_velocity_limit(rig):
+    rig.command_joints("rig", {"slide": 0.25}, mode="position")
+    peak = 0.0
+    for _ in range(800):  # 4 s: the overdamped approach has a time constant of |Δ|/(0.95·v_max)
+        rig.step(5)
+        peak = max(peak, abs(rig.joint_states("rig")[1].velocity))
+    assert rig.joint_states("rig")[1].position == pytest.approx(0.25, abs=1e-3), "target"
+    assert peak < 0.5, f"peak {peak:.4f} m/s above the 0.5 m/s velocity limit"
+
+
+def ur5e_fixed(tmp_path):
+    """The corpus UR5e with its base fixed to the world (a `world` link, as Gazebo users do)."""
+    from corpus_registry import PACKAGES_ROOT
+
+    from converters.collision.plan import CollisionSettings
+    from converters.mjcf.builder import ConvertOptions
+    from converters.pipeline import convert_full
+
+    robot = CORPUS["ur5e"]
+    options = ConvertOptions(collision=CollisionSettings(mode="hull"))
+    paths = package_paths(robot)
+    done = convert_full(
+        PACKAGES_ROOT / robot["entry"],
+        args=robot["xacro_args"],
+        package_paths=paths,
+        options=options,
+    )
+    text = done.description.text
+    root = text.index(">", text.index("<robot")) + 1
+    anchor = (
+        '<link name="world"/><joint name="world_fix" type="fixed"><parent link="world"/>'
+        '<child link="base_link"/></joint>'
+    )
+    path = write_urdf(tmp_path, text[:root] + anchor + text[root:], "ur5e.urdf")
+    return convert_full(path, package_paths=paths, options=options).spec
+
+
+@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
+def test_ur5e_reaches_half_a_radian_on_every_joint_within_2_s_and_holds_1_mrad(tmp_path):
+    world = World()
+    world.spawn(ur5e_fixed(tmp_path), name="ur", pose=Pose(z=1.0))  # on a 1 m pedestal
+    start = {s.name: s.position for s in world.joint_states("ur")}
+    targets = {name: q + 0.5 for name, q in start.items()}
+    commands = world.command_joints("ur", targets, mode="position")
+    limits = {c.actuator.split("/")[1]: c.velocity_limit for c in commands}
+    assert set(limits) == set(targets) and all(math.isfinite(v) for v in limits.values())
+    worst = {name: 0.0 for name in targets}  # peak |v| / v_max
+    reached = {}
+    for k in range(1, 3001):
+        world.step(1)
+        for s in world.joint_states("ur"):
+            worst[s.name] = max(worst[s.name], abs(s.velocity) / limits[s.name])
+            if abs(s.position - targets[s.name]) > 1e-3:
+                reached.pop(s.name, None)
+            else:
+                reached.setdefault(s.name, k * 1e-3)
+    assert set(reached) == set(targets), f"joints holding within 1 mrad at 3 s: {reached}"
+    late = {n: t for n, t in reached.items() if t > 2.0}
+    assert not late, f"reached (and then held within 1 mrad) later than 2 s: {late}"
+    over = {n: round(r, 4) for n, r in worst.items() if r > 1.0}
+    assert not over, f"peak speed / velocity limit above 1: {over}"
+    assert sum(w.number for w in world.data.warning) == 0, "MuJoCo warnings"
+
+
+TRAJECTORY = """joint_names: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint]
+points:
+  - {positions: [0.2, -0.2, 0.3], time_from_start: {sec: 0, nanosec: 500000000}}
+  - {positions: [0.4, -0.4, 0.6], velocities: [0.2, -0.2, 0.3], time_from_start: 1.0}
+  - {positions: [0.5, -0.5, 0.8], velocities: [0.0, 0.0, 0.0], time_from_start: 1.5}
+  - {positions: [0.3, -0.3, 0.5], time_from_start: 2.0}
+  - {positions: [0.0, 0.0, 0.0], time_from_start: 2.5}
+"""
+
+
+@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
+def test_ur5e_follows_a_five_point_trajectory_with_a_bounded_tracking_error(tmp_path):
+    from twin_cli.control import follow_trajectory, read_trajectory, sample, tracking_report
+
+    world = World()
+    world.spawn(ur5e_fixed(tmp_path), name="ur", pose=Pose(z=1.0))
+    trajectory = read_trajectory(TRAJECTORY, "five.yaml")
+    follow_trajectory(world, "ur", trajectory)
+    own_worst = 0.0  # the test's own measurement against the interpolated reference
+    for _ in range(260):  # 2.6 s
+        world.step(10)
+        t = float(world.data.time)
+        reference, _ = sample(trajectory, (0.0, 0.0, 0.0), t)
+        q = {s.name: s.position for s in world.joint_states("ur")}
+        errors = [abs(q[n] - r) for n, r in zip(trajectory.joint_names, reference, strict=True)]
+        own_worst = max(own_worst, *errors)
+    report = tracking_report(world, "ur")
+    assert report is not None and not report["active"], "the follower finished at 2.5 s"
+    assert set(report["final_error"]) == set(trajectory.joint_names)
+    assert max(report["max_error"].values()) < 0.02, f"max tracking error {report['max_error']}"
+    assert max(report["final_error"].values()) < 5e-3, f"final error {report['final_error']}"
+    world.step(400)  # then the last point is held
+    settled = {
+        s.name: abs(s.position) for s in world.joint_states("ur") if s.name in report["max_error"]
+    }
+    assert max(settled.values()) < 1e-3, f"|q - last point| 0.4 s after the end: {settled}"
+    assert own_worst < 0.03, f"worst error against the spline reference {own_worst:.4f} rad"
+    assert sum(w.number for w in world.data.warning) == 0, "MuJoCo warnings"
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("joint_names: [spin]\npoints:\n  - {positions: [0.1]}\n", "no time_from_start"),
+        (
+            "joint_names: [slide]\npoints:\n  - {positions: [0.1], time_from_start: 1}\n"
+            "  - {positions: [0.2], time_from_start: 1}\n",
+            "not after 1 s",
+        ),
+        ("joint_names: [elbow]\npoints:\n  - {positions: [0.1], time_from_start: 1}\n", "elbow"),
+        ("joint_names: [slide]\npoints:\n  - {positions: [0.29], time_from_start: 1}\n", "0.29"),
+        ("time_from_start,slide\n1,0.1\n,0.2\n", "no time_from_start"),
+    ],
+)
+def test_malformed_trajectory_is_refused_and_leaves_the_world_unchanged(rig, text, words):
+    from twin_cli.control import follow_trajectory, read_trajectory
+
+    name = "bad.csv" if text.startswith("time_from_start") else "bad.yaml"
+    with pytest.raises((InvalidRequestError, PartNotFoundError), match=re.escape(words)):
+        follow_trajectory(rig, "rig", read_trajectory(text, name))
+    assert rig._commands == {} and not rig._observers, "no command or controller was kept"

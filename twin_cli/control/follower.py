@@ -1,0 +1,197 @@
+"""The trajectory follower: joint_trajectory_controller as a consumer of the world, in sim time.
+
+It runs at the controller manager's update rate (UPDATE_RATE, 100 Hz by default) as a world
+observer (twin_cli.world.observers): the stepping splits its batches there, so there is no Python
+per physics step. Each update samples the trajectory (twin_cli.control.trajectory), measures the
+tracking error of the joints against the reference of that instant, and writes the next
+reference into the joints' position servos: target position and the velocity their damping
+tracks (the feed-forward a position+velocity interface gets). After the last point the joints
+keep holding it and the follower reports its errors.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import weakref
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from twin_cli.control.trajectory import Trajectory, sample
+from twin_cli.errors import InvalidRequestError, PartNotFoundError
+
+UPDATE_RATE = 100.0  # [Hz] controller_manager's usual update_rate
+
+
+@dataclass
+class TrackingReport:
+    """Tracking errors [rad or m] by joint: the largest over the run and the one at the end."""
+
+    entity: str
+    joint_names: tuple[str, ...]
+    duration: float
+    active: bool = True
+    elapsed: float = 0.0
+    max_error: dict[str, float] = field(default_factory=dict)
+    final_error: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {
+            "entity": self.entity,
+            "joint_names": list(self.joint_names),
+            "duration": self.duration,
+            "active": self.active,
+            "elapsed": self.elapsed,
+            "max_error": dict(self.max_error),
+            "final_error": dict(self.final_error),
+        }
+
+
+class TrajectoryFollower:
+    """Follows one trajectory on one entity of a World (see module docstring)."""
+
+    def __init__(self, world: Any, entity: str, trajectory: Trajectory, rate: float) -> None:
+        self.world, self.entity, self.trajectory = world, entity, trajectory
+        self.report = TrackingReport(entity, trajectory.joint_names, trajectory.duration)
+        with world.lock:
+            _check_points(world, entity, trajectory)
+            states = {s.name: s.position for s in world.joint_states(entity)}
+            for joint in trajectory.joint_names:
+                if joint not in states:
+                    raise PartNotFoundError(entity, "joint", joint, list(states))
+            self.start = tuple(states[j] for j in trajectory.joint_names)
+            commands = world.command_joints(
+                entity, dict(zip(trajectory.joint_names, self.start, strict=True)), mode="position"
+            )
+            self.keys = [c.actuator for c in commands]
+            self.qpos = [world.model.joint(f"{entity}/{j}").qposadr[0] for j in self.start_names]
+            self.t0 = float(world.data.time)
+            self._model, self._ids, self._last = None, None, None
+            self.handle = world.add_observer(self._update, rate)
+
+    @property
+    def start_names(self) -> tuple[str, ...]:
+        return self.trajectory.joint_names
+
+    def _update(self) -> None:
+        """One controller update (the world's lock is held): measure, then command."""
+        world = self.world
+        t = float(world.data.time) - self.t0
+        if t < -1e-9 or any(k not in world._commands for k in self.keys):
+            self.stop()  # the world was reset or the commands were replaced
+            return
+        reference, _ = sample(self.trajectory, self.start, t)
+        for name, q, r in zip(self.start_names, self.qpos, reference, strict=True):
+            error = abs(float(world.data.qpos[q]) - r)
+            self.report.max_error[name] = max(self.report.max_error.get(name, 0.0), error)
+            if t >= self.trajectory.duration - 1e-9:
+                self.report.final_error[name] = error
+        self.report.elapsed = t
+        nxt, speed = sample(self.trajectory, self.start, t + 1.0 / UPDATE_RATE)
+        self._write(nxt, speed)
+        if t >= self.trajectory.duration - 1e-9:
+            self.stop()
+
+    def _write(self, positions: tuple[float, ...], speeds: tuple[float, ...]) -> None:
+        """Moves each position servo's target and damping reference: ctrl and the bias constant.
+
+        Only those two numbers change (see actuation.apply_command), written as arrays; actuator
+        ids and gains are looked up again after a recompile. The world's command records get the
+        last reference when the follower stops.
+        """
+        import numpy as np
+
+        world = self.world
+        if self._model is not world.model:
+            self._model = world.model
+            self._ids = np.array([world.model.actuator(k).id for k in self.keys])
+            commands = [world._commands[k] for k in self.keys]
+            gear = np.abs(world.model.actuator_gear[self._ids, 0])
+            gear[gear == 0] = 1.0
+            self._kv = np.array([c.kv for c in commands]) / gear
+            self._hold = np.array([c.hold for c in commands]) / gear
+        world.data.ctrl[self._ids] = positions
+        world.model.actuator_biasprm[self._ids, 0] = self._kv * np.array(speeds) + self._hold
+        self._last = (positions, speeds)
+
+    def _record_last(self) -> None:
+        positions, speeds = self._last
+        for key, p, v in zip(self.keys, positions, speeds, strict=True):
+            if key in self.world._commands:
+                cmd = self.world._commands[key]
+                self.world._commands[key] = replace(cmd, target=p, feedforward=v)
+
+    def stop(self) -> None:
+        """Stops updating; the joints keep their last target."""
+        self.report.active = False
+        self.world.remove_observer(self.handle)
+        if self._last is not None:
+            self._record_last()
+
+
+def _check_points(world: Any, entity: str, trajectory: Trajectory) -> None:
+    """Refuses positions outside a joint's range or velocities past its limit (world unchanged)."""
+    from twin_cli.world.joint_control import allowed_range, limits_of
+
+    world._require(entity)
+    model = world.model
+    for i, joint in enumerate(trajectory.joint_names):
+        j = model.joint(f"{entity}/{joint}").id if f"{entity}/{joint}" in _names(model) else -1
+        if j < 0:
+            continue  # command_joints names the unknown joint with the known ones
+        limits = limits_of(model, entity, joint)
+        low, high = allowed_range(model, j, "position", limits, math.inf)
+        for k, point in enumerate(trajectory.points):
+            value = point.positions[i]
+            if not low <= value <= high:
+                raise InvalidRequestError(
+                    f"trajectory point {k} joint [{joint}] of [{entity}]",
+                    f"position {value:g} is outside [{low:g}, {high:g}]",
+                    "keep positions inside the joint's range",
+                )
+            speed = point.velocities[i] if point.velocities else 0.0
+            if abs(speed) > limits.velocity:
+                raise InvalidRequestError(
+                    f"trajectory point {k} joint [{joint}] of [{entity}]",
+                    f"velocity {speed:g} exceeds the limit {limits.velocity:g}",
+                    "slow the trajectory down",
+                )
+
+
+def _names(model: Any) -> set[str]:
+    return {model.joint(j).name for j in range(model.njnt)}
+
+
+_FOLLOWERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_LOCK = threading.Lock()
+
+
+def follow_trajectory(
+    world: Any, entity: str, trajectory: Trajectory, rate: float = UPDATE_RATE
+) -> TrajectoryFollower:
+    """Starts following `trajectory` on `entity` (replacing its running one); returns at once.
+
+    Raises:
+        EntityNotFoundError, PartNotFoundError, InvalidRequestError: the world is unchanged.
+    """
+    if not (math.isfinite(rate) and rate > 0):
+        raise InvalidRequestError("trajectory rate", f"{rate} Hz", "give a rate > 0 Hz")
+    with _LOCK:
+        running = _FOLLOWERS.setdefault(world, {})
+        follower = TrajectoryFollower(world, entity, trajectory, rate)
+        old = running.get(entity)
+        if old is not None and old.report.active:
+            with world.lock:
+                old.stop()
+        running[entity] = follower
+        return follower
+
+
+def tracking_report(world: Any, entity: str) -> dict | None:
+    """The entity's last trajectory report, or None when it never followed one."""
+    with _LOCK:
+        follower = _FOLLOWERS.get(world, {}).get(entity)
+    if follower is None:
+        return None
+    with world.lock:
+        return follower.report.to_dict()

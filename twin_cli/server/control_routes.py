@@ -1,0 +1,91 @@
+"""Routes of joint control: several joints at once, each joint's mode, and trajectories.
+
+`twin command`, `twin joints` and `twin trajectory` use them; the world's old single-joint
+`/entities/{name}/command` stays as it was (clipping instead of refusing).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from fastapi import APIRouter
+from pydantic import Field
+
+from twin_cli.server.holder import WorldDep
+from twin_cli.server.models import Body, Finite
+
+router = APIRouter()
+
+
+class CommandsBody(Body):
+    """Targets by joint name, in one mode; refused as a whole if any is outside its limits."""
+
+    mode: Literal["position", "velocity", "effort"] = "position"
+    targets: dict[str, Finite]
+
+
+class PointBody(Body):
+    """One trajectory_msgs/JointTrajectoryPoint; time_from_start in seconds."""
+
+    positions: list[Finite]
+    velocities: list[Finite] | None = None
+    accelerations: list[Finite] | None = None
+    time_from_start: Finite | None = None
+
+
+class TrajectoryBody(Body):
+    """A trajectory_msgs/JointTrajectory and the controller's update rate [Hz]."""
+
+    joint_names: list[str]
+    points: list[PointBody]
+    rate: Annotated[float, Field(gt=0.0, le=10000.0)] = 100.0
+
+
+@router.post("/entities/{name}/commands")
+def commands(name: str, body: CommandsBody, world: WorldDep) -> dict:
+    done = world.command_joints(name, dict(body.targets), mode=body.mode)
+    return {"commanded": name, "mode": body.mode, "joints": [c.actuator for c in done]}
+
+
+@router.get("/entities/{name}/control")
+def control(name: str, world: WorldDep) -> list[dict]:
+    """Each actuated joint: mode, target, position, velocity, effort, modes, gains, limits."""
+    from twin_cli.world.driving import joint_commands
+
+    with world.lock:
+        states = {s.name: s for s in world.joint_states(name)}
+        rows = joint_commands(world, name)
+    return [
+        {
+            "name": joint,
+            **row,
+            "position": states[joint].position,
+            "velocity": states[joint].velocity,
+            "effort": states[joint].effort,
+        }
+        for joint, row in rows.items()
+        if joint in states
+    ]
+
+
+@router.post("/entities/{name}/trajectory")
+def trajectory(name: str, body: TrajectoryBody, world: WorldDep) -> dict:
+    from twin_cli.control import follow_trajectory, trajectory_from_dict
+
+    doc = body.model_dump(exclude={"rate"})
+    follower = follow_trajectory(world, name, trajectory_from_dict(doc), body.rate)
+    return follower.report.to_dict()
+
+
+@router.get("/entities/{name}/trajectory")
+def trajectory_status(name: str, world: WorldDep) -> dict:
+    from twin_cli.control import tracking_report
+    from twin_cli.errors import InvalidRequestError
+
+    world.joint_states(name)  # unknown entity: the usual error
+    report = tracking_report(world, name)
+    if report is None:
+        raise InvalidRequestError(
+            f"trajectory of [{name}]", "none was sent", "send one with twin trajectory"
+        )
+    return report

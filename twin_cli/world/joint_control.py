@@ -1,0 +1,151 @@
+"""What a motor may be commanded to: its modes, bounds, PID gains and velocity limit, and the rule
+that turns a command into servo gains.
+
+The converter writes one `control:<joint>` text per motor (converters.mjcf.control_data); a
+model without one (hand-written MJCF) offers every mode with no velocity limit. The gain rule
+(documented in docs/control.md):
+
+- position: kp from the tag's `pos_kp`, else from the joint's reflected inertia
+  I = 1/(M⁻¹)ᵢᵢ: kp = I·min((MAX_OMEGA_DT/dt)², v/(dt·|Δ|)) for a step of Δ, v = SPEED_MARGIN·
+  v_max; kv from `pos_kd`, else max(2·√(kp·I), kp·|Δ|/v): an overdamped PD from rest never moves
+  faster than kp·|Δ|/kv = v, and kv ≤ I/dt keeps one saturated step from jumping past it. A
+  fixed-base entity's servo also feeds forward the gravity load of the target posture.
+- velocity: kv from `vel_kp`, else full effort at VELOCITY_BAND of the velocity limit.
+- effort: Gazebo's velocity rule (see twin_cli.world.actuation.apply_command).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from converters.description import MODES
+
+MAX_OMEGA_DT = 0.5  # ω·dt of the position servo's spring (explicit in implicitfast: < 2)
+SPEED_MARGIN = 0.95  # position servo's design speed, as a fraction of the velocity limit
+FULL_EFFORT_SPEED = 1.0  # [rad/s or m/s] velocity error at full effort without a velocity limit
+UNLIMITED_OMEGA = 30.0  # [rad/s] servo bandwidth of a joint without an effort limit
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """One motor's command modes and bounds.
+
+    Attributes:
+        modes: the modes it accepts. source: "ros2_control", "transmission", "default" (no
+            tag) or "model" (no control record: a hand-written model).
+        bounds: mode → (min, max) of the interface (None: unbounded side).
+        pid: mode → (kp, ki, kd) from the tag. velocity: velocity limit [rad/s or m/s] (inf: none).
+    """
+
+    modes: tuple[str, ...] = MODES
+    source: str = "model"
+    bounds: dict = field(default_factory=dict)
+    pid: dict = field(default_factory=dict)
+    velocity: float = math.inf
+
+
+def limits_of(model: mujoco.MjModel, entity: str, joint: str) -> JointLimits:
+    """The `<entity>/control:<joint>` record of `model`, or every mode unbounded."""
+    t = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, f"{entity}/control:{joint}")
+    if t < 0:
+        return JointLimits()
+    start = model.text_adr[t]
+    raw = bytes(model.text_data[start : start + model.text_size[t] - 1]).decode()
+    record = json.loads(raw)
+    velocity = record.get("velocity_limit")
+    return JointLimits(
+        tuple(record["modes"]),
+        record["source"],
+        {m: tuple(b) for m, b in record.get("bounds", {}).items()},
+        {m: tuple(g) for m, g in record.get("pid", {}).items()},
+        float(velocity) if velocity is not None and velocity > 0 else math.inf,
+    )
+
+
+def posture_loads(
+    model: mujoco.MjModel, data: mujoco.MjData, targets: dict[int, float]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Reflected inertia 1/(M⁻¹)ᵢᵢ [kg m² or kg] and static load [N m or N] of every dof.
+
+    Computed at rest in the posture with the position `targets` (qpos address → value) written
+    over the current one, on a scratch copy so the world's data (and warm start) stays untouched.
+    The load is what holds that posture against gravity and springs: qfrc_bias − qfrc_passive.
+    """
+    scratch = mujoco.MjData(model)
+    scratch.qpos[:] = data.qpos
+    for address, value in targets.items():
+        scratch.qpos[address] = value
+    mujoco.mj_forward(model, scratch)
+    full = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, scratch, full)  # MuJoCo 4 signature: (m, d, dst)
+    load = np.array(scratch.qfrc_bias) - np.array(scratch.qfrc_passive)
+    return 1.0 / np.diag(np.linalg.inv(full)), load
+
+
+def servo_rule(
+    mode: str, limits: JointLimits, effort: float, inertia: float, timestep: float, step: float
+) -> tuple[float, float, str]:
+    """(kp, kv, rule) for a command; `step` is |target − q| [rad or m] (position mode).
+
+    Args:
+        mode: the command's mode. limits: the motor's record. effort: effort limit [N m or N].
+        inertia: reflected inertia [kg m² or kg]. timestep: [s].
+    """
+    pid = limits.pid.get(mode)
+    vmax = limits.velocity
+    if mode == "position":
+        kp, kv = _position_gains(inertia, timestep, step, SPEED_MARGIN * vmax)
+        if pid:
+            kp, kv = pid[0], max(pid[2], kp * step / (SPEED_MARGIN * vmax))
+        return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
+    if mode == "velocity":
+        if pid:
+            return 0.0, pid[0], "tag PID (vel_kp)"
+        if math.isfinite(effort) and math.isfinite(vmax):
+            return 0.0, effort / ((1.0 - SPEED_MARGIN) * vmax), "full effort at 5 % of v_max"
+        if math.isfinite(effort):
+            return 0.0, effort / FULL_EFFORT_SPEED, "full effort at 1 rad/s error"
+        return 0.0, inertia * UNLIMITED_OMEGA, "reflected inertia"
+    return 0.0, 0.0, "Gazebo velocity rule" if math.isfinite(vmax) else "effort"
+
+
+def _position_gains(inertia: float, h: float, step: float, speed: float) -> tuple[float, float]:
+    """kp, kv of the position servo on reflected inertia I for a step [rad or m] at time step h.
+
+    kp = I·min(ω_max², speed/(h·step)), kv = max(2√(kp·I), kp·step/speed): overdamped enough
+    that the joint approaches at most at `speed`, and kv ≤ I/h, so one step of full effort never
+    carries the joint past the speed at which the servo starts braking (under saturation the
+    damping is explicit).
+    """
+    omega2 = (MAX_OMEGA_DT / h) ** 2
+    if math.isfinite(speed) and step > 0:
+        omega2 = min(omega2, speed / (h * step))
+    kp = inertia * omega2
+    kv = 2.0 * math.sqrt(kp * inertia)
+    if math.isfinite(speed):
+        kv = max(kv, kp * step / speed)
+    return kp, kv
+
+
+def allowed_range(
+    model: mujoco.MjModel, joint: int, mode: str, limits: JointLimits, effort: float
+) -> tuple[float, float]:
+    """The values a `mode` command may take: the interface bounds within the joint's limits."""
+    low, high = -math.inf, math.inf
+    if mode == "position" and model.jnt_limited[joint]:
+        low, high = (float(v) for v in model.jnt_range[joint])
+    elif mode == "velocity":
+        low, high = -limits.velocity, limits.velocity
+    elif mode == "effort":
+        low, high = -effort, effort
+    bound = limits.bounds.get(mode, (None, None))
+    if bound[0] is not None:
+        low = max(low, bound[0])
+    if bound[1] is not None:
+        high = min(high, bound[1])
+    return low, high
