@@ -65,6 +65,7 @@ class LoadedSource:
     default_name: str
     description: str | None = None
     sensors: tuple = ()
+    plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (URDF/SDF)
 
 
 def load_source(
@@ -135,6 +136,7 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
         name,
         _urdf_or_none(done.description.text),
         done.sensors,
+        done.plugins,
     )
 
 
@@ -155,7 +157,9 @@ def _load_description(
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
-    return LoadedSource(spec, str(path), report.to_dict(), None, name, description, done.sensors)
+    return LoadedSource(
+        spec, str(path), report.to_dict(), None, name, description, done.sensors, done.plugins
+    )
 
 
 def _urdf_or_none(text: str) -> str | None:
