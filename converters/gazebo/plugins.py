@@ -60,7 +60,7 @@ class DiffDrive:
 
 
 def plugin_kind(blob: Blob) -> str:
-    """"diff_drive", "command_interfaces" or "not_run", from the plugin's filename."""
+    """ "diff_drive", "command_interfaces" or "not_run", from the plugin's filename."""
     filename = (blob.kind or "").rsplit("/", 1)[-1]
     if filename in DIFF_DRIVE_FILES:
         return "diff_drive"

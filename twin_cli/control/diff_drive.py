@@ -3,10 +3,10 @@
 The controller is a world observer (`World.add_observer`) at the plugin's update rate (at
 least MIN_RATE), so the stepping loop calls it between batches, in simulated time, with the
 world's lock held: no Python per physics step. Each update it ramps the wheels' rim speeds
-towards the commanded twist (`kinematics.ramp`, the plugin's `max_wheel_acceleration`), writes them as velocity
-targets through the world's joint command API (a velocity servo whose force is capped at the
-wheel motor's ±`max_wheel_torque`, Gazebo's `fmax`), stops the wheels once the command's
-duration ran out, and integrates encoder odometry when the plugin asks for it.
+towards the commanded twist (`kinematics.ramp`, the plugin's `max_wheel_acceleration`),
+writes them as velocity targets through the world's joint command API (a velocity servo whose
+force is capped at the wheel motor's ±`max_wheel_torque`, Gazebo's `fmax`), stops the wheels
+once the command's duration ran out, and integrates encoder odometry when the plugin asks.
 """
 
 from __future__ import annotations

@@ -59,4 +59,3 @@ def body_twist(left: float, right: float, radius: float, separation: float) -> t
     """Forward speed [m/s] and yaw rate [rad/s] from wheel joint speeds [rad/s]."""
     v_left, v_right = left * radius, right * radius
     return (v_left + v_right) / 2.0, (v_right - v_left) / separation
-
