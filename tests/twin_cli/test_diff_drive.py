@@ -33,7 +33,8 @@ def _spawn(world: World) -> None:
     from corpus_registry import PACKAGES_ROOT
 
     paths = {k: str(v) for k, v in package_paths(ROBOT).items()}
-    world.spawn(str(PACKAGES_ROOT / ROBOT["entry"]), name="tb3", package_paths=paths, on_ground=True)
+    entry = str(PACKAGES_ROOT / ROBOT["entry"])
+    world.spawn(entry, name="tb3", package_paths=paths, on_ground=True)
     world.step(300)  # settle on the ground [ms]
 
 
