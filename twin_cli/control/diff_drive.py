@@ -47,8 +47,10 @@ class DiffDriveController:
         self.rims = (0.0, 0.0)  # rim speeds [m/s] written at the last update
         self.updates = 0
         self.entity_record: Any = None  # the Entity this controller was made for
+        self._written: dict = {}  # the world's commands after our last write (reset clears them)
         self._start()
         self.handle = world.add_observer(self._update, self.rate)
+        self.observed_rate = self.rate
 
     def _start(self) -> None:
         """Odometry frame = the entity's pose now (Gazebo's encoder odometry starts at zero)."""
@@ -62,10 +64,26 @@ class DiffDriveController:
             self.target = (linear, angular)
             now = float(self.world.data.time)
             self.until = math.inf if duration is None else now + duration
+            self._observe_at(self.rate)  # ramping: the fast rate (see MIN_RATE)
+
+    def _observe_at(self, rate: float) -> None:
+        """Re-registers the update at `rate` [Hz] (no-op when already there)."""
+        if rate != self.observed_rate:
+            if self.observed_rate:
+                self.world.remove_observer(self.handle)
+            self.handle = self.world.add_observer(self._update, rate)
+            self.observed_rate = rate
 
     def stop(self) -> None:
-        """Stops calling the controller (entity deleted or world replaced)."""
+        """Stops calling the controller (entity deleted or world replaced); targets stay."""
         self.world.remove_observer(self.handle)
+        self.observed_rate = 0.0
+
+    def resume(self) -> None:
+        """Calls the controller again after `stop` (at the fast rate until the wheels settle)."""
+        with self.world.lock:
+            self.last_time = float(self.world.data.time)
+            self._observe_at(self.rate)
 
     # ------------------------------------------------------------------ the update
     def _update(self) -> None:
@@ -79,8 +97,8 @@ class DiffDriveController:
             self._start()
             return
         dt, self.last_time = now - self.last_time, now
-        speeds = self.wheel_speeds()
         if self.plugin.odometry_source == "encoder" and dt > 0:
+            speeds = self.wheel_speeds()
             left, right = float(np.mean(speeds[0])), float(np.mean(speeds[1]))
             self.encoder = integrate_encoders(
                 self.encoder, left, right, self.radius, self.plugin.wheel_separation, dt
@@ -89,18 +107,21 @@ class DiffDriveController:
             self.target, self.until = (0.0, 0.0), math.inf
         goals = rim_speeds(*self.target, self.plugin.wheel_separation)
         accel = self.plugin.max_wheel_acceleration
-        self.rims = (
-            ramp(self.rims[0], goals[0], accel, dt),
-            ramp(self.rims[1], goals[1], accel, dt),
-        )
-        self._write()
+        rims = (ramp(self.rims[0], goals[0], accel, dt), ramp(self.rims[1], goals[1], accel, dt))
+        if rims != self.rims or self.updates == 0 or self.world._commands != self._written:
+            self.rims = rims
+            self._write()  # only on a change: a held command costs the loop no writes
         self.updates += 1
+        # Wheels at their goal: the plugin's own rate is enough for timeouts and odometry.
+        self._observe_at(self.rate if rims != goals else self.plugin_rate)
 
     def _write(self) -> None:
+        """Writes the rim speeds as wheel velocity targets (through the world's command API)."""
         sides = ((self.plugin.left_joints, self.rims[0]), (self.plugin.right_joints, self.rims[1]))
         for joints, rim in sides:
             for joint in joints:
                 self.world.command(self.entity, joint, mode="velocity", value=rim / self.radius)
+        self._written = dict(self.world._commands)
 
     def wheel_speeds(self) -> tuple[list[float], list[float]]:
         """Left and right wheel joint speeds [rad/s] now (world lock held)."""

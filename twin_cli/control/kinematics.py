@@ -33,7 +33,9 @@ def ramp(current: float, target: float, acceleration: float, dt: float) -> float
     if acceleration <= 0.0:
         return target
     step = acceleration * dt
-    return current + min(max(target - current, -step), step)
+    if abs(target - current) <= step:
+        return target  # exactly: the controller compares rim speeds with their goals
+    return current + math.copysign(step, target - current)
 
 
 def integrate_encoders(
