@@ -29,5 +29,6 @@ def test_the_default_is_odes_100_m_per_s() -> None:
 def test_a_negative_correcting_velocity_names_the_line(tmp_path: Path) -> None:
     path = tmp_path / "w.world"
     path.write_text(WORLD.format(value="-1"))
-    with pytest.raises(ConversionError, match=r"w\.world:3: <contact_max_correcting_vel>.*give a speed >= 0"):
+    where = r"w\.world:3: <contact_max_correcting_vel>: -1\.0 m/s; give a speed >= 0"
+    with pytest.raises(ConversionError, match=where):
         world_from_sdf(path)
