@@ -17,8 +17,8 @@ from twin_cli.cli.output import Output
 
 def drive(
     entity: Annotated[str, typer.Argument(help="The entity with a diff-drive plugin.")],
-    linear: Annotated[float, typer.Option("--linear", help="Forward speed [m/s].")] = 0.0,
-    angular: Annotated[float, typer.Option("--angular", help="Yaw rate [rad/s].")] = 0.0,
+    linear: Annotated[float, typer.Option("--linear", help="Forward speed, m/s.")] = 0.0,
+    angular: Annotated[float, typer.Option("--angular", help="Yaw rate, rad/s.")] = 0.0,
     duration: Annotated[
         float | None,
         typer.Option("-d", "--duration", help="Sim seconds, then the wheels stop (default: hold)."),
