@@ -31,6 +31,7 @@ class Conversion:
     provenance: Provenance
     description: RobotDescription
     sensors: tuple[SensorSpec, ...] = ()
+    plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (run by twin_cli.control)
 
 
 def read_description(
@@ -150,6 +151,7 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
+    from converters.gazebo.plugins import add_drive_motors, read_plugins
     from converters.gazebo.sensor_sites import add_sensors
 
     options = options or ConvertOptions()
@@ -159,7 +161,9 @@ def build_description(
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
-    return Conversion(spec, report, provenance, robot, sensors)
+    plugins = read_plugins(robot.gazebo.plugins, robot.source)
+    add_drive_motors(spec, plugins, report)
+    return Conversion(spec, report, provenance, robot, sensors, plugins)
 
 
 def convert(

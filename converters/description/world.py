@@ -37,7 +37,9 @@ class WorldDescription:
         timestep: [s] `<physics><max_step_size>`; rate: [Hz] `<real_time_update_rate>`
             (0 = as fast as possible); real_time_factor: the target factor;
         iterations: solver iterations (`<ode><solver><iters>`);
-        gravity: [m/s²]; models: in file order; lights: world-level lights.
+        gravity: [m/s²]; models: in file order; lights: world-level lights;
+        contact_max_correcting_vel: [m/s] ODE's cap on the speed at which contacts push
+            overlapping bodies apart (`<ode><constraints>`; SDF default 100).
     """
 
     name: str
@@ -49,3 +51,4 @@ class WorldDescription:
     gravity: tuple[float, float, float]
     models: tuple[PlacedModel, ...] = ()
     lights: tuple[Light, ...] = ()
+    contact_max_correcting_vel: float = 100.0

@@ -123,9 +123,13 @@ def _report_joint_flags(ext: JointExtension, subject: str, report: Report) -> No
 def report_blobs(ext: GazeboExtensions, report: Report) -> None:
     """Report every kept-verbatim element (plugins, unknown tags) as ignored, with why.
 
-    Sensors are reported by `converters.gazebo.sensor_sites`, which maps them.
+    Sensors are reported by `converters.gazebo.sensor_sites`, which maps them; model plugins by
+    `converters.gazebo.plugins` (run as twin controllers or not run).
     """
-    for blob in ext.plugins + ext.model_blobs:
+    from converters.gazebo.plugins import report_plugins
+
+    report_plugins(ext.plugins, report)
+    for blob in ext.model_blobs:
         _report_blob("model", blob, report)
     for link, link_ext in ext.links.items():
         for blob in link_ext.blobs:

@@ -31,6 +31,10 @@ WORLD_IGNORED = (
     "state",
     "plugin",
 )
+DEFAULT_MAX_CORRECTING_VEL = (
+    100.0  # [m/s] physics.sdf <ode><constraints><contact_max_correcting_vel>
+)
+CORRECTING_PATH = "ode/constraints/contact_max_correcting_vel"
 
 
 def read_world(ctx: SdfContext, world: Any, text: str = "") -> WorldDescription:
@@ -82,12 +86,16 @@ def _physics(ctx: SdfContext, world: Any) -> dict[str, Any]:
             "rate": DEFAULT_RATE,
             "real_time_factor": 1.0,
             "iterations": DEFAULT_ITERATIONS,
+            "contact_max_correcting_vel": DEFAULT_MAX_CORRECTING_VEL,
         }
     step = ctx.number(chosen, "max_step_size", DEFAULT_STEP)
     if step <= 0:
         raise ctx.error(chosen.find("max_step_size"), f"{step} s", "give a positive step in s")
     rate = ctx.number(chosen, "real_time_update_rate", DEFAULT_RATE)
     iterations = ctx.number(chosen, "ode/solver/iters", DEFAULT_ITERATIONS)
+    correcting = ctx.number(chosen, CORRECTING_PATH, DEFAULT_MAX_CORRECTING_VEL)
+    if correcting < 0:
+        raise ctx.error(chosen.find(CORRECTING_PATH), f"{correcting} m/s", "give a speed >= 0")
     if chosen.get("type", "ode") != "ode":
         ctx.report.approximated("world <physics>", f"engine {chosen.get('type')} → MuJoCo")
     return {
@@ -95,6 +103,7 @@ def _physics(ctx: SdfContext, world: Any) -> dict[str, Any]:
         "rate": max(rate, 0.0),
         "real_time_factor": ctx.number(chosen, "real_time_factor", 1.0),
         "iterations": max(int(iterations), 1),
+        "contact_max_correcting_vel": correcting,
     }
 
 

@@ -145,6 +145,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
                 dict(joints or {}),
                 loaded.description,
                 sensors=loaded.sensors,
+                plugins=loaded.plugins,
             )
             self._commit(self._spec, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report, loaded.cached)

@@ -97,6 +97,7 @@ class Entity:
     joints: dict[str, float] = field(default_factory=dict)
     description: str | None = field(default=None, repr=False)
     sensors: tuple = field(default=(), repr=False)
+    plugins: tuple = field(default=(), repr=False)  # DiffDrive records (twin_cli.control)
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:

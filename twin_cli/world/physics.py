@@ -46,6 +46,7 @@ class PhysicsSettings:
                 "integrator": s.integrator,
                 "gravity": list(s.gravity),
                 "target_factor": s.timestep * s.rate if s.rate > 0 else None,
+                "contact_max_correcting_vel": s.contact_max_correcting_vel,
                 "not_applicable": list(ODE_ONLY_FIELDS),
                 "threads": self.threads,
                 "pool_threads": self.pool_threads,

@@ -48,6 +48,7 @@ def world_from_sdf(
         gravity=description.gravity,
         iterations=description.iterations,
         ground=False,
+        contact_max_correcting_vel=description.contact_max_correcting_vel,
     )
     world = World(settings, name=name)
     world.set_lights(description.lights)

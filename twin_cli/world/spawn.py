@@ -72,6 +72,7 @@ class LoadedSource:
     notes: tuple[str, ...] = ()
     cached: bool = False
     mesh_keys: dict[str, str] | None = None
+    plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (URDF/SDF)
 
 
 def load_source(
@@ -142,6 +143,7 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
         name,
         _urdf_or_none(done.description.text),
         done.sensors,
+        done.plugins,
     )
 
 
@@ -196,7 +198,9 @@ def _convert_description(
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
-    return LoadedSource(spec, str(path), report.to_dict(), None, name, description, done.sensors)
+    return LoadedSource(
+        spec, str(path), report.to_dict(), None, name, description, done.sensors, done.plugins
+    )
 
 
 def _urdf_or_none(text: str) -> str | None:

@@ -36,6 +36,7 @@ class WorldSettings:
     ground: bool = True
     solver: str = options.SOLVER
     integrator: str = options.INTEGRATOR
+    contact_max_correcting_vel: float = 100.0  # [m/s] ODE's; shown by `twin physics`
 
 
 @dataclass(frozen=True)

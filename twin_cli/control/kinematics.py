@@ -1,0 +1,63 @@
+"""Differential-drive kinematics: (v, ω) → wheel speeds, the acceleration ramp, encoder odometry.
+
+Pure functions of numbers, testable without a world. The rules are gazebo_ros_diff_drive's:
+rim speeds v ∓ ω·b/2 for the left/right wheel (b the wheel separation); the commanded rim speed
+moves towards its target by at most `max_wheel_acceleration`·dt per update (0 = at once); the
+encoder odometry integrates the wheels' travel with the heading taken at the middle of the
+update (Siegwart, Autonomous Mobile Robots, 2011, p. 337).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """A planar pose: x, y [m] and heading theta [rad]."""
+
+    x: float = 0.0
+    y: float = 0.0
+    theta: float = 0.0
+
+
+def rim_speeds(linear: float, angular: float, separation: float) -> tuple[float, float]:
+    """Left and right wheel rim speeds [m/s] for a body twist (v [m/s], ω [rad/s])."""
+    half = angular * separation / 2.0
+    return linear - half, linear + half
+
+
+def ramp(current: float, target: float, acceleration: float, dt: float) -> float:
+    """`current` moved towards `target` by at most acceleration·dt [m/s]; 0 = no limit."""
+    if acceleration <= 0.0:
+        return target
+    step = acceleration * dt
+    if abs(target - current) <= step:
+        return target  # exactly: the controller compares rim speeds with their goals
+    return current + math.copysign(step, target - current)
+
+
+def integrate_encoders(
+    pose: Pose2D, left: float, right: float, radius: float, separation: float, dt: float
+) -> Pose2D:
+    """The pose after the wheels turned at `left`/`right` [rad/s] for `dt` [s].
+
+    Args:
+        pose: start pose in the odometry frame.
+        left, right: wheel joint speeds [rad/s]; radius [m]; separation [m]; dt [s].
+    """
+    s_left, s_right = left * radius * dt, right * radius * dt
+    travel, turn = (s_left + s_right) / 2.0, (s_right - s_left) / separation
+    heading = pose.theta + turn / 2.0
+    return Pose2D(
+        pose.x + travel * math.cos(heading),
+        pose.y + travel * math.sin(heading),
+        pose.theta + turn,
+    )
+
+
+def body_twist(left: float, right: float, radius: float, separation: float) -> tuple[float, float]:
+    """Forward speed [m/s] and yaw rate [rad/s] from wheel joint speeds [rad/s]."""
+    v_left, v_right = left * radius, right * radius
+    return (v_left + v_right) / 2.0, (v_right - v_left) / separation
