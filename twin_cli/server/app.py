@@ -25,7 +25,7 @@ from twin_cli.errors import (
     RequestError,
     TwinError,
 )
-from twin_cli.server import consumer_routes, sensor_routes
+from twin_cli.server import consumer_routes, sensor_routes, view_routes
 from twin_cli.server.holder import WorldDep, WorldHolder
 from twin_cli.server.models import (
     CommandBody,
@@ -338,6 +338,7 @@ def create_app(
     app.include_router(router)
     app.include_router(consumer_routes.router)
     app.include_router(sensor_routes.router)
+    app.include_router(view_routes.router)
     app.add_exception_handler(TwinError, _known_error)
     app.add_exception_handler(ConversionError, _known_error)
     app.add_exception_handler(RequestValidationError, _validation_error)

@@ -36,6 +36,7 @@ class ServeOptions:
         background: started by a client that holds the world's start lock.
         record: a rosbag2 MCAP file to record into from the start (100 Hz), or None.
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
+        view: serve MuJoCo's web viewer on 127.0.0.1 from the start.
     """
 
     world: str = runtime.DEFAULT_WORLD
@@ -47,6 +48,7 @@ class ServeOptions:
     background: bool = False
     record: str | None = None
     foxglove: int | None = None
+    view: bool = False
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -152,6 +154,9 @@ def serve(opts: ServeOptions) -> None:
     Raises:
         WorldRunningError: a server for this world already runs.
     """
+    from twin_cli.view.offscreen import use_egl
+
+    use_egl()  # before mujoco's first import: snapshots render offscreen on EGL
     import uvicorn
 
     from twin_cli.server.app import create_app
@@ -182,9 +187,12 @@ def serve(opts: ServeOptions) -> None:
                 sys.stderr.write(
                     f"twin: serving world [{opts.world}] on {paths.socket}; log {paths.log}\n"
                 )
+            if opts.view:
+                _start_view(app)
             with contextlib.suppress(KeyboardInterrupt):
                 server.run(sockets=sockets)
         finally:
+            _close_views(app)
             consumers.close()
             app.state.holder.world.stop()
             log.info("world [%s] stopped", opts.world)
@@ -220,3 +228,18 @@ def _listen(paths: runtime.WorldPaths, tcp: tuple[str, int] | None, token: str |
     if not ipaddress.ip_address(host).is_loopback:
         log.warning("TCP listener on non-loopback %s:%d; every request needs the token", host, port)
     return sockets
+
+
+def _start_view(app: Any) -> None:
+    """`--view`: the web viewer on 127.0.0.1; its URL on stderr."""
+    from twin_cli.server.view_routes import view_service
+
+    url = view_service(app.state).start()["url"]
+    sys.stderr.write(f"twin: viewer on {url}\n")
+
+
+def _close_views(app: Any) -> None:
+    """Closes the web viewer, if one runs, so the page says the world went away."""
+    service = getattr(app.state, "views", None)
+    if service is not None:
+        service.close()

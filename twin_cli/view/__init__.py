@@ -16,7 +16,7 @@ _WHERE = {
     "WebHost": "twin_cli.view.host",
     "ViewAddress": "twin_cli.view.host",
     "ViewService": "twin_cli.view.service",
-    "OffscreenUnavailable": "twin_cli.view.offscreen",
+    "CameraView": "twin_cli.view.offscreen",
     "snapshot_png": "twin_cli.view.offscreen",
 }
 __getattr__ = lazy_getattr(__name__, _WHERE)

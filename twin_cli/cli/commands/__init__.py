@@ -7,7 +7,7 @@ import importlib
 import typer
 
 # Each module registers its commands on the app. Keep this list in the order of `twin --help`.
-MODULES = ("convert", "cache", "serve", "world", "record", "sensors", "validate")
+MODULES = ("convert", "cache", "serve", "world", "record", "sensors", "validate", "view")
 
 
 def register_all(app: typer.Typer) -> None:

@@ -32,6 +32,9 @@ def serve(
         int | None,
         typer.Option(help="Stream live to Foxglove on 127.0.0.1:PORT (Foxglove's is 8765)."),
     ] = None,
+    view: Annotated[
+        bool, typer.Option("--view", help="Serve MuJoCo's web viewer on 127.0.0.1 too.")
+    ] = False,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
     from twin_cli.server.process import ServeOptions
@@ -47,6 +50,7 @@ def serve(
         background,
         str(record) if record else None,
         foxglove,
+        view,
     )
     run_server(opts)
 

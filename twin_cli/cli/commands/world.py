@@ -63,6 +63,9 @@ def spawn(
         tuple[float, float, float, float] | None,
         typer.Option(help="Orientation as a quaternion X Y Z W, instead of -R -P -Y."),
     ] = None,
+    view: Annotated[
+        bool, typer.Option("--view", help="Also show the world in the web viewer (twin view).")
+    ] = False,
 ) -> None:
     """Spawn a robot or model; prints its name once it exists in the world."""
     with usage_errors():
@@ -84,6 +87,10 @@ def spawn(
             xml=xml,
             quat=quat,
         )
+    if view:
+        from twin_cli.cli.commands.view import start_view
+
+        start_view(world)
 
 
 def delete(name: NameArg, world: WorldOpt = "default") -> None:
