@@ -113,28 +113,34 @@ def png_bytes(pixels: Any) -> bytes:
     return buffer.getvalue()
 
 
-def entity_view(world: Any, entity: str | None, width: int, height: int) -> CameraView:
-    """The camera on `entity`'s bodies (its root body's position, its bodies' spread), or on
-    the whole scene; call with the world's lock held."""
+def entity_view(model: Any, data: Any, bodies: Any, width: int, height: int) -> CameraView:
+    """The camera on an entity's `bodies` (its root body's centre of mass, its bodies' spread),
+    or on the whole scene when `bodies` is None."""
     import numpy as np
 
-    model, data = world.model, world.data
-    if entity is None:
+    if bodies is None or not len(bodies):
         return aim(model, data, model.stat.center, float(model.stat.extent) / 2, width, height)
-    ix = world._require(entity)
-    points = data.xpos[ix.bodies]
-    centre = data.xipos[ix.bodies[0]] if len(ix.bodies) else np.zeros(3)
-    spread = float(np.max(np.linalg.norm(points - centre, axis=1))) if len(points) else 0.0
+    centre = data.xipos[bodies[0]]
+    spread = float(np.max(np.linalg.norm(data.xpos[bodies] - centre, axis=1)))
     return aim(model, data, centre, max(spread, 0.3), width, height)
 
 
 def snapshot_png(world: Any, *, entity: str | None, width: int, height: int) -> tuple[bytes, dict]:
-    """Renders `world` now; returns the PNG and the camera (`CameraView.to_dict`)."""
+    """Renders `world` now; returns the PNG and the camera (`CameraView.to_dict`).
+
+    The state is copied under the world's lock and rendered outside it (the loop keeps
+    stepping); the copy is brought up to date with `mj_forward`, since a paused world that was
+    just spawned into has not computed its body poses yet.
+    """
     import copy
 
-    with world.lock:  # copy under the lock; render outside it, so the loop keeps stepping
-        view = entity_view(world, entity, width, height)
+    import mujoco
+
+    with world.lock:
+        bodies = None if entity is None else world._require(entity).bodies
         model, data = world.model, copy.copy(world.data)
+    mujoco.mj_forward(model, data)
+    view = entity_view(model, data, bodies, width, height)
     return png_bytes(render(model, data, view)), view.to_dict()
 
 
