@@ -23,6 +23,7 @@ PACKAGES = [
     "twin_cli.sensors",
     "twin_cli.server",
     "twin_cli.validate",
+    "twin_cli.view",
     "twin_cli.world",
 ]
 
