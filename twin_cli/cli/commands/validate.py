@@ -30,6 +30,10 @@ MarkdownOpt = Annotated[
     Path | None, typer.Option("--markdown", help="Write a Markdown summary to FILE.")
 ]
 PlotsOpt = Annotated[Path | None, typer.Option("--plots", help="Write PNG plots into DIR.")]
+VideoOpt = Annotated[
+    Path | None,
+    typer.Option("--video", help="Write one MP4 per physics scenario into DIR (offscreen EGL)."),
+]
 RepairOpt = Annotated[
     bool,
     typer.Option(
@@ -58,6 +62,7 @@ def validate(
     json: JsonOpt = False,
     markdown: MarkdownOpt = None,
     plots: PlotsOpt = None,
+    video: VideoOpt = None,
     repair_inertia: RepairOpt = False,
     collision: CollisionOpt = None,
     joint: JointOpt = None,
@@ -71,19 +76,21 @@ def validate(
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input."""
     from twin_cli.cli.output import Output
     from twin_cli.validate import report as render
+    from twin_cli.validate import video as films
     from twin_cli.validate.runner import validate as run_validation
 
-    run = run_validation(
-        robot,
-        **source_inputs(arg, package),
-        scenarios=scenario,
-        only=only,
-        skip=skip,
-        repair_inertia=repair_inertia,
-        collision=collision,
-        joints=joint_positions(joint),
-        as_written=as_written,
-    )
+    with films.filming(video):
+        run = run_validation(
+            robot,
+            **source_inputs(arg, package),
+            scenarios=scenario,
+            only=only,
+            skip=skip,
+            repair_inertia=repair_inertia,
+            collision=collision,
+            joints=joint_positions(joint),
+            as_written=as_written,
+        )
     out = Output(json)
     if json:
         out.data(run.to_dict())
@@ -96,6 +103,8 @@ def validate(
     if plots:
         for path in render.write_plots(run, plots):
             out.line(f"plot: {path}")
+    for path in films.written if video else []:
+        out.line(f"video: {path}")
     raise typer.Exit(0 if run.passed else 1)
 
 

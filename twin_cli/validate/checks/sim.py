@@ -90,6 +90,9 @@ class ScenarioRun:
         self.time = 0.0
         self.q_hold = self.qpos()[[j.qpos for j in self.joints]].copy()
         self.kp, self.kd = self._hold_gains()
+        from twin_cli.validate import video
+
+        video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
         model = self.world.model
