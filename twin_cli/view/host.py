@@ -11,6 +11,8 @@ swaps it in place (no reload) and keeps its camera, since the model path stays "
 
 from __future__ import annotations
 
+import contextlib
+import io
 import ipaddress
 import logging
 import queue
@@ -19,6 +21,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
+
+from mujoco.studio import messages
 
 from twin_cli.view.bridge import WorldBridge
 
@@ -65,6 +69,11 @@ def _viewer_class(host: str) -> type:
         def _host(self, _ignored: str) -> None:
             pass
 
+        @messages.handler(priority=messages.Priority.INTERNAL)
+        def _on_post_model(self, event: messages.PostModelEvent) -> None:
+            """Serves the new model; the page swaps it in place (MuJoCo's prints a line)."""
+            self._update_model()
+
     return BoundWebViewer
 
 
@@ -110,7 +119,9 @@ class WebHost:
 
         def run(endpoint: Any) -> None:
             try:
-                viewer = viewer_class(config, endpoint, plugins=[studio_app.App()])
+                # MuJoCo prints a banner (URL, "Ctrl+C to quit") on stdout: twin prints its own.
+                with contextlib.redirect_stdout(io.StringIO()):
+                    viewer = viewer_class(config, endpoint, plugins=[studio_app.App()])
             except BaseException as exc:
                 bound.put(exc)
                 raise
