@@ -46,3 +46,28 @@ def test_validate_video_writes_one_playable_video_per_physics_scenario(tmp_path)
     next(falling)
     first, *_, last = (np.frombuffer(f, np.uint8) for f in falling)
     assert np.abs(first.astype(int) - last).mean() > 1.0, "the falling robot does not move"
+
+
+def test_plots_draw_the_threshold_and_the_markdown_report_embeds_them(tmp_path):
+    """The slip plot has its threshold line, free fall its allowed band; the report links both."""
+    from PIL import Image
+
+    plots, report = tmp_path / "plots", tmp_path / "report.md"
+    proc = subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", "validate", str(HUMANOID),
+         "--only", "gravity", "--only", "friction_standing",
+         "--plots", str(plots), "--markdown", str(report)],
+        capture_output=True, text=True, timeout=300, env=os.environ.copy(),
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    text = report.read_text()
+    for name in ("gravity_free_fall.png", "friction_standing_foot_slip.png"):
+        assert f"](plots/{name})" in text, f"{name} is not embedded in the report"
+        assert (plots / name).is_file()
+    slip = np.asarray(Image.open(plots / "friction_standing_foot_slip.png").convert("RGB"))
+    red = (slip[..., 0] > 180) & (slip[..., 1] < 100) & (slip[..., 2] < 100)
+    rows = np.flatnonzero(red.sum(axis=1) > slip.shape[1] // 5)  # a dotted line: ~30 % red
+    assert len(rows), "no red threshold line across the slip plot"
+    fall = np.asarray(Image.open(plots / "gravity_free_fall.png").convert("RGB")).astype(int)
+    green = (fall[..., 1] > fall[..., 0] + 20) & (fall[..., 1] > fall[..., 2] + 20)
+    assert green.sum() > 50, "no allowed band drawn on the free-fall plot"

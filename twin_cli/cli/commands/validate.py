@@ -99,7 +99,12 @@ def validate(
     if junit:
         junit.write_text(render.junit_xml(run), encoding="utf-8")
     if markdown:
-        markdown.write_text(render.markdown(run), encoding="utf-8")
+        linked = None
+        if plots:  # linked from where the Markdown file is, if the plots are below it
+            base = markdown.resolve().parent
+            target = plots.resolve()
+            linked = str(target.relative_to(base)) if target.is_relative_to(base) else str(target)
+        markdown.write_text(render.markdown(run, plots=linked), encoding="utf-8")
     if plots:
         for path in render.write_plots(run, plots):
             out.line(f"plot: {path}")
