@@ -30,6 +30,7 @@ log = logging.getLogger("twin.view")
 
 SYNC_HZ = 30.0  # [Hz] of wall time; the page renders at the browser's rate in between
 START_TIMEOUT_S = 30.0  # [s] for the viewer thread to bind its port and start its server
+CLOSE_TIMEOUT_S = 20.0  # [s] for the viewer thread to end after its exit event
 LOOPBACK = "127.0.0.1"
 
 
@@ -173,8 +174,16 @@ class WebHost:
             self._thread.join()
             self._thread = None
         handle, self._handle = self._handle, None
-        if handle is not None:
-            try:
-                handle.close()
-            except Exception:
-                log.exception("viewer closed with an error")
+        if handle is None:
+            return
+        try:
+            handle.close()
+        except Exception:
+            log.exception("viewer closed with an error")
+        # `close` waits only 5 s for the viewer thread; its ImGui context is process-global, and
+        # a viewer started while the old thread still draws crashes in MuJoCo's extension
+        # (seen on a loaded machine). Wait until the thread has really ended.
+        alive = getattr(handle, "_is_alive_fn", None)
+        deadline = time.monotonic() + CLOSE_TIMEOUT_S
+        while alive is not None and alive() and time.monotonic() < deadline:
+            time.sleep(0.05)
