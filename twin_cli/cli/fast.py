@@ -93,6 +93,7 @@ GRAMMARS: dict[str, Grammar] = {
             JSON,
             Opt(("--xml",), "xml", str),
             Opt(("--quat",), "quat", float, nargs=4),
+            _flag("--view", dest="view"),
         ),
     ),
     "delete": Grammar("delete", (NAME,), (WORLD,)),

@@ -104,8 +104,10 @@ def spawn(
     json: bool,
     xml: str | None = None,
     quat: tuple[float, float, float, float] | None = None,
+    view: bool = False,
 ) -> None:
-    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`)."""
+    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`);
+    `view` also shows the world in the web viewer (its URL on stderr)."""
     inputs = pairs.source_inputs(arg, package)
     joints = pairs.joint_positions(joint)
     pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
@@ -118,6 +120,9 @@ def spawn(
         result = c.spawn(
             file, name=name, pose=pose, on_ground=on_ground, joints=joints, **source, **inputs
         )
+        if view:
+            url = c.request("POST", "/view", body={})["url"]
+            sys.stderr.write(f"twin: viewer on {url}\n")
     out = Output(json)
     if json:
         out.data(result)

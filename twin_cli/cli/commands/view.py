@@ -56,15 +56,6 @@ def view(
         webbrowser.open(reply["url"], new=2)
 
 
-def start_view(world: str) -> None:
-    """`twin spawn --view`: the viewer on 127.0.0.1; its URL on stderr."""
-    from twin_cli.server.client import connect
-
-    with connect(world) as client:
-        reply = client.request("POST", "/view", body={})
-    sys.stderr.write(f"twin: viewer on {reply['url']}\n")
-
-
 def snapshot(
     out: Annotated[Path, typer.Argument(help="The PNG file to write (OUT.png).")],
     entity: Annotated[

@@ -86,11 +86,8 @@ def spawn(
             json=json,
             xml=xml,
             quat=quat,
+            view=view,
         )
-    if view:
-        from twin_cli.cli.commands.view import start_view
-
-        start_view(world)
 
 
 def delete(name: NameArg, world: WorldOpt = "default") -> None:
