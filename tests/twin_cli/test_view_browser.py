@@ -1,7 +1,7 @@
 """The web viewer in a real browser (Debian's headless chromium) on a real world server.
 
-One page for the whole module (its first load takes ~12 s with WebGL in SwiftShader), checked in
-sequence: the humanoid shows, a spawned red box appears without a page reload, the page's Pause
+One page (its first load takes ~12 s with WebGL in SwiftShader), checked in sequence by one
+test: the humanoid shows, a spawned red box appears without a page reload, the page's Pause
 pauses the world, the page's Reset puts entities back at their spawn poses.
 """
 
@@ -74,7 +74,7 @@ def wait_for(what: str, test, timeout: float = WAIT_S):
     pytest.fail(f"{what} within {timeout:.0f} s (last: {last}; screenshots in {SHOTS})")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def page(tmp_path_factory, serve_world):
     from playwright.sync_api import sync_playwright
 
@@ -95,7 +95,7 @@ def page(tmp_path_factory, serve_world):
             browser.close()
 
 
-def test_1_the_page_shows_the_humanoid(page):
+def _the_page_shows_the_humanoid(page):
     tab, out = page
     wait_for(
         "the humanoid's trousers appear on the page",
@@ -103,7 +103,7 @@ def test_1_the_page_shows_the_humanoid(page):
     )
 
 
-def test_2_a_spawned_red_box_appears_without_a_page_reload(page):
+def _a_spawned_red_box_appears_without_a_page_reload(page):
     tab, out = page
     # The humanoid's shirt (0.8 0.2 0.2) renders as red as the box: count the red it adds.
     before = int(pure_red(shot(tab, "before_box", out)).sum())
@@ -118,7 +118,7 @@ def test_2_a_spawned_red_box_appears_without_a_page_reload(page):
     assert tab.evaluate("window.twinLoaded") == "same page", "the page was reloaded"
 
 
-def test_3_pause_in_the_page_pauses_the_world(page):
+def _pause_in_the_page_pauses_the_world(page):
     tab, _ = page
     assert "Paused[F]" in twin("stats", "-d", "0").stdout
     tab.mouse.click(*PAUSE_BUTTON)
@@ -127,7 +127,7 @@ def test_3_pause_in_the_page_pauses_the_world(page):
     )
 
 
-def test_4_reset_in_the_page_puts_entities_back_at_their_spawn_pose(page):
+def _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page):
     tab, _ = page
     fallen = json.loads(twin("pose", "box", "--json").stdout)
     assert fallen["z"] < SPAWN_Z - 0.3, f"the box did not fall first: z {fallen['z']} m"
@@ -140,3 +140,11 @@ def test_4_reset_in_the_page_puts_entities_back_at_their_spawn_pose(page):
     wait_for("`twin pose box` back at its spawn pose (0.6, 0, 1.0) m", back)
     stats = twin("stats", "-d", "0").stdout
     assert "SimTime[0.00]" in stats and "Paused[T]" in stats, stats
+
+
+def test_the_viewer_shows_and_drives_the_world(page):
+    """One test (one page: pytest-xdist must not split the steps over workers), in order."""
+    _the_page_shows_the_humanoid(page)
+    _a_spawned_red_box_appears_without_a_page_reload(page)
+    _pause_in_the_page_pauses_the_world(page)
+    _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page)
