@@ -115,3 +115,28 @@ def test_snapshot_of_a_red_box_has_red_pixels_where_the_camera_projects_it(tmp_p
     )
     centre_uv = project(np.array([centre]), camera)[0].round().astype(int)
     assert pure_red(pixels)[centre_uv[1], centre_uv[0]], "the box centre's pixel is not red"
+
+
+def test_a_viewer_perturbation_adds_to_pushes_and_neither_erases_the_other(tmp_path):
+    """World.perturb (the page's Ctrl+drag) and World.push (`twin push`) on one body sum in
+    xfrc_applied; when the push ends the drag stays, and ending the drag leaves no force."""
+    from twin_cli.world import Pose, World, WorldSettings
+
+    urdf = tmp_path / "box.urdf"
+    urdf.write_text(red_box(0.2))
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0), ground=False))
+    world.spawn(str(urdf), name="box", pose=Pose(z=1.0))
+    body = world.model.body("box/box").id
+    world.push("box", (10.0, 0.0, 0.0), duration=0.01)  # 10 steps of 1 ms
+    world.perturb({"box/box": (0.0, 4.0, 0.0, 0.0, 0.0, 0.5)})
+    assert list(world.data.xfrc_applied[body]) == [10.0, 4.0, 0.0, 0.0, 0.0, 0.5]
+    world.step(5)
+    world.perturb({"box/box": (0.0, 3.0, 0.0, 0.0, 0.0, 0.0)})  # the next frame of the drag
+    assert list(world.data.xfrc_applied[body]) == [10.0, 3.0, 0.0, 0.0, 0.0, 0.0]
+    world.step(10)  # the push has ended
+    assert list(world.data.xfrc_applied[body]) == [0.0, 3.0, 0.0, 0.0, 0.0, 0.0]
+    world.perturb({})
+    assert not world.data.xfrc_applied[body].any(), "the ended drag left a force"
+    # Momentum oracle: 10 N for 0.01 s + the drag's y forces (4 N × 5 ms, 3 N × 10 ms) on 1 kg.
+    vx, vy = world.data.qvel[0], world.data.qvel[1]
+    assert abs(vx - 0.1) < 1e-9 and abs(vy - (4 * 0.005 + 3 * 0.010)) < 1e-9, (vx, vy)
