@@ -102,3 +102,51 @@ def test_every_world_command_against_a_running_world_imports_nothing_heavy(tmp_p
         if server.poll() is None:
             server.terminate()
             server.wait(timeout=20)
+
+
+def test_view_and_snapshot_import_neither_physics_nor_the_viewer(tmp_path, monkeypatch):
+    """`twin view` and `twin snapshot` only ask the server (which hosts and renders)."""
+    monkeypatch.setenv(runtime.RUNTIME_ENV, str(tmp_path))
+    env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
+    env.pop("TWIN_WORLD", None)
+    server = subprocess.Popen(
+        [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", WORLD],
+        env=env,
+        stderr=subprocess.DEVNULL,
+    )
+    client = Client(WORLD)
+    commands = [
+        ["view"],
+        ["snapshot", str(tmp_path / "w.png"), "--width", "64"],
+        ["view", "--stop"],
+    ]
+    try:
+        runtime.wait_until(client.paths, client.alive, server, 60.0)
+        for args in commands:
+            proc = subprocess.run(
+                [
+                    sys.executable,
+                    "-X",
+                    "importtime",
+                    "-m",
+                    "twin_cli.cli.app",
+                    *args,
+                    "--world",
+                    WORLD,
+                ],
+                env=env,
+                capture_output=True,
+                text=True,
+                timeout=60,
+            )
+            assert proc.returncode in (0, 2), f"twin {args}: {proc.stderr[-500:]}"
+            names = set(
+                re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s*([\w.]+)", proc.stderr, re.M)
+            )
+            heavy = {n for n in names if n.split(".")[0] in HEAVY or n.startswith("twin_cli.view")}
+            assert not heavy, f"twin {args} imported {sorted(heavy)}"
+            assert "mujoco.studio" not in names
+    finally:
+        client.close()
+        server.terminate()
+        server.wait(timeout=20)

@@ -24,6 +24,7 @@ PACKAGES = [
     "twin_cli.control",
     "twin_cli.server",
     "twin_cli.validate",
+    "twin_cli.view",
     "twin_cli.world",
 ]
 

@@ -139,3 +139,14 @@ class OutcomeUnknownError(TwinError):
             "set TWIN_TIMEOUT (s) to wait longer"
         )
         self.world = world
+
+
+class OffscreenUnavailableError(TwinError):
+    """No offscreen OpenGL for `twin snapshot` or `twin validate --video`."""
+
+    def __init__(self, problem: str) -> None:
+        super().__init__(
+            f"offscreen rendering is not available ({problem}); install Mesa's EGL "
+            "(Debian/Ubuntu: `apt-get install libegl-mesa0 libgl1-mesa-dri`) and run with "
+            "MUJOCO_GL=egl (the world server sets it when unset)"
+        )

@@ -95,6 +95,7 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--quat",), "quat", float, nargs=4),
             Opt(("--at",), "at", str, multiple=True),
             Opt(("--names",), "names", str),
+            _flag("--view", dest="view"),
         ),
     ),
     "delete": Grammar("delete", (NAME,), (WORLD,)),

@@ -112,10 +112,12 @@ def spawn(
     quat: tuple[float, float, float, float] | None = None,
     at: list[str] | None = None,
     names: str | None = None,
+    view: bool = False,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
-    With `--at` (repeated), one entity per pose in one request (`spawn_many`).
+    With `--at` (repeated), one entity per pose in one request (`spawn_many`); `view` also shows
+    the world in the web viewer (its URL on stderr).
     """
     if name is not None:
         from twin_cli.names import name_message, name_problem
@@ -143,6 +145,9 @@ def spawn(
         result = c.spawn(
             file, name=name, pose=pose, on_ground=on_ground, joints=joints, **source, **inputs
         )
+        if view:
+            url = c.request("POST", "/view", body={})["url"]
+            sys.stderr.write(f"twin: viewer on {url}\n")
     out = Output(json)
     if json:
         out.data(result)

@@ -27,7 +27,7 @@ from twin_cli.errors import (
     RequestError,
     TwinError,
 )
-from twin_cli.server import consumer_routes, control_routes, sensor_routes
+from twin_cli.server import consumer_routes, control_routes, sensor_routes, view_routes
 from twin_cli.server.holder import WorldDep, WorldHolder
 from twin_cli.server.models import (
     CommandBody,
@@ -416,7 +416,13 @@ def create_app(
     app.state.operations = Operations()
     app.state.world_name = world_name
     app.state.request_exit = request_exit or (lambda: None)
-    for routes in (router, consumer_routes.router, sensor_routes.router, control_routes.router):
+    for routes in (
+        router,
+        consumer_routes.router,
+        sensor_routes.router,
+        control_routes.router,
+        view_routes.router,
+    ):
         app.include_router(routes, responses=ERROR_RESPONSES)
     app.add_exception_handler(TwinError, _known_error)
     app.add_exception_handler(ConversionError, _known_error)

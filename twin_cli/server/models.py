@@ -174,3 +174,19 @@ class SpawnBatchBody(SpawnBody):
 
     poses: Annotated[list[PoseBody], Field(min_length=1, max_length=1000)]
     names: list[EntityName] | None = None
+
+
+class ViewBody(Body):
+    """`twin view`: MuJoCo's web viewer on this world (loopback unless a host is given)."""
+
+    port: Annotated[int, Field(ge=0, le=65535)] = 0
+    host: str = "127.0.0.1"
+
+
+class SnapshotBody(Body):
+    """`twin snapshot`: a PNG of the world rendered offscreen, written on the server's host."""
+
+    path: str
+    entity: str | None = None
+    width: Annotated[int, Field(ge=1, le=4096)] = 640
+    height: Annotated[int, Field(ge=1, le=4096)] = 480

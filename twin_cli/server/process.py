@@ -37,6 +37,7 @@ class ServeOptions:
         record: a rosbag2 MCAP file to record into from the start (100 Hz), or None.
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
         autosave: seconds between autosaves to `<world>.autosave.json`; 0 turns it off.
+        view: serve MuJoCo's web viewer on 127.0.0.1 from the start.
     """
 
     world: str = runtime.DEFAULT_WORLD
@@ -49,6 +50,7 @@ class ServeOptions:
     record: str | None = None
     foxglove: int | None = None
     autosave: float = 10.0
+    view: bool = False
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -187,6 +189,9 @@ def serve(opts: ServeOptions) -> None:
     Raises:
         WorldRunningError: a server for this world already runs.
     """
+    from twin_cli.view.offscreen import use_egl
+
+    use_egl()  # before mujoco's first import: snapshots render offscreen on EGL
     import uvicorn
 
     from twin_cli.server.app import create_app
@@ -219,9 +224,12 @@ def serve(opts: ServeOptions) -> None:
                 sys.stderr.write(
                     f"twin: serving world [{opts.world}] on {paths.socket}; log {paths.log}\n"
                 )
+            if opts.view:
+                _start_view(app)
             with contextlib.suppress(KeyboardInterrupt):
                 server.run(sockets=sockets)
         finally:
+            _close_views(app)
             consumers.close()
             saver.close()
             app.state.holder.world.stop()
@@ -267,3 +275,18 @@ def _autosaver(app: Any, path: Path | None, interval: float) -> Any:
     saver = Autosaver(lambda: app.state.holder.world, path or Path(os.devnull), interval)
     app.state.autosaver = saver
     return saver
+
+
+def _start_view(app: Any) -> None:
+    """`--view`: the web viewer on 127.0.0.1; its URL on stderr."""
+    from twin_cli.server.view_routes import view_service
+
+    url = view_service(app.state).start()["url"]
+    sys.stderr.write(f"twin: viewer on {url}\n")
+
+
+def _close_views(app: Any) -> None:
+    """Closes the web viewer, if one runs, so the page says the world went away."""
+    service = getattr(app.state, "views", None)
+    if service is not None:
+        service.close()

@@ -51,8 +51,9 @@ def junit_xml(run: ValidationRun) -> str:
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
 
 
-def markdown(run: ValidationRun) -> str:
-    """A Markdown summary for CI pages (e.g. $GITHUB_STEP_SUMMARY)."""
+def markdown(run: ValidationRun, plots: str | None = None) -> str:
+    """A Markdown summary for CI pages (e.g. $GITHUB_STEP_SUMMARY); with `plots` (the plot
+    directory as the page should link it), each plot is embedded below the table."""
     verdict = "passed" if run.passed else "FAILED"
     lines = [
         f"## twin validate: `{run.robot}` {verdict}",
@@ -70,11 +71,24 @@ def markdown(run: ValidationRun) -> str:
         for r in problems:
             for hint in r.hints or r.details:
                 lines.append(f"- **{r.check}** ({r.status.value}): {hint}")
+    if plots is not None:
+        pictures = [(r, s) for r in run.results for s in r.series]
+        if pictures:
+            lines += ["", "### Plots", ""]
+        for r, series in pictures:
+            lines.append(f"![{label(r)}: {series.label}]({plots}/{plot_name(r, series.label)})")
     return "\n".join(lines) + "\n"
 
 
+def plot_name(r: CheckResult, series_label: str) -> str:
+    """The PNG file name of one result's series."""
+    slug = re.sub(r"[^a-z0-9]+", "_", f"{r.check}_{series_label}".lower()).strip("_")
+    return f"{slug}.png"
+
+
 def write_plots(run: ValidationRun, directory: str | Path) -> list[Path]:
-    """One PNG per result series (free fall against ½gt², foot slip over time); Agg backend."""
+    """One PNG per result series (free fall against ½gt², foot slip over time) with the check's
+    threshold drawn (a line, or the allowed band around the oracle); Agg backend."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -89,13 +103,18 @@ def write_plots(run: ValidationRun, directory: str | Path) -> list[Path]:
             for label, values in series.values.items():
                 style = "--" if label.startswith("½") else "-"
                 ax.plot(series.t, values, style, label=label)
+            if series.band is not None:
+                low, high = series.band
+                ax.fill_between(series.t, low, high, color="green", alpha=0.2, label="allowed")
+            if series.threshold is not None:
+                ax.axhline(series.threshold, color="red", linestyle=":", label="threshold")
             ax.set_xlabel("time [s]")
             ax.set_ylabel(f"{series.label} [{series.unit}]")
             ax.set_title(f"{run.robot}: {r.check} ({r.status.value})")
             ax.grid(True, alpha=0.3)
             ax.legend()
-            slug = re.sub(r"[^a-z0-9]+", "_", f"{r.check}_{series.label}".lower()).strip("_")
-            path = directory / f"{slug}.png"
+            fig.tight_layout()  # keeps long axis labels inside the picture
+            path = directory / plot_name(r, series.label)
             fig.savefig(path)
             plt.close(fig)
             written.append(path)

@@ -8,12 +8,14 @@ robot is always converted with `ConvertOptions(repair_inertia=True)`; the conver
 
 from __future__ import annotations
 
+import contextlib
 import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from twin_cli.errors import ScenarioError, TwinError, UnknownCheckError
+from twin_cli.validate import video
 from twin_cli.validate.checks import CHECKS, MODEL_CHECKS
 from twin_cli.validate.checks.base import CheckResult, DeclaredJoint, RobotUnderTest, Status, result
 from twin_cli.validate.scenario import Scenario, load_builtin, resolve, with_joints
@@ -173,7 +175,8 @@ def run_check(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> Ch
     thresholds = {**check.defaults, **sc.thresholds}
     start = time.perf_counter()
     try:
-        outcome = check.run(robot, sc, thresholds)
+        with video.scenario(sc.name) if check.kind == "physics" else contextlib.nullcontext():
+            outcome = check.run(robot, sc, thresholds)
         finish()
     except Exception as exc:  # noqa: BLE001 - one broken check must not hide the others
         finish()

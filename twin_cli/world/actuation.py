@@ -11,6 +11,7 @@ after a recompile, since compiling restores the spec's motor.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import mujoco
@@ -151,16 +152,26 @@ class Push:
 
 
 def apply_pushes(
-    model: mujoco.MjModel, data: mujoco.MjData, pushes: list[Push], bodies: set[str]
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    pushes: list[Push],
+    bodies: set[str],
+    perturbation: Mapping[str, Sequence[float]] | None = None,
 ) -> None:
-    """Sets `xfrc_applied` of `bodies` to the sum of the active pushes on each."""
+    """Sets `xfrc_applied` of `bodies` to the sum of the active pushes on each.
+
+    `perturbation` (body name → wrench, a viewer's mouse drag) is added on top: the engine owns
+    `xfrc_applied`, and pushes and the drag are kept apart so that neither erases the other.
+    """
+    extra = perturbation or {}
     for body in bodies:
         b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
         if b < 0:
             continue
-        data.xfrc_applied[b] = np.sum(
-            [p.wrench for p in pushes if p.body == body] or [np.zeros(6)], axis=0
-        )
+        wrenches = [p.wrench for p in pushes if p.body == body]
+        if body in extra:
+            wrenches.append(tuple(extra[body]))
+        data.xfrc_applied[b] = np.sum(wrenches or [np.zeros(6)], axis=0)
 
 
 @dataclass(frozen=True)

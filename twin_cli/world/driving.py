@@ -7,6 +7,7 @@ commands); the servo and push arithmetic lives in `twin_cli.world.actuation`.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import mujoco
 
@@ -44,7 +45,20 @@ class EntityControl:
             body = self._link_name(name, ix, link)
             steps = max(1, round(duration / self.model.opt.timestep))
             self._pushes.append(control.Push(body, tuple(wrench), self._iterations + steps))
-            control.apply_pushes(self.model, self.data, self._pushes, {body})
+            control.apply_pushes(self.model, self.data, self._pushes, {body}, self._perturbation)
+
+    def perturb(self, wrenches: dict[str, Sequence[float]]) -> None:
+        """Sets a viewer's mouse perturbation: world-frame wrench [N, N m] per full body name.
+
+        Replaces the previous perturbation (a drag is re-sent every frame; `{}` ends it) and is
+        added to the pushes of `push` on the same body, never written over them. Unknown bodies
+        are ignored (the viewer may still show a model from before a spawn or delete).
+        """
+        wrench = {b: tuple(finite_vector("perturbation", w, 6)) for b, w in wrenches.items()}
+        with self.lock:
+            touched = set(self._perturbation) | set(wrench)
+            self._perturbation = wrench
+            control.apply_pushes(self.model, self.data, self._pushes, touched, wrench)
 
     def _link_name(self, name: str, ix: EntityIndex, link: str | None) -> str:
         links = [

@@ -76,6 +76,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         self._index: dict[str, EntityIndex] = {}
         self._commands: dict[str, control.JointCommand] = {}
         self._pushes: list[control.Push] = []
+        self._perturbation: dict[str, tuple[float, ...]] = {}  # a viewer's drag, by body
         self._damping: control.Damping | None = None
         self._iterations = 0
         self._stepping_time = 0.0  # [s] inside mj_step (RunControl.stepping_time)
@@ -198,6 +199,9 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
                 k: c for k, c in self._commands.items() if not k.startswith(f"{name}/")
             }
             self._pushes = [p for p in self._pushes if not p.body.startswith(f"{name}/")]
+            self._perturbation = {
+                b: w for b, w in self._perturbation.items() if not b.startswith(f"{name}/")
+            }
             self._commit(trial, model, data, index)
 
     def _free_name(self, name: str | None, default: str) -> str:
@@ -267,7 +271,13 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         cap_contact_stiffness(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
         self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
-        control.apply_pushes(model, data, self._pushes, {p.body for p in self._pushes})
+        control.apply_pushes(
+            model,
+            data,
+            self._pushes,
+            {p.body for p in self._pushes} | set(self._perturbation),
+            self._perturbation,
+        )
 
     # ----------------------------------------------------------------- entities
     def _require(self, name: str) -> EntityIndex:

@@ -69,6 +69,7 @@ class RunControl:
                 self._loop.reset_clock()
                 return
             self._commands, self._pushes = {}, []
+            self._perturbation = {}
             model = self._spec.compile()
             data = mujoco.MjData(model)
             index = index_entities(model, list(self._entities))
@@ -205,4 +206,4 @@ class RunControl:
     def _expire_pushes(self) -> None:
         ended = {p.body for p in self._pushes if p.end_step <= self._iterations}
         self._pushes = [p for p in self._pushes if p.end_step > self._iterations]
-        control.apply_pushes(self.model, self.data, self._pushes, ended)
+        control.apply_pushes(self.model, self.data, self._pushes, ended, self._perturbation)

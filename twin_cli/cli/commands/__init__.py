@@ -17,6 +17,7 @@ MODULES = (
     "validate",
     "control",
     "drive",
+    "view",
 )
 
 

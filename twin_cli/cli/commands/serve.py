@@ -43,6 +43,9 @@ def serve(
     no_autosave: Annotated[
         bool, typer.Option("--no-autosave", help="Do not autosave (same as --autosave 0).")
     ] = False,
+    view: Annotated[
+        bool, typer.Option("--view", help="Serve MuJoCo's web viewer on 127.0.0.1 too.")
+    ] = False,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
     from twin_cli.server.process import ServeOptions
@@ -58,6 +61,7 @@ def serve(
         background,
         str(record) if record else None,
         foxglove,
+        view=view,
         autosave=0.0 if no_autosave else autosave,
     )
     run_server(opts)

@@ -31,6 +31,10 @@ MarkdownOpt = Annotated[
     Path | None, typer.Option("--markdown", help="Write a Markdown summary to FILE.")
 ]
 PlotsOpt = Annotated[Path | None, typer.Option("--plots", help="Write PNG plots into DIR.")]
+VideoOpt = Annotated[
+    Path | None,
+    typer.Option("--video", help="Write one MP4 per physics scenario into DIR (offscreen EGL)."),
+]
 RepairOpt = Annotated[
     bool,
     typer.Option(
@@ -65,6 +69,7 @@ def validate(
     json: JsonOpt = False,
     markdown: MarkdownOpt = None,
     plots: PlotsOpt = None,
+    video: VideoOpt = None,
     repair_inertia: RepairOpt = False,
     collision: CollisionOpt = None,
     joint: JointOpt = None,
@@ -85,6 +90,7 @@ def validate(
     """
     from twin_cli.cli.output import Output
     from twin_cli.validate import report as render
+    from twin_cli.validate import video as films
     from twin_cli.validate.runner import validate as run_validation
 
     if sweep or len(robots) > 1 or jobs is not None or ray is not None:
@@ -110,18 +116,19 @@ def validate(
             plots=plots,
         )
     robot = robots[0]
-    run = run_validation(
-        robot,
-        **source_inputs(arg, package),
-        scenarios=scenario,
-        only=only,
-        skip=skip,
-        repair_inertia=repair_inertia,
-        collision=collision,
-        joints=joint_positions(joint),
-        as_written=as_written,
-        record=record,
-    )
+    with films.filming(video):
+        run = run_validation(
+            robot,
+            **source_inputs(arg, package),
+            scenarios=scenario,
+            only=only,
+            skip=skip,
+            repair_inertia=repair_inertia,
+            collision=collision,
+            joints=joint_positions(joint),
+            as_written=as_written,
+            record=record,
+        )
     out = Output(json)
     if json:
         out.data(run.to_dict())
@@ -130,7 +137,12 @@ def validate(
     if junit:
         junit.write_text(render.junit_xml(run), encoding="utf-8")
     if markdown:
-        markdown.write_text(render.markdown(run), encoding="utf-8")
+        linked = None
+        if plots:  # linked from where the Markdown file is, if the plots are below it
+            base = markdown.resolve().parent
+            target = plots.resolve()
+            linked = str(target.relative_to(base)) if target.is_relative_to(base) else str(target)
+        markdown.write_text(render.markdown(run, plots=linked), encoding="utf-8")
     if plots:
         for path in render.write_plots(run, plots):
             out.line(f"plot: {path}")
@@ -139,6 +151,8 @@ def validate(
 
         for path in written:
             out.line(f"recording: {path}")
+    for path in films.written if video else []:
+        out.line(f"video: {path}")
     raise typer.Exit(0 if run.passed else 1)
 
 

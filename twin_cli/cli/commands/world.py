@@ -73,6 +73,9 @@ def spawn(
     names: Annotated[
         str | None, typer.Option(help="Names of the --at entities, comma-separated.")
     ] = None,
+    view: Annotated[
+        bool, typer.Option("--view", help="Also show the world in the web viewer (twin view).")
+    ] = False,
 ) -> None:
     """Spawn a robot or model; prints its name once it exists in the world."""
     with usage_errors():
@@ -95,6 +98,7 @@ def spawn(
             quat=quat,
             at=at,
             names=names,
+            view=view,
         )
 
 

@@ -24,12 +24,15 @@ class Status(enum.Enum):
 
 @dataclass(frozen=True)
 class Series:
-    """A time series for a plot: `t` [s] against `values`, with an optional oracle curve."""
+    """A time series for a plot: `t` [s] against `values`, with an optional oracle curve and
+    the check's threshold (a horizontal line, or a band around the oracle)."""
 
     label: str
     unit: str
     t: tuple[float, ...]
     values: dict[str, tuple[float, ...]]
+    threshold: float | None = None  # a limit on the values, drawn as a line (same unit)
+    band: tuple[tuple[float, ...], tuple[float, ...]] | None = None  # (low, high) allowed over t
 
 
 @dataclass(frozen=True)

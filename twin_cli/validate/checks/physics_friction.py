@@ -75,7 +75,13 @@ def check_friction_standing(robot: RobotUnderTest, scenario: Scenario, th: dict[
             f"{names[worst]} slides {fmt_len(slip)} while standing: raise mu1/mu2 in its "
             "<gazebo> block, or check that the posture hold is not fighting a joint limit"
         )
-    series = Series("foot slip", "m", tuple(times), {names[b]: tuple(slips[b]) for b in feet})
+    series = Series(
+        "foot slip",
+        "m",
+        tuple(times),
+        {names[b]: tuple(slips[b]) for b in feet},
+        threshold=th["max_slip_m"],
+    )
     return judged(
         "friction_standing",
         "physics",

@@ -73,8 +73,13 @@ def check_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float
             + (f"; links with gravity off: {', '.join(off)}" if off else "")
             + ": check <gravity>/turnGravityOff tags and dampingFactor on the links"
         )
+    tol = th["rel_tol"]
     series = Series(
-        "free fall", "m", tuple(t), {"measured drop": tuple(drop), "½gt²": tuple(expected)}
+        "free fall",
+        "m",
+        tuple(t),
+        {"measured drop": tuple(drop), "½gt²": tuple(expected)},
+        band=(tuple(e * (1 - tol) for e in expected), tuple(e * (1 + tol) for e in expected)),
     )
     return judged(
         "gravity",

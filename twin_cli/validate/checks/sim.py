@@ -93,6 +93,9 @@ class ScenarioRun:
         from twin_cli.validate.recording import attach
 
         attach(self.world, scenario.name)  # `twin validate --record DIR`
+        from twin_cli.validate import video
+
+        video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
         model = self.world.model

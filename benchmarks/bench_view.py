@@ -1,0 +1,116 @@
+"""Web viewer figures in one run: what a connected viewer costs the unthrottled loop, and the
+real-time factor with one (issue 10).
+
+Targets: with a browser showing the world, the unthrottled loop keeps ≥ 0.95 of its steps/s
+without a viewer (alternating windows on the same world), and real-time mode holds a factor of
+1.00 ± 0.01. The browser is Debian's headless chromium on the same machine: on 2 shared cores it
+takes CPU from the loop (WebGL through SwiftShader), so the ratio is also given with the viewer
+attached and no browser (the server's own share: the sync thread and the viewer thread).
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import time
+from pathlib import Path
+
+from twin_cli.view.host import WebHost
+from twin_cli.world import Pose, World, WorldSettings
+
+HUMANOID = Path(__file__).parents[1] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+WINDOW_S = 3.0  # [s] of wall time per window
+WINDOWS = 5
+PAGE_LOAD_S = 20.0  # [s] for the page to load and connect before a window
+REALTIME_SECONDS = 10.0  # [s]
+TARGETS = {"viewer_vs_plain": 0.95, "realtime_factor": (0.99, 1.01)}
+CHROMIUM = "/usr/bin/chromium"
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
+
+
+def _world() -> World:
+    world = World(WorldSettings(rate=0.0))
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    world.step(2000)  # settled on the ground: the same contacts in every window
+    return world
+
+
+def _steps_per_s(world: World) -> float:
+    """Steps/s of the running loop over one window of wall time."""
+    first, start = world.stats().iterations, time.perf_counter()
+    time.sleep(WINDOW_S)
+    return (world.stats().iterations - first) / (time.perf_counter() - start)
+
+
+def _realtime(world: World) -> dict:
+    """Real-time factor over 10 s at 1 kHz."""
+    world.set_physics(rate=1000.0)
+    world.reset(time_only=True)  # the meter from now
+    time.sleep(REALTIME_SECONDS)
+    stats, figures = world.stats(), world.loop_figures()
+    world.set_physics(rate=0.0)
+    return {
+        "factor": stats.factor,
+        "sim_over_wall": stats.sim_time / stats.real_time,
+        "dropped_steps": figures.dropped,
+    }
+
+
+def measure(browser: object | None) -> dict:
+    """Windows without a viewer, then the same number with one (and a browser on it).
+
+    One viewer per process: MuJoCo 4.0.0's web viewer hangs when a process starts its third,
+    so the windows are not alternated; medians of WINDOWS each.
+    """
+    world = _world()
+    world.start()
+    try:
+        plain = [_steps_per_s(world) for _ in range(WINDOWS)]
+        host = WebHost(lambda: world)
+        address = host.start()
+        page = None
+        if browser is not None:
+            page = browser.new_page(viewport={"width": 800, "height": 600})
+            page.goto(address.url)
+            time.sleep(PAGE_LOAD_S)
+        before, start = host.syncs, time.perf_counter()
+        viewed = [_steps_per_s(world) for _ in range(WINDOWS)]
+        syncs = (host.syncs - before) / (time.perf_counter() - start)
+        realtime = _realtime(world)
+        if page is not None:
+            page.close()
+        host.close()
+    finally:
+        world.stop()
+    return {
+        "viewer_vs_plain": statistics.median(viewed) / statistics.median(plain),
+        "plain_steps_per_s": [round(x) for x in plain],
+        "viewer_steps_per_s": [round(x) for x in viewed],
+        "syncs_per_s": syncs,
+        "realtime_with_viewer": realtime,
+    }
+
+
+def run() -> dict:
+    result: dict = {"load_average": os.getloadavg()[0], "targets": TARGETS}
+    if not os.access(CHROMIUM, os.X_OK):
+        result["no_browser"] = measure(None)
+        result["browser"] = f"skipped: no {CHROMIUM} (apt-get install chromium)"
+        return result
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
+        try:
+            result["browser"] = measure(browser)
+        finally:
+            browser.close()
+    result["load_average_end"] = os.getloadavg()[0]
+    return result

@@ -1,0 +1,90 @@
+"""`twin view` and `twin snapshot`: the server hosts the viewer and renders; this side only asks.
+
+Client-side like the world commands: neither mujoco nor the viewer is imported here (the server
+owns the model and data, so it hosts the page and renders the pictures).
+"""
+
+from __future__ import annotations
+
+import sys
+import webbrowser
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from twin_cli.cli.options import JsonOpt, WorldOpt
+from twin_cli.cli.output import Output
+
+HostOpt = Annotated[
+    str,
+    typer.Option(help="Address to listen on (default 127.0.0.1: this machine only)."),
+]
+
+
+def view(
+    world: WorldOpt = "default",
+    port: Annotated[int, typer.Option(help="Port (0: the first free one from 8080).")] = 0,
+    host: HostOpt = "127.0.0.1",
+    open_page: Annotated[bool, typer.Option("--open", help="Open the page in a browser.")] = False,
+    stop: Annotated[bool, typer.Option("--stop", help="Close the viewer.")] = False,
+    json: JsonOpt = False,
+) -> None:
+    """Show the running world in MuJoCo's web viewer (like gzclient); prints the page's URL.
+
+    The page can pause, run and reset the world and push bodies (Ctrl+drag). With --host other
+    than 127.0.0.1 anyone who reaches the port can do the same: there is no password.
+    """
+    from twin_cli.server.client import connect
+
+    with connect(world, start=not stop) as client:
+        if stop:
+            reply = client.request("DELETE", "/view")
+        else:
+            reply = client.request("POST", "/view", body={"host": host, "port": port})
+    out = Output(json)
+    if json:
+        out.data(reply)
+        return
+    if stop:
+        out.line(f"closed the viewer at {reply['stopped']}")
+        return
+    if reply.get("warning"):
+        sys.stderr.write(f"twin: warning: {reply['warning']}\n")
+    out.line(reply["url"])
+    if open_page:
+        webbrowser.open(reply["url"], new=2)
+
+
+def snapshot(
+    out: Annotated[Path, typer.Argument(help="The PNG file to write (OUT.png).")],
+    entity: Annotated[
+        str | None, typer.Option(help="Aim at this entity (default: the whole scene).")
+    ] = None,
+    width: Annotated[int, typer.Option(help="Width in pixels.")] = 640,
+    height: Annotated[int, typer.Option(help="Height in pixels.")] = 480,
+    world: WorldOpt = "default",
+    json: JsonOpt = False,
+) -> None:
+    """Render the running world offscreen into a PNG (no browser or display needed)."""
+    from twin_cli.server.client import connect
+
+    body = {
+        "path": str(out.expanduser().resolve()),
+        "entity": entity,
+        "width": width,
+        "height": height,
+    }
+    with connect(world) as client:
+        reply = client.request("POST", "/snapshot", body=body)
+    sink = Output(json)
+    if json:
+        sink.data(reply)
+    else:
+        sink.line(f"{reply['path']}: {width}x{height} PNG")
+
+
+def register(app: typer.Typer) -> None:
+    """Add `twin view` and `twin snapshot` to the `twin` app."""
+    app.command("view")(view)
+    app.command("snapshot")(snapshot)

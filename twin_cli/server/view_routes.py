@@ -1,0 +1,60 @@
+"""Routes of the world's pictures: the web viewer (`/view`) and offscreen snapshots.
+
+Kept apart from the world routes (`app.py`); the viewer and the renderer live in `twin_cli.view`.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from fastapi import APIRouter, Request
+
+from twin_cli.server.holder import WorldDep
+from twin_cli.server.models import SnapshotBody, ViewBody
+
+log = logging.getLogger("twin.server")
+router = APIRouter()
+
+
+def views(request: Request) -> Any:
+    """The server's web viewer service (`twin_cli.view.service.ViewService`)."""
+    return view_service(request.app.state)
+
+
+def view_service(state: Any) -> Any:
+    """The viewer service kept on the app's `state`, made on first use."""
+    if getattr(state, "views", None) is None:
+        from twin_cli.view.service import ViewService
+
+        holder = state.holder
+        state.views = ViewService(lambda: holder.world)
+    return state.views
+
+
+@router.post("/view", status_code=201)
+def start_view(body: ViewBody, request: Request) -> dict:
+    """Serve MuJoCo's web viewer on this world (`twin view`); replies with its URL."""
+    status = views(request).start(host=body.host, port=body.port)
+    log.info("viewer on %s", status["url"])
+    return status
+
+
+@router.get("/view")
+def view_status(request: Request) -> dict:
+    return views(request).status()
+
+
+@router.delete("/view")
+def stop_view(request: Request) -> dict:
+    return views(request).stop()
+
+
+@router.post("/snapshot")
+def snapshot(body: SnapshotBody, world: WorldDep) -> dict:
+    """Render the world offscreen into a PNG at `path` (atomically); reply with the camera."""
+    from twin_cli.view.offscreen import snapshot_png, write_atomically
+
+    png, camera = snapshot_png(world, entity=body.entity, width=body.width, height=body.height)
+    write_atomically(body.path, png)
+    return {"path": body.path, "bytes": len(png), "camera": camera}

@@ -1,0 +1,23 @@
+"""Seeing a running world: MuJoCo's web viewer on the served world, and offscreen snapshots.
+
+A consumer of the world (design.md §7), like `twin_cli.record`: it reads the world under its lock
+and acts on it only through `World`'s methods. Modules: `bridge` (the page's actions → World),
+`host` (the viewer thread, its bind address, the sync thread), `service` (the server's one
+viewer), `offscreen` (PNG snapshots with mujoco.Renderer on EGL). Exports load lazily, so that
+importing the package imports neither mujoco nor the viewer.
+"""
+
+from __future__ import annotations
+
+from twin_cli.lazy import lazy_getattr
+
+_WHERE = {
+    "WorldBridge": "twin_cli.view.bridge",
+    "WebHost": "twin_cli.view.host",
+    "ViewAddress": "twin_cli.view.host",
+    "ViewService": "twin_cli.view.service",
+    "CameraView": "twin_cli.view.offscreen",
+    "snapshot_png": "twin_cli.view.offscreen",
+}
+__getattr__ = lazy_getattr(__name__, _WHERE)
+__all__ = sorted(_WHERE)

@@ -1,0 +1,189 @@
+"""MuJoCo's web viewer hosted on a running world: the page, its bind address, the sync thread.
+
+The viewer (`mujoco.studio`, shipped in the mujoco wheel: page, WASM renderer and fonts are served
+from the wheel, no internet) runs in its own daemon thread and renders in the browser. The world
+keeps stepping in its own thread; a sync thread here calls `ViewerHandle.sync` at `SYNC_HZ` of
+wall time, holding the world's lock only for that call (0.25-0.6 ms measured), so the page sees
+the world ~30 times a second and the stepping loop never runs Python per step for it. When a
+spawn or delete has recompiled the world, `sync` is given the new model and sends it; the page
+swaps it in place (no reload) and keeps its camera, since the model path stays "".
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import ipaddress
+import logging
+import queue
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from mujoco.studio import messages
+
+from twin_cli.view.bridge import WorldBridge
+
+log = logging.getLogger("twin.view")
+
+SYNC_HZ = 30.0  # [Hz] of wall time; the page renders at the browser's rate in between
+START_TIMEOUT_S = 30.0  # [s] for the viewer thread to bind its port and start its server
+CLOSE_TIMEOUT_S = 20.0  # [s] for the viewer thread to end after its exit event
+LOOPBACK = "127.0.0.1"
+
+
+@dataclass(frozen=True)
+class ViewAddress:
+    """Where the page is served: `host` as bound, `port`, and the URL to open."""
+
+    host: str
+    port: int
+
+    @property
+    def url(self) -> str:
+        shown = "localhost" if ipaddress.ip_address(self.host).is_loopback else self.host
+        shown = f"[{shown}]" if ":" in shown else shown
+        return f"http://{shown}:{self.port}/"
+
+    @property
+    def public(self) -> bool:
+        """Whether other machines may reach it (anything but a loopback address)."""
+        return not ipaddress.ip_address(self.host).is_loopback
+
+
+def _viewer_class(host: str) -> type:
+    """`WebViewer` bound to `host` instead of the "::" (all interfaces) it hard-codes.
+
+    `WebViewer.__init__` assigns `self._host = "::"` and binds right after; a class property
+    whose setter ignores that assignment makes it bind `host` (MuJoCo 4.0.0 has no option).
+    """
+    from mujoco.studio import web_viewer
+
+    class BoundWebViewer(web_viewer.WebViewer):
+        @property
+        def _host(self) -> str:
+            return host
+
+        @_host.setter
+        def _host(self, _ignored: str) -> None:
+            pass
+
+        @messages.handler(priority=messages.Priority.INTERNAL)
+        def _on_post_model(self, event: messages.PostModelEvent) -> None:
+            """Serves the new model; the page swaps it in place (MuJoCo's prints a line)."""
+            self._update_model()
+
+    return BoundWebViewer
+
+
+class WebHost:
+    """One web viewer on a world: started by `start`, ended by `close`.
+
+    Args:
+        current_world: returns the served world (the server may swap it on `/load`).
+        host: address to bind; 127.0.0.1 unless the user asked otherwise.
+        port: TCP port; 0 takes the first free one from 8080 on (MuJoCo's rule).
+        rate: syncs per second of wall time.
+    """
+
+    def __init__(
+        self,
+        current_world: Callable[[], Any],
+        *,
+        host: str = LOOPBACK,
+        port: int = 0,
+        rate: float = SYNC_HZ,
+    ) -> None:
+        self._current = current_world
+        self._host, self._port, self._period = host, port, 1.0 / rate
+        self._bridge = WorldBridge(current_world())
+        self._handle: Any = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self.address: ViewAddress | None = None
+        self.syncs = 0
+
+    def start(self) -> ViewAddress:
+        """Binds the port, starts the viewer and the sync thread; returns where to look.
+
+        Raises:
+            RuntimeError: the port is taken (MuJoCo's message), or the viewer did not start.
+        """
+        from mujoco.studio import app as studio_app
+        from mujoco.studio import launch_thread, viewer_protocol
+
+        bound: queue.Queue[Any] = queue.Queue()
+        viewer_class = _viewer_class(self._host)
+        config = viewer_protocol.ViewerConfig(gfx="web", http_port=self._port, title="twin")
+
+        def run(endpoint: Any) -> None:
+            try:
+                # MuJoCo prints a banner (URL, "Ctrl+C to quit") on stdout: twin prints its own.
+                with contextlib.redirect_stdout(io.StringIO()):
+                    viewer = viewer_class(config, endpoint, plugins=[studio_app.App()])
+            except BaseException as exc:
+                bound.put(exc)
+                raise
+            bound.put(viewer._http_port)
+            viewer_protocol.run_viewer_loop(viewer)
+
+        self._handle = launch_thread.launch_thread(run, sim_plugins=[self._bridge])
+        reply = bound.get(timeout=START_TIMEOUT_S)
+        if isinstance(reply, BaseException):
+            self._handle = None
+            raise RuntimeError(str(reply)) from reply
+        self.address = ViewAddress(self._host, int(reply))
+        world = self._current()
+        with world.lock:
+            self._handle.set_model(world.model, data=world.data)
+        self._thread = threading.Thread(target=self._run, name="twin-view-sync", daemon=True)
+        self._thread.start()
+        log.info("viewer on %s (bound to %s)", self.address.url, self._host)
+        return self.address
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def _run(self) -> None:
+        """Syncs at the wall-clock rate until closed or the viewer thread ends."""
+        due = time.monotonic()
+        try:
+            while not self._stop.is_set() and self._handle.is_running():
+                self.sync_once()
+                due = max(due + self._period, time.monotonic())
+                self._stop.wait(max(0.0, due - time.monotonic()))
+        except Exception:
+            log.exception("viewer sync ended")
+
+    def sync_once(self) -> None:
+        """One sync: page actions in, the world's model (if new) and state out; lock held."""
+        world = self._current()
+        self._bridge.world = world
+        with world.lock:
+            self._bridge.show_pause_state()
+            self._handle.sync(world.model, world.data)
+        self.syncs += 1
+
+    def close(self) -> None:
+        """Stops syncing and closes the viewer (the page shows it ended); idempotent."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        handle, self._handle = self._handle, None
+        if handle is None:
+            return
+        try:
+            handle.close()
+        except Exception:
+            log.exception("viewer closed with an error")
+        # `close` waits only 5 s for the viewer thread; its ImGui context is process-global, and
+        # a viewer started while the old thread still draws crashes in MuJoCo's extension
+        # (seen on a loaded machine). Wait until the thread has really ended.
+        alive = getattr(handle, "_is_alive_fn", None)
+        deadline = time.monotonic() + CLOSE_TIMEOUT_S
+        while alive is not None and alive() and time.monotonic() < deadline:
+            time.sleep(0.05)
