@@ -158,7 +158,26 @@ def add_drive_motors(spec: Any, drives: tuple[DiffDrive, ...], report: Report) -
             motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
             motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
             motor.ctrlrange = [-drive.max_wheel_torque, drive.max_wheel_torque]
+            _velocity_only(spec, joint, drive)
             driven.add(joint)
+
+
+def _velocity_only(spec: Any, joint: str, drive: DiffDrive) -> None:
+    """The plugin drives its wheels by velocity only (its joints' only command interface)."""
+    import json
+
+    from converters.mjcf.control_data import TEXT_PREFIX
+
+    record = {
+        "modes": ["velocity"],
+        "source": "diff_drive",
+        "where": drive.where,
+        "bounds": {},
+        "pid": {},
+        "velocity_limit": None,
+        "plugin": None,
+    }
+    spec.add_text(name=TEXT_PREFIX + joint, data=json.dumps(record))
 
 
 def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:

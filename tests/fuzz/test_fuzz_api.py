@@ -4,9 +4,9 @@ Properties, for every operation: no 5xx; the status code is one the schema docum
 matches the schema of that status; afterwards the world still steps. `make test` runs a few
 derandomised cases per operation; `make fuzz` many more (TWIN_FUZZ_EXAMPLES).
 Left out: operations that end the server (/shutdown), or write files or open listeners at
-paths and addresses the fuzzer invents (/save, /record, /foxglove): as root on the test machine
-they could write anywhere. `/step` counts are capped at 1,000 so one case cannot hold the world
-for minutes (the schema allows 10^7: a legitimate, slow request).
+paths and addresses the fuzzer invents (/save, /record, /foxglove, /view, /snapshot): as root on
+the test machine they could write anywhere. `/step` counts are capped at 1,000 so one case
+cannot hold the world for minutes (the schema allows 10^7: a legitimate, slow request).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from twin_cli.server import runtime  # noqa: E402
 from twin_cli.server.client import Client  # noqa: E402
 
 EXAMPLES = int(os.environ.get("TWIN_FUZZ_API_EXAMPLES", 5))  # per operation
-SKIPPED = ("/shutdown", "/save", "/record", "/foxglove")
+SKIPPED = ("/shutdown", "/save", "/record", "/foxglove", "/view", "/snapshot")
 MAX_STEPS = 1000
 
 

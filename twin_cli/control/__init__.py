@@ -5,40 +5,30 @@ only through the engine's API (joint commands). `trajectory` reads
 trajectory_msgs/JointTrajectory files and interpolates them as joint_trajectory_controller does;
 `follower` follows one on an entity at the controller manager's update rate and reports the
 tracking error; `kinematics`, `diff_drive` and `drives` run gazebo_ros' diff-drive plugin.
+
+Exports are lazy (`twin_cli.lazy`): `twin trajectory` reads its file with `trajectory` on the
+client, which must not import mujoco or numpy through this package.
 """
 
 from __future__ import annotations
 
-from twin_cli.control.diff_drive import DiffDriveController
-from twin_cli.control.drives import controller_of, drive, odometry
-from twin_cli.control.follower import (
-    UPDATE_RATE,
-    TrackingReport,
-    TrajectoryFollower,
-    follow_trajectory,
-    tracking_report,
-)
-from twin_cli.control.trajectory import (
-    Trajectory,
-    TrajectoryPoint,
-    read_trajectory,
-    sample,
-    trajectory_from_dict,
-)
+from twin_cli.lazy import lazy_getattr
 
-__all__ = [
-    "UPDATE_RATE",
-    "DiffDriveController",
-    "TrackingReport",
-    "Trajectory",
-    "TrajectoryFollower",
-    "TrajectoryPoint",
-    "controller_of",
-    "drive",
-    "follow_trajectory",
-    "odometry",
-    "read_trajectory",
-    "sample",
-    "tracking_report",
-    "trajectory_from_dict",
-]
+_WHERE = {
+    "DiffDriveController": "twin_cli.control.diff_drive",
+    "controller_of": "twin_cli.control.drives",
+    "drive": "twin_cli.control.drives",
+    "odometry": "twin_cli.control.drives",
+    "UPDATE_RATE": "twin_cli.control.follower",
+    "TrackingReport": "twin_cli.control.follower",
+    "TrajectoryFollower": "twin_cli.control.follower",
+    "follow_trajectory": "twin_cli.control.follower",
+    "tracking_report": "twin_cli.control.follower",
+    "Trajectory": "twin_cli.control.trajectory",
+    "TrajectoryPoint": "twin_cli.control.trajectory",
+    "read_trajectory": "twin_cli.control.trajectory",
+    "sample": "twin_cli.control.trajectory",
+    "trajectory_from_dict": "twin_cli.control.trajectory",
+}
+__all__ = sorted(_WHERE)
+__getattr__ = lazy_getattr("twin_cli.control", _WHERE)

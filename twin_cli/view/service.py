@@ -30,6 +30,7 @@ class ViewService:
         self._current = current_world
         self._lock = threading.Lock()
         self.host: WebHost | None = None
+        self._closed_once = False
 
     def start(self, *, host: str = LOOPBACK, port: int = 0) -> dict:
         """Starts the viewer (or reports the running one); returns `status()`.
@@ -41,7 +42,15 @@ class ViewService:
             if self.host is not None and self.host.running:
                 return self.status()
             if self.host is not None:
-                self.host.close()
+                self.close()
+            if self._closed_once:
+                raise RequestError(
+                    "viewer",
+                    "MuJoCo 4.0's web viewer cannot start again in a server process where one "
+                    "was closed (its extension crashes the process)",
+                    "restart the world to view it again: `twin save F`, `twin stop`, "
+                    "`twin load F`, then `twin view`",
+                )
             web = WebHost(self._current, host=host, port=port)
             try:
                 web.start()
@@ -83,3 +92,4 @@ class ViewService:
         if self.host is not None:
             self.host.close()
             self.host = None
+            self._closed_once = True

@@ -143,7 +143,7 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
         name,
         _urdf_or_none(done.description.text),
         done.sensors,
-        done.plugins,
+        plugins=done.plugins,
     )
 
 
@@ -199,7 +199,14 @@ def _convert_description(
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
     return LoadedSource(
-        spec, str(path), report.to_dict(), None, name, description, done.sensors, done.plugins
+        spec,
+        str(path),
+        report.to_dict(),
+        None,
+        name,
+        description,
+        done.sensors,
+        plugins=done.plugins,
     )
 
 

@@ -37,7 +37,7 @@ def view(
     """
     from twin_cli.server.client import connect
 
-    with connect(world, start=not stop) as client:
+    with connect(world) as client:
         if stop:
             reply = client.request("DELETE", "/view")
         else:
