@@ -197,7 +197,10 @@ class ScenarioRun:
         done = 0
         while done < steps:
             for action in pushes:
-                if self.time <= action.at < self.time + chunk * dt - 1e-12:
+                # Half-step windows: sim time accumulates rounding (0.1 + … != 0.6), and an
+                # action at an exact multiple of the step must fall in exactly one window.
+                start = self.time - 0.5 * dt
+                if start <= action.at < start + chunk * dt:
                     self._push(action)
             if per_step:
                 self._apply_joint_forces()
