@@ -6,8 +6,9 @@ it belongs to an MjData, so it is installed again on every new data (spawn, dele
 It only pays with several islands to share out, so it is installed when the world has at least
 `POOL_MIN_TREES` kinematic trees: a one-robot world steps as before. The pool changes no
 answer (a trajectory of 8 colliding humanoids is bit-equal with and without it), only speed;
-measured on a 2-core machine at load average 12-15 it was *slower* (0.5-0.7x at 8-64 humanoids,
-`benchmarks/bench_scale.py`): with both cores taken its workers wait for a core.
+measured on a 2-core machine it did not pay (unthrottled factor with / without: 0.77-1.07 at
+1-64 humanoids on a quiet machine, 0.5-0.7 at load 12-15; `benchmarks/bench_scale.py`), so a world
+starts with one thread (no pool) and `twin physics --threads N` asks for one.
 
 Sleeping (`mjENBL_SLEEP`) freezes islands whose speed stays under `sleep_tolerance` [m/s, rad/s]
 for 10 steps; contacts with awake bodies and pushes wake them. Off by default: a sleeping robot's
@@ -18,8 +19,6 @@ unless the tolerance is raised (`--sleep-tolerance`).
 """
 
 from __future__ import annotations
-
-import os
 
 import mujoco
 import numpy as np
@@ -32,11 +31,13 @@ SLEEP_BIT = int(mujoco.mjtEnableBit.mjENBL_SLEEP)
 
 
 def default_threads() -> int:
-    """The engine threads a new world uses: the cores this process may run on."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not Linux
-        return max(1, os.cpu_count() or 1)
+    """The engine threads a new world uses: one (no pool) until a user asks for more.
+
+    Measured on the 2-core machine twin is tested on (`python -m benchmarks scale`, load 1.9),
+    MuJoCo 4.0's pool did not pay at any robot count: unthrottled factor with / without it
+    1.07 (1 humanoid), 0.77 (8), 0.93 (32), 0.97 (64). `twin physics --threads N` turns it on.
+    """
+    return 1
 
 
 def check_threads(threads: int) -> int:

@@ -169,7 +169,7 @@ def physics(
     world: WorldOpt = "default",
     json: JsonOpt = False,
     threads: Annotated[
-        int | None, typer.Option(help="MuJoCo engine threads, 1-64 (default: the cores).")
+        int | None, typer.Option(help="MuJoCo engine threads, 1-64 (default 1: no pool).")
     ] = None,
     sleep: Annotated[
         bool, typer.Option("--sleep", help="Let resting robots sleep (off by default).")
