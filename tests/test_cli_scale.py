@@ -54,3 +54,20 @@ def test_five_humanoids_in_one_command_then_refusals_and_the_cache(twin):
     assert physics["threads"] >= 1 and physics["sleep"] is False, physics
     changed = json.loads(twin("physics", "--threads", "2", "--sleep", "--json").stdout)
     assert (changed["threads"], changed["pool_threads"], changed["sleep"]) == (2, 2, True)
+
+
+def test_a_bad_name_in_names_is_refused_before_any_world_starts(twin):
+    bad = twin("spawn", str(scenarios.HUMANOID), "--names", "a/b,c", "--at", "0,0", "--at", "1,1",
+               check=False)  # fmt: skip
+    assert bad.returncode == 2 and "a/b" in bad.stderr and "Traceback" not in bad.stderr
+    listed = twin("list", check=False)  # gz's line: no world was started for the refusal
+    assert listed.returncode == 1 and "not running" in listed.stderr, listed.stderr
+
+
+def test_video_and_record_with_a_sweep_are_refused_not_ignored(tmp_path):
+    twin = Twin(tmp_path / "rt")
+    for flag in ("--video", "--record"):
+        out = twin("validate", str(scenarios.HUMANOID), "--sweep", "foot_mu=0.5:1:2", flag,
+                   str(tmp_path / "out"), check=False)  # fmt: skip
+        assert out.returncode == 2 and "--sweep" in out.stderr, (flag, out.stderr)
+        assert not (tmp_path / "out").exists(), f"{flag} wrote files it was not asked to"

@@ -56,7 +56,21 @@ def _wait_for_autosave_after(path: Path, moment: float) -> None:
 
 
 def test_commands_other_than_spawn_never_start_a_world(twin):
-    for args in (["list"], ["gravity", "--moon"], ["pause"], ["pose", "x"], ["physics"]):
+    commands = (
+        ["list"],
+        ["gravity", "--moon"],
+        ["pause"],
+        ["pose", "x"],
+        ["physics"],
+        ["view"],
+        ["view", "--stop"],
+        ["snapshot", str(twin.dir.parent / "shot.png")],
+        ["command", "x", "j=0.1"],
+        ["drive", "x", "--linear", "0.1"],
+        ["odom", "x"],
+        ["sensors", "x"],
+    )
+    for args in commands:
         probe = twin(*args, check=False)
         assert probe.returncode == 1, f"twin {args}: exit {probe.returncode} {probe.stderr}"
         assert probe.stderr.splitlines()[0] == GZ_LINE, f"twin {args}: {probe.stderr!r}"

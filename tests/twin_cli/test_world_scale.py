@@ -144,3 +144,42 @@ def test_instances_of_a_robot_share_its_meshes_in_the_world(tmp_path):
     world.delete("b_0")
     world.delete("b_1")
     assert world.model.nmesh == 0 and len(world._spec.meshes) == 0  # none left behind
+
+
+DIFF_DRIVE_BOT = """<robot name="bot">
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0"
+    ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.3 0.2 0.05"/></geometry>
+    </collision></link>
+  <link name="l"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <link name="r"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <joint name="lj" type="continuous"><parent link="base"/><child link="l"/>
+    <origin xyz="0 0.1 0"/><axis xyz="0 1 0"/></joint>
+  <joint name="rj" type="continuous"><parent link="base"/><child link="r"/>
+    <origin xyz="0 -0.1 0"/><axis xyz="0 1 0"/></joint>
+  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
+    <left_joint>lj</left_joint><right_joint>rj</right_joint>
+    <wheel_separation>0.2</wheel_separation><wheel_diameter>0.1</wheel_diameter>
+  </plugin></gazebo>
+</robot>"""
+SCENE = """<mujoco model="scene"><worldbody><light pos="0 0 3"/>
+  <geom name="floor" type="plane" size="2 2 0.1"/>
+  <body name="ball"><freejoint/><geom type="sphere" size="0.1" mass="1"/></body>
+</worldbody></mujoco>"""
+
+
+def test_batch_instances_keep_their_drive_plugin_and_the_sources_notes(tmp_path):
+    """A batch spawn gives each instance what a single spawn gives it (plugins, notes)."""
+    from twin_cli.control import controller_of, drive
+
+    bot, scene = tmp_path / "bot.urdf", tmp_path / "scene.xml"
+    bot.write_text(DIFF_DRIVE_BOT)
+    scene.write_text(SCENE)
+    world = World()
+    world.spawn_batch(str(bot), base="d", poses=[Pose(x=0.0, z=0.1), Pose(x=1.0, z=0.1)])
+    for name in ("d_0", "d_1"):
+        drive(world, name, 0.1, 0.0, 0.5)  # refused for an entity without a drive plugin
+        assert controller_of(world, name) is not None, f"{name} lost its diff drive"
+    balls = world.spawn_batch(str(scene), base="s", poses=[Pose(x=3.0, z=1.0)])
+    assert any("is a scene" in w for w in balls[0].warnings), balls[0].warnings

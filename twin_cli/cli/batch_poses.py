@@ -48,4 +48,9 @@ def parse_names(text: str | None, count: int) -> list[str] | None:
             f"--names {text!r} gives {len(names)} names for {count} poses; "
             "give one distinct name per --at, separated by commas"
         )
+    from twin_cli.names import name_message, name_problem
+
+    for name in names:
+        if name_problem(name) is not None:
+            raise BadOption(f"--names: {name_message(name)}")
     return names

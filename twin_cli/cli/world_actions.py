@@ -130,7 +130,7 @@ def spawn(
         spawn_many(
             file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
             name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
-            world=world, json=json, xml=xml, quat=quat, x=x, y=y,
+            world=world, json=json, xml=xml, quat=quat, x=x, y=y, view=view,
         )  # fmt: skip
         return
     inputs = pairs.source_inputs(arg, package)
@@ -177,6 +177,7 @@ def spawn_many(
     quat: tuple[float, float, float, float] | None,
     x: float = 0.0,
     y: float = 0.0,
+    view: bool = False,
 ) -> None:
     """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
     from twin_cli.cli import batch_poses
@@ -199,6 +200,9 @@ def spawn_many(
             file, poses=poses, names=listed, name=name, on_ground=on_ground, joints=joints,
             **source, **inputs,
         )  # fmt: skip
+        if view:
+            url = c.request("POST", "/view", body={})["url"]
+            sys.stderr.write(f"twin: viewer on {url}\n")
     out = Output(json)
     if json:
         out.data(results)

@@ -105,8 +105,16 @@ def _spawn(body: SpawnBody, world: Any) -> dict:
 
 
 @router.post("/entities/batch", status_code=201)
-def spawn_batch(body: SpawnBatchBody, world: WorldDep) -> list[dict]:
-    """Spawn one file or text at many poses: one conversion, one recompile, all or nothing."""
+def spawn_batch(body: SpawnBatchBody, world: WorldDep, request: Request) -> list[dict]:
+    """Spawn one file or text at many poses: one conversion, one recompile, all or nothing.
+
+    A repeat with the same `Idempotency-Key` header gets the first request's outcome.
+    """
+    key = request.headers.get("idempotency-key")
+    return request.app.state.operations.run(key, lambda: _spawn_batch(body, world))
+
+
+def _spawn_batch(body: SpawnBatchBody, world: Any) -> list[dict]:
     from twin_cli.world.spawn import DescriptionText
 
     source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)

@@ -19,9 +19,8 @@ from twin_cli.errors import NotRunningError, RequestError
 from twin_cli.server import runtime
 from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
 
-# Seconds: most requests are a lock and a copy; spawn converts (CoACD can take minutes cold).
+# Seconds: most requests are a lock and a copy; spawn, delete and load wait in `long_request`.
 DEFAULT_TIMEOUT_S = 10.0
-SPAWN_TIMEOUT_S = 600.0
 STOP_TIMEOUT_S = 15.0
 
 
@@ -230,7 +229,15 @@ class Client:
             "poses": poses,
             "names": names,
         }
-        return self.request("POST", "/entities/batch", body=body, timeout=SPAWN_TIMEOUT_S)
+        label = ",".join(names) if names else options.get("name") or "robot"
+        return self.long_request(
+            "POST",
+            "/entities/batch",
+            body=body,
+            what=f"spawn of {len(poses)} entities [{label}]",
+            operation=f"spawn batch {label} {len(poses)}",
+            repeat="the same twin spawn ... --at ... command",
+        )
 
     def delete(self, name: str) -> dict:
         return self.long_request(
@@ -349,7 +356,7 @@ def _seg(name: str) -> str:
 def connect(
     world: str = runtime.DEFAULT_WORLD,
     *,
-    start: bool = True,
+    start: bool = False,
     announce: Any = None,
     serve_args: tuple[str, ...] = (),
 ) -> Client:

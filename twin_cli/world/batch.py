@@ -111,9 +111,12 @@ class BatchSpawning:
                 self._entities[n] = Entity(
                     n, loaded.source, dict(args or {}), dict(package_paths or {}), pose,
                     on_ground, state, loaded.report, loaded.xml, dict(joints or {}),
-                    loaded.description, sensors=loaded.sensors,
+                    loaded.description, sensors=loaded.sensors, plugins=loaded.plugins,
                 )  # fmt: skip
-                warnings = placement.start_warnings(model, data, index, n, pose.z)
+                warnings = [
+                    *loaded.notes,
+                    *placement.start_warnings(model, data, index, n, pose.z),
+                ]
                 results.append(
                     SpawnResult(n, loaded.source, warnings, loaded.report, loaded.cached)
                 )

@@ -94,6 +94,11 @@ def validate(
     from twin_cli.validate.runner import validate as run_validation
 
     if sweep or len(robots) > 1 or jobs is not None or ray is not None:
+        if video or record:
+            raise typer.BadParameter(
+                "--video and --record film or record one robot's scenarios; run them without "
+                "--sweep, --jobs, --ray and with one ROBOT"
+            )
         options = {
             **source_inputs(arg, package),
             "scenarios": scenario,
