@@ -260,3 +260,23 @@ CONTROL_RIG = f"""<robot name="wheel">
   </ros2_control>
 </robot>
 """
+
+
+# Two wheels on continuous joints `lj`/`rj`, 0.2 m apart: the links a diff-drive plugin names.
+TWO_WHEELS = """
+  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <link name="l"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <link name="r"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <joint name="lj" type="continuous"><parent link="base"/><child link="l"/>
+    <origin xyz="0 0.1 0"/><axis xyz="0 1 0"/></joint>
+  <joint name="rj" type="continuous"><parent link="base"/><child link="r"/>
+    <origin xyz="0 -0.1 0"/><axis xyz="0 1 0"/></joint>
+"""
+
+
+def two_wheel_bot(plugins: str) -> str:
+    """`TWO_WHEELS` with `plugins` (XML) in the model's `<gazebo>` block."""
+    return f'<robot name="bot">{TWO_WHEELS}<gazebo>{plugins}</gazebo></robot>'

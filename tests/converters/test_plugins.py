@@ -7,23 +7,12 @@ from pathlib import Path
 
 import mujoco
 import pytest
+from models import two_wheel_bot
 
 from converters.errors import GazeboTagError
 from converters.gazebo.plugins import DiffDrive
 from converters.pipeline import convert_full
 
-WHEELS = """
-  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0"
-    ixz="0" iyz="0"/></inertial></link>
-  <link name="l"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
-    ixz="0" iyz="0"/></inertial></link>
-  <link name="r"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
-    ixz="0" iyz="0"/></inertial></link>
-  <joint name="lj" type="continuous"><parent link="base"/><child link="l"/>
-    <origin xyz="0 0.1 0"/><axis xyz="0 1 0"/></joint>
-  <joint name="rj" type="continuous"><parent link="base"/><child link="r"/>
-    <origin xyz="0 -0.1 0"/><axis xyz="0 1 0"/></joint>
-"""
 ROS2 = """<plugin name="dd" filename="libgazebo_ros_diff_drive.so">
   <left_joint>lj</left_joint><right_joint>rj</right_joint><wheel_separation>0.2</wheel_separation>
   <wheel_diameter>0.1</wheel_diameter><max_wheel_torque>3</max_wheel_torque>
@@ -39,7 +28,7 @@ OTHERS = """<plugin name="imu" filename="libgazebo_ros_imu_sensor.so"/>
 
 
 def _convert(tmp_path: Path, plugins: str):  # noqa: ANN202
-    text = f'<robot name="bot">{WHEELS}<gazebo>{plugins}</gazebo></robot>'
+    text = two_wheel_bot(plugins)
     path = tmp_path / "bot.urdf"
     path.write_text(text)
     return convert_full(path)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from models import block
+from models import block, two_wheel_bot
 
 import scenarios
 from twin_cli.errors import EntityExistsError, InvalidRequestError
@@ -146,23 +146,11 @@ def test_instances_of_a_robot_share_its_meshes_in_the_world(tmp_path):
     assert world.model.nmesh == 0 and len(world._spec.meshes) == 0  # none left behind
 
 
-DIFF_DRIVE_BOT = """<robot name="bot">
-  <link name="base"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0"
-    ixz="0" iyz="0"/></inertial><collision><geometry><box size="0.3 0.2 0.05"/></geometry>
-    </collision></link>
-  <link name="l"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
-    ixz="0" iyz="0"/></inertial></link>
-  <link name="r"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
-    ixz="0" iyz="0"/></inertial></link>
-  <joint name="lj" type="continuous"><parent link="base"/><child link="l"/>
-    <origin xyz="0 0.1 0"/><axis xyz="0 1 0"/></joint>
-  <joint name="rj" type="continuous"><parent link="base"/><child link="r"/>
-    <origin xyz="0 -0.1 0"/><axis xyz="0 1 0"/></joint>
-  <gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
-    <left_joint>lj</left_joint><right_joint>rj</right_joint>
-    <wheel_separation>0.2</wheel_separation><wheel_diameter>0.1</wheel_diameter>
-  </plugin></gazebo>
-</robot>"""
+DIFF_DRIVE_BOT = two_wheel_bot(
+    '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>lj</left_joint>'
+    "<right_joint>rj</right_joint><wheel_separation>0.2</wheel_separation>"
+    "<wheel_diameter>0.1</wheel_diameter></plugin>"
+)
 SCENE = """<mujoco model="scene"><worldbody><light pos="0 0 3"/>
   <geom name="floor" type="plane" size="2 2 0.1"/>
   <body name="ball"><freejoint/><geom type="sphere" size="0.1" mass="1"/></body>
