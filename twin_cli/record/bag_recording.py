@@ -99,6 +99,21 @@ class BagRecording(Follows):
         with self._world.lock:
             self._capture()
 
+    def set_sampling(self, on: bool) -> None:
+        """Suspends or resumes sampling, keeping the encoder and the file open.
+
+        For benchmarks that alternate the loop with and without sampling on one recording, so
+        slow drifts in the machine's speed cancel; a suspended stretch is a gap in the bag.
+        """
+        with self._world.lock:
+            if self._done.is_set() or (self._handle is not None) == on:
+                return
+            if on:
+                self._handle = self._world.add_observer(self._capture, self.rate)
+            else:
+                self._world.remove_observer(self._handle)
+                self._handle = None
+
     def stop(self) -> RecordingStatus:
         """Stops sampling, lets the encoder write what is queued and close the file."""
         self._finish_sampling()
