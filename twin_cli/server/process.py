@@ -28,7 +28,8 @@ class ServeOptions:
 
     Attributes:
         world: world name (one server per name).
-        world_file: a Gazebo SDF world, a world saved by `twin save`, or None (empty world).
+        world_file: a Gazebo SDF world, an MJCF scene, a world saved by `twin save`, or None
+            (empty world).
         rate: real-time update rate [Hz]; 0 = unthrottled; None = the world's default.
         step: physics timestep [s]; None = the world's default.
         paused: start paused.

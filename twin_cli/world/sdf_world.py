@@ -59,9 +59,14 @@ def world_from_sdf(
 
 
 def load_world(path: str | os.PathLike, *, name: str = "default") -> World:
-    """A world from a file: a Gazebo SDF world (`.sdf`, `.world`), or one `twin save` wrote."""
+    """A world from a file: a Gazebo SDF world (`.sdf`, `.world`), an MJCF scene, or one that
+    `twin save` wrote."""
+    from twin_cli.world.mjcf_world import is_mjcf_file, world_from_mjcf
+
     if is_world_file(path):
         return world_from_sdf(path, name=name)
+    if is_mjcf_file(path):
+        return world_from_mjcf(path, name=name)
     return World.load(path)
 
 

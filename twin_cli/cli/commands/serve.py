@@ -15,7 +15,10 @@ from twin_cli.cli.options import WorldOpt
 
 def serve(
     world_file: Annotated[
-        Path | None, typer.Argument(help="A Gazebo SDF world (.sdf, .world) or a `twin save` file.")
+        Path | None,
+        typer.Argument(
+            help="An SDF world (.sdf, .world), an MJCF scene (.xml) or a `twin save` file."
+        ),
     ] = None,
     world: WorldOpt = "default",
     rate: Annotated[float | None, typer.Option(help="Real-time update rate (Hz); 0 = max.")] = None,
