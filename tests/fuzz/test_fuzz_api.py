@@ -3,10 +3,12 @@
 Properties, for every operation: no 5xx; the status code is one the schema documents; the body
 matches the schema of that status; afterwards the world still steps. `make test` runs a few
 derandomised cases per operation; `make fuzz` many more (TWIN_FUZZ_EXAMPLES).
-Left out: operations that end the server (/shutdown), or write files or open listeners at
-paths and addresses the fuzzer invents (/save, /record, /foxglove, /view, /snapshot): as root on
-the test machine they could write anywhere. `/step` counts are capped at 1,000 so one case
-cannot hold the world for minutes (the schema allows 10^7: a legitimate, slow request).
+Operations that write files or open listeners (/save, /record, /foxglove, /view, /snapshot) are
+fuzzed with every path confined to the server's temporary directory (the fuzzed name is kept,
+its '/' replaced) and every host set to 127.0.0.1: as root on the test machine they could
+otherwise write anywhere or listen on every interface. /shutdown is called last, once, and
+must end the server cleanly. `/step` counts are capped at 1,000 and snapshot sizes at 640 px so
+one case cannot hold the world for minutes (both legitimate, slow requests).
 """
 
 from __future__ import annotations
@@ -27,8 +29,9 @@ from twin_cli.server import runtime  # noqa: E402
 from twin_cli.server.client import Client  # noqa: E402
 
 EXAMPLES = int(os.environ.get("TWIN_FUZZ_API_EXAMPLES", 5))  # per operation
-SKIPPED = ("/shutdown", "/save", "/record", "/foxglove", "/view", "/snapshot")
+CONFINED = ("/save", "/record", "/foxglove", "/view", "/snapshot")
 MAX_STEPS = 1000
+MAX_PIXELS = 640  # [px] per snapshot side
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +61,13 @@ def live(tmp_path_factory):
         client.spawn(box, name="box", pose={"z": 0.5})
         address = (rt / "apifuzz.tcp").read_text().strip()
         token = (rt / "apifuzz.token").read_text().strip()
-        yield {"client": client, "proc": proc, "url": f"http://{address}", "token": token}
+        yield {
+            "client": client,
+            "proc": proc,
+            "url": f"http://{address}",
+            "token": token,
+            "root": rt,
+        }
     finally:
         proc.terminate()
         proc.wait(timeout=30)
@@ -74,7 +83,15 @@ def _schema_document() -> dict:
 
 
 DOCUMENT = _schema_document()
-schema = schemathesis.openapi.from_dict(DOCUMENT).exclude(path_regex="|".join(SKIPPED))
+OPENAPI = schemathesis.openapi.from_dict(DOCUMENT)
+schema = OPENAPI.exclude(path_regex="|".join(("/shutdown", *CONFINED)))
+confined = OPENAPI.include(path_regex="|".join(f"^{p}$" for p in CONFINED))
+CHECKS = [
+    checks.not_a_server_error,
+    checks.status_code_conformance,
+    checks.content_type_conformance,
+    checks.response_schema_conformance,
+]
 
 
 def test_live_server_serves_the_fuzzed_schema(live):
@@ -99,17 +116,43 @@ def test_live_server_serves_the_fuzzed_schema(live):
 def test_api_answers_within_its_schema_and_never_5xx(case, live):
     if case.path == "/step" and isinstance(case.body, dict) and isinstance(case.body.get("n"), int):
         case.body["n"] = min(case.body["n"], MAX_STEPS)
+    _call(case, live)
+
+
+def _call(case, live) -> None:  # noqa: ANN001
     case.call_and_validate(
         base_url=live["url"],
         headers={"Authorization": f"Bearer {live['token']}"},
-        checks=[
-            checks.not_a_server_error,
-            checks.status_code_conformance,
-            checks.content_type_conformance,
-            checks.response_schema_conformance,
-        ],
+        checks=CHECKS,
         timeout=120,
     )
+
+
+def _confine(body: dict, root) -> None:  # noqa: ANN001
+    """Paths into `root` (the fuzzed name kept, '/' and NUL replaced), hosts to loopback."""
+    if isinstance(body.get("path"), str) and body["path"]:
+        name = body["path"].replace("/", "_").replace("\x00", "_")
+        body["path"] = str(root / "confined" / name)
+    if "host" in body:
+        body["host"] = "127.0.0.1"
+    for side in ("width", "height"):
+        if isinstance(body.get(side), int):
+            body[side] = min(body[side], MAX_PIXELS)
+
+
+@confined.parametrize()
+@settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=list(HealthCheck),
+)
+def test_file_and_listener_operations_within_a_sandbox(case, live):
+    root = live["root"]
+    (root / "confined").mkdir(exist_ok=True)
+    if isinstance(case.body, dict):
+        _confine(case.body, root)
+    _call(case, live)
 
 
 def test_world_still_steps_after_the_fuzz(live):
@@ -121,3 +164,11 @@ def test_world_still_steps_after_the_fuzz(live):
     time.sleep(0.5)
     after = client.stats()["sim_time"]
     assert after > before, f"sim time stuck at {before} s after the fuzz"
+
+
+def test_shutdown_answers_and_ends_the_server(live):
+    """Last: /shutdown answers within its schema and the server exits with status 0."""
+    ops = OPENAPI.include(path_regex="^/shutdown$")
+    operation = next(iter(ops.get_all_operations())).ok()
+    _call(operation.Case(), live)
+    assert live["proc"].wait(timeout=30) == 0, "the server did not end cleanly"
