@@ -61,8 +61,25 @@ def lidar_post(
 </robot>"""
 
 
-def hanging_load(mass: float, *, direction: str = "parent_to_child", frame: str = "child") -> str:
-    """A load of `mass` [kg] hanging 0.3 m below a world-fixed support by a locked slider."""
+def hanging_load(
+    mass: float,
+    *,
+    direction: str = "parent_to_child",
+    frame: str = "child",
+    rate: float = 100.0,
+    noise: tuple[float, float] = (0.0, 0.0),
+) -> str:
+    """A load of `mass` [kg] hanging 0.3 m below a world-fixed support by a locked slider;
+    `noise` is the SDF Gaussian stddev of each force [N] and torque [N m] axis (0: none)."""
+    axes = "".join(
+        f"<{group}>"
+        + "".join(
+            f'<{a}><noise type="gaussian"><stddev>{std}</stddev></noise></{a}>' for a in "xyz"
+        )
+        + f"</{group}>"
+        for group, std in zip(("force", "torque"), noise, strict=True)
+        if std > 0
+    )
     return f"""<robot name="hanging">
   <link name="world"/>
   <joint name="mount" type="fixed"><parent link="world"/><child link="support"/>
@@ -75,9 +92,9 @@ def hanging_load(mass: float, *, direction: str = "parent_to_child", frame: str 
   <link name="load"><inertial><origin xyz="0 0 -0.1"/><mass value="{mass}"/>
     <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <gazebo reference="hook"><provideFeedback>true</provideFeedback>
-    <sensor type="force_torque" name="ft"><update_rate>100</update_rate>
+    <sensor type="force_torque" name="ft"><update_rate>{rate}</update_rate>
     <force_torque><frame>{frame}</frame><measure_direction>{direction}</measure_direction>
-    </force_torque></sensor></gazebo>
+    {axes}</force_torque></sensor></gazebo>
 </robot>"""
 
 

@@ -143,6 +143,8 @@ class ForceTorqueSpec(SensorSpec):
     `frame` is `child`, `parent` or `sensor` (the frame the wrench is expressed in);
     `measure_direction` is `child_to_parent` (Gazebo's default: what the child applies on the
     parent) or `parent_to_child`. `child_body`/`parent_body` are the joint's MuJoCo bodies.
+    `force_noise` [N] and `torque_noise` [N m] are per axis of the reported frame (SDF
+    `<force><x><noise>`, ..., or a gazebo_ros F/T plugin's `<gaussianNoise>` on all six).
     """
 
     joint: str = ""
@@ -150,6 +152,8 @@ class ForceTorqueSpec(SensorSpec):
     measure_direction: str = "child_to_parent"
     child_body: str = ""
     parent_body: str = ""
+    force_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
+    torque_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
 
 
 @dataclass(frozen=True)

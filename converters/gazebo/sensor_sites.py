@@ -201,15 +201,18 @@ def _details(sensor: SensorSpec) -> str:
             f"range {sensor.range_min:g}..{sensor.range_max:g} m; noise {_noise(sensor.noise)}"
         )
     if isinstance(sensor, ForceTorqueSpec):
+        noisy = sensor.force_noise + sensor.torque_noise
+        stddevs = ", ".join(f"{n.stddev:g}" for n in noisy if n.active) or "none"
         return (
             f"wrench of joint '{sensor.joint}' in the {sensor.frame} frame, "
-            f"{sensor.measure_direction}"
+            f"{sensor.measure_direction}; noise stddev {stddevs}"
         )
     if isinstance(sensor, CameraSpec):
         kind = "depth" if sensor.depth else "colour"
         return (
-            f"{kind} image {sensor.width}×{sensor.height}, hfov {sensor.horizontal_fov:g} rad "
-            "(offscreen rendering: needs MUJOCO_GL=egl or osmesa)"
+            f"{kind} image {sensor.width}×{sensor.height}, hfov {sensor.horizontal_fov:g} rad, "
+            f"clip {sensor.near:g}..{sensor.far:g} m (offscreen rendering: needs MUJOCO_GL=egl "
+            "or osmesa; image noise not simulated)"
         )
     return f"contacts of {len(getattr(sensor, 'geoms', ()))} collision geoms"
 

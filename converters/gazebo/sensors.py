@@ -50,6 +50,7 @@ AXES = ("x", "y", "z")
 # Plugin children naming the topic (gazebo_ros ROS 1 plugins) and the frame (both ROS versions).
 TOPIC_TAGS = ("topicName", "bumperTopicName", "topic_name")
 FRAME_TAGS = ("frameName", "frame_name")
+PLUGIN_NOISE_TAGS = ("gaussianNoise", "gaussian_noise")  # gazebo_ros F/T plugins, [N] and [N m]
 
 
 @dataclass(frozen=True)
@@ -229,6 +230,13 @@ def _read_force_torque(
             raise reader.ctx.fail(
                 f"{reader.prefix} force_torque/{tag}", value, " or ".join(allowed)
             )
+    ft = reader.el.find("force_torque")
+    force, torque = NO_NOISE3, NO_NOISE3
+    if ft is not None:
+        force = _group_noise(reader, ft, "force")
+        torque = _group_noise(reader, ft, "torque")
+    if not any(n.active for n in force + torque):
+        force = torque = _plugin_noise(reader)
     return ForceTorqueSpec(
         **common,
         joint=placement.joint,
@@ -236,20 +244,47 @@ def _read_force_torque(
         measure_direction=direction,
         child_body=placement.body,
         parent_body=placement.parent_body,
+        force_noise=force,
+        torque_noise=torque,
     )
+
+
+def _group_noise(reader: _Reader, el: ET.Element, group: str) -> tuple[Noise, Noise, Noise]:
+    """SDF 1.6+ per-axis noise of a vector (`<force><x><noise>`, ...)."""
+    x, y, z = (reader.noise(el.find(f"{group}/{axis}/noise")) for axis in AXES)
+    return (x, y, z)
+
+
+def _plugin_noise(reader: _Reader) -> tuple[Noise, Noise, Noise]:
+    """The gazebo_ros F/T plugin's `<gaussianNoise>` (ROS 1) or `<gaussian_noise>` (ROS 2):
+    a zero-mean Gaussian of that standard deviation on every axis, as the plugin adds it."""
+    for plugin in reader.el.findall("plugin"):
+        for tag in PLUGIN_NOISE_TAGS:
+            stddev = reader.number(tag, 0.0, plugin)
+            if stddev > 0.0:
+                noise = Noise("gaussian", stddev=stddev)
+                return (noise, noise, noise)
+    return NO_NOISE3
 
 
 def _read_camera(reader: _Reader, common: dict[str, Any], placement: Placement) -> CameraSpec:
     camera = reader.el.find("camera")
     if camera is None:
         return CameraSpec(**common, depth=common["type"].lower() in DEPTH_TYPES)
+    near = reader.number("clip/near", 0.1, camera)
+    far = reader.number("clip/far", 100.0, camera)
+    if not 0.0 < near < far:
+        expected = "0 < near < far (metres)"
+        raise reader.ctx.fail(
+            f"{reader.prefix} camera/clip", f"near {near:g} far {far:g}", expected
+        )
     return CameraSpec(
         **common,
         width=reader.integer("image/width", 320, camera),
         height=reader.integer("image/height", 240, camera),
         horizontal_fov=reader.number("horizontal_fov", 1.047, camera),
-        near=reader.number("clip/near", 0.1, camera),
-        far=reader.number("clip/far", 100.0, camera),
+        near=near,
+        far=far,
         image_format=reader.text("image/format", "R8G8B8", camera),
         depth=common["type"].lower() in DEPTH_TYPES,
         noise=reader.noise(camera.find("noise")),

@@ -156,6 +156,11 @@ def test_unknown_sensor_types_are_reported_ignored(tmp_path: Path) -> None:
         ('<sensor type="ray" name="s"><update_rate>fast</update_rate></sensor>', "update_rate"),
         ('<sensor type="ray" name="s"><ray><range><max>x</max></range></ray></sensor>', "max"),
         ('<sensor type="imu" name="s"><pose>0 0</pose></sensor>', "pose"),
+        (
+            '<sensor type="depth" name="s"><camera><clip><near>5</near><far>2</far></clip>'
+            "</camera></sensor>",
+            "clip.*0 < near < far",
+        ),
     ],
 )
 def test_bad_sensor_values_name_the_sensor_and_tag(tmp_path: Path, sensor: str, tag: str) -> None:
@@ -211,3 +216,32 @@ def test_lidar_post_model_is_static_and_its_scan_frame_is_lumped(tmp_path: Path)
     done = convert_full(write_urdf(tmp_path, lidar_post()))
     (lidar,) = done.sensors
     assert (lidar.body, lidar.topic, lidar.frame_id) == ("base", "scan", "scan")
+
+
+def test_force_torque_noise_is_read_per_axis_and_reported(tmp_path: Path) -> None:
+    done = convert_full(write_urdf(tmp_path, hanging_load(1.0, noise=(0.5, 0.05))))
+    (ft,) = done.sensors
+    assert ft.force_noise == (Noise("gaussian", stddev=0.5),) * 3
+    assert ft.torque_noise == (Noise("gaussian", stddev=0.05),) * 3
+    (line,) = _mapped(done)
+    assert "noise stddev 0.5, 0.5, 0.5, 0.05, 0.05, 0.05" in line
+
+
+def test_a_gazebo_ros_ft_plugins_gaussian_noise_applies_to_all_six_axes(tmp_path: Path) -> None:
+    plugin = '<plugin name="ft" filename="libgazebo_ros_ft_sensor.so"><gaussianNoise>0.2'
+    text = hanging_load(1.0).replace(
+        "</force_torque>", f"</force_torque>{plugin}</gaussianNoise></plugin>"
+    )
+    (ft,) = convert_full(write_urdf(tmp_path, text)).sensors
+    assert ft.force_noise == ft.torque_noise == (Noise("gaussian", stddev=0.2),) * 3
+
+
+def test_camera_clip_planes_are_kept_and_reported(tmp_path: Path) -> None:
+    sensor = (
+        '<sensor type="depth" name="s"><camera><clip><near>0.3</near><far>4</far></clip>'
+        "</camera></sensor>"
+    )
+    done = _robot(tmp_path, sensor)
+    (camera,) = done.sensors
+    assert (camera.near, camera.far, camera.depth) == (0.3, 4.0, True)
+    assert "clip 0.3..4 m" in _mapped(done)[0]

@@ -23,6 +23,18 @@ W, H, HFOV = 64, 48, 1.0  # [px], [px], [rad]
 CAM_Z = 0.5  # [m] camera height
 BOX = (2.0, 0.3, CAM_Z, 0.1)  # centre x, y, z and half size [m]
 
+# Cameras like the two below with other <clip> planes [m] (the box's near face is 1.9 m ahead).
+CLIPS = {"depth_short": ("depth", 0.05, 1.5), "depth_long": ("depth", 0.05, 3.0),
+         "depth_near": ("depth", 2.5, 10.0), "cam_short": ("camera", 0.05, 1.5),
+         "cam_near": ("camera", 2.5, 10.0)}  # fmt: skip
+SENSOR = """<sensor type="{kind}" name="{name}"><pose>0 0 {z} 0 0 0</pose><camera>
+    <horizontal_fov>{hfov}</horizontal_fov><image><width>{w}</width><height>{h}</height></image>
+    <clip><near>{near}</near><far>{far}</far></clip></camera></sensor>"""
+CLIPPED = "\n".join(
+    SENSOR.format(kind=k, name=n, z=CAM_Z, hfov=HFOV, w=W, h=H, near=near, far=far)
+    for n, (k, near, far) in CLIPS.items()
+)
+
 POST = f"""<robot name="campost">
   <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
     ixy="0" ixz="0" iyz="0"/></inertial></link>
@@ -34,8 +46,10 @@ POST = f"""<robot name="campost">
   <sensor type="depth" name="depth"><pose>0 0 {CAM_Z} 0 0 0</pose><update_rate>30</update_rate>
     <camera><horizontal_fov>{HFOV}</horizontal_fov><image><width>{W}</width>
     <height>{H}</height></image><clip><near>0.05</near><far>50</far></clip></camera></sensor>
+  {CLIPPED}
   </gazebo>
 </robot>"""
+
 
 CHILD = """
 import json, sys
@@ -56,8 +70,13 @@ world.spawn(box, name="box")
 readings = SensorSuite(world, "post").read()
 rgb = np.frombuffer(readings["cam"].data, np.uint8).reshape(HEIGHT, WIDTH, 3)
 depth = np.frombuffer(readings["depth"].data, np.float32).reshape(HEIGHT, WIDTH)
+def image(reading):
+    if reading.encoding == "32FC1":
+        return np.frombuffer(reading.data, np.float32).reshape(HEIGHT, WIDTH).tolist()
+    return np.frombuffer(reading.data, np.uint8).reshape(HEIGHT, WIDTH, 3).tolist()
 print(json.dumps({"rgb": rgb.tolist(), "depth": depth.tolist(),
-                  "encodings": [readings["cam"].encoding, readings["depth"].encoding]}))
+                  "encodings": [readings["cam"].encoding, readings["depth"].encoding],
+                  "clipped": {name: image(r) for name, r in readings.items()}}))
 """.replace("HEIGHT", str(H)).replace("WIDTH", str(W))
 
 
@@ -105,3 +124,36 @@ def test_depth_camera_reads_the_distance_to_the_near_face(images) -> None:
     centre = depth[int(v), int(u)]
     assert centre == pytest.approx(x - h, abs=0.01), "metres along the view axis to the face"
     assert depth[int(v), 2] > 10.0, "nothing to the right within range: far background"
+
+
+def _red(rgb: np.ndarray) -> np.ndarray:
+    return (rgb[..., 0] > 2 * rgb[..., 1] + 20) & (rgb[..., 0] > 2 * rgb[..., 2] + 20)
+
+
+def test_depth_beyond_the_far_clip_is_inf_and_within_it_the_box_reads_its_distance(
+    images,
+) -> None:
+    u, v, _ = _projection()
+    x, _, _, h = BOX
+    # JSON carries ±inf as ±Infinity; json.loads reads them back as floats.
+    short = np.array(images["clipped"]["depth_short"])
+    assert np.isposinf(short).all(), "far 1.5 m < 1.9 m to the box: nothing within range"
+    long = np.array(images["clipped"]["depth_long"])
+    assert long[int(v), int(u)] == pytest.approx(x - h, abs=0.01), "far 3 m: the box at 1.9 m"
+    assert np.isposinf(long[int(v), 2]), "background beyond far reads +inf (REP 117)"
+    assert np.isfinite(long).sum() > 20, "the box's pixels are finite"
+
+
+def test_a_box_nearer_than_the_near_clip_reads_minus_inf(images) -> None:
+    u, v, _ = _projection()
+    near = np.array(images["clipped"]["depth_near"])
+    assert np.isneginf(near[int(v), int(u)]), "box 1.9 m ahead, near plane 2.5 m: −inf"
+    assert not np.isfinite(near).any(), "nothing between 2.5 m and 10 m in view"
+    assert np.isposinf(near[int(v), 2])
+
+
+def test_colour_cameras_do_not_draw_what_lies_outside_their_clip_planes(images) -> None:
+    assert _red(np.array(images["rgb"], np.float64)).sum() > 20, "50 m far plane: the box shows"
+    for name in ("cam_short", "cam_near"):
+        rgb = np.array(images["clipped"][name], np.float64)
+        assert not _red(rgb).any(), f"{name}: the box at 1.9 m is outside {CLIPS[name][1:]} m"

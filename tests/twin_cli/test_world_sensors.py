@@ -167,6 +167,47 @@ def test_force_torque_child_to_parent_is_the_reaction(tmp_path: Path) -> None:
     assert wrench.force[2] == pytest.approx(-2.0 * _gravity(world), rel=1e-6)
 
 
+F_STD, T_STD = 0.5, 0.05  # [N], [N m] per axis
+FT_DRAWS = 2_000
+
+
+def _assert_noise_law(values: np.ndarray, expected: np.ndarray, stddev: float) -> None:
+    """Each column's mean is `expected` within 3 standard errors and its sample std is
+    `stddev` within 3 standard errors of a std estimate (σ/√(2(n−1)), Gaussian)."""
+    n = len(values)
+    se_mean, se_std = stddev / math.sqrt(n), stddev / math.sqrt(2 * (n - 1))
+    for axis in range(values.shape[1]):
+        got_mean, got_std = values[:, axis].mean(), values[:, axis].std(ddof=1)
+        assert abs(got_mean - expected[axis]) < 3 * se_mean, f"axis {axis} mean {got_mean}"
+        assert abs(got_std - stddev) < 3 * se_std, f"axis {axis} stddev {got_std}"
+
+
+def test_noisy_force_torque_readings_scatter_around_m_g_with_the_tags_stddev(
+    tmp_path: Path,
+) -> None:
+    from twin_cli.sensors import SensorStream
+
+    mass = 2.0
+    world = _world_with(tmp_path, hanging_load(mass, rate=1000.0, noise=(F_STD, T_STD)), "hang")
+    world.step(100)
+    g = _gravity(world)
+    suite = SensorSuite(world, "hang")
+    polled = []
+    for _ in range(FT_DRAWS):  # one reading per 1 ms period: a fresh draw each time
+        world.step(1)
+        polled.append(suite.read()["ft"])
+    stream = SensorStream(SensorSuite(world, "hang", seed=1))
+    world.step(FT_DRAWS)  # one call: the stream captures FT_DRAWS readings, noise drawn at once
+    streamed = stream.drain()
+    stream.close()
+    assert len(streamed) == FT_DRAWS
+    for readings in (polled, streamed):
+        force = np.array([r.force for r in readings])
+        torque = np.array([r.torque for r in readings])
+        _assert_noise_law(force, np.array([0.0, 0.0, mass * g]), F_STD)
+        _assert_noise_law(torque, np.zeros(3), T_STD)
+
+
 # ------------------------------------------------------------------------------------- contact
 def test_bumper_reports_contact_exactly_while_the_ball_touches(tmp_path: Path) -> None:
     radius = 0.05

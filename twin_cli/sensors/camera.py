@@ -6,6 +6,14 @@ aspect. Rendering needs an offscreen OpenGL context, which MuJoCo picks when it 
 imported (`MUJOCO_GL=egl` or `osmesa`; measured: EGL on Mesa llvmpipe ~17 frames/s at
 320×240). Without one, reading the camera fails with a message saying how to get one; the
 other sensors keep working. Depth images are metres along the view axis (32FC1).
+
+The sensor's `<clip>` planes replace the model's global ones (`<visual><map znear zfar>`) in
+the rendered scene's frustum. A colour camera is clipped at near and far, as Gazebo's is. A depth
+camera, as gz-sensors' (REP 117), is rendered from DEPTH_NEAR so that an object nearer than the
+near plane still hides what is behind it, then reports −inf where the depth is ≤ near and +inf
+where it is ≥ far (nothing within range). MuJoCo's renderer converts depth with the model's
+planes, so depth frames are rendered and converted here, with the sensor's (reversed Z:
+1 at the near plane, 0 at the far one).
 """
 
 from __future__ import annotations
@@ -20,6 +28,8 @@ from converters.description.sensors import CameraSpec
 from twin_cli.errors import InvalidRequestError
 from twin_cli.sensors.frames import element_id
 from twin_cli.sensors.readings import ImageReading
+
+DEPTH_NEAR = 0.01  # [m] near plane a depth camera is rendered from (gz-rendering's default)
 
 
 class CameraSensor:
@@ -42,7 +52,11 @@ class CameraSensor:
         with self._lock:
             renderer = self._open(model)
             renderer.update_scene(data, camera=self.camera)
-            pixels = renderer.render()
+            if self.spec.depth:
+                pixels = _render_depth(renderer, self.spec.near, self.spec.far)
+            else:
+                _clip(renderer.scene, self.spec.near, self.spec.far)
+                pixels = renderer.render()
         encoding = "32FC1" if self.spec.depth else "rgb8"
         raw = pixels.astype(np.float32 if self.spec.depth else np.uint8).tobytes()
         return ImageReading(
@@ -63,8 +77,6 @@ class CameraSensor:
                 "start the world with MUJOCO_GL=egl (or osmesa) in its environment, and an "
                 "image no larger than the model's <visual><global offwidth/offheight>",
             ) from exc
-        if self.spec.depth:
-            renderer.enable_depth_rendering()
         self._renderer = renderer
         return renderer
 
@@ -72,3 +84,43 @@ class CameraSensor:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+
+def _clip(scene: Any, near: float, far: float) -> None:
+    """Sets the frustum planes [m] of the scene's cameras (both eyes) after `update_scene`.
+
+    MuJoCo sizes the frustum at its near plane, so its extents scale with it (same view angle).
+    """
+    for camera in scene.camera:
+        scale = near / camera.frustum_near
+        camera.frustum_center *= scale
+        camera.frustum_width *= scale
+        camera.frustum_bottom *= scale
+        camera.frustum_top *= scale
+        camera.frustum_near, camera.frustum_far = near, far
+
+
+def _render_depth(renderer: Any, near: float, far: float) -> np.ndarray:
+    """Depth [m] along the view axis, top row first: −inf nearer than `near`, +inf from `far`.
+
+    Uses the renderer's own GL context and buffers (`mujoco.Renderer` has no public call that
+    renders with other clip planes than the model's); segmentation mode, as its depth mode,
+    leaves the skybox and lighting out.
+    """
+    render_near = min(DEPTH_NEAR, near)
+    _clip(renderer.scene, render_near, far)
+    flags = renderer.scene.flags
+    saved = flags.copy()
+    flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = True
+    try:
+        buffer = np.empty((renderer.height, renderer.width), np.float32)
+        mujoco.mjr_render(renderer._rect, renderer.scene, renderer._mjr_context)
+        mujoco.mjr_readPixels(None, buffer, renderer._rect, renderer._mjr_context)
+    finally:
+        np.copyto(flags, saved)
+    reversed_z = np.flipud(buffer).astype(np.float64)  # GL rows are bottom first
+    with np.errstate(divide="ignore"):
+        depth = render_near * far / (render_near + reversed_z * (far - render_near))
+    depth[(reversed_z <= 0.0) | (depth >= far)] = np.inf
+    depth[depth <= near] = -np.inf
+    return depth.astype(np.float32)

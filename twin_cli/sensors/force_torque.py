@@ -11,6 +11,8 @@ The converter adds MuJoCo's `force` and `torque` sensors on the site (on the chi
 same wrench, computed in C at every step, in the site frame about the site. A reading copies
 those six numbers and the rotation to the asked frame (the last step's, as Gazebo reports
 the last physics update); without them (or before the world stepped) it is computed here.
+The tags' noise (per axis of force and torque) is added to the reading in the asked frame, as
+Gazebo's F/T sensor adds it to the wrench it publishes.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 
 from converters.description.sensors import NATIVE_PARTS, ForceTorqueSpec
 from twin_cli.sensors.frames import body_id, native_slice, site_id
+from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import WrenchReading
 
 
@@ -33,6 +36,7 @@ class ForceTorqueSensor:
         self.site = self.child = self.parent = -1
         self.native: slice | None = None
         self.sign = -1.0 if spec.measure_direction == "child_to_parent" else 1.0
+        self.noise = NoiseSampler(spec.force_noise + spec.torque_noise, rng)
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
@@ -62,8 +66,15 @@ class ForceTorqueSensor:
         values = self.capture(data)
         return self.reading(values if values is not None else self.compute(model, data), time)
 
-    def reading(self, values: np.ndarray, time: float, *, noisy: bool = False) -> WrenchReading:
-        """The reading of `values` (as `capture` returns them; SDF's F/T noise is not read)."""
+    def noisy_batch(self, values: np.ndarray) -> np.ndarray:
+        """Rows of `capture` values (N×6) with the tags' noise drawn for all rows at once."""
+        return self.noise.apply(values)
+
+    def reading(self, values: np.ndarray, time: float, *, noisy: bool = True) -> WrenchReading:
+        """The reading of `values` (as `capture` returns them), with the tags' noise unless
+        `noisy` is False (values from `noisy_batch`)."""
+        if noisy:
+            values = self.noise.apply_one(values)
         return WrenchReading(
             self.spec.name,
             self.spec.type,

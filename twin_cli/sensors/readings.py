@@ -107,8 +107,9 @@ class WrenchReading(Reading):
 
 @dataclass(frozen=True)
 class ImageReading(Reading):
-    """sensor_msgs/Image: `width`×`height`, `encoding` rgb8 or 32FC1 (depth [m]); `data` is
-    the raw bytes (rows top to bottom), omitted from `to_dict` (served as its size only)."""
+    """sensor_msgs/Image: `width`×`height`, `encoding` rgb8 or 32FC1 (depth [m]; −inf nearer
+    than the clip's near plane, +inf from its far plane, as REP 117); `data` is the raw bytes
+    (rows top to bottom), omitted from `to_dict` (served as its size only)."""
 
     width: int
     height: int
