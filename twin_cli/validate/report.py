@@ -99,20 +99,21 @@ def write_plots(run: ValidationRun, directory: str | Path) -> list[Path]:
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    written = []
+    written, fig = [], None
     for r in run.results:
         for series in r.series:
-            fig = figure(run.robot, r, series)
+            fig = figure(run.robot, r, series, reuse=fig)
             path = directory / plot_name(r, series.label)
             tmp = path.with_suffix(".png.tmp")
             fig.savefig(tmp, format="png")
-            plt.close(fig)
             tmp.replace(path)
             written.append(path)
+    if fig is not None:
+        plt.close(fig)
     return written
 
 
-def figure(robot: str, r: CheckResult, series: Series) -> Figure:
+def figure(robot: str, r: CheckResult, series: Series, reuse: Figure | None = None) -> Figure:
     """The picture of what a check measured with its threshold drawn: curves over time (free
     fall against ½gt², slip, energy...) or one bar per item (joint, sensor), the threshold as a
     red dotted line or the allowed band in green; Agg backend, 6×4 in at 100 dpi."""
@@ -121,7 +122,12 @@ def figure(robot: str, r: CheckResult, series: Series) -> Figure:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
+    if reuse is None:
+        fig = plt.figure(figsize=(6, 4), dpi=100)
+    else:  # one canvas for many plots: its renderer's text-size cache stays warm
+        fig = reuse
+        fig.clear()
+    ax = fig.add_subplot()
     if series.categories:
         ax.bar(series.t, next(iter(series.values.values())), color="tab:blue", label="measured")
         ax.set_xticks(series.t, series.categories, rotation=30, ha="right", fontsize=8)
