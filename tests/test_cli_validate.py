@@ -8,6 +8,7 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import matplotlib.image
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "twin_cli"))
@@ -43,9 +44,24 @@ def test_humanoid_passes_every_check_and_writes_every_report(tmp_path):
     assert int(suite.get("tests")) == len(cases) == expected, "JUnit counts the checks that ran"
     assert int(suite.get("failures")) == 0 and not suite.findall("testcase/failure")
     assert "twin validate: `humanoid` passed" in md.read_text()
-    pngs = sorted(p.name for p in plots.glob("*.png"))
-    assert pngs == ["friction_standing_foot_slip.png", "gravity_free_fall.png"], pngs
-    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in plots.glob("*.png"))
+    assert_one_embedded_plot_per_physics_check(report["checks"], md.read_text(), plots)
+
+
+def assert_one_embedded_plot_per_physics_check(checks: list[dict], text: str, plots: Path):
+    """Every physics check that ran has at least one PNG, a readable image, embedded in the
+    Markdown (`![check ...](plots/NAME.png)`); no PNG is left unembedded or half-written."""
+    embedded: dict[str, set[str]] = {}
+    for line in text.splitlines():
+        if line.startswith("![") and "](plots/" in line:
+            check = line[2:].split(":")[0].split(" (")[0]
+            embedded.setdefault(check, set()).add(line.split("](plots/")[1].rstrip(")"))
+    physics = {c["check"] for c in checks if c["kind"] == "physics" and c["status"] != "skip"}
+    assert physics and set(embedded) == physics, (sorted(embedded), sorted(physics))
+    files = {p.name for p in plots.iterdir()}
+    assert files == set().union(*embedded.values()), "every file embedded, no .tmp left"
+    for name in files:
+        image = matplotlib.image.imread(plots / name)  # a valid PNG decodes
+        assert image.shape[0] >= 300 and image.shape[1] >= 500, (name, image.shape)
 
 
 BROKEN = [

@@ -122,3 +122,27 @@ def test_ray_box_oracle_is_d_over_cos_theta() -> None:
     )
     np.testing.assert_allclose(got[:3], 2.0 / np.cos(angles[:3]), rtol=1e-12)
     assert np.isinf(got[3])
+
+
+def test_each_sensor_check_plots_what_it_measured_with_its_threshold(sensed) -> None:
+    from twin_cli.validate import report
+    from twin_cli.validate.checks import CHECKS
+
+    limits = {
+        "sensor_imu": "tol_m_s2",
+        "sensor_lidar": "tol_m",
+        "sensor_contact": "max_wrong_samples",
+    }
+    for check, outcome in sensed.items():
+        (series,) = outcome.series
+        ax = report.figure("sensed", outcome, series).axes[0]
+        red = [line for line in ax.get_lines() if line.get_color() == "red"]
+        assert [float(line.get_ydata()[0]) for line in red] == [
+            CHECKS[check].defaults[limits[check]]
+        ]
+    rays = sensed["sensor_lidar"].series[0]
+    assert len(rays.t) == 91, "one error per ray that meets the wall"
+    worst = float(np.nanmax(next(iter(rays.values.values()))))
+    measured = float(sensed["sensor_lidar"].measured.split()[0])  # printed with 3 digits
+    assert worst == pytest.approx(measured, rel=5e-3, abs=1e-12), "the plot's worst ray = verdict"
+    assert sensed["sensor_contact"].series[0].categories == ("foot_contact", "rear_bumper")

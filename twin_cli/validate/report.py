@@ -5,9 +5,13 @@ from __future__ import annotations
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from twin_cli.validate.checks.base import CheckResult, Status
+from twin_cli.validate.checks.base import CheckResult, Series, Status
 from twin_cli.validate.runner import ValidationRun
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 MARK = {Status.PASS: "pass", Status.WARN: "warn", Status.FAIL: "FAIL", Status.SKIP: "skip"}
 MD_MARK = {Status.PASS: "✅", Status.WARN: "⚠️", Status.FAIL: "❌", Status.SKIP: "➖"}
@@ -87,8 +91,7 @@ def plot_name(r: CheckResult, series_label: str) -> str:
 
 
 def write_plots(run: ValidationRun, directory: str | Path) -> list[Path]:
-    """One PNG per result series (free fall against ½gt², foot slip over time) with the check's
-    threshold drawn (a line, or the allowed band around the oracle); Agg backend."""
+    """One PNG per result series, written atomically (a temporary file renamed into place)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -96,26 +99,68 @@ def write_plots(run: ValidationRun, directory: str | Path) -> list[Path]:
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    written = []
+    written, fig = [], None
     for r in run.results:
         for series in r.series:
-            fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
-            for label, values in series.values.items():
-                style = "--" if label.startswith("½") else "-"
-                ax.plot(series.t, values, style, label=label)
-            if series.band is not None:
-                low, high = series.band
-                ax.fill_between(series.t, low, high, color="green", alpha=0.2, label="allowed")
-            if series.threshold is not None:
-                ax.axhline(series.threshold, color="red", linestyle=":", label="threshold")
-            ax.set_xlabel("time [s]")
-            ax.set_ylabel(f"{series.label} [{series.unit}]")
-            ax.set_title(f"{run.robot}: {r.check} ({r.status.value})")
-            ax.grid(True, alpha=0.3)
-            ax.legend()
-            fig.tight_layout()  # keeps long axis labels inside the picture
+            fig = figure(run.robot, r, series, reuse=fig)
             path = directory / plot_name(r, series.label)
-            fig.savefig(path)
-            plt.close(fig)
+            tmp = path.with_suffix(".png.tmp")
+            fig.savefig(tmp, format="png")
+            tmp.replace(path)
             written.append(path)
+    if fig is not None:
+        plt.close(fig)
     return written
+
+
+def figure(robot: str, r: CheckResult, series: Series, reuse: Figure | None = None) -> Figure:
+    """The picture of what a check measured with its threshold drawn: curves over time (free
+    fall against ½gt², slip, energy...) or one bar per item (joint, sensor), the threshold as a
+    red dotted line or the allowed band in green; Agg backend, 6×4 in at 100 dpi."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if reuse is None:
+        fig = plt.figure(figsize=(6, 4), dpi=100)
+    else:  # one canvas for many plots: its renderer's text-size cache stays warm
+        fig = reuse
+        fig.clear()
+    ax = fig.add_subplot()
+    if series.categories:
+        ax.bar(series.t, next(iter(series.values.values())), color="tab:blue", label="measured")
+        ax.set_xticks(series.t, series.categories, rotation=30, ha="right", fontsize=8)
+        ax.set_xlim(-1.0, max(len(series.t), 2))  # one bar stays a bar, not a block
+    else:
+        for name, values in series.values.items():
+            ax.plot(series.t, values, "--" if name.startswith("½") else "-", label=name)
+    if series.band is not None:
+        low, high = series.band
+        ax.fill_between(series.t, low, high, color="green", alpha=0.2, label="allowed")
+    if series.threshold is not None:
+        ax.axhline(series.threshold, color="red", linestyle=":", label="threshold")
+    if series.log:
+        ax.set_yscale("log")
+    elif series.threshold is not None:
+        ax.set_ylim(*_span(series))
+    ax.set_xlabel(series.x_label)
+    ax.set_ylabel(f"{series.label} [{series.unit}]")
+    ax.set_title(f"{robot}: {r.check} ({r.status.value})")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()  # keeps long axis labels and rotated names inside the picture
+    return fig
+
+
+def _span(series: Series) -> tuple[float, float]:
+    """Linear value-axis limits that show both the values and the threshold: a check far
+    inside its limit (all zeros, say) would otherwise autoscale the threshold out of view."""
+    import numpy as np
+
+    values = np.concatenate([np.asarray(v, dtype=float) for v in series.values.values()])
+    values = values[np.isfinite(values)]
+    low = min(float(values.min(initial=0.0)), 0.0, float(series.threshold))
+    high = max(float(values.max(initial=0.0)), float(series.threshold))
+    pad = 0.08 * ((high - low) or abs(float(series.threshold)) or 1.0)
+    return low - pad, high + pad

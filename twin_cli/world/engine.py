@@ -45,6 +45,7 @@ from twin_cli.world.observers import Observers
 from twin_cli.world.physics import PhysicsSettings
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
+from twin_cli.world.respec import SpecRenewal
 from twin_cli.world.running import STATE, RunControl
 from twin_cli.world.scene import build_world_spec, replace_lights
 from twin_cli.world.values import (
@@ -61,7 +62,7 @@ WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
 _Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
 
-class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads):
+class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads, SpecRenewal):
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
@@ -155,6 +156,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
         try:
             home = spawn.prepare_child(loaded.spec, self._spec)
+            self._keep_spec(name, loaded.spec, loaded.mesh_keys)  # for renew_spec
             shared_meshes.prepare(loaded.spec, self._spec, loaded.mesh_keys)
             spawn.attach(self._spec, loaded.spec, name, pose)
         except ValueError as exc:
@@ -203,6 +205,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
                 b: w for b, w in self._perturbation.items() if not b.startswith(f"{name}/")
             }
             self._commit(trial, model, data, index)
+            self._count_delete()  # every RENEW_EVERY deletes: a fresh spec (bounded memory)
 
     def _free_name(self, name: str | None, default: str) -> str:
         if name is not None:
@@ -222,6 +225,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
             trial = self._spec.copy()
             replace_lights(trial, lights)
             self._commit(trial, *self._rebuild(trial, None, "<lights>"))
+            self._lights = list(lights)  # replayed by renew_spec
 
     def _rebuild(self, trial: mujoco.MjSpec, new: str | None, source: str) -> _Built:
         """Compiles `trial` into a new model and data carrying every existing entity's state."""

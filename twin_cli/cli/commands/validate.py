@@ -142,6 +142,7 @@ def validate(
     if junit:
         junit.write_text(render.junit_xml(run), encoding="utf-8")
     if markdown:
+        markdown.parent.mkdir(parents=True, exist_ok=True)
         linked = None
         if plots:  # linked from where the Markdown file is, if the plots are below it
             base = markdown.resolve().parent

@@ -33,6 +33,24 @@ class Series:
     values: dict[str, tuple[float, ...]]
     threshold: float | None = None  # a limit on the values, drawn as a line (same unit)
     band: tuple[tuple[float, ...], tuple[float, ...]] | None = None  # (low, high) allowed over t
+    x_label: str = "time [s]"  # what `t` is, with its unit
+    categories: tuple[str, ...] = ()  # bar names when `t` indexes items, not time (see `bars`)
+    log: bool = False  # a logarithmic value axis (errors many decades below the threshold)
+
+
+def bars(label: str, unit: str, values: dict[str, float], threshold: float, **extra: Any) -> Series:
+    """A Series of one value per named item (joint, sensor, surface) against one threshold,
+    drawn as bars: for checks that measure a number per item rather than a time series."""
+    names = tuple(values)
+    return Series(
+        label,
+        unit,
+        tuple(float(i) for i in range(len(names))),
+        {label: tuple(float(v) for v in values.values())},
+        threshold=float(threshold),
+        categories=names,
+        **extra,
+    )
 
 
 @dataclass(frozen=True)

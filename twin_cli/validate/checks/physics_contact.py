@@ -13,6 +13,7 @@ import numpy as np
 from twin_cli.validate.checks.base import (
     CheckResult,
     RobotUnderTest,
+    Series,
     Status,
     fmt_len,
     judged,
@@ -72,6 +73,8 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         return skip_fixed("ground_contact")
     deepest: dict[int, float] = {}
     speeds: list[float] = []
+    times: list[float] = []
+    depths: list[tuple[float, float]] = []  # (time [s], deepest penetration now [m]) settled
     lowest = [np.inf]
     previous = [run.subtree_com()]
     settle = scenario.duration * 0.5
@@ -79,12 +82,16 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
     def sample(r: ScenarioRun) -> None:
         com = r.subtree_com()
         speeds.append(float(np.linalg.norm(com - previous[0]) / (10 * r.world.model.opt.timestep)))
+        times.append(r.time)
         previous[0] = com
         with r.world.lock:
             lowest[0] = min(lowest[0], min(float(r.world.data.xipos[b][2]) for b in r.bodies))
         if r.time >= settle:
+            now = 0.0
             for geom, dist in r.ground_contacts():
                 deepest[geom] = max(deepest.get(geom, 0.0), -dist)
+                now = max(now, -dist)
+            depths.append((r.time, now))
 
     run.run(scenario.duration, sample, every=10)
     final_speed = float(np.mean(speeds[-20:]))
@@ -108,6 +115,23 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         hints.append(
             "no contact with the ground after settling: the robot has no collision geometry"
         )
+    plots = [
+        Series(
+            "ground penetration",
+            "m",
+            tuple(t for t, _ in depths),
+            {"deepest contact (settled half)": tuple(d for _, d in depths)},
+            threshold=th["max_penetration_m"],
+        ),
+        Series(
+            "COM speed",
+            "m/s",
+            tuple(times),
+            {"COM speed": tuple(speeds)},
+            threshold=th["rest_speed_m_s"],
+            log=True,
+        ),
+    ]
     return judged(
         "ground_contact",
         "physics",
@@ -115,6 +139,7 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         f"≤ {fmt_len(th['max_penetration_m'])}, ≤ {th['rest_speed_m_s']:g} m/s",
         hints,
         value=depth,
+        series=plots,
     )
 
 
@@ -139,11 +164,16 @@ def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
         far_face = float(run.world.data.xpos[box_body][0]) + scenario.obstacles[0].size[0] / 2
         near_face = far_face - scenario.obstacles[0].size[0]
     touched, furthest = [False], [-np.inf]
+    times: list[float] = []
+    fronts: list[float] = []  # the foremost link COM past the near face [m], per sample
 
     def sample(r: ScenarioRun) -> None:
         with r.world.lock:
             data = r.world.data
-            furthest[0] = max(furthest[0], max(float(data.xipos[b][0]) for b in r.bodies))
+            front = max(float(data.xipos[b][0]) for b in r.bodies)
+            furthest[0] = max(furthest[0], front)
+            times.append(r.time)
+            fronts.append(front - near_face)
             for i in range(data.ncon):
                 if {int(data.contact[i].geom1), int(data.contact[i].geom2)} & box_geoms:
                     touched[0] = True
@@ -165,4 +195,13 @@ def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
         f"< {fmt_len(scenario.obstacles[0].size[0] - th['max_intrusion_m'])}",
         hints,
         value=beyond,
+        series=[
+            Series(
+                "foremost link COM past the box's near face",
+                "m",
+                tuple(times),
+                {"foremost link COM": tuple(fronts)},
+                threshold=scenario.obstacles[0].size[0] - th["max_intrusion_m"],
+            )
+        ],
     )

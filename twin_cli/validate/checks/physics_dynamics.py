@@ -12,12 +12,13 @@ import time
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Status, judged, result
+from twin_cli.validate.checks.base import RobotUnderTest, Series, Status, bars, judged, result
 from twin_cli.validate.checks.model_joints import SLIDE, limited_range
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
 FREE = 0  # mjtJoint mjJNT_FREE
+REALTIME_CHUNKS = 5  # the capacity is timed over this many equal slices of the scenario
 REACHED_RAD = 0.01
 """A drive reached its stop when the joint came within this of it [rad or m]; a joint whose
 velocity limit keeps it from crossing its range within the drive reaches neither stop."""
@@ -57,6 +58,7 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     run = ScenarioRun(robot, scenario)
     over, under = _violations(run, th["settle_fraction"])
     hints, worst, reached = [], 0.0, 0
+    ratios: dict[str, float] = {}  # "joint upper" → violation over its tolerance
     model = run.world.model
     for i in over:
         joint = run.joints[i]
@@ -67,6 +69,7 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         for side, amount, bound in (("upper", over[i], hi), ("lower", under[i], lo)):
             reached += amount > -REACHED_RAD
             worst = max(worst, amount / tol)
+            ratios[f"{joint.name} {side}"] = max(amount / tol, 0.0)
             if amount > tol:
                 enforced = "soft" if model.jnt_limited[joint.joint] else "not enforced"
                 hints.append(
@@ -83,6 +86,9 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         f"≤ {th['max_violation_rad']:g} rad / {th['max_violation_m']:g} m past a limit",
         hints=hints,
         value=worst,
+        series=[bars("past the limit", "× tolerance", ratios, 1.0, x_label="joint and stop")]
+        if ratios
+        else [],
     )
 
 
@@ -149,6 +155,16 @@ def check_inertia(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float
         f"≤ {th['rel_tol']:g}",
         hints,
         value=error,
+        series=[
+            bars(
+                "angular acceleration error",
+                "1",
+                {"|α − I⁻¹τ| / |I⁻¹τ|": max(error, 1e-16)},  # a log axis cannot show 0
+                th["rel_tol"],
+                x_label="locked robot under a known torque τ",
+                log=True,
+            )
+        ],
     )
 
 
@@ -164,12 +180,16 @@ def check_stability(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
     low, high = run.extent()
     scale = run.mass * 9.81 * max(float(high[2] - low[2]), 0.1)  # [J]
     peak, spin, finite = [start_energy], {b: 0.0 for b in run.bodies}, [True]
+    times, gains = [0.0], [0.0]  # energy above the start, over m·g·h, per sample
 
     def sample(r: ScenarioRun) -> None:
         with r.world.lock:
             data = r.world.data
             finite[0] = finite[0] and bool(np.all(np.isfinite(data.qpos)))
-            peak[0] = max(peak[0], float(np.sum(data.energy)))
+            energy = float(np.sum(data.energy))
+            peak[0] = max(peak[0], energy)
+            times.append(r.time)
+            gains.append((energy - start_energy) / scale)
             for b in r.bodies:
                 spin[b] = max(spin[b], float(np.linalg.norm(data.cvel[b][:3])))
 
@@ -183,6 +203,15 @@ def check_stability(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
         f"≤ {th['max_energy_gain']:.0%}, ≤ {th['max_spin_rad_s']:g} rad/s, 0 warnings",
         hints,
         value=gain,
+        series=[
+            Series(
+                "energy gain over m·g·h",
+                "1",
+                tuple(times),
+                {"E(t) − E(0)": tuple(gains)},
+                threshold=th["max_energy_gain"],
+            )
+        ],
     )
 
 
@@ -221,9 +250,15 @@ def check_realtime(robot: RobotUnderTest, scenario: Scenario, th: dict[str, floa
     w = scenario.world
     target = w.rate * w.timestep if w.rate > 0 else 1.0
     run.run(0.1, None, every=100)  # warm-up
-    start = time.perf_counter()
-    run.run(scenario.duration, None, every=100)
-    factor = scenario.duration / (time.perf_counter() - start)
+    times, factors, wall, begin = [], [], 0.0, run.time
+    for _ in range(REALTIME_CHUNKS):  # timed in slices for the plot; the verdict is the total
+        sim, start = run.time, time.perf_counter()
+        run.run(scenario.duration / REALTIME_CHUNKS, None, every=100)
+        spent = time.perf_counter() - start
+        wall += spent
+        times.append(run.time)
+        factors.append((run.time - sim) / spent)
+    factor = (run.time - begin) / wall
     hints = []
     if factor < th["min_factor"] * target:
         hints.append(
@@ -238,4 +273,14 @@ def check_realtime(robot: RobotUnderTest, scenario: Scenario, th: dict[str, floa
         f"≥ {th['min_factor'] * target:g}×",
         hints,
         value=factor,
+        series=[
+            Series(
+                "capacity",
+                "× real time",
+                tuple(times),
+                {"simulated s per wall s": tuple(factors)},
+                threshold=th["min_factor"] * target,
+                log=True,
+            )
+        ],
     )

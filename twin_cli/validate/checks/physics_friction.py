@@ -13,7 +13,15 @@ import math
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Series, Status, fmt_len, judged, result
+from twin_cli.validate.checks.base import (
+    RobotUnderTest,
+    Series,
+    Status,
+    bars,
+    fmt_len,
+    judged,
+    result,
+)
 from twin_cli.validate.checks.model_inertia import collision_geoms
 from twin_cli.validate.checks.physics_contact import skip_fixed
 from twin_cli.validate.checks.sim import ScenarioRun
@@ -143,14 +151,15 @@ def slide_on_slope(robot: RobotUnderTest, spec, scenario: Scenario, theta: float
     return float(np.linalg.norm((run.subtree_com() - start)[:2]))
 
 
-def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]]:
-    """Run the stick and slide probes of one foot geom; return (hints, details)."""
+def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str], float]:
+    """Run the stick and slide probes of one foot geom; return (hints, details, the distance
+    [m] it slid on the slope where it should stick)."""
     spec = probe_spec(robot.model, geom)
     name = robot.model.body(int(robot.model.geom_bodyid[geom])).name
     g, t = 9.81, scenario.duration
     hints, details = [], []
     theta_stick = math.atan(th["stick_factor"] * mu)
-    slid = slide_on_slope(robot, spec, scenario, theta_stick)
+    slid = stuck = slide_on_slope(robot, spec, scenario, theta_stick)
     details.append(f"{name}: μ={mu:.3g}, {math.degrees(theta_stick):.1f}° slides {fmt_len(slid)}")
     if slid > th["max_stick_slip_m"]:
         hints.append(
@@ -169,7 +178,7 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
                 f"Coulomb with μ={mu:.3g} predicts {fmt_len(expected)}: the pair's friction is "
                 "not min(μ); another surface's μ wins"
             )
-    return hints, details
+    return hints, details, stuck
 
 
 def _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details) -> list[str]:
@@ -205,13 +214,14 @@ def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[s
             robot.model.geom_priority[local],
         )
         by_surface.setdefault(key, local)
-    hints, details, mus = [], [], []
+    hints, details, mus, stuck = [], [], [], {}
     for (mu_foot, _), geom in sorted(by_surface.items())[: int(th["max_probes"])]:
         mu = min(mu_foot, GROUND_MU)
         mus.append(mu)
-        h, d = _probe_verdicts(robot, scenario, geom, mu, th)
+        h, d, slid = _probe_verdicts(robot, scenario, geom, mu, th)
         hints += h
         details += d
+        stuck[f"{robot.model.body(int(robot.model.geom_bodyid[geom])).name} μ={mu:.3g}"] = slid
     return result(
         "friction_incline",
         "physics",
@@ -221,4 +231,15 @@ def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[s
         hints=hints,
         details=details,
         value=float(len(hints)),
+        series=[
+            bars(
+                "slide on the sticking slope",
+                "m",
+                stuck,
+                th["max_stick_slip_m"],
+                x_label=f"foot surface (probe block on a slope tan θ = {th['stick_factor']:g}μ)",
+            )
+        ]
+        if stuck
+        else [],
     )

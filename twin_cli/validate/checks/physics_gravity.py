@@ -107,6 +107,19 @@ def check_moon_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
             f"measured acceleration {accel:.3f} m/s² is {ratio:.4f} of Earth's, expected "
             f"{target:.4f}: the world's gravity preset did not reach the robot"
         )
+    # the apparent acceleration 2·drop/t² so far, as the verdict computes it at the end
+    late = t > 0.1 * t[-1]  # early samples divide a tiny drop by a tiny t²
+    ratios = 2.0 * -disp[late, 2] / t[late] ** 2 / gravity_share(run) / 9.81
+    series = Series(
+        "a over g_earth",
+        "1",
+        tuple(t[late]),
+        {"measured 2·drop/t² / 9.81": tuple(ratios)},
+        band=(
+            tuple(np.full(len(ratios), target * (1 - th["rel_tol"]))),
+            tuple(np.full(len(ratios), target * (1 + th["rel_tol"]))),
+        ),
+    )
     return judged(
         "moon_gravity",
         "physics",
@@ -114,6 +127,7 @@ def check_moon_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         f"{target:.4f} ± {th['rel_tol']:.0%}",
         hints,
         value=ratio,
+        series=[series],
     )
 
 
@@ -140,6 +154,13 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
             f"link '{name}' moves {fmt_len(moved[worst])} without gravity or control: check its "
             "joint springs (springStiffness/springReference) and initial overlaps"
         )
+    series = Series(
+        "COM drift",
+        "m",
+        tuple(t),
+        {"|COM − start|": tuple(np.linalg.norm(disp, axis=1))},
+        threshold=th["max_com_drift_m"],
+    )
     return judged(
         "zero_gravity",
         "physics",
@@ -147,4 +168,5 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         f"≤ {fmt_len(th['max_com_drift_m'])}, ≤ {fmt_len(th['max_link_motion_m'])}",
         hints,
         value=drift,
+        series=[series],
     )

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Status, judged, result
+from twin_cli.validate.checks.base import RobotUnderTest, Series, Status, bars, judged, result
 from twin_cli.validate.checks.sim import PLANE, ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
@@ -80,7 +80,7 @@ def check_sensor_imu(robot: RobotUnderTest, scenario: Scenario, th: dict[str, fl
 
     run.run(scenario.duration, sample, every=1)
     dt = float(run.world.model.opt.timestep)
-    hints, worst = [], 0.0
+    hints, worst, biases = [], 0.0, {}
     for name, rows in samples.items():
         table = np.array(rows)  # per step: f − Rᵀ(−g) (3), gyro (3), R (9), site velocity (3)
         mean_a = (table[-1, 15:18] - table[0, 15:18]) / (dt * (len(table) - 1))
@@ -88,14 +88,16 @@ def check_sensor_imu(robot: RobotUnderTest, scenario: Scenario, th: dict[str, fl
         bias = float(np.linalg.norm(table[:-1, 0:3].mean(axis=0) - R.T @ mean_a))
         spin = float(np.linalg.norm(table[:, 3:6].mean(axis=0)))
         worst = max(worst, bias)
+        biases[name] = bias
         if bias > th["tol_m_s2"] or spin > th["max_rate_rad_s"]:
             hints.append(
                 f"IMU '{name}' at rest reads {bias:.3g} m/s² off Rᵀ·(a − g) and "
                 f"{spin:.3g} rad/s: check its <pose> and that its link is the one it moves with"
             )
+    plot = bars("specific force off Rᵀ·(a − g)", "m/s²", biases, th["tol_m_s2"], x_label="IMU")
     return judged(
         "sensor_imu", "physics", f"{worst:.3g} m/s² off gravity",
-        f"≤ {th['tol_m_s2']:g} m/s²", hints,
+        f"≤ {th['tol_m_s2']:g} m/s²", hints, series=[plot],
     )  # fmt: skip
 
 
@@ -130,7 +132,7 @@ def check_sensor_lidar(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     run = ScenarioRun(robot, scenario)
     run.run(scenario.duration)
     box = run.world.model.body("obstacle0/box").id
-    worst, seen, hints = 0.0, 0, []
+    worst, seen, hints, plots = 0.0, 0, [], []
     with run.world.lock:
         data = _evaluated(run)
         centre, R = data.xpos[box].copy(), data.xmat[box].reshape(3, 3).copy()
@@ -148,6 +150,7 @@ def check_sensor_lidar(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
             error = np.abs(measured[judged_rays] - expected[judged_rays])
             off = float(np.max(np.where(np.isfinite(error), error, 1e9), initial=0.0))
             worst = max(worst, off)
+            plots.append(_ray_errors(spec.name, np.flatnonzero(judged_rays), error, th["tol_m"]))
             if off > th["tol_m"]:
                 hints.append(
                     f"lidar '{spec.name}': a ray reads {off:.3g} m off the box's distance: "
@@ -156,7 +159,21 @@ def check_sensor_lidar(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     if not seen:
         return _no_ray_reaches(scenario)
     return judged(
-        "sensor_lidar", "physics", f"{worst:.3g} m over {seen} rays", f"≤ {th['tol_m']:g} m", hints
+        "sensor_lidar", "physics", f"{worst:.3g} m over {seen} rays", f"≤ {th['tol_m']:g} m", hints,
+        series=[p for p in plots if p.t],
+    )  # fmt: skip
+
+
+def _ray_errors(name: str, rays: np.ndarray, error: np.ndarray, tol: float) -> Series:
+    """|measured − slab distance| [m] of each ray that reaches the box, by ray index."""
+    shown = np.where(np.isfinite(error), error, np.nan)  # a missed ray leaves a gap
+    return Series(
+        f"lidar {name} range error",
+        "m",
+        tuple(float(i) for i in rays),
+        {"|measured − oracle|": tuple(float(e) for e in shown)},
+        threshold=tol,
+        x_label="ray index",
     )
 
 
@@ -198,9 +215,13 @@ def check_sensor_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         if k > th["max_wrong_samples"]
     ]
     summary = ", ".join(f"{n}: touching {touched[n]}" for n in wrong)
+    plot = bars(
+        "samples disagreeing with the touch oracle", "samples", wrong, th["max_wrong_samples"],
+        x_label="contact sensor",
+    )  # fmt: skip
     return judged(
         "sensor_contact", "physics", f"{sum(wrong.values())} wrong samples ({summary})",
-        f"≤ {th['max_wrong_samples']:g}", hints,
+        f"≤ {th['max_wrong_samples']:g}", hints, series=[plot],
     )  # fmt: skip
 
 

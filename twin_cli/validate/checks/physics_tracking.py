@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Status, result
+from twin_cli.validate.checks.base import RobotUnderTest, Status, bars, result
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
@@ -153,4 +153,15 @@ def _verdict(run, names, steps, late, peak, sine_err, amp, th):  # noqa: ANN001,
         f"≤ {th['max_speed_ratio']:g}×",
         hints=fails + warns,
         value=worst_error,
+        series=[
+            bars("step settling time", "s", late, th["max_settle_s"], x_label="joint"),
+            bars(
+                "sine error over amplitude",
+                "1",
+                {n: e / abs(amp[n]) for n, e in sine_err.items()},
+                th["max_sine_error_fraction"],
+                x_label="joint",
+            ),
+            bars("peak speed over limit", "1", peak, th["max_speed_ratio"], x_label="joint"),
+        ],
     )
