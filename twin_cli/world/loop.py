@@ -18,6 +18,9 @@ from twin_cli.world import realtime as rt
 PAUSED_POLL_S = 0.05  # [s] how often a paused loop wakes to sample the meter
 YIELD_POLL_S = 0.00005  # [s] sleep while a request waits for the lock
 YIELD_MAX_S = 0.01  # [s] longest the loop defers to waiting requests after a batch
+# [s] longest sleep between due steps: at a rate of 1e-4 Hz the next step is hours away, and a
+# rate change or `stop` must still be seen at once (the API fuzz found the server deaf to both).
+IDLE_POLL_S = 0.05
 
 
 class Steppable(Protocol):
@@ -147,7 +150,8 @@ class SteppingLoop:
                 pacer = rt.start_pacer(rate, now, done)
             n, pacer = rt.steps_due(pacer, now, done, batch)
             if n == 0:
-                time.sleep(max(0.0, rt.next_wake(pacer, done) - time.perf_counter()))
+                wait = rt.next_wake(pacer, done) - time.perf_counter()
+                self._stop.wait(min(max(0.0, wait), IDLE_POLL_S))
                 continue
             self._lateness = rt.record_lateness(
                 self._lateness, now - rt.due_time(pacer, done + 1), pacer.period
