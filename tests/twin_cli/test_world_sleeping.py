@@ -12,9 +12,9 @@ from twin_cli.world import Pose, World
 
 ROBOTS = 4
 DROP = 0.3  # [m] each humanoid starts this far above its resting height
-SETTLE_S = 1.0  # [s] sim time within which every dropped humanoid must be asleep
+SETTLE_S = 1.0  # [s] sim time by which every dropped humanoid is asleep (0.5 s measured)
 TOLERANCE = 0.01  # [m/s] a landed humanoid chatters at 2-6 mm/s on Gazebo's stiff contacts
-POSE_TOL = 1e-3  # [m, rad] resting qpos, sleeping vs awake world (measured under 1e-4)
+POSE_TOL = 1e-3  # [m, rad] resting qpos, sleeping vs awake world (5e-4 measured)
 PUSH_TOL = 0.005  # [m] a woken robot's travel vs one that never slept (0.5 mm measured)
 COMMAND_TOL = 1e-3  # [rad] joint angle reached after a command, sleeping vs awake world
 
