@@ -79,13 +79,31 @@ def _unthrottled(count: int, threads: int) -> dict:
     }
 
 
-def _realtime(count: int, threads: int) -> float:
+def _realtime(count: int, threads: int, sleep: bool = False) -> float:
     world = _standing(count, rate=1000.0)
-    world.set_engine(threads=threads)
+    world.set_engine(threads=threads, sleep=sleep)
     world.start()
     try:
         time.sleep(REALTIME_S)
         return round(world.loop_figures().factor, 3)
+    finally:
+        world.stop()
+
+
+def _realtime_sleeping(count: int) -> dict:
+    """Real-time factor of `count` standing humanoids with sleeping on, and how many slept.
+
+    Robots on their servos may sleep since twin_cli.world.sleeping; they rest still enough to
+    sleep at MuJoCo's default tolerance (1e-3 m/s) within 0.1 s of standing.
+    """
+    world = _standing(count, rate=1000.0)
+    world.set_engine(sleep=True)
+    world.start()
+    try:
+        time.sleep(REALTIME_S)
+        with world.lock:
+            asleep = int(world.model.ntree) - int(world.data.ntree_awake)
+        return {"factor": round(world.loop_figures().factor, 3), "asleep": asleep}
     finally:
         world.stop()
 
@@ -143,6 +161,7 @@ def run() -> dict:
         "unthrottled": scaling,
         "realtime_64_factor": _realtime(64, best),
         "realtime_64_threads": best,
+        "realtime_64_sleeping": _realtime_sleeping(64),
         "spawn_into_50": _spawn_latency(),
         "booster_t1": _boosters(),
         "load_average_1min": os.getloadavg()[0],

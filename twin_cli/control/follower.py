@@ -101,6 +101,8 @@ class TrajectoryFollower:
         """
         import numpy as np
 
+        from twin_cli.world.sleeping import wake_actuated
+
         world = self.world
         if self._model is not world.model:
             self._model = world.model
@@ -111,6 +113,7 @@ class TrajectoryFollower:
             self._kv = np.array([c.kv for c in commands]) / gear
             self._hold = np.array([c.hold for c in commands]) / gear
         world.data.ctrl[self._ids] = positions
+        wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
         world.model.actuator_biasprm[self._ids, 0] = self._kv * np.array(speeds) + self._hold
         self._last = (positions, speeds)
 

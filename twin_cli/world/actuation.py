@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from twin_cli.world import sleeping
+
 MODES = ("position", "velocity", "effort")
 VELOCITY_BAND = 0.01  # fraction of the velocity limit over which Gazebo's rule fades the effort
 GAZEBO_STEP = 0.001  # [s] dampingFactor is the velocity fraction lost per Gazebo step
@@ -96,6 +98,7 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
       v and stays 0 beyond (the servo's pull reverses sign and the range clips it to 0).
       implicitfast integrates the gain's velocity term implicitly, so it is stable at any gain.
     """
+    sleeping.wake_actuated(model, data, (a,))  # a sleeping robot must feel its new command
     gear = abs(model.actuator_gear[a][0]) or 1.0
     limit = cmd.effort / gear
     model.actuator_gaintype[a] = _FIXED

@@ -13,9 +13,10 @@ starts with one thread (no pool) and `twin physics --threads N` asks for one.
 Sleeping (`mjENBL_SLEEP`) freezes islands whose speed stays under `sleep_tolerance` [m/s, rad/s]
 for 10 steps; contacts with awake bodies and pushes wake them. Off by default: a sleeping robot's
 state is held, not integrated, which is a different (if tiny) answer from the one the physics
-tests check. Measured: with Gazebo's stiff contacts (kp/kd) a box resting on the ground still
-creeps at 2-3 mm/s after 0.3 s, above MuJoCo's 1e-3 tolerance, so robots at rest rarely sleep
-unless the tolerance is raised (`--sleep-tolerance`).
+tests check. Robots used to never sleep, not for contact creep but because MuJoCo never lets
+an actuated tree sleep on its own: `twin_cli.world.sleeping` allows it and wakes a robot on
+every command. Humanoids placed at rest then sleep at the default 1e-3 tolerance within 0.1 s;
+dropped ones chatter on Gazebo's stiff contacts at 2-6 mm/s and need `--sleep-tolerance 0.01`.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.world.sleeping import allow_actuated
 
 POOL_MIN_TREES = 4  # kinematic trees (robots, free objects) before the pool is worth its overhead
 MAX_THREADS = 64
@@ -80,6 +82,7 @@ class EngineThreads:
 
     def _install_pool(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """Gives a new MjData the pool this world's settings ask for (caller holds the lock)."""
+        allow_actuated(model)  # robots on their servos may sleep too (twin_cli.world.sleeping)
         size = pool_size(self.threads, model)
         if size and not data.threadpool:  # mj_recompile keeps the pool of the data it reuses
             mujoco.mju_threadpool(data, size)

@@ -14,6 +14,7 @@ from twin_cli.world import actuation as control
 from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.entities import element_names
 from twin_cli.world.scene import ODE_ONLY_FIELDS
+from twin_cli.world.sleeping import wake_trees
 from twin_cli.world.values import check_settings, finite_vector
 
 
@@ -32,6 +33,7 @@ class PhysicsSettings:
             self.model.opt.gravity[:] = g
             self._spec.option.gravity = g
             self.settings = replace(self.settings, gravity=tuple(g))
+            wake_trees(self.data, range(self.model.ntree))  # sleeping robots feel it too
 
     def physics(self) -> dict:
         """Timestep [s], rate [Hz], iterations, solver, integrator, gravity, target factor, and
@@ -93,4 +95,5 @@ class PhysicsSettings:
                 self.model, element_names(self.model, self.model.name_numericadr)
             )
             self._loop.reanchor()
+            wake_trees(self.data, range(self.model.ntree))  # new settings act on every robot
             return self.physics()
