@@ -32,6 +32,7 @@ from twin_cli.world import shared_meshes, spawn
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.pose import Pose
 from twin_cli.world.scene import adopt_world_globals, build_world_spec, replace_lights
+from twin_cli.world.sleeping import allow_actuated
 from twin_cli.world.values import scene_settings
 
 __all__ = ["RENEW_EVERY", "SpecRenewal", "model_bytes"]
@@ -100,13 +101,15 @@ class SpecRenewal:
 
     def _compiles_to_model(self, spec: mujoco.MjSpec) -> bool:
         """Whether `spec` compiles, as `World._rebuild` and `_commit` finish every model (joint
-        commands written into actuators, contact stiffness capped), to `model` byte for byte."""
+        commands written into actuators, contact stiffness capped, actuated robots allowed to
+        sleep), to `model` byte for byte."""
         try:
             candidate = spec.compile()
         except (ValueError, RuntimeError):
             return False
         self._reapply_commands(candidate, mujoco.MjData(candidate))
         cap_contact_stiffness(candidate)
+        allow_actuated(candidate)
         return model_bytes(candidate) == model_bytes(self.model)
 
     def _fresh_spec(self) -> mujoco.MjSpec | None:
