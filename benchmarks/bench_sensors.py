@@ -9,22 +9,27 @@ so they step the identical trajectory (readings never act on physics): a window'
 by ±30 % along a trajectory, which earlier unpaired windows mixed into the ratio. Target:
 throughput with sensors ≥ 0.90 of the plain loop (median of pairs on one world: the bundled
 humanoid lying on the ground, a sensor post and a wall), in CPU time of the stepping thread.
-Three ways of reading: `sensors` (the Python loop above, `SensorSuite.read`), `observed`
-(`SensorSuite.read` from world observers at the rates, 500-step batches) and `streamed` (a
-`SensorStream`: observers copy, readings are built per batch). Per-read costs are printed too.
+Four ways of reading: `sensors` (the Python loop above, `SensorSuite.read`), `observed`
+(`SensorSuite.read` from world observers at the rates, 500-step batches), `streamed` (a
+`SensorStream`: observers copy, readings are built per batch) and `recorded` (as recordings
+and the Foxglove stream take them: observers copy, another thread builds; also in wall
+time). Per-read costs are printed too.
 """
 
 from __future__ import annotations
 
 import os
+import queue
 import statistics
 import tempfile
+import threading
 import time
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from twin_cli.record.sensor_feed import SensorFeed
 from twin_cli.sensors import SensorStream, SensorSuite
 from twin_cli.sensors.snapshot import STATE
 from twin_cli.world import Pose, World
@@ -36,7 +41,12 @@ PAIRS = 7
 # Windows are timed in CPU time of the stepping thread (observers and drains run in it too):
 # on a shared machine (load ≫ cores) wall time measures the neighbours, ±40 % between pairs.
 clock = time.thread_time
-TARGETS = {"sensors_vs_plain": 0.90, "observed_vs_plain": 0.90, "streamed_vs_plain": 0.90}
+TARGETS = {
+    "sensors_vs_plain": 0.90,
+    "observed_vs_plain": 0.90,
+    "streamed_vs_plain": 0.90,
+    "recorded_vs_plain": 0.90,
+}
 SENSOR_POST = """<robot name="post">
   <link name="base"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
     ixy="0" ixz="0" iyz="0"/></inertial><collision><origin xyz="0 0 0.1"/>
@@ -84,8 +94,16 @@ def _plain(world: World) -> float:
     return STEPS / (clock() - start)
 
 
+def _plain_both(world: World) -> tuple[float, float]:
+    """`_plain` in the stepping thread's CPU time and in wall time."""
+    wall, start = time.perf_counter(), clock()
+    for _ in range(STEPS // 500):
+        world.step(500)
+    return STEPS / (clock() - start), STEPS / (time.perf_counter() - wall)
+
+
 def _with_sensors(world: World, suite: SensorSuite) -> float:
-    suite._readings.clear()  # the same readings are due in every window (same sim times)
+    suite.forget()  # the same readings are due in every window (same sim times)
     start = clock()
     for k in range(STEPS // IMU_EVERY):
         world.step(IMU_EVERY)
@@ -97,7 +115,7 @@ def _with_sensors(world: World, suite: SensorSuite) -> float:
 def _observed(world: World, suite: SensorSuite) -> float:
     """Steps as a running world does (500-step batches), the readings taken by observers at
     the sensors' rates in sim time (as the recorder takes its samples): no Python step loop."""
-    suite._readings.clear()
+    suite.forget()
     handles = [
         world.add_observer(lambda: suite.read(["imu"]), 1000.0 / IMU_EVERY),
         world.add_observer(lambda: suite.read(["lidar"]), 1000.0 / LIDAR_EVERY),
@@ -128,6 +146,40 @@ def _streamed(world: World, suite: SensorSuite) -> float:
     return STEPS / elapsed
 
 
+def _recorded(world: World) -> tuple[float, float]:
+    """As a recording takes them (`twin_cli.record.sensor_feed`): observers at the sensors'
+    rates only copy (`SensorFeed.capture`), a consumer thread builds the readings (rays cast
+    there). Steps/s in the stepping thread's CPU time, and in wall time (the consumer runs on
+    the other core meanwhile); every reading is built before the window ends."""
+    feed = SensorFeed(world, ["post"])
+    captured: queue.SimpleQueue = queue.SimpleQueue()
+    built = []
+
+    def consume() -> None:
+        while (item := captured.get()) is not None:
+            built.extend(feed.build(item))
+
+    consumer = threading.Thread(target=consume)
+    consumer.start()
+    handles = [
+        world.add_observer(lambda rate=rate: captured.put(feed.capture(rate)), rate)
+        for rate in feed.rates()
+    ]
+    wall, start = time.perf_counter(), clock()
+    for _ in range(STEPS // 500):
+        world.step(500)
+    cpu = clock() - start
+    for handle in handles:
+        world.remove_observer(handle)
+    captured.put(None)
+    consumer.join()
+    wall = time.perf_counter() - wall
+    expected = STEPS // IMU_EVERY + STEPS // LIDAR_EVERY
+    if len(built) != expected:
+        raise RuntimeError(f"built {len(built)} readings, expected {expected}")
+    return STEPS / cpu, STEPS / wall
+
+
 def _read_cost(world: World, suite: SensorSuite, name: str, n: int) -> float:
     """Median CPU time [µs] of a fresh reading of `name` (one step between reads)."""
     costs = []
@@ -147,7 +199,14 @@ def throughput(tmp: Path) -> dict:
         start = np.empty(mujoco.mj_stateSize(world.model, STATE))
         mujoco.mj_getState(world.model, world.data, start, STATE)
     ratios, observed, streamed, plain, sensed = [], [], [], [], []
+    recorded, recorded_wall = [], []
     for _ in range(PAIRS):
+        _restore(world, start, sensors=False)
+        p, p_wall = _plain_both(world)
+        _restore(world, start, sensors=True)
+        r, r_wall = _recorded(world)
+        recorded.append(r / p)
+        recorded_wall.append(r_wall / p_wall)
         _restore(world, start, sensors=False)
         p = _plain(world)
         _restore(world, start, sensors=True)
@@ -165,6 +224,10 @@ def throughput(tmp: Path) -> dict:
         "ratios": [round(x, 3) for x in ratios],
         "observed_vs_plain_median": statistics.median(observed),
         "observed_ratios": [round(x, 3) for x in observed],
+        "recorded_vs_plain_median": statistics.median(recorded),
+        "recorded_ratios": [round(x, 3) for x in recorded],
+        "recorded_wall_vs_plain_median": statistics.median(recorded_wall),
+        "recorded_wall_ratios": [round(x, 3) for x in recorded_wall],
         "streamed_vs_plain_median": statistics.median(streamed),
         "streamed_ratios": [round(x, 3) for x in streamed],
         "plain_steps_per_s": statistics.median(plain),

@@ -45,16 +45,19 @@ class Follows:
         self._follow_sensors(world)
 
     def _follow_sensors(self, world: Any) -> None:
-        """Observes `world` at its fastest sensor's rate (no sensors: not at all)."""
+        """Observes `world` at each of its sensors' rates (no sensors: not at all)."""
         self._stop_sensors()
-        rate = self._feed.rate()
-        if rate > 0 and not self._done.is_set():
+        rates = self._feed.rates()
+        if rates and not self._done.is_set():
             with world.lock:
                 self._capture_sensors()
                 self._sensor_world = world
-                self._sensor_handle = world.add_observer(self._capture_sensors, rate)
+                self._sensor_handles = [
+                    world.add_observer(lambda rate=rate: self._capture_sensors(rate), rate)
+                    for rate in rates
+                ]
 
     def _stop_sensors(self) -> None:
-        if getattr(self, "_sensor_handle", None) is not None:
-            self._sensor_world.remove_observer(self._sensor_handle)
-            self._sensor_handle = None
+        for handle in getattr(self, "_sensor_handles", ()):
+            self._sensor_world.remove_observer(handle)
+        self._sensor_handles = []

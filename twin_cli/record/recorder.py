@@ -107,7 +107,7 @@ class Recording(Follows):
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
-        self._queue: queue.SimpleQueue[Sample | list | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Sample | tuple | None] = queue.SimpleQueue()
         self._handle: int | None = None
         self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
         self._busy, self._newest = False, None
@@ -168,12 +168,12 @@ class Recording(Follows):
         if self._until is not None and sample.time >= self._until - 1e-9:
             self._finish_sampling()
 
-    def _capture_sensors(self) -> None:
+    def _capture_sensors(self, rate: float | None = None) -> None:
         if self._done.is_set():
             return
-        readings = self._feed.fresh()
-        if readings and not (self._latest_only and self._busy):  # a busy live view skips them
-            self._queue.put(readings)
+        captured = self._feed.capture(rate)  # copies; the worker builds the readings
+        if captured and not (self._latest_only and self._busy):  # a busy live view skips them
+            self._queue.put((self._feed, captured))
 
     def _finish_sampling(self) -> None:
         if self._done.is_set():
@@ -189,8 +189,9 @@ class Recording(Follows):
         kinematics, layout = Kinematics(), None
         try:
             while (sample := self._next()) is not None:
-                if isinstance(sample, list):
-                    self._publish_readings(sample)
+                if isinstance(sample, tuple):
+                    feed, captured = sample
+                    self._publish_readings(feed.build(captured))
                     continue
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)

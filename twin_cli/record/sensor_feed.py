@@ -1,14 +1,20 @@
-"""The recorded entities' sensor readings, taken in the stepping thread at the sensors' rates.
+"""The recorded entities' sensor readings: copied in the stepping thread, built in the consumer's.
 
 Read through `twin_cli.sensors.SensorSuite` (its public API only: how readings are computed is
-that package's business). One world observer runs at the fastest sensor's rate; each call
-returns the readings that are new since the last (a suite refreshes a sensor once per its own
-period and hands back the previous reading otherwise). Suites are rebuilt when the world's
+that package's business). One world observer per distinct sensor rate calls `capture` at that
+rate in sim time (so a 30 Hz camera is stamped at its own period, not at a faster IMU's next
+tick; sensors of entities spawned later go with the fastest observer); it copies what the due
+sensors need (their sensordata, or the world's state: a few
+µs); the recorder's own thread calls `build`, which casts the lidar rays, renders the cameras
+and draws the noise there, off the stepping thread (design.md §7). A sensor that cannot be read
+in this process (a camera without offscreen GL) is left out of the recording from then on, with
+one warning naming it and the fix; the other sensors go on. Suites are rebuilt when the world's
 model changes (spawn, delete, load).
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from typing import Any
 
@@ -17,7 +23,10 @@ from twin_cli.record.topics import Topic
 from twin_cli.sensors import Reading, SensorSuite
 from twin_cli.world.observers import world_view
 
+log = logging.getLogger("twin.record")
 MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
+
+Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pending)
 
 
 class SensorFeed:
@@ -27,33 +36,61 @@ class SensorFeed:
         self._world, self._names = world, tuple(entities)
         self._model: Any = None
         self._suites: dict[str, SensorSuite] = {}
-        self._last: dict[tuple[str, str], float] = {}
+        self._wanted: dict[str, list[str]] = {}  # entity → its sensors still recorded
+        self._rates: list[float] = []  # [Hz] of the observers, fastest first
+        self._groups: dict[float | None, dict[str, list[str]]] = {}  # rate → entity → sensors
+        self.dropped: dict[tuple[str, str], str] = {}  # (entity, sensor) → why
 
-    def rate(self) -> float:
-        """[Hz] of sim time the feed must be called at: the fastest sensor's (0: no sensors)."""
+    def rates(self) -> list[float]:
+        """[Hz] of sim time to call `capture(rate)` at, one per distinct sensor rate, fastest
+        first (empty: no sensors). Rates are capped at MAX_RATE and the step rate."""
         with self._world.lock:
             self._refresh()
-            step = 1.0 / float(self._world.model.opt.timestep)
-        rates = [
-            (spec.update_rate or step)
-            for suite in self._suites.values()
-            for spec in suite.specs.values()
-        ]
-        return min(max(rates, default=0.0), MAX_RATE, step)
+            specs = [spec for suite in self._suites.values() for spec in suite.specs.values()]
+            self._rates = sorted({self._rate(spec) for spec in specs}, reverse=True)
+            self._group()
+        return list(self._rates)
 
-    def fresh(self) -> list[tuple[Topic, Reading]]:
-        """Readings taken since the last call; call with the world's lock held."""
+    def capture(self, rate: float | None = None) -> Captured:
+        """Copies what the sensors due now need (of the observer at `rate`; None: all sensors);
+        call with the world's lock held."""
         self._refresh()
         out = []
+        group = self._groups.get(rate, self._wanted) if rate is not None else self._wanted
         for entity, suite in self._suites.items():
-            for name, reading in suite.read().items():
-                if self._last.get((entity, name)) == reading.time:
-                    continue
-                self._last[(entity, name)] = reading.time
-                topic = sensor_topic(entity, name, suite.specs[name].topic, reading)
+            names = group.get(entity)
+            if names:
+                pending = suite.capture(names)
+                if pending.native or pending.rest:
+                    out.append((suite, pending))
+        return out
+
+    def build(self, captured: Captured) -> list[tuple[Topic, Reading]]:
+        """The readings of `captured` with their topics (any thread but the stepping one)."""
+        out = []
+        for suite, pending in captured:
+            errors: dict[str, Exception] = {}
+            for name, reading in suite.complete(pending, errors).items():
+                topic = sensor_topic(suite.entity, name, suite.specs[name].topic, reading)
                 if topic is not None:
                     out.append((topic, reading))
+            for name, error in errors.items():
+                self._drop(suite.entity, name, error)
         return out
+
+    def fresh(self) -> list[tuple[Topic, Reading]]:
+        """`capture` and `build` at once (lock held): for callers that step the world themselves."""
+        return self.build(self.capture())
+
+    def _drop(self, entity: str, name: str, error: Exception) -> None:
+        if (entity, name) in self.dropped:
+            return
+        self.dropped[(entity, name)] = str(error)
+        self._wanted[entity] = [n for n in self._wanted.get(entity, ()) if n != name]
+        for group in self._groups.values():
+            if entity in group:
+                group[entity] = [n for n in group[entity] if n != name]
+        log.warning("not recording sensor '%s' of [%s]: %s", name, entity, error)
 
     def _refresh(self) -> None:
         if self._world.model is self._model:
@@ -62,5 +99,22 @@ class SensorFeed:
         names = self._names or tuple(view.index)
         suites = {n: SensorSuite(self._world, n) for n in names if n in view.index}
         self._suites = {n: s for n, s in suites.items() if s.names}
-        self._last = {}
+        self._wanted = {
+            n: [s for s in suite.names if (n, s) not in self.dropped]
+            for n, suite in self._suites.items()
+        }
         self._model = view.model
+        self._group()
+
+    def _group(self) -> None:
+        """Sensors by the observer that captures them: their own rate's, else the fastest."""
+        self._groups = {rate: {} for rate in self._rates}
+        for entity, names in self._wanted.items():
+            for name in names:
+                rate = self._rate(self._suites[entity].specs[name])
+                group = rate if rate in self._groups else (self._rates or [None])[0]
+                self._groups.setdefault(group, {}).setdefault(entity, []).append(name)
+
+    def _rate(self, spec: Any) -> float:
+        step = 1.0 / float(self._world.model.opt.timestep)
+        return min(spec.update_rate or step, MAX_RATE, step)

@@ -1,11 +1,13 @@
 """Sensor readings (`twin_cli.sensors`) as the ROS messages gazebo_ros sensor plugins publish.
 
 IMU → sensor_msgs/Imu, ray → sensor_msgs/LaserScan (one row: the first vertical row), force/torque
-→ geometry_msgs/WrenchStamped, contact/bumper → gazebo_msgs/ContactsState. rosbags ships no
-gazebo_msgs (Gazebo classic's package is not part of any ROS 2 distribution it carries), so the
-two contact types are registered in its typestore from their definitions below (the
-interface of gazebo_ros_bumper); the bag stores the definitions with the messages, so every
-reader decodes them. Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name).
+→ geometry_msgs/WrenchStamped, contact/bumper → gazebo_msgs/ContactsState, camera and depth →
+sensor_msgs/Image (rgb8, or 32FC1 metres as gazebo_ros' depth camera; little-endian rows).
+rosbags ships no gazebo_msgs (Gazebo classic's package is not part of any ROS 2 distribution it
+carries), so the two contact types are registered in its typestore from their definitions below
+(the interface of gazebo_ros_bumper); the bag stores the definitions with the messages, so every
+reader decodes them. Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name);
+images go to `/<entity>/<topic>/image_raw`, as gazebo_ros' cameras publish them.
 """
 
 from __future__ import annotations
@@ -16,12 +18,20 @@ import numpy as np
 
 from twin_cli.record import messages as ros
 from twin_cli.record.topics import Message, Topic
-from twin_cli.sensors import ContactReading, ImuReading, Reading, ScanReading, WrenchReading
+from twin_cli.sensors import (
+    ContactReading,
+    ImageReading,
+    ImuReading,
+    Reading,
+    ScanReading,
+    WrenchReading,
+)
 
 IMU = "sensor_msgs/msg/Imu"
 SCAN = "sensor_msgs/msg/LaserScan"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 CONTACTS = "gazebo_msgs/msg/ContactsState"
+IMAGE = "sensor_msgs/msg/Image"
 CONTACT_DEFINITIONS = {
     "gazebo_msgs/msg/ContactState": """string info
 string collision1_name
@@ -36,7 +46,14 @@ float64[] depths
 gazebo_msgs/ContactState[] states
 """,
 }
-TYPES = {ImuReading: IMU, ScanReading: SCAN, WrenchReading: WRENCH, ContactReading: CONTACTS}
+TYPES = {
+    ImuReading: IMU,
+    ScanReading: SCAN,
+    WrenchReading: WRENCH,
+    ContactReading: CONTACTS,
+    ImageReading: IMAGE,
+}
+PIXEL_BYTES = {"rgb8": 3, "32FC1": 4}
 _UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
 
 
@@ -53,19 +70,20 @@ def register_contact_types(store: Any) -> None:
 
 
 def sensor_topic(entity: str, name: str, topic: str, reading: Reading) -> Topic | None:
-    """The topic of one sensor's readings (None: a kind not published, e.g. camera images)."""
+    """The topic of one sensor's readings (None: a kind that is not published)."""
     kind = TYPES.get(type(reading))
     if kind is None:
         return None
-    return Topic(f"/{entity}/{(topic or name).strip('/')}", kind)
+    suffix = "/image_raw" if kind == IMAGE else ""  # as gazebo_ros' cameras (image_transport)
+    return Topic(f"/{entity}/{(topic or name).strip('/')}{suffix}", kind)
 
 
 def sensor_message(topic: Topic, reading: Reading) -> Message:
     """The ROS message of `reading` on `topic`, stamped with its sim time."""
     T = ros.types()
     header = T["std_msgs/msg/Header"](stamp=ros.stamp(reading.time), frame_id=reading.frame_id)
-    build = {IMU: _imu, SCAN: _scan, WRENCH: _wrench, CONTACTS: _contacts}[topic.type]
-    return Message(topic.name, topic.type, reading.time, build(T, header, reading))
+    build = {IMU: _imu, SCAN: _scan, WRENCH: _wrench, CONTACTS: _contacts, IMAGE: _image}
+    return Message(topic.name, topic.type, reading.time, build[topic.type](T, header, reading))
 
 
 def _vector(T: Any, v: Any) -> Any:
@@ -124,3 +142,15 @@ def _contacts(T: Any, header: Any, r: ContactReading) -> Any:
             )
         )
     return T[CONTACTS](header=header, states=states)
+
+
+def _image(T: Any, header: Any, r: ImageReading) -> Any:
+    return T[IMAGE](
+        header=header,
+        height=r.height,
+        width=r.width,
+        encoding=r.encoding,
+        is_bigendian=0,
+        step=r.width * PIXEL_BYTES[r.encoding],
+        data=np.frombuffer(r.data, dtype=np.uint8),
+    )

@@ -18,6 +18,7 @@ planes, so depth frames are rendered and converted here, with the sensor's (reve
 
 from __future__ import annotations
 
+import os
 import threading
 from typing import Any
 
@@ -68,22 +69,33 @@ class CameraSensor:
         if self._renderer is not None:
             self._renderer._gl_context.make_current()  # requests run on pool threads
             return self._renderer
+        if _window_backend() and threading.current_thread() is not threading.main_thread():
+            # GLFW may only start on the main thread: elsewhere it aborts the process.
+            raise self._unavailable("MUJOCO_GL selects GLFW, which renders on the main thread only")
         try:
             renderer = mujoco.Renderer(model, self.spec.height, self.spec.width)
         except (mujoco.FatalError, RuntimeError, ValueError) as exc:
-            raise InvalidRequestError(
-                f"camera sensor '{self.spec.name}' of [{self.entity}]",
-                f"cannot render offscreen ({str(exc).splitlines()[0]})",
-                "start the world with MUJOCO_GL=egl (or osmesa) in its environment, and an "
-                "image no larger than the model's <visual><global offwidth/offheight>",
-            ) from exc
+            raise self._unavailable(str(exc).splitlines()[0]) from exc
         self._renderer = renderer
         return renderer
+
+    def _unavailable(self, why: str) -> InvalidRequestError:
+        return InvalidRequestError(
+            f"camera sensor '{self.spec.name}' of [{self.entity}]",
+            f"cannot render offscreen ({why})",
+            "start the world with MUJOCO_GL=egl (or osmesa) in its environment, and an "
+            "image no larger than the model's <visual><global offwidth/offheight>",
+        )
 
     def _close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+
+def _window_backend() -> bool:
+    """Whether MuJoCo renders through GLFW here (MUJOCO_GL unset or glfw: a desktop's window)."""
+    return os.environ.get("MUJOCO_GL", "glfw").lower() in ("", "glfw")
 
 
 def _clip(scene: Any, near: float, far: float) -> None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import mujoco
@@ -26,7 +27,7 @@ from converters.description.sensors import (
     RaySpec,
     SensorSpec,
 )
-from twin_cli.errors import EntityNotFoundError, PartNotFoundError
+from twin_cli.errors import EntityNotFoundError, InvalidRequestError, PartNotFoundError
 from twin_cli.sensors.camera import CameraSensor
 from twin_cli.sensors.contact import ContactSensor
 from twin_cli.sensors.force_torque import ForceTorqueSensor
@@ -45,6 +46,23 @@ SENSOR_TYPES: dict[type, Any] = {
 }
 KINEMATIC = (RaySpec, CameraSpec)  # sensors that read poses only
 DUE_TOLERANCE = 1e-9  # [s] sim time accumulates rounding (0.2 != 200 * 0.001)
+
+
+@dataclass(frozen=True)
+class Pending:
+    """What `SensorSuite.capture` copied under the lock, for `complete` to build readings from.
+
+    Attributes:
+        time: sim time [s]; wanted: the sensors asked for (due or not).
+        native: sensordata values of the due sensors MuJoCo computes (IMU, F/T), by name.
+        rest: the other due sensors, read from `snapshot` (None when there are none).
+    """
+
+    time: float
+    wanted: list[str]
+    native: dict[str, np.ndarray]
+    rest: list[str]
+    snapshot: Snapshot | None
 
 
 def period_slot(time: float, rate: float, timestep: float) -> int:
@@ -85,27 +103,56 @@ class SensorSuite:
         Raises:
             EntityNotFoundError: the entity was deleted.
             PartNotFoundError: a name that is not one of the entity's sensors (lists them).
+            InvalidRequestError: a due camera cannot render here (no offscreen GL).
         """
         with self.world.lock:  # held for a few µs: copies, no physics
-            time, model, record = float(self.world.data.time), self.world.model, self._entity()
-            if record is not self._record:  # deleted and spawned again, or loaded
-                self._build(record)
-            wanted = list(self.specs) if names is None else list(names)
-            for name in wanted:
-                if name not in self.specs:
-                    raise PartNotFoundError(self.entity, "sensor", name, list(self.specs))
-            due = [n for n in wanted if self._due(n, time, model.opt.timestep)]
-            if model is not self._model:
-                self._bind(model)
-            captured = {n: self._capture(n) for n in due}
-            rest = [n for n in due if captured[n] is None]
-            snapshot = self._snapshot(time, model, record) if rest else None
-        for name, values in captured.items():
-            if values is not None:
-                self._store(name, self._sensors[name].reading(values, time), time, model)
-        if snapshot is not None:
-            self._refresh(rest, snapshot)
-        return {n: self._readings[n] for n in wanted}
+            pending = self.capture(names)
+        self.complete(pending)
+        return {n: self._readings[n] for n in pending.wanted}
+
+    def capture(self, names: Sequence[str] | None = None) -> Pending:
+        """Copies what the due sensors among `names` need; call with the world's lock held.
+
+        Their update periods count as served from here, so a recorder that completes the
+        readings in another thread never captures one period twice.
+
+        Raises: as `read`, without the camera's error (that comes from `complete`).
+        """
+        time, model, record = float(self.world.data.time), self.world.model, self._entity()
+        if record is not self._record:  # deleted and spawned again, or loaded
+            self._build(record)
+        wanted = list(self.specs) if names is None else list(names)
+        for name in wanted:
+            if name not in self.specs:
+                raise PartNotFoundError(self.entity, "sensor", name, list(self.specs))
+        timestep = model.opt.timestep
+        due = [n for n in wanted if self._due(n, time, timestep)]
+        if model is not self._model:
+            self._bind(model)
+        for name in due:
+            self._slots[name] = period_slot(time, self.specs[name].update_rate, timestep)
+        native = {n: self._capture(n) for n in due}
+        rest = [n for n in due if native[n] is None]
+        snapshot = self._snapshot(time, model, record) if rest else None
+        native = {n: v for n, v in native.items() if v is not None}
+        return Pending(time, wanted, native, rest, snapshot)
+
+    def complete(
+        self, pending: Pending, errors: dict[str, Exception] | None = None
+    ) -> dict[str, Reading]:
+        """Builds the readings `pending` captured (outside the lock), in name order.
+
+        Args:
+            errors: if given, a sensor that cannot be read here (a camera without offscreen GL)
+                is left out and its error put there; else the error is raised.
+        """
+        fresh = {}
+        for name, values in pending.native.items():
+            fresh[name] = self._sensors[name].reading(values, pending.time)
+        if pending.snapshot is not None:
+            fresh.update(self._refresh(pending.rest, pending.snapshot, errors))
+        self._readings.update(fresh)
+        return {n: fresh[n] for n in pending.wanted if n in fresh}
 
     def _entity(self) -> Any:
         """The entity's record (the world's; read-only); call with the lock held."""
@@ -131,22 +178,29 @@ class SensorSuite:
 
     def _due(self, name: str, time: float, timestep: float) -> bool:
         slot = period_slot(time, self.specs[name].update_rate, timestep)
-        return name not in self._readings or slot != self._slots.get(name)
+        return slot != self._slots.get(name)
 
-    def _store(self, name: str, reading: Reading, time: float, model: Any) -> None:
-        self._readings[name] = reading
-        rate = self.specs[name].update_rate
-        self._slots[name] = period_slot(time, rate, model.opt.timestep)
+    def forget(self) -> None:
+        """Makes every sensor due again (as after a reset); for benchmarks that replay a window."""
+        self._slots.clear()
 
-    def _refresh(self, due: list[str], snapshot: Snapshot) -> None:
+    def _refresh(
+        self, due: list[str], snapshot: Snapshot, errors: dict[str, Exception] | None
+    ) -> dict[str, Reading]:
         # Rays and cameras need poses only (mj_kinematics, a few µs); the others need the
         # forward dynamics of the whole world (measured: ~30 µs with a humanoid in it).
         dynamics = any(not isinstance(self.specs[n], KINEMATIC) for n in due)
         data = self._evaluator.evaluate(snapshot, dynamics=dynamics)
-        model = snapshot.model
+        model, out = snapshot.model, {}
         for name in due:
-            reading = self._sensors[name].read(model, data, snapshot.time)
-            self._store(name, reading, snapshot.time, model)
+            try:
+                out[name] = self._sensors[name].read(model, data, snapshot.time)
+            except InvalidRequestError as exc:
+                if errors is None:
+                    self._slots.pop(name, None)  # not served: due again at the next read
+                    raise
+                errors[name] = exc
+        return out
 
 
 def describe_sensors(specs: Sequence[SensorSpec]) -> list[dict[str, Any]]:
