@@ -266,3 +266,73 @@ def test_twin_load_moves_a_recording_or_says_it_stopped(tmp_path, serve_world):
     first = [round(0.2 + 0.01 * k, 9) for k in range(11)]
     # rosbags yields messages in log-time order: the loaded world's clock restarted at 0.2 s.
     assert clock == sorted(first + [round(0.2 + 0.01 * k, 9) for k in range(6)]), clock
+
+
+RED_BOX = """<robot name="redbox"><link name="box"><inertial><mass value="1"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+  <visual><geometry><box size="0.2 0.2 0.2"/></geometry><material name="red">
+  <color rgba="1 0 0 1"/></material></visual>
+  <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+  <gazebo><static>true</static></gazebo></robot>"""
+
+
+def _image_session(port: int, client, topic: str) -> list:
+    """Subscribe to one image topic and step the paused world until an image arrives."""
+    import websockets
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+
+    async def run() -> list:
+        url = f"ws://127.0.0.1:{port}"
+        async with websockets.connect(url, subprotocols=FOXGLOVE_SUBPROTOCOLS) as ws:
+            channels: dict[str, dict] = {}
+            got: list = []
+            deadline = time.monotonic() + 60.0
+            await asyncio.to_thread(client.step, 10)
+            while not got:
+                frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                if isinstance(frame, str):
+                    op = json.loads(frame)
+                    if op["op"] == "advertise":
+                        channels.update({c["topic"]: c for c in op["channels"]})
+                        if topic in channels:
+                            sub = {"id": 1, "channelId": channels[topic]["id"]}
+                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": [sub]}))
+                            await asyncio.sleep(2.0)  # no acknowledgement: let the server take it
+                            await asyncio.to_thread(client.step, 100)
+                elif frame[0] == MESSAGE_DATA:
+                    schema = channels[topic]["schemaName"]
+                    got.append((schema, store.deserialize_cdr(frame[13:], schema)))
+            return got
+
+    return asyncio.run(run())
+
+
+def test_foxglove_clients_receive_camera_images_as_sensor_msgs_image(tmp_path, serve_world):
+    from test_camera_sensor import CAM_Z, H, W, _red
+    from test_record_camera import POST
+
+    probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8)"
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    if subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True).returncode:
+        import pytest
+
+        pytest.skip("no offscreen EGL here; install libegl-mesa0 (CI has it)")
+    (tmp_path / "campost.urdf").write_text(POST)
+    (tmp_path / "redbox.urdf").write_text(RED_BOX)
+    port = free_port()
+    with serve_world(tmp_path, "foxcam", "--paused", "--foxglove", str(port)) as (client, _):
+        client.spawn(str(tmp_path / "campost.urdf"), name="post")
+        # 2 m ahead of the camera and 0.3 m to its left: the left half of the picture.
+        client.spawn(
+            str(tmp_path / "redbox.urdf"), name="box", pose={"x": 2.0, "y": 0.3, "z": CAM_Z}
+        )
+        got = _image_session(port, client, "/post/cam/image_raw")
+    schema, image = got[-1]
+    assert schema == "sensor_msgs/msg/Image"
+    assert (image.width, image.height, image.encoding, image.step) == (W, H, "rgb8", 3 * W)
+    rgb = np.asarray(image.data, np.uint8).reshape(H, W, 3).astype(np.float64)
+    red = _red(rgb)
+    assert red.sum() > 20, "the red box is in the picture"
+    assert not red[:, W // 2 :].any(), "to the camera's left: nothing red in the right half"

@@ -170,6 +170,7 @@ class BagRecording(Follows):
     def _capture(self) -> None:
         if self._done.is_set():
             return
+        self._watch_sensors()
         world = self._world
         if world.model is not self._model:
             self._send_layout()

@@ -31,7 +31,9 @@ class Follows:
             self._handle = None
         with old.lock:
             old_time = float(old.data.time)
+        self._stop_sensors()
         self._world, self._sampler, self._model = world, sampler, None
+        self._feed = SensorFeed(world, self._entities)
         if self._done.is_set():
             return
         with world.lock:
@@ -41,12 +43,19 @@ class Follows:
             self._capture()
             if not self._done.is_set():
                 self._handle = world.add_observer(self._capture, self.rate)
-        self._feed = SensorFeed(world, self._entities)
         self._follow_sensors(world)
+
+    def _watch_sensors(self) -> None:
+        """From a state sample (lock held): a new model (spawn, delete) may bring sensors and
+        rates, so the sensor observers are registered again."""
+        if self._world.model is not getattr(self, "_sensor_model", None):
+            self._follow_sensors(self._world)
 
     def _follow_sensors(self, world: Any) -> None:
         """Observes `world` at each of its sensors' rates (no sensors: not at all)."""
         self._stop_sensors()
+        with world.lock:
+            self._sensor_model = world.model
         rates = self._feed.rates()
         if rates and not self._done.is_set():
             with world.lock:

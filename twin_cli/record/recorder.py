@@ -157,6 +157,7 @@ class Recording(Follows):
     def _capture(self) -> None:
         if self._done.is_set():
             return
+        self._watch_sensors()
         sample = self._sampler.capture()
         if self._latest_only:
             with self._slot_lock:
