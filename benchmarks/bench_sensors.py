@@ -1,52 +1,48 @@
 """Sensor figures in one run: what a 10 Hz 360-ray lidar and a 200 Hz IMU cost the loop (issue 14).
 
-The worst case is measured: every reading is taken at its rate in sim time (as a recorder
-would), so the world steps in 5-step batches (the IMU's period at 1 ms) and reads the IMU after
-each and the lidar after every twentieth; the plain loop steps the same sim time in 500-step
-batches with MuJoCo's sensors disabled (`mjDSBL_SENSOR`: the per-step cost of the IMU's native
-sensors is counted against the sensors). Both windows of a pair start from the same saved state,
-so they step the identical trajectory (readings never act on physics): a window's cost varies
-by ±30 % along a trajectory, which earlier unpaired windows mixed into the ratio. Target:
-throughput with sensors ≥ 0.90 of the plain loop (median of pairs on one world: the bundled
-humanoid lying on the ground, a sensor post and a wall), in CPU time of the stepping thread.
-Four ways of reading: `sensors` (the Python loop above, `SensorSuite.read`), `observed`
-(`SensorSuite.read` from world observers at the rates, 500-step batches), `streamed` (a
-`SensorStream`: observers copy, readings are built per batch) and `recorded` (as recordings
-and the Foxglove stream take them: observers copy, another thread builds; also in wall
-time). Per-read costs are printed too.
+Every reading is taken at its rate in sim time, as a recording takes them, on one world: the
+bundled humanoid lying on the ground, a sensor post and a wall. Arms, each a 200-step window
+(two lidar scans, forty IMU samples) started from the same saved state, so every window steps
+the identical trajectory (readings never act on physics):
+- `plain`: 200 steps with MuJoCo's sensors disabled (`mjDSBL_SENSOR`: the per-step cost of the
+  IMU's native sensors is counted against the sensors);
+- `observed`: `SensorSuite.read` from world observers at the sensors' rates (every reading
+  built in the stepping thread);
+- `recorded`: as recordings and the Foxglove stream take them (`SensorFeed`, `SensorPump`):
+  the lidar's observer copies the state at 10 Hz; the IMU's samples are kept by MuJoCo
+  (`twin_cli.sensors.history`) and copied in batches by an observer at 12.5 Hz; the pump's
+  thread builds the readings (rays cast there) while the loop steps; the window ends when they
+  are all built.
+Ratios come from 100 finely interleaved plain/variant pairs (benchmarks/paired.py: single
+windows of this VM swing 0.5-1.3), in the stepping thread's CPU time (what the readings add
+to the loop) and in wall time (which also counts the consumer thread's GIL and core). Target:
+≥ 0.90 of the plain loop. Per-read costs are printed too.
 """
 
 from __future__ import annotations
 
 import os
-import queue
 import statistics
 import tempfile
-import threading
 import time
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from twin_cli.record.sensor_feed import SensorFeed
-from twin_cli.sensors import SensorStream, SensorSuite
+from benchmarks.paired import interleaved_ratio
+from twin_cli.record.sensor_feed import KEPT, SensorFeed
+from twin_cli.record.sensor_pump import SensorPump
+from twin_cli.sensors import SensorSuite
 from twin_cli.sensors.snapshot import STATE
 from twin_cli.world import Pose, World
 
 HUMANOID = Path(__file__).parents[1] / "scenarios" / "robots" / "humanoid.urdf.xacro"
-STEPS = 2000  # per window: 2 s of sim time
+WINDOW = 200  # [steps] per arm: 0.2 s of sim time
 IMU_EVERY, LIDAR_EVERY = 5, 100  # steps at 1 ms: 200 Hz and 10 Hz
-PAIRS = 7
-# Windows are timed in CPU time of the stepping thread (observers and drains run in it too):
-# on a shared machine (load ≫ cores) wall time measures the neighbours, ±40 % between pairs.
-clock = time.thread_time
-TARGETS = {
-    "sensors_vs_plain": 0.90,
-    "observed_vs_plain": 0.90,
-    "streamed_vs_plain": 0.90,
-    "recorded_vs_plain": 0.90,
-}
+PAIRS = 100  # interleaved windows per ratio
+clock = time.thread_time  # the stepping thread's CPU (observers run in it)
+TARGETS = {"observed_vs_plain": 0.90, "recorded_vs_plain": 0.90}
 SENSOR_POST = """<robot name="post">
   <link name="base"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
     ixy="0" ixz="0" iyz="0"/></inertial><collision><origin xyz="0 0 0.1"/>
@@ -87,97 +83,54 @@ def _restore(world: World, state: np.ndarray, *, sensors: bool) -> None:
             world.model.opt.disableflags |= flag
 
 
-def _plain(world: World) -> float:
-    start = clock()
-    for _ in range(STEPS // 500):
-        world.step(500)
-    return STEPS / (clock() - start)
+class _Arms:
+    """The benchmark's arms on one world, each a WINDOW-step call from the same state."""
 
+    def __init__(self, world: World, suite: SensorSuite, state: np.ndarray) -> None:
+        self.world, self.suite, self.state = world, suite, state
+        self.feed = SensorFeed(world, ["post"])
+        self.rates = self.feed.rates()
+        self.built = 0
+        self.pump = SensorPump(self._count).start()
 
-def _plain_both(world: World) -> tuple[float, float]:
-    """`_plain` in the stepping thread's CPU time and in wall time."""
-    wall, start = time.perf_counter(), clock()
-    for _ in range(STEPS // 500):
-        world.step(500)
-    return STEPS / (clock() - start), STEPS / (time.perf_counter() - wall)
+    def plain(self) -> None:
+        _restore(self.world, self.state, sensors=False)
+        self.world.step(WINDOW)
 
+    def observed(self) -> None:
+        _restore(self.world, self.state, sensors=True)
+        self.suite.forget()  # the same readings are due in every window (same sim times)
+        world, suite = self.world, self.suite
+        handles = [
+            world.add_observer(lambda: suite.read(["imu"]), 1000.0 / IMU_EVERY),
+            world.add_observer(lambda: suite.read(["lidar"]), 1000.0 / LIDAR_EVERY),
+        ]
+        world.step(WINDOW)
+        for handle in handles:
+            world.remove_observer(handle)
 
-def _with_sensors(world: World, suite: SensorSuite) -> float:
-    suite.forget()  # the same readings are due in every window (same sim times)
-    start = clock()
-    for k in range(STEPS // IMU_EVERY):
-        world.step(IMU_EVERY)
-        due = ["imu", "lidar"] if (k * IMU_EVERY) % LIDAR_EVERY == 0 else ["imu"]
-        suite.read(due)
-    return STEPS / (clock() - start)
+    def recorded(self) -> None:
+        """One window of a recording's sensor path; it ends when its readings are built."""
+        _restore(self.world, self.state, sensors=True)
+        world, feed = self.world, self.feed
+        for suite in feed._suites.values():
+            suite.forget()
+        pump = self.pump
+        with world.lock:
+            pump.capture(feed)  # as a recording's start: from this instant on
+        handles = [
+            world.add_observer(lambda rate=rate: pump.capture(feed, rate), rate)
+            for rate in self.rates
+        ]
+        world.step(WINDOW)
+        for handle in handles:
+            world.remove_observer(handle)
+        with world.lock:
+            pump.capture(feed, KEPT)  # as a recording's end: the samples kept since the last look
+        pump.flush()
 
-
-def _observed(world: World, suite: SensorSuite) -> float:
-    """Steps as a running world does (500-step batches), the readings taken by observers at
-    the sensors' rates in sim time (as the recorder takes its samples): no Python step loop."""
-    suite.forget()
-    handles = [
-        world.add_observer(lambda: suite.read(["imu"]), 1000.0 / IMU_EVERY),
-        world.add_observer(lambda: suite.read(["lidar"]), 1000.0 / LIDAR_EVERY),
-    ]
-    start = clock()
-    for _ in range(STEPS // 500):
-        world.step(500)
-    elapsed = clock() - start
-    for handle in handles:
-        world.remove_observer(handle)
-    return STEPS / elapsed
-
-
-def _streamed(world: World, suite: SensorSuite) -> float:
-    """As `_observed`, through a `SensorStream`: the observers only copy (sensordata, or the
-    state for the lidar), and every reading is built when drained after each batch (counted)."""
-    stream = SensorStream(suite, ["imu", "lidar"])
-    start = clock()
-    count = 0
-    for _ in range(STEPS // 500):
-        world.step(500)
-        count += len(stream.drain())
-    elapsed = clock() - start
-    stream.close()
-    expected = STEPS // IMU_EVERY + STEPS // LIDAR_EVERY
-    if count != expected:
-        raise RuntimeError(f"stream drained {count} readings, expected {expected}")
-    return STEPS / elapsed
-
-
-def _recorded(world: World) -> tuple[float, float]:
-    """As a recording takes them (`twin_cli.record.sensor_feed`): observers at the sensors'
-    rates only copy (`SensorFeed.capture`), a consumer thread builds the readings (rays cast
-    there). Steps/s in the stepping thread's CPU time, and in wall time (the consumer runs on
-    the other core meanwhile); every reading is built before the window ends."""
-    feed = SensorFeed(world, ["post"])
-    captured: queue.SimpleQueue = queue.SimpleQueue()
-    built = []
-
-    def consume() -> None:
-        while (item := captured.get()) is not None:
-            built.extend(feed.build(item))
-
-    consumer = threading.Thread(target=consume)
-    consumer.start()
-    handles = [
-        world.add_observer(lambda rate=rate: captured.put(feed.capture(rate)), rate)
-        for rate in feed.rates()
-    ]
-    wall, start = time.perf_counter(), clock()
-    for _ in range(STEPS // 500):
-        world.step(500)
-    cpu = clock() - start
-    for handle in handles:
-        world.remove_observer(handle)
-    captured.put(None)
-    consumer.join()
-    wall = time.perf_counter() - wall
-    expected = STEPS // IMU_EVERY + STEPS // LIDAR_EVERY
-    if len(built) != expected:
-        raise RuntimeError(f"built {len(built)} readings, expected {expected}")
-    return STEPS / cpu, STEPS / wall
+    def _count(self, readings: list) -> None:
+        self.built += len(readings)
 
 
 def _read_cost(world: World, suite: SensorSuite, name: str, n: int) -> float:
@@ -198,43 +151,22 @@ def throughput(tmp: Path) -> dict:
     with world.lock:
         start = np.empty(mujoco.mj_stateSize(world.model, STATE))
         mujoco.mj_getState(world.model, world.data, start, STATE)
-    ratios, observed, streamed, plain, sensed = [], [], [], [], []
-    recorded, recorded_wall = [], []
-    for _ in range(PAIRS):
-        _restore(world, start, sensors=False)
-        p, p_wall = _plain_both(world)
-        _restore(world, start, sensors=True)
-        r, r_wall = _recorded(world)
-        recorded.append(r / p)
-        recorded_wall.append(r_wall / p_wall)
-        _restore(world, start, sensors=False)
-        p = _plain(world)
-        _restore(world, start, sensors=True)
-        s = _with_sensors(world, suite)
-        _restore(world, start, sensors=True)
-        o = _observed(world, suite)
-        _restore(world, start, sensors=True)
-        streamed.append(_streamed(world, suite) / p)
-        plain.append(p)
-        sensed.append(s)
-        ratios.append(s / p)
-        observed.append(o / p)
-    return {
-        "sensors_vs_plain_median": statistics.median(ratios),
-        "ratios": [round(x, 3) for x in ratios],
-        "observed_vs_plain_median": statistics.median(observed),
-        "observed_ratios": [round(x, 3) for x in observed],
-        "recorded_vs_plain_median": statistics.median(recorded),
-        "recorded_ratios": [round(x, 3) for x in recorded],
-        "recorded_wall_vs_plain_median": statistics.median(recorded_wall),
-        "recorded_wall_ratios": [round(x, 3) for x in recorded_wall],
-        "streamed_vs_plain_median": statistics.median(streamed),
-        "streamed_ratios": [round(x, 3) for x in streamed],
-        "plain_steps_per_s": statistics.median(plain),
-        "sensors_steps_per_s": statistics.median(sensed),
-        "imu_read_us": _read_cost(world, suite, "imu", 200),
-        "lidar_360_read_us": _read_cost(world, suite, "lidar", 50),
-    }
+    arms = _Arms(world, suite, start)
+    out = {}
+    for name, arm in (("observed", arms.observed), ("recorded", arms.recorded)):
+        out[f"{name}_vs_plain"] = interleaved_ratio(arms.plain, arm, pairs=PAIRS, clock=clock)
+        out[f"{name}_wall_vs_plain"] = interleaved_ratio(arms.plain, arm, pairs=PAIRS)
+    # Every reading of every recorded window: the IMU's, and the lidar's at its start too.
+    expected = 2 * PAIRS * (WINDOW // IMU_EVERY + WINDOW // LIDAR_EVERY + 1)
+    if arms.built != expected:
+        raise RuntimeError(f"built {arms.built} readings, expected {expected}")
+    plain_s = time.perf_counter()
+    for _ in range(10):
+        arms.plain()
+    out["plain_steps_per_s"] = 10 * WINDOW / (time.perf_counter() - plain_s)
+    out["imu_read_us"] = _read_cost(world, suite, "imu", 200)
+    out["lidar_360_read_us"] = _read_cost(world, suite, "lidar", 50)
+    return out
 
 
 def run() -> dict:

@@ -24,6 +24,9 @@ NATIVE_PARTS: dict[str, tuple[tuple[str, str], ...]] = {
     ),
     "force_torque": (("force", "mjSENS_FORCE"), ("torque", "mjSENS_TORQUE")),
 }
+# Samples an IMU's native sensors keep in MuJoCo's sensor history (`nsample`), computed at the
+# IMU's update period (`interval`): a recorder reads them in one look every few dozen periods.
+HISTORY_SAMPLES = 64
 
 
 @dataclass(frozen=True)

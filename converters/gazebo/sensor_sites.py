@@ -17,6 +17,7 @@ import numpy as np
 from converters.description import RobotDescription
 from converters.description.gazebo import Blob
 from converters.description.sensors import (
+    HISTORY_SAMPLES,
     NATIVE_PARTS,
     CameraSpec,
     ForceTorqueSpec,
@@ -140,15 +141,24 @@ def _add_native(spec: Any, sensor: SensorSpec) -> None:
     accelerometer is the specific force a − g (+g up at rest) and its force/torque sensors are
     the child body's interaction wrench at the site, in the site frame: what the twin sensors
     report (`twin_cli.sensors.native`).
+    An IMU's are computed only at its update period (`interval`) and keep their last
+    HISTORY_SAMPLES samples with their times (`nsample`), so a recorder reads every sample in
+    one look instead of stopping the stepping at each period (`twin_cli.sensors.history`).
     """
     import mujoco
 
-    for part, kind in NATIVE_PARTS.get(NATIVE_KIND.get(type(sensor), ""), ()):
+    kind_name = NATIVE_KIND.get(type(sensor), "")
+    history = {}
+    if kind_name == "imu":
+        period = 1.0 / sensor.update_rate if sensor.update_rate > 0 else 0.0
+        history = {"nsample": HISTORY_SAMPLES, "interval": [period, 0.0]}
+    for part, kind in NATIVE_PARTS.get(kind_name, ()):
         spec.add_sensor(
             name=f"{sensor.site}:{part}",
             type=getattr(mujoco.mjtSensor, kind),
             objtype=mujoco.mjtObj.mjOBJ_SITE,
             objname=sensor.site,
+            **history,
         )
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from models import write_urdf
 from record_helpers import read_bag, seconds
 from sensor_models import bumper_ball, imu_box, lidar_post
@@ -90,12 +91,15 @@ def test_the_live_streams_worker_publishes_sensor_topics_too(tmp_path):
     world.spawn(write_urdf(tmp_path, imu_box(rate=IMU_RATE), "imu.urdf"), name="imu")
     path = tmp_path / "live.mcap"
     recording = Recording(world, [BagSink(path)], rate=30.0).start()
-    first = SensorSuite(world, "imu").read()["imu"]
     world.step(100)
     assert recording.stop().error is None
+    last = SensorSuite(world, "imu").read()["imu"]  # the newest sample MuJoCo kept
     bag = read_bag(path)
     stamps = [seconds(m.header.stamp) for _, m in bag["/imu/imu"]]
-    assert np.allclose(np.diff(stamps), 1 / IMU_RATE, atol=1e-9) and len(stamps) == 21
-    a = bag["/imu/imu"][0][1].linear_acceleration
-    assert (a.x, a.y, a.z) == tuple(first.linear_acceleration)
+    # Every 200 Hz sample MuJoCo kept, at its own sim time: t = 0 ... 0.095 s (the sample of
+    # t = 0.1 s is computed at the start of the step after the last one).
+    assert np.allclose(stamps, [k / IMU_RATE for k in range(20)], atol=1e-9), stamps
+    assert last.time == pytest.approx(stamps[-1], abs=1e-12)
+    a = bag["/imu/imu"][-1][1].linear_acceleration
+    assert (a.x, a.y, a.z) == tuple(last.linear_acceleration)
     assert "/imu/joint_states" in bag, "the world's topics stay announced"

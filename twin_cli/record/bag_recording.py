@@ -2,25 +2,20 @@
 
 The stepping thread's share per sample is one copy of qpos, qvel, qfrc_actuator and the mocap
 poses into shared memory (a few µs); the encoder process builds and writes the messages. Sensor
-readings are copied at the sensors' rates (`SensorFeed.capture`) and built by a thread of this
-process (ray casting, rendering: `SensorFeed.build`), which sends them to the encoder. Nothing is
-dropped: when that thread falls MAX_SENSOR_BACKLOG captures behind (cameras render slower than
-real time on a CPU), the loop waits for it, as it waits for a full ring, and as gz-sim's
-rendering sensors hold the simulation back; the wait is counted in `blocked_s`. The
-interface is `Recording`'s: `start`, `stop`, `wait`, `status`, `capture_now`.
+readings are copied at the sensors' rates and built by a `SensorPump` thread of this process (ray
+casting, rendering), which sends them to the encoder; the loop's waits for a full ring or a
+backlogged pump are `blocked_s`. The interface is `Recording`'s: `start`, `stop`, `wait`,
+`status`, `capture_now`.
 """
 
 from __future__ import annotations
 
-import logging
 import math
 import os
-import queue
 import socket
 import subprocess
 import sys
 import threading
-import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -31,11 +26,10 @@ from twin_cli.record.follow import Follows
 from twin_cli.record.mcap_writer import open_output
 from twin_cli.record.recorder import RecordingStatus, check_rate
 from twin_cli.record.sampler import Sampler
-from twin_cli.record.sensor_feed import SensorFeed
+from twin_cli.record.sensor_feed import KEPT, SensorFeed
+from twin_cli.record.sensor_pump import SensorPump
 from twin_cli.world.observers import world_view
 
-log = logging.getLogger("twin.record")
-MAX_SENSOR_BACKLOG = 256  # captures waiting for the sensor thread before the loop waits
 RING_BYTES = 32 << 20  # [B] ~40 s of a humanoid at 1,000 samples per wall second
 START_TIMEOUT_S = 60.0  # [s] for the encoder's answer when stopping (imports on a loaded host)
 
@@ -78,11 +72,7 @@ class BagRecording(Follows):
         self._writer = ring.RingWriter(data, self._header, self._alive)
         self._model: Any = None
         self._feed = SensorFeed(world, entities)
-        self._sensor_queue: queue.Queue[tuple | None] = queue.Queue(MAX_SENSOR_BACKLOG)
-        self._sensor_thread = threading.Thread(
-            target=self._build_sensors, name="twin-record-sensors", daemon=True
-        )
-        self._sensor_blocked_s = 0.0  # [s] the loop waited for the sensor thread
+        self._pump = SensorPump(self._send_readings, "record-sensors")
         self._send_lock = threading.Lock()  # the stepping and sensor threads share the pipe
         self._epoch = -1
         self._until: float | None = None
@@ -100,7 +90,7 @@ class BagRecording(Follows):
         self._process = subprocess.Popen(command, pass_fds=fds, stdin=subprocess.DEVNULL)
         os.close(self._ring_fd)
         self._child.close()
-        self._sensor_thread.start()
+        self._pump.start()
         with self._world.lock:
             now = float(self._world.data.time)
             self._until = None if self._duration is None else now + self._duration
@@ -135,7 +125,8 @@ class BagRecording(Follows):
         self._finish_sampling()
         if not self._closed:
             self._closed = True
-            self._end_sensor_thread()
+            self._pump.close()
+            self._error = self._error or self._pump.error
             figures = {"blocked_s": round(self._writer.blocked_s, 6), "waits": self._writer.waits}
             try:
                 self._send(("stop", figures))
@@ -162,7 +153,7 @@ class BagRecording(Follows):
             start,
             end,
             self._error,
-            self._writer.blocked_s + self._sensor_blocked_s,
+            self._writer.blocked_s + self._pump.blocked_s,
             self._writer.waits,
         )
 
@@ -184,20 +175,7 @@ class BagRecording(Follows):
     def _capture_sensors(self, rate: float | None = None) -> None:
         if self._done.is_set():
             return
-        captured = self._feed.capture(rate)  # copies; the sensor thread builds the readings
-        if not captured:
-            return
-        try:
-            self._sensor_queue.put_nowait((self._feed, captured))
-        except queue.Full:
-            start = time.perf_counter()
-            while self._sensor_thread.is_alive():
-                try:
-                    self._sensor_queue.put((self._feed, captured), timeout=ring.WAIT_S * 100)
-                    break
-                except queue.Full:
-                    continue
-            self._sensor_blocked_s += time.perf_counter() - start
+        self._pump.capture(self._feed, rate)  # copies; the pump's thread builds the readings
 
     def _send_layout(self) -> None:
         view = world_view(self._world)
@@ -209,30 +187,20 @@ class BagRecording(Follows):
     def _finish_sampling(self) -> None:
         if self._done.is_set():
             return
+        if self._sensor_handles:  # the samples MuJoCo kept since the last look
+            with self._world.lock:
+                self._pump.capture(self._feed, KEPT)
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
         self._stop_sensors()
 
-    # ------------------------------------------------------------ sensor thread
-    def _build_sensors(self) -> None:
-        """Builds captured sensor readings and sends them to the encoder, until None."""
-        while (item := self._sensor_queue.get()) is not None:
-            feed, captured = item
-            try:
-                readings = feed.build(captured)
-                if readings:
-                    self._send(("readings", readings))
-            except (EOFError, OSError):
-                self._error = self._error or "the encoder process ended; the recording stopped"
-            except Exception as exc:  # a sensor that fails: report it, keep the recording
-                log.exception("sensor readings failed")
-                self._error = self._error or f"sensor readings: {type(exc).__name__}: {exc}"
-
-    def _end_sensor_thread(self) -> None:
-        if self._sensor_thread.is_alive():
-            self._sensor_queue.put(None)
-            self._sensor_thread.join()
+    # ------------------------------------------------------------ sensor pump thread
+    def _send_readings(self, readings: list) -> None:
+        try:
+            self._send(("readings", readings))
+        except (EOFError, OSError):
+            self._error = self._error or "the encoder process ended; the recording stopped"
 
     def _send(self, message: tuple) -> None:
         with self._send_lock:

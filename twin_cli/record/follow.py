@@ -16,7 +16,9 @@ from twin_cli.record.sensor_feed import SensorFeed
 
 class Follows:
     """`retarget`: observe another world from now on (mixin; see module docstring); and the
-    sensor observer both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
+    sensor observers both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
+
+    _sensor_handles: tuple[int, ...] | list[int] = ()  # sensor observers of `_sensor_world`
 
     def retarget(self, world: Any) -> None:
         """Samples `world` instead of the current one, starting with a sample now.

@@ -19,8 +19,9 @@ from twin_cli.errors import InvalidRequestError
 from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
 from twin_cli.record.sampler import Kinematics, Sample, Sampler
-from twin_cli.record.sensor_feed import SensorFeed
+from twin_cli.record.sensor_feed import KEPT, SensorFeed
 from twin_cli.record.sensor_messages import sensor_message
+from twin_cli.record.sensor_pump import SensorPump
 from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
 
 log = logging.getLogger("twin.record")
@@ -107,7 +108,7 @@ class Recording(Follows):
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
-        self._queue: queue.SimpleQueue[Sample | tuple | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Sample | list | None] = queue.SimpleQueue()
         self._handle: int | None = None
         self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
         self._busy, self._newest = False, None
@@ -117,6 +118,7 @@ class Recording(Follows):
         self._error: str | None = None
         self._worker = threading.Thread(target=self._work, name="twin-record", daemon=True)
         self._feed = SensorFeed(world, entities)
+        self._pump = SensorPump(self._queue.put, "record-sensors")  # readings to the worker
         self._sensor_topics: dict[str, Topic] = {}  # worker thread: sensor topics seen so far
         self._layout_topics: list[Topic] = []
 
@@ -124,6 +126,7 @@ class Recording(Follows):
     def start(self) -> Recording:
         """Takes the first sample now and follows the world's stepping from here on."""
         self._worker.start()
+        self._pump.start()
         with self._world.lock:
             now = float(self._world.data.time)
             self._until = None if self._duration is None else now + self._duration
@@ -172,17 +175,20 @@ class Recording(Follows):
     def _capture_sensors(self, rate: float | None = None) -> None:
         if self._done.is_set():
             return
-        captured = self._feed.capture(rate)  # copies; the worker builds the readings
-        if captured and not (self._latest_only and self._busy):  # a busy live view skips them
-            self._queue.put((self._feed, captured))
+        if not (self._latest_only and self._busy):  # a busy live view skips them
+            self._pump.capture(self._feed, rate)  # copies; the pump's thread builds them
 
     def _finish_sampling(self) -> None:
         if self._done.is_set():
             return
+        if self._sensor_handles:  # the samples MuJoCo kept since the last look
+            with self._world.lock:
+                self._pump.capture(self._feed, KEPT)
         self._done.set()
         if self._handle is not None:
             self._world.remove_observer(self._handle)
         self._stop_sensors()
+        self._pump.close()  # its last readings are queued before the end
         self._queue.put(None)
 
     # ------------------------------------------------------------ worker thread
@@ -190,9 +196,8 @@ class Recording(Follows):
         kinematics, layout = Kinematics(), None
         try:
             while (sample := self._next()) is not None:
-                if isinstance(sample, tuple):
-                    feed, captured = sample
-                    self._publish_readings(feed.build(captured))
+                if isinstance(sample, list):
+                    self._publish_readings(sample)
                     continue
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)

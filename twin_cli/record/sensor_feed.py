@@ -3,13 +3,14 @@
 Read through `twin_cli.sensors.SensorSuite` (its public API only: how readings are computed is
 that package's business). One world observer per distinct sensor rate calls `capture` at that
 rate in sim time (so a 30 Hz camera is stamped at its own period, not at a faster IMU's next
-tick; sensors of entities spawned later go with the fastest observer); it copies what the due
-sensors need (their sensordata, or the world's state: a few
-µs); the recorder's own thread calls `build`, which casts the lidar rays, renders the cameras
-and draws the noise there, off the stepping thread (design.md §7). A sensor that cannot be read
-in this process (a camera without offscreen GL) is left out of the recording from then on, with
-one warning naming it and the fix; the other sensors go on. Suites are rebuilt when the world's
-model changes (spawn, delete, load).
+tick; sensors of entities spawned later go with the fastest observer). It copies what the due
+sensors need, or, for a sensor whose samples MuJoCo keeps (an IMU: `twin_cli.sensors.history`),
+every sample since the last look: that observer runs POLLS_PER_HISTORY times per history
+length instead of at every period, and each sample keeps its own sim time. The recorder's own
+thread calls `build`, which casts the lidar rays, renders the cameras and draws the noise there,
+off the stepping thread (design.md §7). A sensor that cannot be read in this process (a camera
+without offscreen GL) is left out of the recording from then on, with one warning naming it and
+the fix; the other sensors go on. Suites are rebuilt when the world's model changes.
 """
 
 from __future__ import annotations
@@ -20,11 +21,13 @@ from typing import Any
 
 from twin_cli.record.sensor_messages import sensor_topic
 from twin_cli.record.topics import Topic
-from twin_cli.sensors import Reading, SensorSuite
+from twin_cli.sensors import HISTORY_SAMPLES, Reading, SensorSuite
 from twin_cli.world.observers import world_view
 
 log = logging.getLogger("twin.record")
 MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
+KEPT = -1.0  # `capture(KEPT)`: every sensor with a history, whatever its rate (a last look)
+POLLS_PER_HISTORY = 4  # looks at a sensor's kept samples per HISTORY_SAMPLES periods
 
 Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pending)
 
@@ -40,14 +43,17 @@ class SensorFeed:
         self._rates: list[float] = []  # [Hz] of the observers, fastest first
         self._groups: dict[float | None, dict[str, list[str]]] = {}  # rate → entity → sensors
         self.dropped: dict[tuple[str, str], str] = {}  # (entity, sensor) → why
+        self._kept: dict[str, set[str]] = {}  # entity → its sensors with a history
+        self._last: dict[tuple[str, str], float] = {}  # (entity, sensor) → last sample [s]
 
     def rates(self) -> list[float]:
         """[Hz] of sim time to call `capture(rate)` at, one per distinct sensor rate, fastest
         first (empty: no sensors). Rates are capped at MAX_RATE and the step rate."""
         with self._world.lock:
             self._refresh()
-            specs = [spec for suite in self._suites.values() for spec in suite.specs.values()]
-            self._rates = sorted({self._rate(spec) for spec in specs}, reverse=True)
+            self._rates = sorted(
+                {self._rate(e, n) for e, u in self._suites.items() for n in u.names}, reverse=True
+            )
             self._group()
         return list(self._rates)
 
@@ -56,13 +62,24 @@ class SensorFeed:
         call with the world's lock held."""
         self._refresh()
         out = []
-        group = self._groups.get(rate, self._wanted) if rate is not None else self._wanted
+        if rate == KEPT:
+            group = {
+                e: [n for n in names if n in self._kept[e]] for e, names in self._wanted.items()
+            }
+        else:
+            group = self._groups.get(rate, self._wanted) if rate is not None else self._wanted
+        now = float(self._world.data.time)
         for entity, suite in self._suites.items():
             names = group.get(entity)
-            if names:
-                pending = suite.capture(names)
-                if pending.native or pending.rest:
-                    out.append((suite, pending))
+            if not names:
+                continue
+            kept = self._kept[entity]
+            since = {n: self._since(entity, n, now) for n in names if n in kept}
+            pending = suite.capture(names, since)
+            for name, (times, _) in pending.batches.items():
+                self._last[(entity, name)] = float(times[-1])
+            if pending.native or pending.rest or pending.batches:
+                out.append((suite, pending))
         return out
 
     def build(self, captured: Captured) -> list[tuple[Topic, Reading]]:
@@ -70,7 +87,8 @@ class SensorFeed:
         out = []
         for suite, pending in captured:
             errors: dict[str, Exception] = {}
-            for name, reading in suite.complete(pending, errors).items():
+            for reading in suite.complete(pending, errors):
+                name = reading.sensor
                 topic = sensor_topic(suite.entity, name, suite.specs[name].topic, reading)
                 if topic is not None:
                     out.append((topic, reading))
@@ -81,6 +99,14 @@ class SensorFeed:
     def fresh(self) -> list[tuple[Topic, Reading]]:
         """`capture` and `build` at once (lock held): for callers that step the world themselves."""
         return self.build(self.capture())
+
+    def _since(self, entity: str, name: str, now: float) -> float:
+        """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
+        the clock went back) this very instant on."""
+        last = self._last.get((entity, name))
+        if last is None or last > now:
+            last = self._last[(entity, name)] = now - 1e-9
+        return last
 
     def _drop(self, entity: str, name: str, error: Exception) -> None:
         if (entity, name) in self.dropped:
@@ -103,6 +129,7 @@ class SensorFeed:
             n: [s for s in suite.names if (n, s) not in self.dropped]
             for n, suite in self._suites.items()
         }
+        self._kept = {n: set(suite.with_history()) for n, suite in self._suites.items()}
         self._model = view.model
         self._group()
 
@@ -111,10 +138,15 @@ class SensorFeed:
         self._groups = {rate: {} for rate in self._rates}
         for entity, names in self._wanted.items():
             for name in names:
-                rate = self._rate(self._suites[entity].specs[name])
+                rate = self._rate(entity, name)
                 group = rate if rate in self._groups else (self._rates or [None])[0]
                 self._groups.setdefault(group, {}).setdefault(entity, []).append(name)
 
-    def _rate(self, spec: Any) -> float:
+    def _rate(self, entity: str, name: str) -> float:
+        """[Hz] of the observer that captures a sensor: its rate (capped), or for one with a
+        history, POLLS_PER_HISTORY looks per history length."""
         step = 1.0 / float(self._world.model.opt.timestep)
+        spec = self._suites[entity].specs[name]
+        if name in self._kept.get(entity, ()):
+            return (spec.update_rate or step) * POLLS_PER_HISTORY / HISTORY_SAMPLES
         return min(spec.update_rate or step, MAX_RATE, step)

@@ -3,13 +3,14 @@
 A consumer of the world (like the recorder): it reads the engine's state under its lock and
 computes outside it; the world never imports it. Modules: `suite` (all sensors of an entity,
 update rates), `stream` (every reading at the sensors' rates, for recorders), `snapshot`
-(state copy and its dynamics), `imu`, `ray`, `contact`, `force_torque`, `camera` (one sensor
-type each), `noise` (Gazebo's Gaussian noise, seeded), `readings` (what each reports),
-`frames` (finding a sensor's elements by name).
+(state copy and its dynamics), `history` (past samples MuJoCo keeps), `imu`, `ray`,
+`contact`, `force_torque`, `camera` (one sensor type each), `noise` (Gazebo's Gaussian noise,
+seeded), `readings` (what each reports), `frames` (finding a sensor's elements by name).
 """
 
 from __future__ import annotations
 
+from twin_cli.sensors.history import HISTORY_SAMPLES
 from twin_cli.sensors.readings import (
     ContactReading,
     ContactState,
@@ -23,6 +24,7 @@ from twin_cli.sensors.stream import SensorStream
 from twin_cli.sensors.suite import SensorSuite, describe_sensors
 
 __all__ = [
+    "HISTORY_SAMPLES",
     "ContactReading",
     "ContactState",
     "ImageReading",

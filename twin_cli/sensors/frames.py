@@ -38,6 +38,13 @@ def entity_bodies(model: Any, entity: str) -> frozenset[int]:
     return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
 
 
+def native_ids(model: Any, entity: str, site: str, parts: tuple[tuple[str, str], ...]) -> list[int]:
+    """The ids of the MuJoCo sensors `<entity>/<site>:<part>`, in `parts` order ([]: one lacks)."""
+    kind = mujoco.mjtObj.mjOBJ_SENSOR
+    ids = [mujoco.mj_name2id(model, kind, f"{entity}/{site}:{part}") for part, _ in parts]
+    return ids if ids and min(ids) >= 0 else []
+
+
 def native_slice(
     model: Any, entity: str, site: str, parts: tuple[tuple[str, str], ...]
 ) -> slice | None:
@@ -46,9 +53,8 @@ def native_slice(
     The converter adds them in `parts` order (`converters.description.sensors.NATIVE_PARTS`);
     None when the model lacks one (a model built before they existed: computed instead).
     """
-    kind = mujoco.mjtObj.mjOBJ_SENSOR
-    ids = [mujoco.mj_name2id(model, kind, f"{entity}/{site}:{part}") for part, _ in parts]
-    if not ids or min(ids) < 0:
+    ids = native_ids(model, entity, site, parts)
+    if not ids:
         return None
     start = int(model.sensor_adr[ids[0]])
     end = start

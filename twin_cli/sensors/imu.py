@@ -7,11 +7,12 @@ gravity), so an IMU lying still reads +9.81 m/s² up and one in free fall reads 
 the centripetal term of the site's offset from the body, in the site frame; so is its `gyro`.
 The orientation is the site's orientation in the world (ENU, as gz-sim reports it).
 
-The converter adds MuJoCo's `framequat`, `gyro` and `accelerometer` sensors on the site, so
-every physics step computes them in C (~1 µs for a humanoid world); a reading copies those ten
-numbers from `sensordata` (the values of the last step, as Gazebo's IMU reports the last
-physics update) and adds noise. A model without them (or a world not stepped since it was
-built) is evaluated on a snapshot instead, with the same functions MuJoCo uses.
+The converter adds MuJoCo's `framequat`, `gyro` and `accelerometer` sensors on the site,
+computed in C at the IMU's update period and kept with their times (`history`); a reading is
+the newest kept sample (the state at its own sim time, as Gazebo's IMU reports its last update)
+with noise added, and a recorder takes every kept sample in one look. A model without them (or
+a world not stepped since it was built) is evaluated on a snapshot instead, with the same
+functions MuJoCo uses.
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ import mujoco
 import numpy as np
 
 from converters.description.sensors import NATIVE_PARTS, ImuSpec
-from twin_cli.sensors.frames import native_slice, site_id
+from twin_cli.sensors.frames import native_ids, native_slice, site_id
+from twin_cli.sensors.history import SensorHistory
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import ImuReading
 
@@ -41,11 +43,31 @@ class ImuSensor:
         self.native: slice | None = None
         self._data: Any = None
         self._view = np.zeros(0)
+        self.history: SensorHistory | None = None
 
     def bind(self, model: Any) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
-        self.native = native_slice(model, self.entity, self.spec.site, NATIVE_PARTS["imu"])
+        parts = NATIVE_PARTS["imu"]
+        self.native = native_slice(model, self.entity, self.spec.site, parts)
+        ids = native_ids(model, self.entity, self.spec.site, parts)
+        self.history = SensorHistory.of(model, ids) if self.native is not None else None
         self._data = None
+
+    def latest(self, data: Any) -> tuple[float, np.ndarray] | None:
+        """The newest sample MuJoCo kept (its time [s] and `capture`'s values), None when
+        there is no history or no sample yet; a copy."""
+        if self.history is None:
+            return None
+        time, values = self.history.latest(data)
+        fresh = values[:4] @ values[:4] > 0.0 and time <= data.time + 1e-12  # not pre-reset
+        return (time, values) if fresh else None
+
+    def samples_since(self, data: Any, time: float) -> tuple[np.ndarray, np.ndarray]:
+        """Every kept sample after sim `time` [s]: times, oldest first, and values (k×10)."""
+        assert self.history is not None
+        times, rows = self.history.since(data, time)
+        computed = np.einsum("ij,ij->i", rows[:, :4], rows[:, :4]) > 0.0
+        return times[computed], rows[computed]
 
     def capture(self, data: Any) -> np.ndarray | None:
         """The last step's (quat w x y z, gyro, specific force) in `sensordata`: a copy; None

@@ -54,15 +54,17 @@ class Pending:
 
     Attributes:
         time: sim time [s]; wanted: the sensors asked for (due or not).
-        native: sensordata values of the due sensors MuJoCo computes (IMU, F/T), by name.
+        native: (sample time [s], values) of the due sensors MuJoCo computes (IMU, F/T).
         rest: the other due sensors, read from `snapshot` (None when there are none).
+        batches: (times, values k×n) of sensors whose kept samples were asked for (`since`).
     """
 
     time: float
     wanted: list[str]
-    native: dict[str, np.ndarray]
+    native: dict[str, tuple[float, np.ndarray]]
     rest: list[str]
     snapshot: Snapshot | None
+    batches: dict[str, tuple[np.ndarray, np.ndarray]]
 
 
 def period_slot(time: float, rate: float, timestep: float) -> int:
@@ -92,6 +94,7 @@ class SensorSuite:
         }
         self._readings: dict[str, Reading] = {}
         self._slots: dict[str, int] = {}
+        self._sampled: dict[str, float] = {}  # sensor with a history → time of its last sample
 
     @property
     def names(self) -> list[str]:
@@ -110,11 +113,15 @@ class SensorSuite:
         self.complete(pending)
         return {n: self._readings[n] for n in pending.wanted}
 
-    def capture(self, names: Sequence[str] | None = None) -> Pending:
+    def capture(
+        self, names: Sequence[str] | None = None, since: dict[str, float] | None = None
+    ) -> Pending:
         """Copies what the due sensors among `names` need; call with the world's lock held.
 
         Their update periods count as served from here, so a recorder that completes the
-        readings in another thread never captures one period twice.
+        readings in another thread never captures one period twice. Sensors in `since` (name
+        → sim time [s]; only those in `with_history`) give every sample MuJoCo kept after that
+        time instead, due or not.
 
         Raises: as `read`, without the camera's error (that comes from `complete`).
         """
@@ -126,33 +133,63 @@ class SensorSuite:
             if name not in self.specs:
                 raise PartNotFoundError(self.entity, "sensor", name, list(self.specs))
         timestep = model.opt.timestep
-        due = [n for n in wanted if self._due(n, time, timestep)]
         if model is not self._model:
             self._bind(model)
+        batches = {}
+        for name, after in (since or {}).items():
+            times, rows = self._sensors[name].samples_since(self.world.data, after)
+            if len(times):
+                batches[name] = (times, rows)
+        kept = since or {}
+        native, due = {}, []
+        for name in wanted:
+            if name in kept:
+                continue
+            sample = self._newest(name)
+            if sample is not None:  # a new sample, else the reading of the last one stands
+                if sample[0] != self._sampled.get(name):
+                    self._sampled[name], native[name] = sample[0], sample
+            elif self._due(name, time, timestep):
+                due.append(name)
         for name in due:
             self._slots[name] = period_slot(time, self.specs[name].update_rate, timestep)
-        native = {n: self._capture(n) for n in due}
+        native.update({n: self._capture(n, time) for n in due})
         rest = [n for n in due if native[n] is None]
         snapshot = self._snapshot(time, model, record) if rest else None
         native = {n: v for n, v in native.items() if v is not None}
-        return Pending(time, wanted, native, rest, snapshot)
+        return Pending(time, wanted, native, rest, snapshot, batches)
+
+    def with_history(self) -> list[str]:
+        """The sensors whose past samples MuJoCo keeps (lock held): `capture(since=...)`."""
+        if self.world.model is not self._model:
+            self._bind(self.world.model)
+        return [n for n, s in self._sensors.items() if getattr(s, "history", None) is not None]
 
     def complete(
         self, pending: Pending, errors: dict[str, Exception] | None = None
-    ) -> dict[str, Reading]:
-        """Builds the readings `pending` captured (outside the lock), in name order.
+    ) -> list[Reading]:
+        """Builds the readings `pending` captured (outside the lock).
 
         Args:
             errors: if given, a sensor that cannot be read here (a camera without offscreen GL)
                 is left out and its error put there; else the error is raised.
         """
         fresh = {}
-        for name, values in pending.native.items():
-            fresh[name] = self._sensors[name].reading(values, pending.time)
+        for name, (time, values) in pending.native.items():
+            fresh[name] = self._sensors[name].reading(values, time)
         if pending.snapshot is not None:
             fresh.update(self._refresh(pending.rest, pending.snapshot, errors))
         self._readings.update(fresh)
-        return {n: fresh[n] for n in pending.wanted if n in fresh}
+        out = list(fresh.values())
+        for name, (times, rows) in pending.batches.items():
+            sensor = self._sensors[name]  # the noise of all rows drawn at once
+            batch = [
+                sensor.reading(v, t, noisy=False)
+                for t, v in zip(times.tolist(), sensor.noisy_batch(rows), strict=True)
+            ]
+            self._readings[name] = batch[-1]
+            out += batch
+        return out
 
     def _entity(self) -> Any:
         """The entity's record (the world's; read-only); call with the lock held."""
@@ -166,10 +203,22 @@ class SensorSuite:
             sensor.bind(model)
         self._model = model
 
-    def _capture(self, name: str) -> Any:
-        """The last step's values of a sensor MuJoCo computes (IMU, F/T), else None."""
+    def _newest(self, name: str) -> tuple[float, np.ndarray] | None:
+        """The newest sample MuJoCo kept of a sensor with a history (None: none, or no sample
+        yet). Such a sensor is read whenever a new sample exists: MuJoCo computes the sample of
+        time t in the step that starts at t, so a period-based rule would serve it a period late.
+        """
+        sensor = self._sensors[name]
+        if getattr(sensor, "history", None) is None:
+            return None
+        return sensor.latest(self.world.data)
+
+    def _capture(self, name: str, time: float) -> tuple[float, np.ndarray] | None:
+        """The last step's values of a sensor MuJoCo computes (F/T, an IMU without history),
+        stamped `time`, else None."""
         capture = getattr(self._sensors[name], "capture", None)
-        return None if capture is None else capture(self.world.data)
+        values = None if capture is None else capture(self.world.data)
+        return None if values is None else (time, values)
 
     def _snapshot(self, time: float, model: Any, record: Any) -> Snapshot:
         state = np.empty(mujoco.mj_stateSize(model, STATE))
@@ -183,6 +232,7 @@ class SensorSuite:
     def forget(self) -> None:
         """Makes every sensor due again (as after a reset); for benchmarks that replay a window."""
         self._slots.clear()
+        self._sampled.clear()
 
     def _refresh(
         self, due: list[str], snapshot: Snapshot, errors: dict[str, Exception] | None
