@@ -20,11 +20,14 @@ def interleaved_ratio(
     *,
     pairs: int = PAIRS,
     clock: Callable[[], float] = time.perf_counter,
+    settle: Callable[[], None] | None = None,
 ) -> float:
     """Throughput of `variant` over that of `plain` (each call does the same work).
 
     Returns summed plain time / summed variant time over `pairs` alternations, so 1.0 means
     no cost and 0.95 a 5 % cost. Pass `clock=time.thread_time` for the calling thread's CPU.
+    `settle`, untimed after each variant call, waits for work the variant left to another
+    thread, so that the next plain window does not share the machine with it.
     """
     plain_s = variant_s = 0.0
     for _ in range(pairs):
@@ -34,4 +37,6 @@ def interleaved_ratio(
         variant()
         plain_s += middle - start
         variant_s += clock() - middle
+        if settle is not None:
+            settle()
     return plain_s / variant_s

@@ -26,7 +26,7 @@ NATIVE_PARTS: dict[str, tuple[tuple[str, str], ...]] = {
 }
 # Samples an IMU's native sensors keep in MuJoCo's sensor history (`nsample`), computed at the
 # IMU's update period (`interval`): a recorder reads them in one look every few dozen periods.
-HISTORY_SAMPLES = 64
+HISTORY_SAMPLES = 100
 
 
 @dataclass(frozen=True)

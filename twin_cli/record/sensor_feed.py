@@ -27,7 +27,7 @@ from twin_cli.world.observers import world_view
 log = logging.getLogger("twin.record")
 MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
 KEPT = -1.0  # `capture(KEPT)`: every sensor with a history, whatever its rate (a last look)
-POLLS_PER_HISTORY = 4  # looks at a sensor's kept samples per HISTORY_SAMPLES periods
+POLLS_PER_HISTORY = 2  # looks at a sensor's kept samples per HISTORY_SAMPLES periods
 
 Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pending)
 

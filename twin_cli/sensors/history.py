@@ -37,18 +37,23 @@ class SensorHistory:
 
     def since(self, data: Any, time: float) -> tuple[np.ndarray, np.ndarray]:
         """Sample times [s] after `time` and not after now (samples from before a reset of the
-        clock are not), oldest first, and their values (k × width)."""
-        ring = data.history
-        address, _ = self.parts[0]
-        times = self._ordered(ring, address)[0]
-        keep = (times > time + 1e-12) & (times <= data.time + 1e-12)
-        rows = np.empty((int(keep.sum()), self.width))
+        clock are not), oldest first, and their values (k × width).
+
+        The parts of one twin sensor share their interval, so they are written in the same
+        steps and their rings stay in step: one cursor orders them all."""
+        ring, n = data.history, self.n
+        first = self.parts[0][0]
+        times = ring[first + 2 : first + 2 + n]
+        new = np.flatnonzero((times > time + 1e-12) & (times <= data.time + 1e-12))
+        cursor = int(ring[first + 1])
+        slots = new[np.argsort((new - cursor - 1) % n)]  # oldest first
+        rows = np.empty((slots.size, self.width))
         column = 0
         for address, dim in self.parts:
-            _, values = self._ordered(ring, address, dim)
-            rows[:, column : column + dim] = values[keep]
+            values = ring[address + 2 + n : address + 2 + n + n * dim].reshape(n, dim)
+            rows[:, column : column + dim] = values[slots]
             column += dim
-        return times[keep], rows
+        return times[slots], rows
 
     def latest(self, data: Any) -> tuple[float, np.ndarray]:
         """The newest sample's time [s] and values (width); it may date from before a reset of
@@ -62,13 +67,3 @@ class SensorHistory:
             out[column : column + dim] = ring[start : start + dim]
             column += dim
         return time, out
-
-    def _ordered(self, ring: np.ndarray, address: int, dim: int = 0) -> tuple[np.ndarray, Any]:
-        n = self.n
-        cursor = int(ring[address + 1])
-        order = (cursor + 1 + np.arange(n)) % n  # oldest first
-        times = ring[address + 2 : address + 2 + n][order]
-        if not dim:
-            return times, None
-        values = ring[address + 2 + n : address + 2 + n + n * dim].reshape(n, dim)[order]
-        return times, values
