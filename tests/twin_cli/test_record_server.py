@@ -208,21 +208,29 @@ def _paused_session(port: int) -> dict:
             subscribed: dict[int, str] = {}
             wanted = ("/clock", "/h/joint_states", "/tf_static")
             deadline = time.monotonic() + 20.0
+            next_id = 1
             while not all(got.get(t) for t in wanted):
                 frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op["op"] == "advertise":
                         channels.update({c["topic"]: c for c in op["channels"]})
-                        if set(wanted) <= set(channels) and not subscribed:
-                            subs = []
-                            for k, topic in enumerate(wanted, start=1):
-                                subscribed[k] = topic
-                                subs.append({"id": k, "channelId": channels[topic]["id"]})
-                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                    elif op["op"] == "unadvertise":  # the spawn's new layout replaces channels
+                        gone = set(op["channelIds"])
+                        channels = {t: c for t, c in channels.items() if c["id"] not in gone}
+                        subscribed.clear()  # subscribe again to what is advertised next
+                    if set(wanted) <= set(channels) and not subscribed:
+                        subs = []
+                        for topic in wanted:
+                            subscribed[next_id] = topic
+                            subs.append({"id": next_id, "channelId": channels[topic]["id"]})
+                            next_id += 1
+                        await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
                 elif frame[0] == MESSAGE_DATA:
                     sub, stamp = struct.unpack_from("<IQ", frame, 1)
-                    topic = subscribed[sub]
+                    topic = subscribed.get(sub)
+                    if topic is None:  # a subscription to a channel since withdrawn
+                        continue
                     message = store.deserialize_cdr(frame[13:], channels[topic]["schemaName"])
                     got.setdefault(topic, []).append((stamp, message))
             return got
@@ -277,7 +285,8 @@ RED_BOX = """<robot name="redbox"><link name="box"><inertial><mass value="1"/>
 
 
 def _image_session(port: int, client, topic: str) -> list:
-    """Subscribe to one image topic and step the paused world until an image arrives."""
+    """Subscribe to one image topic and step the paused world until an image arrives (a live
+    stream drops sensor captures while its worker is busy, as a live view drops frames)."""
     import websockets
     from rosbags.typesys import Stores, get_typestore
 
@@ -288,20 +297,39 @@ def _image_session(port: int, client, topic: str) -> list:
         async with websockets.connect(url, subprotocols=FOXGLOVE_SUBPROTOCOLS) as ws:
             channels: dict[str, dict] = {}
             got: list = []
+            live, sub_id, waits = None, 0, 0  # the subscribed channel and subscription
             deadline = time.monotonic() + 60.0
             await asyncio.to_thread(client.step, 10)
             while not got:
-                frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                try:
+                    frame = await asyncio.wait_for(ws.recv(), 0.5)
+                except TimeoutError:  # a live stream skips sensors while it is busy: step on
+                    assert time.monotonic() < deadline, "no image within 60 s"
+                    waits += 1
+                    if live is not None and waits % 10 == 0:  # the channel may have been
+                        live = None  # replaced under the subscription: subscribe again
+                    elif live is not None:
+                        await asyncio.to_thread(client.step, 50)
+                    if live is not None or topic not in channels:
+                        continue
+                    frame = json.dumps({"op": "resubscribe"})
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op["op"] == "advertise":
                         channels.update({c["topic"]: c for c in op["channels"]})
-                        if topic in channels:
-                            sub = {"id": 1, "channelId": channels[topic]["id"]}
-                            await ws.send(json.dumps({"op": "subscribe", "subscriptions": [sub]}))
-                            await asyncio.sleep(2.0)  # no acknowledgement: let the server take it
-                            await asyncio.to_thread(client.step, 100)
+                    elif op["op"] == "unadvertise":  # a new layout replaces channels
+                        gone = set(op["channelIds"])
+                        channels = {t: c for t, c in channels.items() if c["id"] not in gone}
+                        live = None if live in gone else live
+                    if topic in channels and live is None:
+                        live, sub_id = channels[topic]["id"], sub_id + 1
+                        sub = {"id": sub_id, "channelId": live}
+                        await ws.send(json.dumps({"op": "subscribe", "subscriptions": [sub]}))
+                        await asyncio.sleep(2.0)  # no acknowledgement: let the server take it
+                        await asyncio.to_thread(client.step, 100)
                 elif frame[0] == MESSAGE_DATA:
+                    if struct.unpack_from("<I", frame, 1)[0] != sub_id:
+                        continue  # a subscription to a channel since withdrawn
                     schema = channels[topic]["schemaName"]
                     got.append((schema, store.deserialize_cdr(frame[13:], schema)))
             return got

@@ -34,6 +34,9 @@ class _Subscriptions:
         with self.lock:
             self.resend.add(channel.topic)
 
+    def on_unsubscribe(self, client: Any, channel: Any) -> None:
+        """Nothing to forget: a latched message is re-sent on the next subscription."""
+
     def take(self) -> set[str]:
         with self.lock:
             topics, self.resend = self.resend, set()
