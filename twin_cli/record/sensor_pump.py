@@ -91,3 +91,4 @@ class SensorPump:
                 self.error = self.error or f"sensor readings: {type(exc).__name__}: {exc}"
             finally:
                 self._building = False
+            time.sleep(0)  # hand the GIL to the stepping thread between captures
