@@ -192,3 +192,28 @@ def test_a_full_ring_makes_the_loop_wait_and_says_so_and_a_spawn_changes_the_lay
         (meta,) = [m for m in make_reader(stream).iter_metadata() if m.name == "rosbag2"]
     custom = yaml.safe_load(meta.metadata["serialized_metadata"])["custom_data"]
     assert int(custom["waits"]) == status.waits and float(custom["blocked_s"]) > 0.0
+
+
+def test_observers_added_at_different_times_all_restart_when_the_clock_goes_back():
+    """An observer added at t = 0 and one added at t = 0.5 s (a spawn re-registers a recording's
+    sensor observers): after a reset of the clock to 0.2 s both fire again from there on."""
+    from twin_cli.world.observers import Observers
+
+    class Data:
+        time = 0.0
+
+    def step(k: int) -> None:
+        Data.time = round(Data.time + k * 0.001, 12)
+
+    early: list[float] = []
+    late: list[float] = []
+    observers = Observers()
+    observers.add(lambda: early.append(Data.time), 100.0, 0.0, 0.001)
+    observers.run(500, step, Data, 0.001)
+    observers.add(lambda: late.append(Data.time), 100.0, Data.time, 0.001)
+    Data.time = 0.2  # the clock goes back (reset), before the late observer's origin
+    early.clear()
+    observers.run(50, step, Data, 0.001)
+    expected = [round(0.2 + 0.01 * k, 12) for k in range(1, 6)]
+    assert early == pytest.approx(expected, abs=1e-12)
+    assert late == pytest.approx(expected, abs=1e-12), "the later observer re-anchored too"

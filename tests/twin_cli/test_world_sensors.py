@@ -339,3 +339,19 @@ def test_sdf_joint_force_torque_sensor_reads_m_g(tmp_path: Path, mass: float) ->
     wrench = suite.read()["ft"]
     np.testing.assert_allclose(wrench.force, [0, 0, mass * _gravity(world)], rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(wrench.torque, 0.0, atol=1e-6)  # COM straight below the joint
+
+
+def test_an_imu_keeps_reading_after_a_time_only_reset(tmp_path: Path) -> None:
+    """MuJoCo computes an IMU at its period from its last update time, kept in the sensor
+    history; a time-only reset moves that history with the clock, so fresh samples follow."""
+    text = imu_box(rate=200.0).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    world.step(300)
+    world.reset(time_only=True)
+    world.step(21)
+    reading = SensorSuite(world, "imu").read()["imu"]
+    assert reading.time == pytest.approx(0.020, abs=1e-9), (
+        "the sample of t = 20 ms, not a stale one"
+    )
+    accel = np.array(reading.linear_acceleration)
+    assert accel == pytest.approx([0.0, 0.0, 9.81], abs=0.05), "a static IMU reads +g"

@@ -188,8 +188,7 @@ class Recording(Follows):
         if self._handle is not None:
             self._world.remove_observer(self._handle)
         self._stop_sensors()
-        self._pump.close()  # its last readings are queued before the end
-        self._queue.put(None)
+        self._queue.put(None)  # the worker closes the pump (not here: maybe the stepping thread)
 
     # ------------------------------------------------------------ worker thread
     def _work(self) -> None:
@@ -202,10 +201,16 @@ class Recording(Follows):
                 while sample is not None:
                     layout = self._publish(sample, layout, kinematics)
                     sample = self._next_newest()
+            self._pump.close()  # its last readings, then those still queued
+            while not self._queue.empty():
+                item = self._queue.get()
+                if isinstance(item, list):
+                    self._publish_readings(item)
         except Exception as exc:  # disk full, a closed sink: stop sampling, report it
             log.exception("recording failed")
             self._error = f"{type(exc).__name__}: {exc}"
             self._finish_sampling()
+            self._pump.close()
         finally:
             self._close_sinks()
 

@@ -71,6 +71,8 @@ class SensorFeed:
         now = float(self._world.data.time)
         for entity, suite in self._suites.items():
             names = group.get(entity)
+            if names and self.dropped:
+                names = [n for n in names if (entity, n) not in self.dropped]
             if not names:
                 continue
             kept = self._kept[entity]
@@ -111,11 +113,7 @@ class SensorFeed:
     def _drop(self, entity: str, name: str, error: Exception) -> None:
         if (entity, name) in self.dropped:
             return
-        self.dropped[(entity, name)] = str(error)
-        self._wanted[entity] = [n for n in self._wanted.get(entity, ()) if n != name]
-        for group in self._groups.values():
-            if entity in group:
-                group[entity] = [n for n in group[entity] if n != name]
+        self.dropped[(entity, name)] = str(error)  # the stepping thread filters on it
         log.warning("not recording sensor '%s' of [%s]: %s", name, entity, error)
 
     def _refresh(self) -> None:

@@ -110,7 +110,13 @@ class SensorSuite:
         """
         with self.world.lock:  # held for a few µs: copies, no physics
             pending = self.capture(names)
-        self.complete(pending)
+        try:
+            self.complete(pending)
+        except Exception:  # nothing of this request was served: due again at the next read
+            for name in [*pending.native, *pending.rest]:
+                self._slots.pop(name, None)
+                self._sampled.pop(name, None)
+            raise
         return {n: self._readings[n] for n in pending.wanted}
 
     def capture(

@@ -49,7 +49,7 @@ class _Entry:
 class Observers:
     """The observers of one world, by handle; empty costs one attribute test per batch.
 
-    The earliest due time and origin are kept up to date on every change, so a split costs a
+    The earliest due time is kept up to date on every change, so a split costs a
     few comparisons besides the callbacks (measured: ~20 µs of Python per split before, with
     the interpreter's caches cold after each `mj_step`).
     """
@@ -58,7 +58,7 @@ class Observers:
         self._entries: dict[int, _Entry] = {}
         self._handles = itertools.count(1)
         self._due = math.inf  # [s] the earliest entry's due time
-        self._origin = math.inf  # [s] the earliest entry's origin
+        self._time = -math.inf  # [s] at the end of the last split: later time before it, a reset
 
     def __bool__(self) -> bool:
         return bool(self._entries)
@@ -84,12 +84,12 @@ class Observers:
         tolerance = DUE_TOLERANCE * timestep
         while n > 0:
             now = data.time
-            if now < self._origin:
+            if now < self._time:
                 self._reanchor(now)
             k = min(n, max(1, math.ceil((self._due - now) / timestep - DUE_TOLERANCE)))
             step(k)
             n -= k
-            now = data.time
+            now = self._time = data.time
             if now >= self._due - tolerance:
                 self._notify(now, timestep)
             if not self._entries:
@@ -99,12 +99,11 @@ class Observers:
     def _summarize(self) -> None:
         entries = self._entries.values()
         self._due = min((e.due for e in entries), default=math.inf)
-        self._origin = min((e.origin for e in entries), default=math.inf)
 
     def _reanchor(self, time: float) -> None:
+        """The clock went back (reset, load): every observer starts over from `time`."""
         for entry in self._entries.values():
-            if time < entry.origin:
-                entry.origin, entry.due = time, time + entry.period
+            entry.origin, entry.due = time, time + entry.period
         self._summarize()
 
     def _notify(self, time: float, timestep: float) -> None:

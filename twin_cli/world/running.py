@@ -65,6 +65,7 @@ class RunControl:
                 self._pushes = [
                     replace(p, end_step=p.end_step - self._iterations) for p in self._pushes
                 ]
+                _shift_sensor_history(self.model, self.data, -float(self.data.time))
                 self.data.time, self._iterations = 0.0, 0
                 self._loop.reset_clock()
                 return
@@ -208,3 +209,17 @@ class RunControl:
         ended = {p.body for p in self._pushes if p.end_step <= self._iterations}
         self._pushes = [p for p in self._pushes if p.end_step > self._iterations]
         control.apply_pushes(self.model, self.data, self._pushes, ended, self._perturbation)
+
+
+def _shift_sensor_history(model: mujoco.MjModel, data: mujoco.MjData, shift: float) -> None:
+    """Moves the samples MuJoCo keeps for sensors with a history (an IMU's) by `shift` [s] with
+    the clock, so that a time-only reset does not leave their last update in the future: MuJoCo
+    would compute them again only once sim time passed it. Each ring is [last update, cursor,
+    times[n], values], see `twin_cli.sensors.history`."""
+    ring = data.history
+    for sensor in range(model.nsensor):
+        n = int(model.sensor_history[sensor][0])
+        if n > 0:
+            address = int(model.sensor_historyadr[sensor])
+            ring[address] += shift
+            ring[address + 2 : address + 2 + n] += shift
