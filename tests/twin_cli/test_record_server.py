@@ -207,10 +207,15 @@ def _paused_session(port: int) -> dict:
             got: dict[str, list] = {}
             subscribed: dict[int, str] = {}
             wanted = ("/clock", "/h/joint_states", "/tf_static")
-            deadline = time.monotonic() + 20.0
+            deadline = time.monotonic() + 30.0
             next_id = 1
             while not all(got.get(t) for t in wanted):
-                frame = await asyncio.wait_for(ws.recv(), deadline - time.monotonic())
+                assert time.monotonic() < deadline, f"got {sorted(got)} of {wanted} in 30 s"
+                try:
+                    frame = await asyncio.wait_for(ws.recv(), 2.0)
+                except TimeoutError:  # the paused world republishes every 0.5 s: a subscription
+                    subscribed.clear()  # to a channel replaced meanwhile; subscribe again
+                    frame = json.dumps({"op": "retry"})
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op["op"] == "advertise":
