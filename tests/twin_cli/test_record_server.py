@@ -208,14 +208,18 @@ def _paused_session(port: int) -> dict:
             subscribed: dict[int, str] = {}
             wanted = ("/clock", "/h/joint_states", "/tf_static")
             deadline = time.monotonic() + 30.0
-            next_id = 1
+            next_id, retry_at = 1, deadline
             while not all(got.get(t) for t in wanted):
                 assert time.monotonic() < deadline, f"got {sorted(got)} of {wanted} in 30 s"
                 try:
                     frame = await asyncio.wait_for(ws.recv(), 2.0)
-                except TimeoutError:  # the paused world republishes every 0.5 s: a subscription
-                    subscribed.clear()  # to a channel replaced meanwhile; subscribe again
-                    frame = json.dumps({"op": "retry"})
+                except TimeoutError:
+                    frame = json.dumps({"op": "silence"})
+                if subscribed and time.monotonic() > retry_at:  # the paused world republishes
+                    subscribed.clear()  # every 0.5 s: a topic still missing was subscribed on a
+                    frame = json.dumps({"op": "retry"})  # channel replaced meanwhile; again
+                if isinstance(frame, str) and json.loads(frame)["op"] == "advertise":
+                    retry_at = time.monotonic() + 3.0
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op["op"] == "advertise":
@@ -231,6 +235,7 @@ def _paused_session(port: int) -> dict:
                             subs.append({"id": next_id, "channelId": channels[topic]["id"]})
                             next_id += 1
                         await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+                        retry_at = time.monotonic() + 3.0
                 elif frame[0] == MESSAGE_DATA:
                     sub, stamp = struct.unpack_from("<IQ", frame, 1)
                     topic = subscribed.get(sub)
