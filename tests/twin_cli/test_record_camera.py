@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 from models import write_urdf
 from test_camera_sensor import BOX, CAM_Z, HFOV, H, W, _projection, _red
+from view_helpers import egl_missing
 
 SECONDS = 0.3  # [s] of sim time recorded at a 1 ms step
 CAMERA_HZ, IMU_HZ = 30.0, 100.0
@@ -83,10 +84,9 @@ def _stamp(message) -> float:  # noqa: ANN001
 
 @pytest.fixture(scope="module")
 def egl_bag(tmp_path_factory) -> dict[str, list]:
-    probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8)"
+    if why := egl_missing():
+        pytest.skip(why)
     env = {**os.environ, "MUJOCO_GL": "egl"}
-    if subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True).returncode:
-        pytest.skip("no offscreen EGL here; install libegl-mesa0 (CI has it)")
     bag, out, _ = _record(tmp_path_factory.mktemp("egl"), env)
     assert out == {"error": None, "dropped": []}
     return _messages(bag)

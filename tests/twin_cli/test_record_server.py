@@ -286,14 +286,6 @@ def test_twin_load_moves_a_recording_or_says_it_stopped(tmp_path, serve_world):
     assert clock == sorted(first + [round(0.2 + 0.01 * k, 9) for k in range(6)]), clock
 
 
-RED_BOX = """<robot name="redbox"><link name="box"><inertial><mass value="1"/>
-  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
-  <visual><geometry><box size="0.2 0.2 0.2"/></geometry><material name="red">
-  <color rgba="1 0 0 1"/></material></visual>
-  <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-  <gazebo><static>true</static></gazebo></robot>"""
-
-
 def _image_session(port: int, client, topic: str) -> list:
     """Subscribe to one image topic and step the paused world until an image arrives (a live
     stream drops sensor captures while its worker is busy, as a live view drops frames)."""
@@ -350,15 +342,15 @@ def _image_session(port: int, client, topic: str) -> list:
 def test_foxglove_clients_receive_camera_images_as_sensor_msgs_image(tmp_path, serve_world):
     from test_camera_sensor import CAM_Z, H, W, _red
     from test_record_camera import POST
+    from view_helpers import egl_missing, red_box
 
-    probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8)"
-    env = {**os.environ, "MUJOCO_GL": "egl"}
-    if subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True).returncode:
+    if why := egl_missing():
         import pytest
 
-        pytest.skip("no offscreen EGL here; install libegl-mesa0 (CI has it)")
+        pytest.skip(why)
     (tmp_path / "campost.urdf").write_text(POST)
-    (tmp_path / "redbox.urdf").write_text(RED_BOX)
+    static = "<gazebo><static>true</static></gazebo></robot>"
+    (tmp_path / "redbox.urdf").write_text(red_box(0.2).replace("</robot>", static))
     port = free_port()
     with serve_world(tmp_path, "foxcam", "--paused", "--foxglove", str(port)) as (client, _):
         client.spawn(str(tmp_path / "campost.urdf"), name="post")

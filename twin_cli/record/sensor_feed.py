@@ -98,10 +98,6 @@ class SensorFeed:
                 self._drop(suite.entity, name, error)
         return out
 
-    def fresh(self) -> list[tuple[Topic, Reading]]:
-        """`capture` and `build` at once (lock held): for callers that step the world themselves."""
-        return self.build(self.capture())
-
     def _since(self, entity: str, name: str, now: float) -> float:
         """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
         the clock went back) this very instant on."""

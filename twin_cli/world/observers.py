@@ -81,16 +81,15 @@ class Observers:
 
         A clock that went back (reset) re-anchors the observers at the new time.
         """
-        tolerance = DUE_TOLERANCE * timestep
         while n > 0:
             now = data.time
             if now < self._time:
                 self._reanchor(now)
-            k = min(n, max(1, math.ceil((self._due - now) / timestep - DUE_TOLERANCE)))
+            k = min(n, steps_until_due(now, self._due, timestep))
             step(k)
             n -= k
             now = self._time = data.time
-            if now >= self._due - tolerance:
+            if is_due(now, self._due, timestep):
                 self._notify(now, timestep)
             if not self._entries:
                 step(n)
