@@ -217,3 +217,34 @@ def test_observers_added_at_different_times_all_restart_when_the_clock_goes_back
     expected = [round(0.2 + 0.01 * k, 12) for k in range(1, 6)]
     assert early == pytest.approx(expected, abs=1e-12)
     assert late == pytest.approx(expected, abs=1e-12), "the later observer re-anchored too"
+
+
+def test_an_observer_that_removes_itself_or_adds_another_keeps_the_steps_and_the_grid():
+    """Callbacks may change the observers (a recording ends at its duration, a spawn adds sensor
+    observers): the batch still takes all its steps and later observers keep their own grid."""
+    from twin_cli.world.observers import Observers
+
+    class Data:
+        time = 0.0
+
+    steps: list[int] = []
+
+    def step(k: int) -> None:
+        steps.append(k)
+        Data.time = round(Data.time + k * 0.001, 12)
+
+    observers = Observers()
+    first: list[float] = []
+    second: list[float] = []
+
+    def once_then_more() -> None:
+        first.append(Data.time)
+        if len(first) == 3:
+            observers.remove(handle)
+            observers.add(lambda: second.append(Data.time), 40.0, Data.time, 0.001)
+
+    handle = observers.add(once_then_more, 100.0, 0.0, 0.001)
+    observers.run(200, step, Data, 0.001)
+    assert sum(steps) == 200 and Data.time == pytest.approx(0.2)
+    assert first == pytest.approx([0.01, 0.02, 0.03], abs=1e-12)
+    assert second == pytest.approx([0.03 + 0.025 * k for k in range(1, 7)], abs=1e-12)

@@ -161,9 +161,9 @@ class BagRecording(Follows):
     def _capture(self) -> None:
         if self._done.is_set():
             return
-        self._watch_sensors()
         world = self._world
-        if world.model is not self._model:
+        if world.model is not self._model:  # a spawn or delete: new layout, maybe new sensors
+            self._watch_sensors()
             self._send_layout()
         if not self._writer.put(self._epoch, world.data):
             self._error = "the encoder process ended; the recording stopped"
