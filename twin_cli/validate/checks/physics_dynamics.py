@@ -18,6 +18,7 @@ from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
 FREE = 0  # mjtJoint mjJNT_FREE
+TINY_RAD_S = 1e-9  # [rad/s] the floor of the spin plot's log axis (a link that never turned)
 REALTIME_CHUNKS = 5  # the capacity is timed over this many equal slices of the scenario
 REACHED_RAD = 0.01
 """A drive reached its stop when the joint came within this of it [rad or m]; a joint whose
@@ -210,9 +211,21 @@ def check_stability(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
                 tuple(times),
                 {"E(t) − E(0)": tuple(gains)},
                 threshold=th["max_energy_gain"],
-            )
+            ),
+            bars(
+                "peak spin",
+                "rad/s",
+                {_link(run, b): max(w, TINY_RAD_S) for b, w in spin.items()},  # log: no 0
+                th["max_spin_rad_s"],
+                x_label="link (peak angular speed, no control)",
+                log=True,
+            ),
         ],
     )
+
+
+def _link(run: ScenarioRun, body: int) -> str:
+    return run.world.model.body(body).name.removeprefix(f"{run.entity}/")
 
 
 def _stability_hints(run: ScenarioRun, finite: bool, gain: float, spin: dict, th: dict) -> list:
@@ -235,9 +248,8 @@ def _stability_hints(run: ScenarioRun, finite: bool, gain: float, spin: dict, th
     for b, w in sorted(spin.items(), key=lambda kv: -kv[1]):
         if w <= th["max_spin_rad_s"]:
             break
-        name = model.body(b).name.removeprefix(f"{run.entity}/")
         hints.append(
-            f"link '{name}' spins at {w:.3g} rad/s with no control: its inertia "
+            f"link '{_link(run, b)}' spins at {w:.3g} rad/s with no control: its inertia "
             f"{float(np.sum(model.body_inertia[b])):.3g} kg m² (trace) is too small for "
             f"{float(model.body_mass[b]):.3g} kg"
         )

@@ -151,9 +151,12 @@ def slide_on_slope(robot: RobotUnderTest, spec, scenario: Scenario, theta: float
     return float(np.linalg.norm((run.subtree_com() - start)[:2]))
 
 
-def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str], float]:
+def _probe_verdicts(
+    robot, scenario, geom, mu, th
+) -> tuple[list[str], list[str], float, float | None]:
     """Run the stick and slide probes of one foot geom; return (hints, details, the distance
-    [m] it slid on the slope where it should stick)."""
+    [m] it slid on the slope where it should stick, and on the one where it should slide over
+    Coulomb's distance (None: no slide probe, the slope would be too steep))."""
     spec = probe_spec(robot.model, geom)
     name = robot.model.body(int(robot.model.geom_bodyid[geom])).name
     g, t = 9.81, scenario.duration
@@ -168,9 +171,11 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
         )
     hints += _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details)
     theta_slide = math.atan(th["slide_factor"] * mu)
+    ratio = None
     if theta_slide <= MAX_SLIDE_ANGLE:
         expected = 0.5 * g * (math.sin(theta_slide) - mu * math.cos(theta_slide)) * t * t
         slid = slide_on_slope(robot, spec, scenario, theta_slide)
+        ratio = slid / expected
         details.append(f"{name}: {math.degrees(theta_slide):.1f}° slides {fmt_len(slid)}")
         if slid < th["min_slide_ratio"] * expected:
             hints.append(
@@ -178,7 +183,7 @@ def _probe_verdicts(robot, scenario, geom, mu, th) -> tuple[list[str], list[str]
                 f"Coulomb with μ={mu:.3g} predicts {fmt_len(expected)}: the pair's friction is "
                 "not min(μ); another surface's μ wins"
             )
-    return hints, details, stuck
+    return hints, details, stuck, ratio
 
 
 def _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details) -> list[str]:
@@ -214,14 +219,17 @@ def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[s
             robot.model.geom_priority[local],
         )
         by_surface.setdefault(key, local)
-    hints, details, mus, stuck = [], [], [], {}
+    hints, details, mus, stuck, slides = [], [], [], {}, {}
     for (mu_foot, _), geom in sorted(by_surface.items())[: int(th["max_probes"])]:
         mu = min(mu_foot, GROUND_MU)
         mus.append(mu)
-        h, d, slid = _probe_verdicts(robot, scenario, geom, mu, th)
+        h, d, slid, ratio = _probe_verdicts(robot, scenario, geom, mu, th)
         hints += h
         details += d
-        stuck[f"{robot.model.body(int(robot.model.geom_bodyid[geom])).name} μ={mu:.3g}"] = slid
+        surface = f"{robot.model.body(int(robot.model.geom_bodyid[geom])).name} μ={mu:.3g}"
+        stuck[surface] = slid
+        if ratio is not None:
+            slides[surface] = ratio
     return result(
         "friction_incline",
         "physics",
@@ -231,15 +239,35 @@ def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[s
         hints=hints,
         details=details,
         value=float(len(hints)),
-        series=[
+        series=_incline_series(stuck, slides, th),
+    )
+
+
+def _incline_series(stuck: dict, slides: dict, th: dict[str, float]) -> list[Series]:
+    """Per foot surface: the slide on the slope where it should stick (at most a distance), and
+    on the slope where it should slide, over Coulomb's ½(g sin θ − μ g cos θ)t² (at least a
+    ratio); surfaces too grippy for a slide probe (θ above MAX_SLIDE_ANGLE) have no bar there."""
+    series = []
+    if stuck:
+        probe = f"probe block on a slope tan θ = {th['stick_factor']:g}μ"
+        series.append(
             bars(
                 "slide on the sticking slope",
                 "m",
                 stuck,
                 th["max_stick_slip_m"],
-                x_label=f"foot surface (probe block on a slope tan θ = {th['stick_factor']:g}μ)",
+                x_label=f"foot surface ({probe})",
             )
-        ]
-        if stuck
-        else [],
-    )
+        )
+    if slides:
+        probe = f"probe block on a slope tan θ = {th['slide_factor']:g}μ"
+        series.append(
+            bars(
+                "slide over Coulomb's",
+                "1",
+                slides,
+                th["min_slide_ratio"],
+                x_label=f"foot surface ({probe}; at least the threshold)",
+            )
+        )
+    return series

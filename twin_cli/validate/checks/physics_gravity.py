@@ -9,9 +9,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Series, Status, fmt_len, judged, result
+from twin_cli.validate.checks.base import (
+    RobotUnderTest,
+    Series,
+    Status,
+    bars,
+    fmt_len,
+    judged,
+    result,
+)
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
+
+TINY_M = 1e-12  # [m] the floor of the link-motion plot's log axis (a link that did not move)
 
 
 def _skip_fixed(check: str, run: ScenarioRun):
@@ -161,6 +171,17 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         {"|COM − start|": tuple(np.linalg.norm(disp, axis=1))},
         threshold=th["max_com_drift_m"],
     )
+    names = [run.world.model.body(b).name.removeprefix(f"{run.entity}/") for b in run.bodies]
+    links = bars(
+        "link motion",
+        "m",
+        {
+            n: max(float(d), TINY_M) for n, d in zip(names, moved, strict=True)
+        },  # a log axis has no 0
+        th["max_link_motion_m"],
+        x_label="link (distance from its start, no gravity, no control)",
+        log=True,
+    )
     return judged(
         "zero_gravity",
         "physics",
@@ -168,5 +189,5 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
         f"≤ {fmt_len(th['max_com_drift_m'])}, ≤ {fmt_len(th['max_link_motion_m'])}",
         hints,
         value=drift,
-        series=[series],
+        series=[series, links],
     )
