@@ -5,7 +5,9 @@ Targets: with a browser showing the world, the unthrottled loop keeps ≥ 0.95 o
 without a viewer (alternating windows on the same world), and real-time mode holds a factor of
 1.00 ± 0.01. The browser is Debian's headless chromium on the same machine: on 2 shared cores it
 takes CPU from the loop (WebGL through SwiftShader), so the ratio is also given with the viewer
-attached and no browser (the server's own share: the sync thread and the viewer thread).
+attached and no browser (the server's own share: the sync thread and the viewer thread), and
+each window's share of wall time inside `mj_step` says whether twin's threads or a slower
+`mj_step` account for the difference.
 """
 
 from __future__ import annotations
@@ -42,11 +44,16 @@ def _world() -> World:
     return world
 
 
-def _steps_per_s(world: World) -> float:
-    """Steps/s of the running loop over one window of wall time."""
+def _steps_per_s(world: World, inside: list[float] | None = None) -> float:
+    """Steps/s of the running loop over one window of wall time; appends to `inside` the share
+    of the window the loop spent inside `mj_step` (1.0: nothing but physics)."""
     first, start = world.stats().iterations, time.perf_counter()
+    stepping = world.stepping_time
     time.sleep(WINDOW_S)
-    return (world.stats().iterations - first) / (time.perf_counter() - start)
+    wall = time.perf_counter() - start
+    if inside is not None:
+        inside.append((world.stepping_time - stepping) / wall)
+    return (world.stats().iterations - first) / wall
 
 
 def _realtime(world: World) -> dict:
@@ -64,24 +71,29 @@ def _realtime(world: World) -> dict:
 
 
 def measure(browser: object | None) -> dict:
-    """Windows without a viewer, then the same number with one (and a browser on it).
+    """Windows without a viewer, with one and no page open, then with the page open.
 
     One viewer per process: MuJoCo 4.0.0's web viewer hangs when a process starts its third,
-    so the windows are not alternated; medians of WINDOWS each.
+    so the windows are not alternated; medians of WINDOWS each. The share of wall time inside
+    `mj_step` tells the causes apart: twin's own threads taking the loop's time lower it, while
+    a browser that slows each step (SwiftShader rasterising on the other core of a shared VM)
+    leaves it unchanged and lowers the steps/s.
     """
     world = _world()
     world.start()
     try:
-        plain = [_steps_per_s(world) for _ in range(WINDOWS)]
+        inside: dict[str, list[float]] = {"plain": [], "viewer": [], "browser": []}
+        plain = [_steps_per_s(world, inside["plain"]) for _ in range(WINDOWS)]
         host = WebHost(lambda: world)
         address = host.start()
+        attached = [_steps_per_s(world, inside["viewer"]) for _ in range(WINDOWS)]
         page = None
         if browser is not None:
             page = browser.new_page(viewport={"width": 800, "height": 600})
             page.goto(address.url)
             time.sleep(PAGE_LOAD_S)
         before, start = host.syncs, time.perf_counter()
-        viewed = [_steps_per_s(world) for _ in range(WINDOWS)]
+        viewed = [_steps_per_s(world, inside["browser"]) for _ in range(WINDOWS)]
         syncs = (host.syncs - before) / (time.perf_counter() - start)
         realtime = _realtime(world)
         if page is not None:
@@ -91,8 +103,10 @@ def measure(browser: object | None) -> dict:
         world.stop()
     return {
         "viewer_vs_plain": statistics.median(viewed) / statistics.median(plain),
+        "attached_no_page_vs_plain": statistics.median(attached) / statistics.median(plain),
         "plain_steps_per_s": [round(x) for x in plain],
         "viewer_steps_per_s": [round(x) for x in viewed],
+        "share_in_mj_step": {k: round(statistics.median(v), 3) for k, v in inside.items() if v},
         "syncs_per_s": syncs,
         "realtime_with_viewer": realtime,
     }
