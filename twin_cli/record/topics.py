@@ -91,18 +91,24 @@ def latched_messages(layout: Layout, time: float) -> list[Message]:
 
 
 def live_messages(sample: Sample, xpos: np.ndarray, xquat: np.ndarray) -> list[Message]:
-    """`/clock`, `/tf`, and each entity's joint states (and odometry) at the sample's time."""
+    """`/clock`, `/tf`, and each entity's joint states (and odometry) at the sample's time.
+
+    Runs for every sample of a recording (thousands per wall second when the loop is
+    unthrottled, in the encoder process): one stamp object serves every header of the sample,
+    and poses become Python floats in one `tolist` per entity instead of one per number.
+    """
     T, t = ros.types(), sample.time
     layout = sample.layout
-    clock = Message(CLOCK.name, ros.CLOCK, t, T[ros.CLOCK](clock=ros.stamp(t)))
+    stamp = ros.stamp(t)
+    clock = Message(CLOCK.name, ros.CLOCK, t, T[ros.CLOCK](clock=stamp))
     transforms = []
     for e in layout.entities:
-        transforms += _moving_transforms(layout, e, t, xpos, xquat)
+        transforms += _moving_transforms(layout, e, stamp, xpos, xquat)
     out = [clock, Message(TF.name, ros.TF, t, T[ros.TF](transforms=transforms))]
     for e in layout.entities:
-        out.append(_joint_states(sample, e))
+        out.append(_joint_states(sample, e, stamp))
         if e.free_qpos >= 0:
-            out.append(_odometry(sample, e))
+            out.append(_odometry(sample, e, stamp))
     return out
 
 
@@ -117,16 +123,32 @@ def relative_poses(
 
 
 def _moving_transforms(
-    layout: Layout, e: EntityLayout, t: float, xpos: np.ndarray, xquat: np.ndarray
+    layout: Layout, e: EntityLayout, stamp: Any, xpos: np.ndarray, xquat: np.ndarray
 ) -> list[Any]:
+    T = ros.types()
+    header, stamped = T["std_msgs/msg/Header"], T["geometry_msgs/msg/TransformStamped"]
+    transform, vector, quaternion = (
+        T["geometry_msgs/msg/Transform"],
+        T["geometry_msgs/msg/Vector3"],
+        T["geometry_msgs/msg/Quaternion"],
+    )
     pos, quat = relative_poses(xpos, xquat, e.moving, e.moving_parents)
+    frames = layout.body_frames
     return [
-        _transform(t, layout.body_frames[p], layout.body_frames[b], pos[k], quat[k])
-        for k, (b, p) in enumerate(zip(e.moving, e.moving_parents, strict=True))
+        stamped(
+            header=header(stamp=stamp, frame_id=frames[p]),
+            child_frame_id=frames[b],
+            transform=transform(
+                translation=vector(x=x, y=y, z=z), rotation=quaternion(x=qx, y=qy, z=qz, w=qw)
+            ),
+        )
+        for b, p, (x, y, z), (qw, qx, qy, qz) in zip(
+            e.moving.tolist(), e.moving_parents.tolist(), pos.tolist(), quat.tolist(), strict=True
+        )
     ]
 
 
-def _joint_states(sample: Sample, e: EntityLayout) -> Message:
+def _joint_states(sample: Sample, e: EntityLayout, stamp: Any) -> Message:
     T, model = ros.types(), sample.layout.model
     qa, da = model.jnt_qposadr[e.joint_ids], model.jnt_dofadr[e.joint_ids]
     position, velocity = sample.qpos[qa].copy(), sample.qvel[da].copy()
@@ -136,7 +158,7 @@ def _joint_states(sample: Sample, e: EntityLayout) -> Message:
         velocity[k] = np.linalg.norm(sample.qvel[da[k] : da[k] + 3])
         effort[k] = 0.0
     message = T[ros.JOINT_STATE](
-        header=_header(sample.time, ""),
+        header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=""),
         name=list(e.joint_names),
         position=position,
         velocity=velocity,
@@ -145,7 +167,7 @@ def _joint_states(sample: Sample, e: EntityLayout) -> Message:
     return Message(f"/{e.name}/joint_states", ros.JOINT_STATE, sample.time, message)
 
 
-def _odometry(sample: Sample, e: EntityLayout) -> Message:
+def _odometry(sample: Sample, e: EntityLayout, stamp: Any) -> Message:
     """Free-joint pose in the world; twist in the root frame (MuJoCo: linear qvel is global,
     angular qvel is local)."""
     T = ros.types()
@@ -160,7 +182,7 @@ def _odometry(sample: Sample, e: EntityLayout) -> Message:
     twist = T["geometry_msgs/msg/Twist"](linear=_vector(linear), angular=_vector(v[3:6]))
     zeros = np.zeros(36)
     message = T[ros.ODOMETRY](
-        header=_header(sample.time, WORLD_FRAME),
+        header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=WORLD_FRAME),
         child_frame_id=f"{e.root_frame}",
         pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros),
         twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros),
