@@ -13,7 +13,8 @@ from models import write_urdf
 from sensor_models import bumper_ball, hanging_load, imu_box, lidar_post
 
 from twin_cli.errors import PartNotFoundError
-from twin_cli.sensors import SensorSuite
+from twin_cli.sensors import Reading, SensorSuite
+from twin_cli.sensors.history import SensorHistory
 from twin_cli.sensors.suite import period_slot
 from twin_cli.world import Pose, World
 
@@ -185,8 +186,6 @@ def _assert_noise_law(values: np.ndarray, expected: np.ndarray, stddev: float) -
 def test_noisy_force_torque_readings_scatter_around_m_g_with_the_tags_stddev(
     tmp_path: Path,
 ) -> None:
-    from twin_cli.sensors import SensorStream
-
     mass = 2.0
     world = _world_with(tmp_path, hanging_load(mass, rate=1000.0, noise=(F_STD, T_STD)), "hang")
     world.step(100)
@@ -196,16 +195,32 @@ def test_noisy_force_torque_readings_scatter_around_m_g_with_the_tags_stddev(
     for _ in range(FT_DRAWS):  # one reading per 1 ms period: a fresh draw each time
         world.step(1)
         polled.append(suite.read()["ft"])
-    stream = SensorStream(SensorSuite(world, "hang", seed=1))
-    world.step(FT_DRAWS)  # one call: the stream captures FT_DRAWS readings, noise drawn at once
-    streamed = stream.drain()
-    stream.close()
-    assert len(streamed) == FT_DRAWS
-    for readings in (polled, streamed):
+    fed = _fed(world, ["hang"], FT_DRAWS)  # one call: noise drawn for each batch at once
+    assert len(fed) == FT_DRAWS + 1, "one per period, and the one at the start"
+    for readings in (polled, fed):
         force = np.array([r.force for r in readings])
         torque = np.array([r.torque for r in readings])
         _assert_noise_law(force, np.array([0.0, 0.0, mass * g]), F_STD)
         _assert_noise_law(torque, np.zeros(3), T_STD)
+
+
+def _fed(world: World, entities: list[str], steps: int) -> list[Reading]:
+    """Every reading a recording takes (`twin_cli.record.sensor_feed`, the recorders' sensor
+    path) over one `world.step(steps)` call: a capture at the start, one world observer per
+    rate the feed asks for, a last look at the samples MuJoCo kept; built afterwards."""
+    from twin_cli.record.sensor_feed import KEPT, SensorFeed
+
+    feed = SensorFeed(world, entities)
+    rates = feed.rates()
+    with world.lock:
+        captured = feed.capture()
+    handles = [world.add_observer(lambda r=r: captured.extend(feed.capture(r)), r) for r in rates]
+    world.step(steps)
+    with world.lock:
+        captured.extend(feed.capture(KEPT))
+    for handle in handles:
+        world.remove_observer(handle)
+    return [reading for _, reading in feed.build(captured)]
 
 
 # ------------------------------------------------------------------------------------- contact
@@ -283,26 +298,20 @@ def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
 
 
 # ------------------------------------------------------------------------------------- stream
-def test_a_stream_captures_every_reading_at_the_sensors_rates(tmp_path: Path) -> None:
-    from twin_cli.sensors import SensorStream
-
+def test_a_recordings_feed_takes_every_reading_at_the_sensors_rates(tmp_path: Path) -> None:
     world = _world_with(tmp_path, lidar_post(samples=31), "post")
     world.spawn(_wall(2.0), name="wall")
     box = imu_box(rate=200.0, stddev=0.02).replace("</robot>", STATIC)
     world.spawn(write_urdf(tmp_path, box, "imu.urdf"), name="imu", pose=Pose(x=-3.0, z=0.1))
     world.step(10)  # the box settles on its contacts' first steps
-    imu_stream = SensorStream(SensorSuite(world, "imu"))
-    scan_stream = SensorStream(SensorSuite(world, "post"))
     start = world.data.time
-    world.step(1000)  # one call: 1 s of sim time
-    imus, scans = imu_stream.drain(), scan_stream.drain()
-    imu_stream.close()
-    scan_stream.close()
-    world.step(100)
-    assert not imu_stream.drain(), "closed: nothing more captured"
-    # 200 Hz over 1 s: one reading per 5 ms period, stamped at the period's end; 10 Hz: ten.
-    np.testing.assert_allclose([r.time for r in imus], start + 0.005 * np.arange(1, 201), atol=1e-9)
-    np.testing.assert_allclose([r.time for r in scans], start + 0.1 * np.arange(1, 11), atol=1e-9)
+    readings = _fed(world, ["imu", "post"], 1000)  # one call: 1 s of sim time
+    imus = [r for r in readings if r.sensor == "imu"]
+    scans = [r for r in readings if r.sensor != "imu"]
+    # 200 Hz: the samples MuJoCo kept, each at the start of its 5 ms period (that of t = 1 s is
+    # computed with the next step); 10 Hz: the scan at the start and one per 0.1 s period.
+    np.testing.assert_allclose([r.time for r in imus], start + 0.005 * np.arange(200), atol=1e-9)
+    np.testing.assert_allclose([r.time for r in scans], start + 0.1 * np.arange(11), atol=1e-9)
     for scan in scans:
         assert scan.ranges[len(scan.ranges) // 2] == pytest.approx(2.0, abs=1e-9)
     # The static box: specific force +g on z, noise 0.02 m/s² per axis over 200 draws.
@@ -355,3 +364,35 @@ def test_an_imu_keeps_reading_after_a_time_only_reset(tmp_path: Path) -> None:
     )
     accel = np.array(reading.linear_acceleration)
     assert accel == pytest.approx([0.0, 0.0, 9.81], abs=0.05), "a static IMU reads +g"
+
+
+def test_imu_samples_stay_on_the_period_grid_over_a_long_run(tmp_path: Path) -> None:
+    """MuJoCo keeps each IMU sample with its time; over 20 s of 1 ms steps every one of the
+    4,000 samples of a 200 Hz IMU sits on k · 5 ms (sums of 0.001 and of 0.005 drift apart by
+    rounding, which put samples one step late: 2.001 s, 2.006 s, ...), also after a spawn
+    (a new model) and a timestep change."""
+    text = imu_box(rate=200.0).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    times: list[float] = []
+
+    def collect(steps: int) -> None:
+        model = world.model
+        parts = [s for s in range(model.nsensor) if model.sensor_history[s][0] > 0]
+        history = SensorHistory(model, parts)
+        for _ in range(steps // 200):
+            world.step(200)  # 40 samples, within the 100 the ring keeps
+            new, _ = history.since(world.data, times[-1] if times else -0.001)
+            times.extend(new)
+
+    collect(10_000)
+    world.spawn(_wall(5.0), name="wall")  # recompiled: the history moves to a new MjData
+    collect(10_000)
+    # A sample is computed at the start of its step: the one of t = 20 s comes with the next.
+    assert len(times) == 4000 and times[0] == 0.0, "one sample per 5 ms, from t = 0"
+    periods = np.asarray(times) / 0.005
+    np.testing.assert_allclose(periods, np.round(periods), atol=1e-6, err_msg="on the grid")
+    np.testing.assert_allclose(np.diff(times), 0.005, atol=1e-9)
+    world.set_physics(timestep=0.0005)
+    start = len(times)
+    collect(2_000)  # 1 s more at the new step
+    np.testing.assert_allclose(np.diff(times[start - 1 :]), 0.005, atol=1e-9)

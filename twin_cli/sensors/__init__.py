@@ -2,10 +2,11 @@
 
 A consumer of the world (like the recorder): it reads the engine's state under its lock and
 computes outside it; the world never imports it. Modules: `suite` (all sensors of an entity,
-update rates), `stream` (every reading at the sensors' rates, for recorders), `snapshot`
-(state copy and its dynamics), `history` (past samples MuJoCo keeps), `imu`, `ray`,
-`contact`, `force_torque`, `camera` (one sensor type each), `noise` (Gazebo's Gaussian noise,
-seeded), `readings` (what each reports), `frames` (finding a sensor's elements by name).
+update rates; `capture` then `complete` for recorders, which take every reading: see
+`twin_cli.record.sensor_feed`), `snapshot` (state copy and its dynamics), `history` (past
+samples MuJoCo keeps), `imu`, `ray`, `contact`, `force_torque`, `camera` (one sensor type
+each), `noise` (Gazebo's Gaussian noise, seeded), `readings` (what each reports), `frames`
+(finding a sensor's elements by name).
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ from twin_cli.sensors.readings import (
     ScanReading,
     WrenchReading,
 )
-from twin_cli.sensors.stream import SensorStream
 from twin_cli.sensors.suite import SensorSuite, describe_sensors
 
 __all__ = [
@@ -31,7 +31,6 @@ __all__ = [
     "ImuReading",
     "Reading",
     "ScanReading",
-    "SensorStream",
     "SensorSuite",
     "WrenchReading",
     "describe_sensors",

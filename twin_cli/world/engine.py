@@ -46,7 +46,7 @@ from twin_cli.world.physics import PhysicsSettings
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.respec import SpecRenewal
-from twin_cli.world.running import STATE, RunControl
+from twin_cli.world.running import STATE, RunControl, align_sensor_ticks
 from twin_cli.world.scene import build_world_spec, replace_lights
 from twin_cli.world.values import (
     EntityInfo,
@@ -271,6 +271,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         index: dict[str, EntityIndex],
     ) -> None:
         self._spec, self.model, self.data, self._index = spec, model, data, index
+        align_sensor_ticks(model, data)
         self._install_pool(model, data)
         cap_contact_stiffness(model)
         self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))

@@ -13,6 +13,7 @@ from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world import actuation as control
 from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.entities import element_names
+from twin_cli.world.running import align_sensor_ticks
 from twin_cli.world.scene import ODE_ONLY_FIELDS
 from twin_cli.world.sleeping import wake_trees
 from twin_cli.world.values import check_settings, finite_vector
@@ -90,6 +91,7 @@ class PhysicsSettings:
                 target.solver, target.integrator = SOLVERS[new.solver], INTEGRATORS[new.integrator]
             if "timestep" in changes:  # contacts resolvable at the old step may not be now
                 cap_contact_stiffness(self.model, spec_solrefs(self._spec, self.model))
+                align_sensor_ticks(self.model, self.data)  # the lead is half the new step
             # dampingFactor's per-step keep fraction depends on the timestep.
             self._damping = control.damping_of(
                 self.model, element_names(self.model, self.model.name_numericadr)

@@ -223,3 +223,24 @@ def _shift_sensor_history(model: mujoco.MjModel, data: mujoco.MjData, shift: flo
             address = int(model.sensor_historyadr[sensor])
             ring[address] += shift
             ring[address + 2 : address + 2 + n] += shift
+
+
+def align_sensor_ticks(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """Puts each interval sensor's last tick (ring slot 0) half a step before its grid point.
+
+    MuJoCo computes such a sensor at the first step where last tick + period <= time, then adds
+    the period to the tick. Sim time and the tick are sums of different floats (0.001s and
+    0.005s), so a tick exactly on a step time lost that comparison to rounding now and then: the
+    sample came one step late (2.001 s), and stayed late. Half a step of lead makes the
+    comparison robust and keeps the k·period grid; idempotent (a spawn or a timestep change
+    calls it again).
+    """
+    ring, step = data.history, float(model.opt.timestep)
+    for sensor in range(model.nsensor):
+        period, phase = (float(v) for v in model.sensor_interval[sensor])
+        if int(model.sensor_history[sensor][0]) <= 0 or period <= 0.0:
+            continue
+        lead = min(0.5 * step, 0.25 * period)
+        address = int(model.sensor_historyadr[sensor])
+        ticks = round((float(ring[address]) - phase) / period)
+        ring[address] = phase + ticks * period - lead
