@@ -17,10 +17,11 @@ import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from twin_cli.control.trajectory import Trajectory, sample
+from twin_cli.control.trajectory import Trajectory, sample, sample_block
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 
 UPDATE_RATE = 100.0  # [Hz] controller_manager's usual update_rate
+BLOCK = 100  # updates whose references are sampled at once (1 s at 100 Hz)
 
 
 @dataclass
@@ -64,9 +65,13 @@ class TrajectoryFollower:
                 entity, dict(zip(trajectory.joint_names, self.start, strict=True)), mode="position"
             )
             self.keys = [c.actuator for c in commands]
+            self._keyset = frozenset(self.keys)  # all still commanded: the follower's own
             self.qpos = [world.model.joint(f"{entity}/{j}").qposadr[0] for j in self.start_names]
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
+            self.rate = rate
+            self._block = _References(trajectory, self.start, rate)
+            self._max: Any = None  # numpy: the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)
 
     @property
@@ -74,25 +79,32 @@ class TrajectoryFollower:
         return self.trajectory.joint_names
 
     def _update(self) -> None:
-        """One controller update (the world's lock is held): measure, then command."""
+        """One controller update (the world's lock is held): measure, then command.
+
+        Runs every 10 ms of sim time inside the stepping: the references come from a block
+        sampled ahead (`_References`), and the errors are one numpy expression per update.
+        """
+        import numpy as np
+
         world = self.world
         t = float(world.data.time) - self.t0
-        if t < -1e-9 or any(k not in world._commands for k in self.keys):
+        if t < -1e-9 or not world._commands.keys() >= self._keyset:
             self.stop()  # the world was reset or the commands were replaced
             return
-        reference, _ = sample(self.trajectory, self.start, t)
-        for name, q, r in zip(self.start_names, self.qpos, reference, strict=True):
-            error = abs(float(world.data.qpos[q]) - r)
-            self.report.max_error[name] = max(self.report.max_error.get(name, 0.0), error)
-            if t >= self.trajectory.duration - 1e-9:
-                self.report.final_error[name] = error
+        reference, nxt, speed = self._block.at(t)
+        errors = np.abs(world.data.qpos[self.qpos] - reference)
+        self._max = errors if self._max is None else np.maximum(self._max, errors)
+        names = self.start_names
+        self.report.max_error = dict(zip(names, self._max.tolist(), strict=True))
+        done = t >= self.trajectory.duration - 1e-9
+        if done:
+            self.report.final_error = dict(zip(names, errors.tolist(), strict=True))
         self.report.elapsed = t
-        nxt, speed = sample(self.trajectory, self.start, t + 1.0 / UPDATE_RATE)
         self._write(nxt, speed)
-        if t >= self.trajectory.duration - 1e-9:
+        if done:
             self.stop()
 
-    def _write(self, positions: tuple[float, ...], speeds: tuple[float, ...]) -> None:
+    def _write(self, positions: Any, speeds: Any) -> None:
         """Moves each position servo's target and damping reference: ctrl and the bias constant.
 
         Only those two numbers change (see actuation.apply_command), written as arrays; actuator
@@ -114,12 +126,12 @@ class TrajectoryFollower:
             self._hold = np.array([c.hold for c in commands]) / gear
         world.data.ctrl[self._ids] = positions
         wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
-        world.model.actuator_biasprm[self._ids, 0] = self._kv * np.array(speeds) + self._hold
+        world.model.actuator_biasprm[self._ids, 0] = self._kv * speeds + self._hold
         self._last = (positions, speeds)
 
     def _record_last(self) -> None:
         positions, speeds = self._last
-        for key, p, v in zip(self.keys, positions, speeds, strict=True):
+        for key, p, v in zip(self.keys, positions.tolist(), speeds.tolist(), strict=True):
             if key in self.world._commands:
                 cmd = self.world._commands[key]
                 self.world._commands[key] = replace(cmd, target=p, feedforward=v)
@@ -198,3 +210,36 @@ def tracking_report(world: Any, entity: str) -> dict | None:
         return None
     with world.lock:
         return follower.report.to_dict()
+
+
+class _References:
+    """The follower's references, sampled BLOCK updates at a time: at each update time k/rate
+    [s] after the start, and at one controller period later (the target it writes)."""
+
+    def __init__(self, trajectory: Trajectory, start: tuple[float, ...], rate: float) -> None:
+        self.trajectory, self.start, self.rate = trajectory, start, rate
+        self.first = 0  # update index of the block's first row
+        self.rows: tuple = ()
+
+    def at(self, t: float) -> tuple:
+        """(reference, next target, its speed) at `t` [s]: rows of numpy arrays."""
+        k = round(t * self.rate)
+        if abs(t * self.rate - k) > 1e-6:  # off the update grid (not seen): sample it now
+            import numpy as np
+
+            now, _ = sample(self.trajectory, self.start, t)
+            nxt, speed = sample(self.trajectory, self.start, t + 1.0 / UPDATE_RATE)
+            return np.asarray(now), np.asarray(nxt), np.asarray(speed)
+        if not self.rows or not self.first <= k < self.first + BLOCK:
+            self._fill(k)
+        reference, targets, speeds = self.rows
+        row = k - self.first
+        return reference[row], targets[row], speeds[row]
+
+    def _fill(self, k: int) -> None:
+        import numpy as np
+
+        times = (k + np.arange(BLOCK)) / self.rate
+        reference, _ = sample_block(self.trajectory, self.start, times)
+        targets, speeds = sample_block(self.trajectory, self.start, times + 1.0 / UPDATE_RATE)
+        self.first, self.rows = k, (reference, targets, speeds)
