@@ -185,3 +185,31 @@ def test_malformed_trajectory_is_refused_and_leaves_the_world_unchanged(rig, tex
     with pytest.raises((InvalidRequestError, PartNotFoundError), match=re.escape(words)):
         follow_trajectory(rig, "rig", read_trajectory(text, name))
     assert rig._commands == {} and not rig._observers, "no command or controller was kept"
+
+
+@pytest.mark.parametrize("fields", ["positions", "velocities", "accelerations"])
+def test_block_sampling_equals_joint_trajectory_controllers_spline_at_each_time(fields):
+    """The follower samples its references 100 updates at a time (`sample_block`); each row
+    must be `sample` at that time, for linear, cubic and quintic segments, across waypoints,
+    before the first point (from the start state) and after the last (held, at rest)."""
+    import numpy as np
+
+    from twin_cli.control.trajectory import sample, sample_block, trajectory_from_dict
+
+    points = []
+    for k in range(1, 6):
+        point = {"positions": [0.1 * k, -0.2 * k], "time_from_start": 0.37 * k}
+        if fields != "positions":
+            point["velocities"] = [0.05 * k, -0.01 * k]
+        if fields == "accelerations":
+            point["accelerations"] = [0.02, 0.1]
+        points.append(point)
+    trajectory = trajectory_from_dict({"joint_names": ["a", "b"], "points": points})
+    start = (0.3, -0.1)
+    times = 0.013 + np.arange(250) / 100  # 0.013 s … 2.503 s: every segment, then held
+    positions, velocities = sample_block(trajectory, start, times)
+    for row, t in enumerate(times):
+        position, velocity = sample(trajectory, start, float(t))
+        np.testing.assert_allclose(positions[row], position, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(velocities[row], velocity, rtol=0, atol=1e-12)
+    assert tuple(positions[-1]) == (0.5, -1.0) and not velocities[-1].any(), "held at the end"
