@@ -194,7 +194,8 @@ def test_block_sampling_equals_joint_trajectory_controllers_spline_at_each_time(
     before the first point (from the start state) and after the last (held, at rest)."""
     import numpy as np
 
-    from twin_cli.control.trajectory import sample, sample_block, trajectory_from_dict
+    from twin_cli.control.follower import sample_block
+    from twin_cli.control.trajectory import sample, trajectory_from_dict
 
     points = []
     for k in range(1, 6):

@@ -17,7 +17,7 @@ import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from twin_cli.control.trajectory import Trajectory, sample, sample_block
+from twin_cli.control.trajectory import Trajectory, TrajectoryPoint, sample, segment
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 
 UPDATE_RATE = 100.0  # [Hz] controller_manager's usual update_rate
@@ -243,3 +243,30 @@ class _References:
         reference, _ = sample_block(self.trajectory, self.start, times)
         targets, speeds = sample_block(self.trajectory, self.start, times + 1.0 / UPDATE_RATE)
         self.first, self.rows = k, (reference, targets, speeds)
+
+
+def sample_block(trajectory: Trajectory, start: tuple[float, ...], times: object) -> tuple:
+    """`sample` at many increasing times [s] at once: (positions, velocities) as arrays of
+    len(times) × joints. The follower takes its references a block at a time, so each of its
+    updates only looks a row up."""
+    import bisect
+
+    import numpy as np
+
+    t = np.asarray(times, dtype=float)
+    points = trajectory.points
+    positions = np.tile(np.asarray(points[-1].positions, dtype=float), (len(t), 1))
+    velocities = np.zeros_like(positions)  # held after the end, at rest
+    first = bisect.bisect_right([p.time for p in points], float(t[0])) if len(t) else len(points)
+    for k in range(first, len(points)):
+        before = points[k - 1] if k else TrajectoryPoint(0.0, tuple(start))
+        after = points[k]
+        rows = (t >= before.time) & (t < after.time) if k else t < after.time
+        if rows.any():
+            s, span = t[rows] - before.time, after.time - before.time
+            for j in range(len(start)):
+                p, v = segment(before, after, j, s, span)
+                positions[rows, j], velocities[rows, j] = p, v
+        if after.time > t[-1]:
+            break
+    return positions, velocities

@@ -173,39 +173,13 @@ def sample(
     before = points[k - 1] if k else TrajectoryPoint(0.0, tuple(start))
     after = points[k]
     span = after.time - before.time
-    out = [_segment(before, after, j, t - before.time, span) for j in range(len(start))]
+    out = [segment(before, after, j, t - before.time, span) for j in range(len(start))]
     return tuple(p for p, _ in out), tuple(v for _, v in out)
 
 
-def sample_block(trajectory: Trajectory, start: tuple[float, ...], times: object) -> tuple:
-    """`sample` at many increasing times [s] at once: (positions, velocities) as arrays of
-    len(times) × joints. The follower takes its references a block at a time, so each of its
-    updates only looks a row up (numpy, imported here: the CLI reads trajectories without it)."""
-    import bisect
-
-    import numpy as np
-
-    t = np.asarray(times, dtype=float)
-    points = trajectory.points
-    positions = np.tile(np.asarray(points[-1].positions, dtype=float), (len(t), 1))
-    velocities = np.zeros_like(positions)  # held after the end, at rest
-    first = bisect.bisect_right([p.time for p in points], float(t[0])) if len(t) else len(points)
-    for k in range(first, len(points)):
-        before = points[k - 1] if k else TrajectoryPoint(0.0, tuple(start))
-        after = points[k]
-        rows = (t >= before.time) & (t < after.time) if k else t < after.time
-        if rows.any():
-            s, span = t[rows] - before.time, after.time - before.time
-            for j in range(len(start)):
-                p, v = _segment(before, after, j, s, span)
-                positions[rows, j], velocities[rows, j] = p, v
-        if after.time > t[-1]:
-            break
-    return positions, velocities
-
-
-def _segment(a: TrajectoryPoint, b: TrajectoryPoint, j: int, s: float, T: float) -> tuple:
-    """Position and velocity of joint j at s [s] into a segment of T [s] (JTC's spline rule)."""
+def segment(a: TrajectoryPoint, b: TrajectoryPoint, j: int, s: float, T: float) -> tuple:
+    """Position and velocity of joint j at s [s] into a segment of T [s] (JTC's spline rule);
+    s may be a numpy array of times (the follower samples blocks of them)."""
     p0, p1 = a.positions[j], b.positions[j]
     if b.velocities is None:
         return p0 + (p1 - p0) * s / T, (p1 - p0) / T
