@@ -8,7 +8,7 @@ import re
 import pytest
 from corpus_registry import CORPUS, package_paths
 from models import CONTROL_RIG as WHEEL_URDF
-from models import write_urdf
+from models import ball_on_plane, write_urdf
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import Pose, World, WorldSettings
@@ -214,3 +214,26 @@ def test_block_sampling_equals_joint_trajectory_controllers_spline_at_each_time(
         np.testing.assert_allclose(positions[row], position, rtol=0, atol=1e-12)
         np.testing.assert_allclose(velocities[row], velocity, rtol=0, atol=1e-12)
     assert tuple(positions[-1]) == (0.5, -1.0) and not velocities[-1].any(), "held at the end"
+
+
+def test_the_follower_keeps_measuring_its_joints_after_an_earlier_entity_is_deleted(tmp_path):
+    """Deleting an entity that comes first in the model moves every later joint's address; the
+    follower looks them up again, so its tracking report stays that of its own joints."""
+    from converters import convert
+    from twin_cli.control import follow_trajectory, tracking_report, trajectory_from_dict
+
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
+    world.spawn(write_urdf(tmp_path, ball_on_plane(1.0), "ball.urdf"), name="ball", pose=Pose(z=3))
+    spec, _ = convert(write_urdf(tmp_path, WHEEL_URDF))
+    world.spawn(spec, name="rig", pose=Pose(z=1.0))
+    points = [{"positions": [0.2], "time_from_start": 1.0}]
+    follow_trajectory(
+        world, "rig", trajectory_from_dict({"joint_names": ["slide"], "points": points})
+    )
+    world.step(500)
+    world.delete("ball")  # the rig's qpos moves 7 places down
+    world.step(800)
+    report = tracking_report(world, "rig")
+    assert report is not None and not report["active"], "the follower finished at 1 s"
+    assert report["max_error"]["slide"] < 0.02, report
+    assert report["final_error"]["slide"] < 5e-3, report

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import math
 from pathlib import Path
 
 import numpy as np
@@ -248,3 +249,26 @@ def test_an_observer_that_removes_itself_or_adds_another_keeps_the_steps_and_the
     assert sum(steps) == 200 and Data.time == pytest.approx(0.2)
     assert first == pytest.approx([0.01, 0.02, 0.03], abs=1e-12)
     assert second == pytest.approx([0.03 + 0.025 * k for k in range(1, 7)], abs=1e-12)
+
+
+def test_two_observers_at_unrelated_rates_each_fire_on_their_own_grid():
+    """100 Hz and 30 Hz observers stepped in batches of 7: `Observers.run` splits each batch at
+    both grids (30 Hz: the first step at or after k/30 s)."""
+    from twin_cli.world.observers import Observers
+
+    class Data:
+        time = 0.0
+
+    def step(k: int) -> None:
+        Data.time = round(Data.time + k * 0.001, 12)
+
+    fast: list[float] = []
+    slow: list[float] = []
+    observers = Observers()
+    observers.add(lambda: fast.append(Data.time), 100.0, 0.0, 0.001)
+    observers.add(lambda: slow.append(Data.time), 30.0, 0.0, 0.001)
+    for _ in range(143):  # 1.001 s
+        observers.run(7, step, Data, 0.001)
+    assert fast == pytest.approx([0.01 * k for k in range(1, 101)], abs=1e-12)
+    expected = [math.ceil(round(k / 30 / 0.001, 9)) * 0.001 for k in range(1, 31)]
+    assert slow == pytest.approx(expected, abs=1e-12)

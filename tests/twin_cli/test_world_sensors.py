@@ -396,3 +396,39 @@ def test_imu_samples_stay_on_the_period_grid_over_a_long_run(tmp_path: Path) -> 
     start = len(times)
     collect(2_000)  # 1 s more at the new step
     np.testing.assert_allclose(np.diff(times[start - 1 :]), 0.005, atol=1e-9)
+
+
+def _imu_times(world: World, steps: int, after: float) -> list[float]:
+    """Times of the IMU samples MuJoCo keeps over `steps` steps (looks every 20 steps)."""
+    model = world.model
+    parts = [s for s in range(model.nsensor) if model.sensor_history[s][0] > 0]
+    history, times = SensorHistory(model, parts), [after]
+    for _ in range(steps // 20):
+        world.step(20)
+        times.extend(history.since(world.data, times[-1])[0])
+    return times[1:]
+
+
+def test_an_imu_spawned_after_t0_samples_at_its_rate_from_its_spawn(tmp_path: Path) -> None:
+    """MuJoCo starts a new sensor's tick at -period: spawned at t = 2 s it would be sampled at
+    every step until the tick caught up (0.4 s of 1 ms samples). The world brings the tick to
+    the clock, so the first sample is at the spawn and the next ones 5 ms apart."""
+    world = World()
+    world.step(2000)
+    box = imu_box(rate=200.0).replace("</robot>", STATIC)
+    world.spawn(write_urdf(tmp_path, box, "imu.urdf"), name="imu", pose=Pose(z=0.1))
+    times = _imu_times(world, 200, after=1.999)
+    np.testing.assert_allclose(times, 2.0 + 0.005 * np.arange(40), atol=1e-9)
+
+
+def test_a_period_between_steps_samples_at_the_first_step_after_each_grid_point(
+    tmp_path: Path,
+) -> None:
+    """400 Hz at 1 ms steps: grid points 2.5 ms apart fall on and between steps; each sample is
+    at the first step at or after its grid point (as observers are), never before it."""
+    text = imu_box(rate=400.0).replace("</robot>", STATIC)
+    world = _world_with(tmp_path, text, "imu", Pose(z=0.1))
+    times = np.asarray(_imu_times(world, 1000, after=-0.001))
+    expected = np.ceil(np.round(0.0025 * np.arange(len(times)) / 0.001, 9)) * 0.001
+    assert len(times) == 400
+    np.testing.assert_allclose(times, expected, atol=1e-9)

@@ -66,13 +66,17 @@ class TrajectoryFollower:
             )
             self.keys = [c.actuator for c in commands]
             self._keyset = frozenset(self.keys)  # all still commanded: the follower's own
-            self.qpos = [world.model.joint(f"{entity}/{j}").qposadr[0] for j in self.start_names]
+            self._qpos_model, self.qpos = world.model, self._addresses(world.model)
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
             self.rate = rate
             self._block = _References(trajectory, self.start, rate)
             self._max: Any = None  # numpy: the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)
+
+    def _addresses(self, model: Any) -> list[int]:
+        """The followed joints' qpos addresses in `model`."""
+        return [int(model.joint(f"{self.entity}/{j}").qposadr[0]) for j in self.start_names]
 
     @property
     def start_names(self) -> tuple[str, ...]:
@@ -81,7 +85,7 @@ class TrajectoryFollower:
     def _update(self) -> None:
         """One controller update (the world's lock is held): measure, then command.
 
-        Runs every 10 ms of sim time inside the stepping: the references come from a block
+        Runs at `rate` in sim time inside the stepping: the references come from a block
         sampled ahead (`_References`), and the errors are one numpy expression per update.
         """
         import numpy as np
@@ -92,8 +96,11 @@ class TrajectoryFollower:
             self.stop()  # the world was reset or the commands were replaced
             return
         reference, nxt, speed = self._block.at(t)
+        if world.model is not self._qpos_model:  # a spawn or delete moved the joints' addresses
+            self._qpos_model, self.qpos = world.model, self._addresses(world.model)
         errors = np.abs(world.data.qpos[self.qpos] - reference)
-        self._max = errors if self._max is None else np.maximum(self._max, errors)
+        # fmax: a diverged step's NaN (the world resets that entity) does not stick in the report
+        self._max = errors if self._max is None else np.fmax(self._max, errors)
         names = self.start_names
         self.report.max_error = dict(zip(names, self._max.tolist(), strict=True))
         done = t >= self.trajectory.duration - 1e-9
@@ -214,7 +221,8 @@ def tracking_report(world: Any, entity: str) -> dict | None:
 
 class _References:
     """The follower's references, sampled BLOCK updates at a time: at each update time k/rate
-    [s] after the start, and at one controller period later (the target it writes)."""
+    [s] after the start, and 1/UPDATE_RATE later (the target it writes, as before: the servo
+    tracks it until the next update)."""
 
     def __init__(self, trajectory: Trajectory, start: tuple[float, ...], rate: float) -> None:
         self.trajectory, self.start, self.rate = trajectory, start, rate
