@@ -4,10 +4,8 @@ The converter gives an IMU's MuJoCo sensors its update period as `interval` and 
 `converters.description.sensors.HISTORY_SAMPLES` samples, so MuJoCo computes them only when due
 and remembers the last ones with their times, in C. A recorder then reads every sample of a
 200 Hz IMU in one look every few dozen periods, instead of stopping the stepping at each period
-(each stop costs the loop about as much as a physics step). Layout of one sensor's ring in
-`MjData.history` (MuJoCo 4.0, found by reading it back): [last update time, cursor, times[n],
-values[n×dim]], the newest sample at `cursor`; entries not yet written carry times at or
-before the start.
+(each stop costs the loop about as much as a physics step). The ring's layout is the world's
+business (`twin_cli.world.sensor_rings`, which also keeps the rings in step with the clock).
 """
 
 from __future__ import annotations
@@ -17,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from converters.description.sensors import HISTORY_SAMPLES
+from twin_cli.world.sensor_rings import CURSOR, ring_parts
 
 __all__ = ["HISTORY_SAMPLES", "SensorHistory"]
 
@@ -43,14 +42,14 @@ class SensorHistory:
         steps and their rings stay in step: one cursor orders them all."""
         ring, n = data.history, self.n
         first = self.parts[0][0]
-        times = ring[first + 2 : first + 2 + n]
+        times, _ = ring_parts(ring, first, n, self.parts[0][1])
         new = np.flatnonzero((times > time + 1e-12) & (times <= data.time + 1e-12))
-        cursor = int(ring[first + 1])
+        cursor = int(ring[first + CURSOR])
         slots = new[np.argsort((new - cursor - 1) % n)]  # oldest first
         rows = np.empty((slots.size, self.width))
         column = 0
         for address, dim in self.parts:
-            values = ring[address + 2 + n : address + 2 + n + n * dim].reshape(n, dim)
+            _, values = ring_parts(ring, address, n, dim)
             rows[:, column : column + dim] = values[slots]
             column += dim
         return times[slots], rows
@@ -61,9 +60,9 @@ class SensorHistory:
         ring, out, column = data.history, np.empty(self.width), 0
         time = 0.0
         for address, dim in self.parts:
-            n, cursor = self.n, int(ring[address + 1])
-            time = float(ring[address + 2 + cursor])
-            start = address + 2 + n + cursor * dim
-            out[column : column + dim] = ring[start : start + dim]
+            cursor = int(ring[address + CURSOR])
+            times, values = ring_parts(ring, address, self.n, dim)
+            time = float(times[cursor])
+            out[column : column + dim] = values[cursor]
             column += dim
         return time, out

@@ -46,8 +46,9 @@ from twin_cli.world.physics import PhysicsSettings
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.respec import SpecRenewal
-from twin_cli.world.running import STATE, RunControl, align_sensor_ticks
+from twin_cli.world.running import STATE, RunControl
 from twin_cli.world.scene import build_world_spec, replace_lights
+from twin_cli.world.sensor_rings import align_sensor_ticks
 from twin_cli.world.values import (
     EntityInfo,
     SpawnResult,

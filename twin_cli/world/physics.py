@@ -13,8 +13,8 @@ from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world import actuation as control
 from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.entities import element_names
-from twin_cli.world.running import align_sensor_ticks
 from twin_cli.world.scene import ODE_ONLY_FIELDS
+from twin_cli.world.sensor_rings import align_sensor_ticks
 from twin_cli.world.sleeping import wake_trees
 from twin_cli.world.values import check_settings, finite_vector
 

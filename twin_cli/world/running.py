@@ -7,7 +7,6 @@ start with "_" expect the caller to hold the lock (the loop thread and `step`).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -23,10 +22,10 @@ from twin_cli.world.divergence import (
     warning_counts,
 )
 from twin_cli.world.entities import index_entities, write_state
+from twin_cli.world.sensor_rings import align_sensor_ticks, shift_sensor_history
 from twin_cli.world.values import Stats
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-TICK_LEAD = 1e-3  # of a step: an interval sensor's tick lead when its period is not whole steps
 
 
 class RunControl:
@@ -67,7 +66,7 @@ class RunControl:
                 self._pushes = [
                     replace(p, end_step=p.end_step - self._iterations) for p in self._pushes
                 ]
-                _shift_sensor_history(self.model, self.data, -float(self.data.time))
+                shift_sensor_history(self.model, self.data, -float(self.data.time))
                 self.data.time, self._iterations = 0.0, 0
                 align_sensor_ticks(self.model, self.data)  # the grid of the new clock
                 self._loop.reset_clock()
@@ -212,46 +211,3 @@ class RunControl:
         ended = {p.body for p in self._pushes if p.end_step <= self._iterations}
         self._pushes = [p for p in self._pushes if p.end_step > self._iterations]
         control.apply_pushes(self.model, self.data, self._pushes, ended, self._perturbation)
-
-
-def _shift_sensor_history(model: mujoco.MjModel, data: mujoco.MjData, shift: float) -> None:
-    """Moves the samples MuJoCo keeps for sensors with a history (an IMU's) by `shift` [s] with
-    the clock, so that a time-only reset does not leave their last update in the future: MuJoCo
-    would compute them again only once sim time passed it. Each ring is [last update, cursor,
-    times[n], values], see `twin_cli.sensors.history`."""
-    ring = data.history
-    for sensor in range(model.nsensor):
-        n = int(model.sensor_history[sensor][0])
-        if n > 0:
-            address = int(model.sensor_historyadr[sensor])
-            ring[address] += shift
-            ring[address + 2 : address + 2 + n] += shift
-
-
-def align_sensor_ticks(model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """Puts each interval sensor's last tick (ring slot 0) just before its grid point.
-
-    MuJoCo computes such a sensor at the first step where last tick + period <= time, then adds
-    the period to the tick. Sim time and the tick are sums of different floats (0.001 s and
-    0.005 s), so a tick exactly on a step time lost that comparison to rounding now and then:
-    the sample came one step late (2.001 s), and stayed late. A lead of half a step (when the
-    period is a whole number of steps; else TICK_LEAD of a step, so a grid point between steps
-    still goes to the first step after it) makes the comparison robust and keeps the k·period
-    grid. A tick more than a period behind the clock (a sensor spawned after t = 0, whose tick
-    MuJoCo starts at -period, or a clock moved by a reset) is brought to the clock: MuJoCo
-    would otherwise sample it at every step until the tick caught up. Idempotent: every new
-    model, timestep change and time-only reset calls it.
-    """
-    ring, step, now = data.history, float(model.opt.timestep), float(data.time)
-    for sensor in range(model.nsensor):
-        period, phase = (float(v) for v in model.sensor_interval[sensor])
-        if int(model.sensor_history[sensor][0]) <= 0 or period <= 0.0:
-            continue
-        steps = period / step
-        whole = abs(steps - round(steps)) < 1e-9 * max(1.0, steps)
-        lead = min(0.5 * step, 0.25 * period) if whole else TICK_LEAD * min(step, period)
-        address = int(model.sensor_historyadr[sensor])
-        ticks = round((float(ring[address]) - phase) / period)
-        if phase + (ticks + 2) * period <= now:  # behind: the next sample is the next grid point
-            ticks = math.ceil((now - phase) / period - 1e-9) - 1
-        ring[address] = phase + ticks * period - lead
