@@ -144,6 +144,18 @@ def test_bad_requests_name_the_subject_and_the_fix(tmp_path):
         Recording(world, [], rate=0.0)
 
 
+class FakeClock:
+    """The sim clock `Observers.run` reads (`time`) and a `step(k)` that advances it by k ms."""
+
+    def __init__(self) -> None:
+        self.time = 0.0
+        self.steps: list[int] = []
+
+    def step(self, k: int) -> None:
+        self.steps.append(k)
+        self.time = round(self.time + k * 0.001, 12)
+
+
 def test_observers_fire_on_the_rate_grid_across_batch_sizes():
     """The stepping splits batches where an observer is due: any batch size, same sample times."""
     from twin_cli.world.observers import Observers, next_due, steps_until_due
@@ -151,18 +163,12 @@ def test_observers_fire_on_the_rate_grid_across_batch_sizes():
     assert steps_until_due(0.0, 0.01, 0.001) == 10
     assert next_due(0.0100000000001, 0.0, 0.01, 0.001) == pytest.approx(0.02)
     for batch in (1, 7, 10, 333):
-
-        class Data:
-            time = 0.0
-
-        def step(k: int, data=Data) -> None:
-            data.time = round(data.time + k * 0.001, 12)
-
+        clock = FakeClock()
         seen: list[float] = []
         observers = Observers()
-        observers.add(lambda data=Data, seen=seen: seen.append(data.time), 100.0, 0.0, 0.001)
+        observers.add(lambda clock=clock, seen=seen: seen.append(clock.time), 100.0, 0.0, 0.001)
         for _ in range(1000 // batch):
-            observers.run(batch, step, Data, 0.001)
+            observers.run(batch, clock.step, clock, 0.001)
         expected = [round(0.01 * k, 12) for k in range(1, len(seen) + 1)]
         assert seen == pytest.approx(expected, abs=1e-12), f"batch {batch}"
         assert len(seen) == (1000 // batch) * batch // 10
@@ -200,21 +206,17 @@ def test_observers_added_at_different_times_all_restart_when_the_clock_goes_back
     sensor observers): after a reset of the clock to 0.2 s both fire again from there on."""
     from twin_cli.world.observers import Observers
 
-    class Data:
-        time = 0.0
-
-    def step(k: int) -> None:
-        Data.time = round(Data.time + k * 0.001, 12)
-
+    clock = FakeClock()
+    step = clock.step
     early: list[float] = []
     late: list[float] = []
     observers = Observers()
-    observers.add(lambda: early.append(Data.time), 100.0, 0.0, 0.001)
-    observers.run(500, step, Data, 0.001)
-    observers.add(lambda: late.append(Data.time), 100.0, Data.time, 0.001)
-    Data.time = 0.2  # the clock goes back (reset), before the late observer's origin
+    observers.add(lambda: early.append(clock.time), 100.0, 0.0, 0.001)
+    observers.run(500, step, clock, 0.001)
+    observers.add(lambda: late.append(clock.time), 100.0, clock.time, 0.001)
+    clock.time = 0.2  # the clock goes back (reset), before the late observer's origin
     early.clear()
-    observers.run(50, step, Data, 0.001)
+    observers.run(50, step, clock, 0.001)
     expected = [round(0.2 + 0.01 * k, 12) for k in range(1, 6)]
     assert early == pytest.approx(expected, abs=1e-12)
     assert late == pytest.approx(expected, abs=1e-12), "the later observer re-anchored too"
@@ -225,28 +227,22 @@ def test_an_observer_that_removes_itself_or_adds_another_keeps_the_steps_and_the
     observers): the batch still takes all its steps and later observers keep their own grid."""
     from twin_cli.world.observers import Observers
 
-    class Data:
-        time = 0.0
-
-    steps: list[int] = []
-
-    def step(k: int) -> None:
-        steps.append(k)
-        Data.time = round(Data.time + k * 0.001, 12)
+    clock = FakeClock()
+    step, steps = clock.step, clock.steps
 
     observers = Observers()
     first: list[float] = []
     second: list[float] = []
 
     def once_then_more() -> None:
-        first.append(Data.time)
+        first.append(clock.time)
         if len(first) == 3:
             observers.remove(handle)
-            observers.add(lambda: second.append(Data.time), 40.0, Data.time, 0.001)
+            observers.add(lambda: second.append(clock.time), 40.0, clock.time, 0.001)
 
     handle = observers.add(once_then_more, 100.0, 0.0, 0.001)
-    observers.run(200, step, Data, 0.001)
-    assert sum(steps) == 200 and Data.time == pytest.approx(0.2)
+    observers.run(200, step, clock, 0.001)
+    assert sum(steps) == 200 and clock.time == pytest.approx(0.2)
     assert first == pytest.approx([0.01, 0.02, 0.03], abs=1e-12)
     assert second == pytest.approx([0.03 + 0.025 * k for k in range(1, 7)], abs=1e-12)
 
@@ -256,19 +252,15 @@ def test_two_observers_at_unrelated_rates_each_fire_on_their_own_grid():
     both grids (30 Hz: the first step at or after k/30 s)."""
     from twin_cli.world.observers import Observers
 
-    class Data:
-        time = 0.0
-
-    def step(k: int) -> None:
-        Data.time = round(Data.time + k * 0.001, 12)
-
+    clock = FakeClock()
+    step = clock.step
     fast: list[float] = []
     slow: list[float] = []
     observers = Observers()
-    observers.add(lambda: fast.append(Data.time), 100.0, 0.0, 0.001)
-    observers.add(lambda: slow.append(Data.time), 30.0, 0.0, 0.001)
+    observers.add(lambda: fast.append(clock.time), 100.0, 0.0, 0.001)
+    observers.add(lambda: slow.append(clock.time), 30.0, 0.0, 0.001)
     for _ in range(143):  # 1.001 s
-        observers.run(7, step, Data, 0.001)
+        observers.run(7, step, clock, 0.001)
     assert fast == pytest.approx([0.01 * k for k in range(1, 101)], abs=1e-12)
     expected = [math.ceil(round(k / 30 / 0.001, 9)) * 0.001 for k in range(1, 31)]
     assert slow == pytest.approx(expected, abs=1e-12)
