@@ -51,7 +51,20 @@ POST = f"""<robot name="campost">
 </robot>"""
 
 
-CHILD = """
+# The child's world: the camera post (URDF path `post`) and a red box at BOX (JSON `box`).
+SCENE = """
+x, y, z, h = json.loads(box)
+world = World(WorldSettings(ground=False))
+world.spawn(post, name="post")
+box = mujoco.MjSpec(); box.modelname = "box"
+box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y, z],
+                       rgba=[1, 0, 0, 1])
+world.spawn(box, name="box")
+"""
+
+
+CHILD = (
+    """
 import json, sys
 import mujoco, numpy as np
 from twin_cli.sensors import SensorSuite
@@ -60,13 +73,10 @@ try:
     mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8).close()
 except Exception as exc:
     print(json.dumps({"no_gl": str(exc).splitlines()[0]})); sys.exit(0)
-x, y, z, h = json.loads(sys.argv[2])
-world = World(WorldSettings(ground=False))
-world.spawn(sys.argv[1], name="post")
-box = mujoco.MjSpec(); box.modelname = "box"
-box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y, z],
-                       rgba=[1, 0, 0, 1])
-world.spawn(box, name="box")
+post, box = sys.argv[1], sys.argv[2]
+"""
+    + SCENE
+    + """
 readings = SensorSuite(world, "post").read()
 rgb = np.frombuffer(readings["cam"].data, np.uint8).reshape(HEIGHT, WIDTH, 3)
 depth = np.frombuffer(readings["depth"].data, np.float32).reshape(HEIGHT, WIDTH)
@@ -78,6 +88,7 @@ print(json.dumps({"rgb": rgb.tolist(), "depth": depth.tolist(),
                   "encodings": [readings["cam"].encoding, readings["depth"].encoding],
                   "clipped": {name: image(r) for name, r in readings.items()}}))
 """.replace("HEIGHT", str(H)).replace("WIDTH", str(W))
+)
 
 
 @pytest.fixture(scope="module")

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from models import write_urdf
-from test_camera_sensor import BOX, CAM_Z, HFOV, H, W, _projection, _red
+from test_camera_sensor import BOX, CAM_Z, HFOV, SCENE, H, W, _projection, _red
 from view_helpers import egl_missing
 
 SECONDS = 0.3  # [s] of sim time recorded at a 1 ms step
@@ -38,24 +38,23 @@ POST = f"""<robot name="campost">
   <gazebo reference="base">{SENSORS}</gazebo>
 </robot>"""
 
-CHILD = """
+CHILD = (
+    """
 import json, logging, sys
 import mujoco
 from twin_cli.record import BagRecording
 from twin_cli.world import World, WorldSettings
 logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
-x, y, z, h = json.loads(sys.argv[3])
-world = World(WorldSettings(ground=False))
-world.spawn(sys.argv[1], name="post")
-box = mujoco.MjSpec(); box.modelname = "box"
-box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y, z],
-                       rgba=[1, 0, 0, 1])
-world.spawn(box, name="box")
+post, box = sys.argv[1], sys.argv[3]
+"""
+    + SCENE
+    + """
 recording = BagRecording(world, sys.argv[2], rate=100.0).start()
 world.step(int(round(float(sys.argv[4]) / world.model.opt.timestep)))
 status = recording.stop()
 print(json.dumps({"error": status.error, "dropped": [list(k) for k in recording._feed.dropped]}))
 """
+)
 
 
 def _record(tmp: Path, env: dict) -> tuple[Path, dict, str]:

@@ -69,7 +69,6 @@ class TrajectoryFollower:
             self._qpos_model, self.qpos = world.model, self._addresses(world.model)
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
-            self.rate = rate
             self._block = _References(trajectory, self.start, rate)
             self._max: Any = None  # numpy: the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)

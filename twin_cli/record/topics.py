@@ -64,24 +64,25 @@ def topics(layout: Layout) -> list[Topic]:
 def latched_messages(layout: Layout, time: float) -> list[Message]:
     """`/tf_static` (all entities in one message) and every `robot_description`."""
     T = ros.types()
-    model = layout.model
+    model, stamp = layout.model, ros.stamp(time)
     transforms = []
     for e in layout.entities:
         for b in e.fixed:
-            parent = int(model.body_parentid[b])
+            parent = layout.body_frames[int(model.body_parentid[b])]
             transforms.append(
                 _transform(
-                    time, layout.body_frames[parent], layout.body_frames[b], model.body_pos[b],
-                    model.body_quat[b],
+                    stamp, parent, layout.body_frames[b], model.body_pos[b].tolist(),
+                    model.body_quat[b].tolist(),
                 )
             )  # fmt: skip
         for s in e.sites:
             parent = layout.body_frames[int(model.site_bodyid[s])]
             transforms.append(
                 _transform(
-                    time, parent, layout.site_frames[s], model.site_pos[s], model.site_quat[s]
+                    stamp, parent, layout.site_frames[s], model.site_pos[s].tolist(),
+                    model.site_quat[s].tolist(),
                 )
-            )
+            )  # fmt: skip
     out = [Message(TF_STATIC.name, ros.TF, time, T[ros.TF](transforms=transforms))]
     for e in layout.entities:
         if e.description:
@@ -125,24 +126,11 @@ def relative_poses(
 def _moving_transforms(
     layout: Layout, e: EntityLayout, stamp: Any, xpos: np.ndarray, xquat: np.ndarray
 ) -> list[Any]:
-    T = ros.types()
-    header, stamped = T["std_msgs/msg/Header"], T["geometry_msgs/msg/TransformStamped"]
-    transform, vector, quaternion = (
-        T["geometry_msgs/msg/Transform"],
-        T["geometry_msgs/msg/Vector3"],
-        T["geometry_msgs/msg/Quaternion"],
-    )
     pos, quat = relative_poses(xpos, xquat, e.moving, e.moving_parents)
     frames = layout.body_frames
     return [
-        stamped(
-            header=header(stamp=stamp, frame_id=frames[p]),
-            child_frame_id=frames[b],
-            transform=transform(
-                translation=vector(x=x, y=y, z=z), rotation=quaternion(x=qx, y=qy, z=qz, w=qw)
-            ),
-        )
-        for b, p, (x, y, z), (qw, qx, qy, qz) in zip(
+        _transform(stamp, frames[p], frames[b], xyz, wxyz)
+        for b, p, xyz, wxyz in zip(
             e.moving.tolist(), e.moving_parents.tolist(), pos.tolist(), quat.tolist(), strict=True
         )
     ]
@@ -190,17 +178,19 @@ def _odometry(sample: Sample, e: EntityLayout, stamp: Any) -> Message:
     return Message(f"/{e.name}/odom", ros.ODOMETRY, sample.time, message)
 
 
-def _header(t: float, frame: str) -> Any:
-    return ros.types()["std_msgs/msg/Header"](stamp=ros.stamp(t), frame_id=frame)
-
-
-def _transform(t: float, parent: str, child: str, pos: np.ndarray, quat: np.ndarray) -> Any:
+def _transform(stamp: Any, parent: str, child: str, pos: list, quat: list) -> Any:
+    """A TransformStamped from Python floats: position x, y, z and MuJoCo's w, x, y, z
+    quaternion (one per moving link and sample: plain floats, no numpy indexing)."""
     T = ros.types()
+    (x, y, z), (qw, qx, qy, qz) = pos, quat
     transform = T["geometry_msgs/msg/Transform"](
-        translation=_vector(pos), rotation=_quaternion(quat)
+        translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
+        rotation=T["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw),
     )
     return T["geometry_msgs/msg/TransformStamped"](
-        header=_header(t, parent), child_frame_id=child, transform=transform
+        header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=parent),
+        child_frame_id=child,
+        transform=transform,
     )
 
 
