@@ -164,9 +164,7 @@ def add_drive_motors(spec: Any, drives: tuple[DiffDrive, ...], report: Report) -
 
 def _velocity_only(spec: Any, joint: str, drive: DiffDrive) -> None:
     """The plugin drives its wheels by velocity only (its joints' only command interface)."""
-    import json
-
-    from converters.mjcf.control_data import TEXT_PREFIX
+    from converters.mjcf.control_data import set_control_record
 
     record = {
         "modes": ["velocity"],
@@ -177,7 +175,7 @@ def _velocity_only(spec: Any, joint: str, drive: DiffDrive) -> None:
         "velocity_limit": None,
         "plugin": None,
     }
-    spec.add_text(name=TEXT_PREFIX + joint, data=json.dumps(record))
+    set_control_record(spec, joint, record)
 
 
 def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:

@@ -1,10 +1,13 @@
-"""Each motor's command modes and limits → a custom text `control:<joint>` the world reads.
+"""Each motor's command modes and limits → one custom text `control` the world reads.
 
 A MuJoCo motor knows its effort limit (ctrlrange = forcerange = ±effort) but not the joint's
 velocity limit, the modes its `<ros2_control>`/`<transmission>` tags allow, their `min`/`max`
 bounds or their PID gains. The world needs them at command time to write the actuator's gain,
-bias and force range (twin_cli.world.actuation), so they travel in the model as one JSON text per
-motor; attaching an entity prefixes the name (`<entity>/control:<joint>`) like any element.
+bias and force range (twin_cli.world.actuation), so they travel in the model as one JSON text
+mapping each motor's joint to its record; attaching an entity prefixes the name
+(`<entity>/control`) like any element. One text per model, not one per motor: deleting an
+element from a world spec costs MuJoCo a pass over the whole world (~23 ms with 50 humanoids),
+so a delete's cost would otherwise grow with the robot's motor count.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import json
 from converters.description import CONTROL_PLUGINS, MODES, Joint, JointControl, RobotDescription
 from converters.report import Report
 
-TEXT_PREFIX = "control:"
+CONTROL_TEXT = "control"
 
 
 def control_record(joint: Joint, control: JointControl | None, enabled: str | None) -> dict:
@@ -42,7 +45,7 @@ def control_record(joint: Joint, control: JointControl | None, enabled: str | No
 def add_control_data(
     spec: object, joints: list[Joint], motors: set[str], robot: RobotDescription, report: Report
 ) -> None:
-    """One `control:<joint>` text per motor, and a report line saying which rule applies."""
+    """Each motor's record in the `control` text, and a report line saying which rule applies."""
     controls = {c.joint: c for c in robot.controls}
     plugins = [p.kind for p in robot.gazebo.plugins if p.kind in CONTROL_PLUGINS]
     enabled = plugins[0] if plugins else None
@@ -50,8 +53,18 @@ def add_control_data(
         if joint.name not in motors:
             continue
         record = control_record(joint, controls.get(joint.name), enabled)
-        spec.add_text(name=TEXT_PREFIX + joint.name, data=json.dumps(record))
+        set_control_record(spec, joint.name, record)
         report.mapped(f"joint '{joint.name}' command modes", _rule_text(record))
+
+
+def set_control_record(spec: object, joint: str, record: dict) -> None:
+    """Writes `joint`'s record into the spec's `control` text (created on first use)."""
+    text = spec.text(CONTROL_TEXT)
+    if text is None:
+        text = spec.add_text(name=CONTROL_TEXT, data="{}")
+    records = json.loads(text.data)
+    records[joint] = record
+    text.data = json.dumps(records)
 
 
 def _rule_text(record: dict) -> str:

@@ -23,14 +23,9 @@ LINKS = """<link name="base"><inertial><mass value="1"/>
 def _records(tmp_path, tags: str) -> dict[str, dict]:
     spec, _ = convert(write_urdf(tmp_path, f'<robot name="r">{LINKS}{tags}</robot>'))
     model = spec.compile()
-    out = {}
-    for t in range(model.ntext):
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_TEXT, t)
-        start = model.text_adr[t]
-        out[name.removeprefix("control:")] = json.loads(
-            bytes(model.text_data[start : start + model.text_size[t] - 1]).decode()
-        )
-    return out
+    assert model.ntext == 1  # one text for all motors: a delete costs one element, not one each
+    assert mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_TEXT, 0) == "control"
+    return json.loads(bytes(model.text_data[: model.text_size[0] - 1]).decode())
 
 
 def _transmission(joint: str, interface: str, on_actuator: bool = False) -> str:

@@ -237,3 +237,27 @@ def test_the_follower_keeps_measuring_its_joints_after_an_earlier_entity_is_dele
     assert report is not None and not report["active"], "the follower finished at 1 s"
     assert report["max_error"]["slide"] < 0.02, report
     assert report["final_error"]["slide"] < 5e-3, report
+
+
+def test_motor_records_read_the_same_from_one_text_or_former_per_motor_texts(tmp_path):
+    # MJCF converted before the records were merged held one `control:<joint>` text per motor.
+    import json
+
+    from converters import convert
+    from twin_cli.world.joint_control import limits_of
+
+    spec, _ = convert(write_urdf(tmp_path, WHEEL_URDF))
+    former = spec.copy()
+    merged = former.text("control")
+    for joint, record in json.loads(merged.data).items():
+        former.add_text(name=f"control:{joint}", data=json.dumps(record))
+    former.delete(merged)
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
+    world.spawn(spec, name="now", pose=Pose(z=1.0))
+    world.spawn(former, name="before", pose=Pose(x=2.0, z=1.0))
+    for joint in ("spin", "slide"):
+        now, before = limits_of(world.model, "now", joint), limits_of(world.model, "before", joint)
+        assert now == before, joint
+        assert now.source != "model", f"{joint}: no record found"
+    assert limits_of(world.model, "now", "slide").modes == ("position",)
+    assert limits_of(world.model, "now", "spin").velocity == 3.0

@@ -1,8 +1,8 @@
 """What a motor may be commanded to: its modes, bounds, PID gains and velocity limit, and the rule
 that turns a command into servo gains.
 
-The converter writes one `control:<joint>` text per motor (converters.mjcf.control_data); a
-model without one (hand-written MJCF) offers every mode with no velocity limit. The gain rule
+The converter writes every motor's record into one `control` text (converters.mjcf.control_data);
+a motor without one (hand-written MJCF) offers every mode with no velocity limit. The gain rule
 (documented in docs/control.md):
 
 - position: kp from the tag's `pos_kp`, else from the joint's reflected inertia
@@ -50,13 +50,10 @@ class JointLimits:
 
 
 def limits_of(model: mujoco.MjModel, entity: str, joint: str) -> JointLimits:
-    """The `<entity>/control:<joint>` record of `model`, or every mode unbounded."""
-    t = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, f"{entity}/control:{joint}")
-    if t < 0:
+    """`joint`'s record in the `<entity>/control` text of `model`, or every mode unbounded."""
+    record = _record(model, entity, joint)
+    if record is None:
         return JointLimits()
-    start = model.text_adr[t]
-    raw = bytes(model.text_data[start : start + model.text_size[t] - 1]).decode()
-    record = json.loads(raw)
     velocity = record.get("velocity_limit")
     return JointLimits(
         tuple(record["modes"]),
@@ -65,6 +62,28 @@ def limits_of(model: mujoco.MjModel, entity: str, joint: str) -> JointLimits:
         {m: tuple(g) for m, g in record.get("pid", {}).items()},
         float(velocity) if velocity is not None and velocity > 0 else math.inf,
     )
+
+
+def _record(model: mujoco.MjModel, entity: str, joint: str) -> dict | None:
+    """The joint's JSON record; MJCF converted before the records were merged (one
+    `control:<joint>` text per motor) is read too."""
+    records = _text_json(model, f"{entity}/control")
+    if records is not None:
+        return records.get(joint)
+    return _text_json(model, f"{entity}/control:{joint}")
+
+
+def _text_json(model: mujoco.MjModel, name: str) -> dict | None:
+    """Text `name` as a JSON object; None if absent or not twin's (a hand-written model's)."""
+    t = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, name)
+    if t < 0:
+        return None
+    start = model.text_adr[t]
+    try:
+        value = json.loads(bytes(model.text_data[start : start + model.text_size[t] - 1]))
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
 
 
 def posture_loads(
