@@ -17,6 +17,7 @@ from converters.resources.packages import PackageResolver
 _LOCK = threading.Lock()
 
 XACRO_SUFFIXES = (".xacro",)
+XACRO_MARKERS = ("xmlns:xacro", "<xacro:")  # in a file with another suffix: written in xacro
 
 
 @dataclass(frozen=True)
@@ -35,8 +36,21 @@ class XacroResult:
 
 
 def needs_xacro(path: Path) -> bool:
-    """True for `.xacro` files (incl. `.urdf.xacro`); plain `.urdf` files skip xacro."""
-    return path.suffix.lower() in XACRO_SUFFIXES
+    """True for `.xacro` files (incl. `.urdf.xacro`) and for any other file written in xacro.
+
+    ROS launch files run xacro on whatever file they are given, so packages ship xacro under
+    other names (gz_ros2_control_demos' `test_pendulum_effort.xacro.urdf`); such a file declares
+    xacro's namespace or uses its tags. A URDF that xacro already expanded may keep the
+    namespace declaration; expanding it again changes nothing. Text placeholders without xacro
+    (turtlebot3's `${namespace}`, which its launch file replaces) do not count.
+    """
+    if path.suffix.lower() in XACRO_SUFFIXES:
+        return True
+    try:
+        text = path.read_text(errors="replace")
+    except OSError:
+        return False
+    return any(marker in text for marker in XACRO_MARKERS)
 
 
 @contextlib.contextmanager

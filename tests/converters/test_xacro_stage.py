@@ -61,3 +61,13 @@ def test_xacro_failure_carries_file_and_message(robot: Path) -> None:
     with pytest.raises(XacroError, match="undeclared") as caught:
         expand_xacro(robot, {}, PackageResolver.create(robot, env={}))
     assert str(robot) in str(caught.value)
+
+
+def test_a_xacro_file_with_a_urdf_suffix_is_expanded(robot: Path, tmp_path: Path) -> None:
+    # ROS launch files run xacro on any file: gz_ros2_control_demos ships `*.xacro.urdf`.
+    renamed = tmp_path / "r.xacro.urdf"
+    renamed.write_text(XACRO.replace('<part n="forgotten"/>', ""))
+    result = convert_full(
+        renamed, args={"size": "3"}, package_paths={"helper": robot.parent / "helper"}
+    )
+    assert sorted(link.name for link in result.description.links) == ["base_3", "from_include"]
