@@ -52,15 +52,43 @@ def ball_on_plane(mass: float, kp: float | None = None, kd: float | None = None)
 
 
 def block(
-    mu: float | None = None, size: float = 0.1, mass: float = 1.0, name: str = "block"
+    mu: float | None = None,
+    size: float = 0.1,
+    mass: float = 1.0,
+    name: str = "block",
+    height: float | None = None,
 ) -> str:
-    """A free cube of edge `size` [m] and `mass` [kg]; `mu` sets Gazebo mu1 and mu2 on it."""
+    """A free cube of edge `size` [m] (a plate when `height` [m] is given) and `mass` [kg]; `mu`
+    sets Gazebo mu1 and mu2 on it."""
+    h = size if height is None else height
     return f"""<robot name="{name}">
   <link name="{name}">
-    {_box_inertial(mass, size, size, size)}
-    <collision><geometry><box size="{size} {size} {size}"/></geometry></collision>
+    {_box_inertial(mass, size, size, h)}
+    <collision><geometry><box size="{size} {size} {h}"/></geometry></collision>
   </link>
   {_gazebo(name, mu1=mu, mu2=mu)}
+</robot>"""
+
+
+def wheeled_cart(mu: float, mass: float = 40.0) -> str:
+    """A 0.8×0.5×0.2 m chassis of `mass` [kg] on four 0.5 kg wheels of radius 0.1 m (axles at the
+    chassis' underside, so it clears the ground by 0.1 m); `mu` sets mu1 and mu2 on the wheels."""
+    wheels, joints, tags = [], [], []
+    for name, x, y in (("lf", 0.3, 0.3), ("rf", 0.3, -0.3), ("lb", -0.3, 0.3), ("rb", -0.3, -0.3)):
+        wheels.append(
+            f'<link name="{name}">{_box_inertial(0.5, 0.1, 0.1, 0.1)}<collision>'
+            '<origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.1" length="0.05"/>'
+            "</geometry></collision></link>"
+        )
+        joints.append(
+            f'<joint name="{name}_axle" type="continuous"><parent link="chassis"/>'
+            f'<child link="{name}"/><origin xyz="{x} {y} -0.1"/><axis xyz="0 1 0"/></joint>'
+        )
+        tags.append(_gazebo(name, mu1=mu, mu2=mu))
+    return f"""<robot name="cart">
+  <link name="chassis">{_box_inertial(mass, 0.8, 0.5, 0.2)}
+    <collision><geometry><box size="0.8 0.5 0.2"/></geometry></collision></link>
+  {"".join(wheels)}{"".join(joints)}{"".join(tags)}
 </robot>"""
 
 

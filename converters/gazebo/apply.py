@@ -12,7 +12,9 @@ from typing import Any
 
 from converters.description.gazebo import GazeboExtensions, LinkExtension, Surface
 from converters.gazebo.contact import (
+    CONTACT_MU_MAX,
     DEFAULT_MU,
+    contact_mu,
     contact_softness,
     friction_priority,
 )
@@ -97,7 +99,7 @@ def _apply_surface(
     geom = spec.geom(origin.geom)
     if geom is None:
         return
-    mu = DEFAULT_MU if surface.mu1 is None else surface.mu1
+    mu = contact_mu(DEFAULT_MU if surface.mu1 is None else surface.mu1)
     friction = list(geom.friction)
     friction[0] = mu
     if surface.torsional is not None:
@@ -160,7 +162,15 @@ def _report_surfaces(ext: GazeboExtensions, provenance: Provenance, report: Repo
 
 def _report_surface(subject: str, surface: Surface, report: Report) -> None:
     """One report line per surface value: mapped, approximated or ignored, with the reason."""
-    if surface.mu1 is not None:
+    if surface.mu1 is not None and contact_mu(surface.mu1) < surface.mu1:
+        report.approximated(
+            subject,
+            f"μ1={surface.mu1:g} → {CONTACT_MU_MAX:g}: in MuJoCo's pyramidal friction cone a "
+            f"larger μ lets the contact sink (wheels to their axles at μ 50); μ "
+            f"{CONTACT_MU_MAX:g} already holds on a 63° slope",
+            tag="mu1",
+        )
+    elif surface.mu1 is not None:
         report.mapped(subject, f"μ1={surface.mu1}: friction, min-μ priority", tag="mu1")
     if surface.mu2 is not None and surface.mu2 != (surface.mu1 or DEFAULT_MU):
         report.approximated(

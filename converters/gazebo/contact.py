@@ -35,6 +35,15 @@ DEFAULT_KD = 1.0
 GAZEBO_STEP = 0.001
 """SDF default `max_step_size` [s]; the step the kp/kd mapping is checked for."""
 
+CONTACT_MU_MAX = 2.0
+"""Largest μ a robot's or model's geom gets. MuJoCo's pyramidal friction cone (twin's worlds use
+it, as ODE uses a friction pyramid) builds a contact from the edges n ± μ·t, so with a large μ
+every edge is nearly tangential and the contact gives way along the normal. Measured on a cart
+of four wheels: rest sinkage 0.007 mm at μ 2, 0.24 mm at 5, 5.4 mm at 10 (40 kg chassis; 0.05,
+0.23, 0.68, 1.6 mm at μ 2-5 for 400 kg), and at μ 50-100 the wheels sink to their axles and the
+chassis rests on the ground. Gazebo robots write μ 100 or 1e5 to mean "no slip"; μ 2 already
+holds on a 63° slope. Gazebo's ground plane keeps its μ 100: the min-μ rule lets the capped
+robot geom decide the pair."""
 MU_MIN = 1e-6
 MU_MAX = 1e9
 PRIORITY_PER_DECADE = 1000
@@ -72,6 +81,11 @@ class ContactSoftness:
     damping_ratio: float
     sinkage_gazebo: float
     sinkage: float
+
+
+def contact_mu(mu: float) -> float:
+    """The μ a geom gets for a Gazebo μ: capped at CONTACT_MU_MAX (see there)."""
+    return min(mu, CONTACT_MU_MAX)
 
 
 def friction_priority(mu: float) -> int:

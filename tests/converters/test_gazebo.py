@@ -12,7 +12,12 @@ import pytest
 from converters.errors import GazeboTagError
 from converters.gazebo.apply import DAMPING_FACTOR_PREFIX
 from converters.gazebo.blocks import parse_gazebo
-from converters.gazebo.contact import IMPEDANCE, friction_priority, max_contact_stiffness
+from converters.gazebo.contact import (
+    CONTACT_MU_MAX,
+    IMPEDANCE,
+    friction_priority,
+    max_contact_stiffness,
+)
 from converters.pipeline import convert_full
 from converters.report import Outcome
 
@@ -85,6 +90,15 @@ TAG_TABLE = [
         lambda d, m: (
             _geom(d, m, "arm").friction[0] == pytest.approx(0.25)
             and _geom(d, m, "arm").priority[0] == friction_priority(0.25)
+        ),
+    ),
+    (
+        "mu1 of 'no slip' capped, approximated",
+        _ref("arm", "<mu1>100000</mu1><mu2>100000</mu2>"),
+        lambda d, m: (
+            _geom(d, m, "arm").friction[0] == pytest.approx(CONTACT_MU_MAX)
+            and _geom(d, m, "arm").priority[0] == friction_priority(CONTACT_MU_MAX)
+            and _entry(d, "mu1").outcome is Outcome.APPROXIMATED
         ),
     ),
     (

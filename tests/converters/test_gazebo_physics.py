@@ -96,6 +96,40 @@ def test_incline_threshold_is_sharp_within_three_percent(tmp_path, factor):
         assert slid > 0.03, f"slid only {slid:.4f} m at 103 % of the friction angle"
 
 
+@pytest.mark.parametrize("mu", [1.0, 100.0, 1e5])
+def test_no_slip_wheels_carry_the_cart_on_gazebos_ground(tmp_path, mu):
+    # Gazebo robots write μ 100 or 1e5 for "no slip"; in MuJoCo's pyramidal cone such a μ let
+    # the wheels sink to their axles (the chassis then rested on the ground).
+    model, data = _world(tmp_path, [(models.wheeled_cart(mu), (0.0, 0.0, 0.21))])
+    mujoco.mj_step(model, data, nstep=1500)
+    clearance = data.xpos[model.body("e0/chassis").id, 2] - 0.1
+    assert clearance == pytest.approx(0.1, abs=1e-4), f"chassis {clearance:.5f} m above ground"
+    wheels = {model.body(f"e0/{w}").id for w in ("lf", "rf", "lb", "rb")}
+    load, force = 0.0, np.zeros(6)
+    for i in range(data.ncon):
+        mujoco.mj_contactForce(model, data, i, force)
+        bodies = {int(model.geom_bodyid[g]) for g in (data.contact[i].geom1, data.contact[i].geom2)}
+        assert bodies & wheels, "only the wheels touch the ground"
+        load += force[0]
+    assert load == pytest.approx(42.0 * G, rel=0.01), "the wheels carry m·g"
+
+
+@pytest.mark.parametrize("degrees,holds", [(60.0, True), (66.0, False)])
+def test_no_slip_plate_holds_up_to_the_contact_caps_friction_angle(tmp_path, degrees, holds):
+    # μ 100 becomes twin's contact cap μ 2, which holds up to atan(2) = 63.4° (a plate, which
+    # does not tip over where a cube would).
+    theta = math.radians(degrees)
+    gravity = (G * math.sin(theta), 0.0, -G * math.cos(theta))
+    plate = models.block(100.0, size=0.4, height=0.04)
+    model, data = _world(tmp_path, [(plate, (0.0, 0.0, 0.02))], gravity)
+    mujoco.mj_forward(model, data)
+    start = data.xpos[model.body("e0/block").id, 0]
+    mujoco.mj_step(model, data, nstep=1000)
+    slid = float(data.xpos[model.body("e0/block").id, 0] - start)
+    expected = 0.5 * G * math.cos(theta) * (math.tan(theta) - 2.0)  # ½·a·t² at t = 1 s
+    assert slid < 0.005 if holds else slid == pytest.approx(expected, rel=0.15), slid
+
+
 @pytest.mark.parametrize("kp", [1e4, 1e5])
 def test_converted_ball_sinks_mg_over_kp(tmp_path, kp):
     mass = 2.0
