@@ -70,9 +70,10 @@ def block(
 </robot>"""
 
 
-def wheeled_cart(mu: float, mass: float = 40.0) -> str:
+def wheeled_cart(mu: float = 1.0, mass: float = 40.0, limit: str = "") -> str:
     """A 0.8×0.5×0.2 m chassis of `mass` [kg] on four 0.5 kg wheels of radius 0.1 m (axles at the
-    chassis' underside, so it clears the ground by 0.1 m); `mu` sets mu1 and mu2 on the wheels."""
+    chassis' underside, so it clears the ground by 0.1 m); `mu` sets mu1 and mu2 on the wheels,
+    `limit` is the axles' `<limit …/>` element (effort and velocity: a motor on each)."""
     wheels, joints, tags = [], [], []
     for name, x, y in (("lf", 0.3, 0.3), ("rf", 0.3, -0.3), ("lb", -0.3, 0.3), ("rb", -0.3, -0.3)):
         wheels.append(
@@ -82,7 +83,7 @@ def wheeled_cart(mu: float, mass: float = 40.0) -> str:
         )
         joints.append(
             f'<joint name="{name}_axle" type="continuous"><parent link="chassis"/>'
-            f'<child link="{name}"/><origin xyz="{x} {y} -0.1"/><axis xyz="0 1 0"/></joint>'
+            f'<child link="{name}"/><origin xyz="{x} {y} -0.1"/><axis xyz="0 1 0"/>{limit}</joint>'
         )
         tags.append(_gazebo(name, mu1=mu, mu2=mu))
     return f"""<robot name="cart">

@@ -8,7 +8,7 @@ import re
 import pytest
 from corpus_registry import CORPUS, package_paths
 from models import CONTROL_RIG as WHEEL_URDF
-from models import ball_on_plane, write_urdf
+from models import ball_on_plane, wheeled_cart, write_urdf
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import Pose, World, WorldSettings
@@ -261,3 +261,25 @@ def test_motor_records_read_the_same_from_one_text_or_former_per_motor_texts(tmp
         assert now.source != "model", f"{joint}: no record found"
     assert limits_of(world.model, "now", "slide").modes == ("position",)
     assert limits_of(world.model, "now", "spin").velocity == 3.0
+
+
+def test_velocity_command_rolls_a_wheeled_cart_without_chatter(tmp_path):
+    # ros2_control_demos' diffbot: effort 100 N m, v_max 1 rad/s on light wheels. A clamped step
+    # of MuJoCo's velocity servo is explicit, so its kv must stay under I/h (else the wheels
+    # swung ±117 rad/s every other step and the cart yawed off).
+    cart = write_urdf(tmp_path, wheeled_cart(limit='<limit effort="100" velocity="1.0"/>'))
+    world = World()
+    world.spawn(cart, name="cart", pose=Pose(z=0.21))
+    world.step(500)
+    wheels = {f"{w}_axle": 1.0 for w in ("lf", "rf", "lb", "rb")}
+    world.command_joints("cart", wheels, mode="velocity")
+    peak = 0.0
+    for _ in range(200):
+        world.step(5)
+        peak = max(peak, *(abs(j.velocity) for j in world.joint_states("cart")))
+    speeds = [j.velocity for j in world.joint_states("cart")]
+    assert peak <= 1.0 * 1.01, f"a wheel reached {peak:.3f} rad/s (target and limit 1)"
+    assert speeds == pytest.approx([1.0] * 4, rel=0.01), speeds
+    pose = world.get_pose("cart")
+    assert pose.z == pytest.approx(0.2, abs=1e-4) and abs(pose.yaw) < 1e-4, pose
+    assert 0.08 < pose.x < 0.1, f"rolled {pose.x:.4f} m in 1 s at ω·r = 0.1 m/s"

@@ -10,7 +10,8 @@ a motor without one (hand-written MJCF) offers every mode with no velocity limit
   v_max; kv from `pos_kd`, else max(2·√(kp·I), kp·|Δ|/v): an overdamped PD from rest never moves
   faster than kp·|Δ|/kv = v, and kv ≤ I/dt keeps one saturated step from jumping past it. A
   fixed-base entity's servo also feeds forward the gravity load of the target posture.
-- velocity: kv from `vel_kp`, else full effort at VELOCITY_BAND of the velocity limit.
+- velocity: kv from `vel_kp`, else full effort at 5 % of the velocity limit; with an effort
+  limit, at most I/h (`_velocity_gain`).
 - effort: Gazebo's velocity rule (see twin_cli.world.actuation.apply_command).
 """
 
@@ -123,14 +124,31 @@ def servo_rule(
             kp, kv = pid[0], max(pid[2], kp * step / (SPEED_MARGIN * vmax))
         return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
     if mode == "velocity":
-        if pid:
-            return 0.0, pid[0], "tag PID (vel_kp)"
-        if math.isfinite(effort) and math.isfinite(vmax):
-            return 0.0, effort / ((1.0 - SPEED_MARGIN) * vmax), "full effort at 5 % of v_max"
-        if math.isfinite(effort):
-            return 0.0, effort / FULL_EFFORT_SPEED, "full effort at 1 rad/s error"
-        return 0.0, inertia * UNLIMITED_OMEGA, "reflected inertia"
+        kv, rule = _velocity_gain(pid, effort, vmax, inertia)
+        if math.isfinite(effort) and kv > inertia / timestep:
+            return 0.0, inertia / timestep, f"{rule}, capped at I/h"
+        return 0.0, kv, rule
     return 0.0, 0.0, "Gazebo velocity rule" if math.isfinite(vmax) else "effort"
+
+
+def _velocity_gain(
+    pid: tuple | None, effort: float, vmax: float, inertia: float
+) -> tuple[float, str]:
+    """kv [N m s/rad or N s/m] of the velocity servo before the I/h cap, and its rule.
+
+    The cap: MuJoCo integrates a motor's velocity feedback implicitly only while its force is
+    inside `forcerange`; a clamped step is explicit, so with kv > I/h one step of full effort
+    jumps past the target and the next brakes at full effort the other way. Measured on a cart
+    whose wheels have effort 100 N m and v_max 1 rad/s (kv 2000 against I/h 0.6): the wheels
+    swung ±117 rad/s every other step and the cart drifted and yawed.
+    """
+    if pid:
+        return pid[0], "tag PID (vel_kp)"
+    if math.isfinite(effort) and math.isfinite(vmax):
+        return effort / ((1.0 - SPEED_MARGIN) * vmax), "full effort at 5 % of v_max"
+    if math.isfinite(effort):
+        return effort / FULL_EFFORT_SPEED, "full effort at 1 rad/s error"
+    return inertia * UNLIMITED_OMEGA, "reflected inertia"
 
 
 def _position_gains(inertia: float, h: float, step: float, speed: float) -> tuple[float, float]:
