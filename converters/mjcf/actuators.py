@@ -24,8 +24,8 @@ def actuated_joints(robot: RobotDescription, report: Report) -> list[Joint]:
         source = "all movable non-mimic joints (no <transmission> or <ros2_control>)"
         chosen = list(joints.values())
     chosen = [j for j in chosen if j.kind in ACTUATABLE and j.mimic is None]
-    with_effort = [j for j in chosen if _effort(j) > 0]
-    report.mapped("actuators", f"{len(with_effort)} motor(s) on joints chosen from {source}")
+    motors = chosen if named else [j for j in chosen if _effort(j) > 0]
+    report.mapped("actuators", f"{len(motors)} motor(s) on joints chosen from {source}")
     return chosen
 
 
@@ -34,8 +34,15 @@ def _effort(joint: Joint) -> float:
     return joint.limit.effort if joint.limit and joint.limit.effort else 0.0
 
 
-def add_motors(spec: object, joints: list[Joint], report: Report) -> None:
-    """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m]."""
+def add_motors(
+    spec: object, joints: list[Joint], report: Report, tagged: frozenset[str] = frozenset()
+) -> None:
+    """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m].
+
+    A joint without an effort limit gets an unlimited motor when a `<ros2_control>` or
+    `<transmission>` tag names it (`tagged`): Gazebo drives such joints (diff-drive wheels in
+    gz_ros2_control's demos, husky) with no force bound. Untagged ones get none.
+    """
     import mujoco
 
     limited = [j.name for j in joints if j.limit is not None and (j.limit.velocity or 0) > 0]
@@ -47,12 +54,19 @@ def add_motors(spec: object, joints: list[Joint], report: Report) -> None:
         )
     for joint in joints:
         effort = _effort(joint)
-        if effort <= 0:
+        if effort <= 0 and joint.name not in tagged:
             report.warn(f"joint '{joint.name}'", "no positive effort limit; no motor added")
             continue
         actuator = spec.add_actuator(name=joint.name, target=joint.name)
         actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
         actuator.set_to_motor()
+        if effort <= 0:
+            report.approximated(
+                f"joint '{joint.name}'",
+                "no <limit effort>: a motor without a force bound, as Gazebo drives a joint "
+                "its control tag names; servos use gains from the reflected inertia",
+            )
+            continue
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         actuator.ctrlrange = [-effort, effort]
         actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE

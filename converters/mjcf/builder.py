@@ -102,7 +102,7 @@ def build_spec(
     _add_sites(bodies, plan, robot)
     _add_geoms(spec, bodies, geoms, options.collision, report, provenance)
     actuated = actuated_joints(robot, report)
-    add_motors(spec, actuated, report)
+    add_motors(spec, actuated, report, frozenset(robot.actuated))
     add_control_data(spec, actuated, {a.name for a in spec.actuators}, robot, report)
     add_mimics(spec, robot, report)
     spec.add_key(name=HOME_KEY, qpos=_home(joints, robot))

@@ -283,3 +283,27 @@ def test_velocity_command_rolls_a_wheeled_cart_without_chatter(tmp_path):
     pose = world.get_pose("cart")
     assert pose.z == pytest.approx(0.2, abs=1e-4) and abs(pose.yaw) < 1e-4, pose
     assert 0.08 < pose.x < 0.1, f"rolled {pose.x:.4f} m in 1 s at ω·r = 0.1 m/s"
+
+
+def test_wheels_a_control_tag_names_without_an_effort_limit_get_a_motor(tmp_path):
+    # gz_ros2_control's diff-drive demo and husky: velocity interfaces on continuous joints
+    # without <limit>. Gazebo drives them; twin gave them no motor ("actuated joints: none").
+    tags = "".join(
+        f'<joint name="{w}_axle"><command_interface name="velocity"/>'
+        '<state_interface name="velocity"/></joint>'
+        for w in ("lf", "rf", "lb", "rb")
+    )
+    text = wheeled_cart().replace(
+        "</robot>", f'<ros2_control name="cart" type="system">{tags}</ros2_control></robot>'
+    )
+    world = World()
+    world.spawn(write_urdf(tmp_path, text), name="cart", pose=Pose(z=0.21))
+    world.step(500)
+    wheels = {f"{w}_axle": 1.0 for w in ("lf", "rf", "lb", "rb")}
+    world.command_joints("cart", wheels, mode="velocity")
+    world.step(1000)
+    speeds = [j.velocity for j in world.joint_states("cart")]
+    assert speeds == pytest.approx([1.0] * 4, rel=0.01), speeds
+    pose = world.get_pose("cart")
+    assert pose.z == pytest.approx(0.2, abs=1e-4) and abs(pose.yaw) < 1e-4, pose
+    assert 0.08 < pose.x < 0.1, f"rolled {pose.x:.4f} m in 1 s at ω·r = 0.1 m/s"

@@ -29,7 +29,6 @@ from converters.description import MODES
 MAX_OMEGA_DT = 0.5  # ω·dt of the position servo's spring (explicit in implicitfast: < 2)
 SPEED_MARGIN = 0.95  # position servo's design speed, as a fraction of the velocity limit
 FULL_EFFORT_SPEED = 1.0  # [rad/s or m/s] velocity error at full effort without a velocity limit
-UNLIMITED_OMEGA = 30.0  # [rad/s] servo bandwidth of a joint without an effort limit
 
 
 @dataclass(frozen=True)
@@ -124,7 +123,7 @@ def servo_rule(
             kp, kv = pid[0], max(pid[2], kp * step / (SPEED_MARGIN * vmax))
         return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
     if mode == "velocity":
-        kv, rule = _velocity_gain(pid, effort, vmax, inertia)
+        kv, rule = _velocity_gain(pid, effort, vmax, inertia, timestep)
         if math.isfinite(effort) and kv > inertia / timestep:
             return 0.0, inertia / timestep, f"{rule}, capped at I/h"
         return 0.0, kv, rule
@@ -132,7 +131,7 @@ def servo_rule(
 
 
 def _velocity_gain(
-    pid: tuple | None, effort: float, vmax: float, inertia: float
+    pid: tuple | None, effort: float, vmax: float, inertia: float, timestep: float
 ) -> tuple[float, str]:
     """kv [N m s/rad or N s/m] of the velocity servo before the I/h cap, and its rule.
 
@@ -140,7 +139,10 @@ def _velocity_gain(
     inside `forcerange`; a clamped step is explicit, so with kv > I/h one step of full effort
     jumps past the target and the next brakes at full effort the other way. Measured on a cart
     whose wheels have effort 100 N m and v_max 1 rad/s (kv 2000 against I/h 0.6): the wheels
-    swung ±117 rad/s every other step and the cart drifted and yawed.
+    swung ±117 rad/s every other step and the cart drifted and yawed. Without an effort limit
+    the feedback is always implicit, so kv = I/h: the joint's own inertia reaches the target in
+    about one step, and a load it drives through contact (a wheel's robot) still gets a usable
+    torque per rad/s of error.
     """
     if pid:
         return pid[0], "tag PID (vel_kp)"
@@ -148,7 +150,7 @@ def _velocity_gain(
         return effort / ((1.0 - SPEED_MARGIN) * vmax), "full effort at 5 % of v_max"
     if math.isfinite(effort):
         return effort / FULL_EFFORT_SPEED, "full effort at 1 rad/s error"
-    return inertia * UNLIMITED_OMEGA, "reflected inertia"
+    return inertia / timestep, "I/h (no effort limit)"
 
 
 def _position_gains(inertia: float, h: float, step: float, speed: float) -> tuple[float, float]:
