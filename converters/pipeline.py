@@ -99,6 +99,7 @@ def convert_full(
     args: Mapping[str, str] | None = None,
     package_paths: Mapping[str, str | Path] | None = None,
     options: ConvertOptions | None = None,
+    env: Mapping[str, str] | None = None,
 ) -> Conversion:
     """Convert a xacro, URDF or SDF model file into an MjSpec carrying Gazebo's semantics.
 
@@ -107,12 +108,13 @@ def convert_full(
         args: xacro arguments (`NAME:=VALUE` pairs as a dict).
         package_paths: package name → directory (`--package`), searched first.
         options: keep_fixed, repair_inertia, collision settings.
+        env: the package search variables (ROS_PACKAGE_PATH, ...) to use; None: this process's.
 
     Raises:
         ConversionError: any subclass, with file/link/joint and the fix in its message.
     """
     path = Path(path)
-    resolver = PackageResolver.create(path, package_paths)
+    resolver = PackageResolver.create(path, package_paths, env)
     report = Report(source=str(path))
     text = read_description(path, dict(args or {}), resolver, report)
     options = options or ConvertOptions()
@@ -129,6 +131,7 @@ def convert_text(
     base_dir: str | Path | None = None,
     package_paths: Mapping[str, str | Path] | None = None,
     options: ConvertOptions | None = None,
+    env: Mapping[str, str] | None = None,
 ) -> Conversion:
     """Convert a description given as text (URDF, xacro output or SDF), as SpawnEntity's `xml`.
 
@@ -136,10 +139,10 @@ def convert_text(
         text: the description.
         source: a name for messages (`<stdin>`, `<xml>`, a request id).
         base_dir: where relative mesh paths start (default: the working directory).
-        package_paths, options: as for `convert_full`.
+        package_paths, options, env: as for `convert_full`.
     """
     directory = Path(base_dir or Path.cwd()).resolve()
-    resolver = PackageResolver.create(directory / "description", package_paths)
+    resolver = PackageResolver.create(directory / "description", package_paths, env)
     report = Report(source=source)
     options = options or ConvertOptions()
     robot = read_robot(text, source, directory, resolver, report, as_written=options.as_written)

@@ -113,6 +113,7 @@ def spawn(
     at: list[str] | None = None,
     names: str | None = None,
     view: bool = False,
+    repair_inertia: bool = False,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
@@ -131,6 +132,7 @@ def spawn(
             file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
             name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
             world=world, json=json, xml=xml, quat=quat, x=x, y=y, view=view,
+            repair_inertia=repair_inertia,
         )  # fmt: skip
         return
     inputs = pairs.source_inputs(arg, package)
@@ -143,8 +145,9 @@ def spawn(
     source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
     with _connect(world, start=True) as c:
         result = c.spawn(
-            file, name=name, pose=pose, on_ground=on_ground, joints=joints, **source, **inputs
-        )
+            file, name=name, pose=pose, on_ground=on_ground, joints=joints,
+            repair_inertia=repair_inertia, **source, **inputs,
+        )  # fmt: skip
         if view:
             url = c.request("POST", "/view", body={})["url"]
             sys.stderr.write(f"twin: viewer on {url}\n")
@@ -178,6 +181,7 @@ def spawn_many(
     x: float = 0.0,
     y: float = 0.0,
     view: bool = False,
+    repair_inertia: bool = False,
 ) -> None:
     """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
     from twin_cli.cli import batch_poses
@@ -198,7 +202,7 @@ def spawn_many(
     with _connect(world, start=True) as c:
         results = c.spawn_batch(
             file, poses=poses, names=listed, name=name, on_ground=on_ground, joints=joints,
-            **source, **inputs,
+            repair_inertia=repair_inertia, **source, **inputs,
         )  # fmt: skip
         if view:
             url = c.request("POST", "/view", body={})["url"]

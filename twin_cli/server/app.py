@@ -99,6 +99,8 @@ def _spawn(body: SpawnBody, world: Any) -> dict:
         package_paths=body.package_paths,
         on_ground=body.on_ground,
         joints=body.joints,
+        env=body.env,
+        repair_inertia=body.repair_inertia,
     )
     log.info("spawned %s from %s", result.name, body.source or "<xml>")
     return _plain(result)
@@ -127,6 +129,8 @@ def _spawn_batch(body: SpawnBatchBody, world: Any) -> list[dict]:
         package_paths=body.package_paths,
         on_ground=body.on_ground,
         joints=body.joints,
+        env=body.env,
+        repair_inertia=body.repair_inertia,
     )
     log.info("spawned %d entities from %s", len(results), body.source or "<xml>")
     return _plain(results)

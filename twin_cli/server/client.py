@@ -16,6 +16,7 @@ from typing import Any
 
 from twin_cli import errors as twin_errors
 from twin_cli.errors import NotRunningError, RequestError
+from twin_cli.package_env import package_env
 from twin_cli.server import runtime
 from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
 
@@ -173,10 +174,12 @@ class Client:
         joints: dict[str, float] | None = None,
         xml: str | None = None,
         base_dir: str | None = None,
+        repair_inertia: bool = False,
     ) -> dict:
         """Spawn a file, or a description given as text (`xml`, with `source` None).
 
-        Paths are made absolute here: the server has its own working directory. `joints`:
+        Paths are made absolute here: the server has its own working directory, and this
+        process's package search variables go along (`twin_cli.package_env`). `joints`:
         initial joint positions [rad] or [m] by joint name (Gazebo's `-J`). `base_dir`: where
         relative mesh paths in `xml` start.
         """
@@ -193,6 +196,8 @@ class Client:
             },
             "on_ground": on_ground,
             "joints": joints or {},
+            "env": package_env(),
+            "repair_inertia": repair_inertia,
         }
         label = name or str(source or "<xml>")
         return self.long_request(
@@ -226,6 +231,7 @@ class Client:
             **where,
             **options,
             "package_paths": {k: str(Path(v).expanduser().absolute()) for k, v in packages.items()},
+            "env": package_env(),
             "poses": poses,
             "names": names,
         }

@@ -82,6 +82,14 @@ class SpawnBody(Body):
     joints: dict[str, Finite] = Field(
         default={}, description="initial joint positions [rad] or [m] by URDF joint name (-J)"
     )
+    env: dict[str, str] | None = Field(
+        default=None,
+        description="package search variables (ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, "
+        "GAZEBO_MODEL_PATH, GZ_SIM_RESOURCE_PATH) to resolve with; absent: the server's own",
+    )
+    repair_inertia: bool = Field(
+        default=False, description="bound non-physical inertias instead of refusing the file"
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> SpawnBody:

@@ -75,6 +75,8 @@ class BatchSpawning:
         package_paths: dict[str, str] | None = None,
         on_ground: bool = False,
         joints: dict[str, float] | None = None,
+        env: dict[str, str] | None = None,
+        repair_inertia: bool = False,
     ) -> list[SpawnResult]:
         """Adds one entity per pose, converting the source once and compiling the world once.
 
@@ -88,7 +90,7 @@ class BatchSpawning:
             names = batch_names(spawn.check_entity_name(base), len(poses))
         if names is not None:
             check_batch(list(names), poses, list(self._entities))
-        loaded = spawn.load_source(source, args, package_paths)
+        loaded = spawn.load_source(source, args, package_paths, env, repair_inertia)
         if names is None:
             default = "".join(c if c.isalnum() or c in "-_." else "_" for c in loaded.default_name)
             names = batch_names(default or "model", len(poses))
@@ -111,7 +113,8 @@ class BatchSpawning:
                 self._entities[n] = Entity(
                     n, loaded.source, dict(args or {}), dict(package_paths or {}), pose,
                     on_ground, state, loaded.report, loaded.xml, dict(joints or {}),
-                    loaded.description, sensors=loaded.sensors, plugins=loaded.plugins,
+                    loaded.description, sensors=loaded.sensors, plugins=loaded.plugins, env=env,
+                    repair_inertia=repair_inertia,
                 )  # fmt: skip
                 warnings = [
                     *loaded.notes,

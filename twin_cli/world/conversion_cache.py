@@ -25,8 +25,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from twin_cli.package_env import PACKAGE_ENVS
+
 MAX_ENTRIES = 32  # conversions kept (a booster_t1 spec holds ~8 MB of mesh arrays)
-KEY_ENVS = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH", "GAZEBO_MODEL_PATH", "GZ_SIM_RESOURCE_PATH")
 _WRITE_MODES = ("w", "a", "x", "+")
 _CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")  # imports during a conversion: not data
 _CODE_DIRS = tuple({sys.prefix, sys.base_prefix, sys.exec_prefix})
@@ -95,14 +96,21 @@ def file_digest(path: str) -> str | None:
 
 
 def cache_key(
-    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+    path: Path,
+    args: dict[str, str] | None,
+    package_paths: dict[str, str] | None,
+    env: dict[str, str] | None = None,
+    repair_inertia: bool = False,
 ) -> tuple:
-    """What, besides file contents, decides a conversion's result."""
+    """What, besides file contents, decides a conversion's result (`env`: the caller's package
+    variables, None: the server's own)."""
+    lookup = os.environ if env is None else env
     return (
         str(path),
         tuple(sorted((args or {}).items())),
         tuple(sorted((package_paths or {}).items())),
-        tuple(os.environ.get(name, "") for name in KEY_ENVS),
+        tuple(lookup.get(name, "") for name in PACKAGE_ENVS),
+        repair_inertia,
     )
 
 

@@ -101,6 +101,8 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         package_paths: dict[str, str] | None = None,
         on_ground: bool = False,
         joints: dict[str, float] | None = None,
+        env: dict[str, str] | None = None,
+        repair_inertia: bool = False,
     ) -> SpawnResult:
         """Adds an entity at `pose`; existing entities keep their exact state.
 
@@ -120,7 +122,7 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         """
         if name is not None:
             spawn.check_entity_name(name)
-        loaded = spawn.load_source(source, args, package_paths)
+        loaded = spawn.load_source(source, args, package_paths, env, repair_inertia)
         with self.lock:
             name = self._free_name(name, loaded.default_name)
             try:
@@ -149,6 +151,8 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
                 loaded.description,
                 sensors=loaded.sensors,
                 plugins=loaded.plugins,
+                env=env,
+                repair_inertia=repair_inertia,
             )
             self._commit(self._spec, model, data, index)
             return SpawnResult(name, loaded.source, warnings, loaded.report, loaded.cached)

@@ -83,6 +83,8 @@ class Entity:
         joints: initial joint positions given at spawn (`-J`), name → [rad] or [m].
         description: the URDF text after xacro (for `/robot_description`), else None.
         sensors: its Gazebo sensors (`converters.description.sensors.SensorSpec`), if any.
+        env: the spawning client's package search variables (None: the server's own).
+        repair_inertia: whether non-physical inertias were bounded (`--repair-inertia`).
     """
 
     name: str
@@ -98,6 +100,8 @@ class Entity:
     description: str | None = field(default=None, repr=False)
     sensors: tuple = field(default=(), repr=False)
     plugins: tuple = field(default=(), repr=False)  # DiffDrive records (twin_cli.control)
+    env: dict[str, str] | None = None
+    repair_inertia: bool = False
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:

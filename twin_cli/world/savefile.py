@@ -73,6 +73,8 @@ def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
         "on_ground": entity.on_ground,
         "xml": entity.xml,
         "joints": entity.joints,
+        "env": entity.env,
+        "repair_inertia": entity.repair_inertia,
         "spawn_state": state,
     }
 
@@ -154,6 +156,8 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         args=item["args"] or None,
         package_paths=item["package_paths"] or None,
         joints=item.get("joints") or None,  # absent in files saved before -J existed
+        env=item.get("env"),  # these two: absent in files saved before spawn sent them
+        repair_inertia=bool(item.get("repair_inertia", False)),
     )
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world._entities[item["name"]]
@@ -170,6 +174,9 @@ def _respawn(world: World, item: dict[str, Any]) -> None:
         entity.joints,
         entity.description,
         sensors=entity.sensors,
+        plugins=entity.plugins,
+        env=entity.env,
+        repair_inertia=entity.repair_inertia,
     )
 
 

@@ -79,8 +79,13 @@ def load_source(
     source: str | os.PathLike | mujoco.MjSpec | DescriptionText,
     args: dict[str, str] | None,
     package_paths: dict[str, str] | None,
+    env: dict[str, str] | None = None,
+    repair_inertia: bool = False,
 ) -> LoadedSource:
     """Reads a URDF/xacro/SDF (through the converter), an MJCF file, a text or an MjSpec.
+
+    `env`: the caller's package search variables (twin_cli.package_env; None: this process's).
+    `repair_inertia`: bound non-physical inertias instead of refusing them (`--repair-inertia`).
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
@@ -90,7 +95,7 @@ def load_source(
         spec = source.copy()
         return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
     if isinstance(source, DescriptionText):
-        return _load_text(source, package_paths)
+        return _load_text(source, package_paths, env, repair_inertia)
     path = Path(source).expanduser().resolve()
     if not path.is_file():
         raise SpawnError(path.stem, str(path), "no such file", "check the path")
@@ -98,7 +103,7 @@ def load_source(
     if lower.endswith(MJCF_SUFFIXES):
         return _load_mjcf(path)
     if lower.endswith(URDF_SUFFIXES + SDF_SUFFIXES) or _sniff(path) in ("urdf", "sdf"):
-        return _load_description(path, args, package_paths)
+        return _load_description(path, args, package_paths, env, repair_inertia)
     if _sniff(path) == "mjcf":
         return _load_mjcf(path)
     kinds = ", ".join(URDF_SUFFIXES + SDF_SUFFIXES + MJCF_SUFFIXES)
@@ -118,9 +123,15 @@ def _sniff(path: Path) -> str | None:
         return None
 
 
-def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) -> LoadedSource:
+def _load_text(
+    source: DescriptionText,
+    package_paths: dict[str, str] | None,
+    env: dict[str, str] | None,
+    repair_inertia: bool,
+) -> LoadedSource:
     """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
     from converters.formats import format_of
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_text
 
     if format_of(source.text) == "mjcf":
@@ -132,7 +143,12 @@ def _load_text(source: DescriptionText, package_paths: dict[str, str] | None) ->
             ) from exc
         return LoadedSource(spec, source.label, None, source.text, spec.modelname or "model")
     done = convert_text(
-        source.text, source=source.label, base_dir=source.base_dir, package_paths=package_paths
+        source.text,
+        source=source.label,
+        base_dir=source.base_dir,
+        package_paths=package_paths,
+        options=ConvertOptions(repair_inertia=repair_inertia),
+        env=env,
     )
     name = done.report.robot or "model"
     return LoadedSource(
@@ -180,21 +196,33 @@ def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
 
 
 def _load_description(
-    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+    path: Path,
+    args: dict[str, str] | None,
+    package_paths: dict[str, str] | None,
+    env: dict[str, str] | None,
+    repair_inertia: bool,
 ) -> LoadedSource:
     """A converted file, from the conversion cache when no file it read has changed."""
     from twin_cli.world.conversion_cache import CACHE, cache_key
 
-    key = cache_key(path, args, package_paths)
-    return CACHE.load(key, lambda: _convert_description(path, args, package_paths))
+    key = cache_key(path, args, package_paths, env, repair_inertia)
+    return CACHE.load(
+        key, lambda: _convert_description(path, args, package_paths, env, repair_inertia)
+    )
 
 
 def _convert_description(
-    path: Path, args: dict[str, str] | None, package_paths: dict[str, str] | None
+    path: Path,
+    args: dict[str, str] | None,
+    package_paths: dict[str, str] | None,
+    env: dict[str, str] | None,
+    repair_inertia: bool,
 ) -> LoadedSource:
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
 
-    done = convert_full(path, args=args, package_paths=package_paths)
+    options = ConvertOptions(repair_inertia=repair_inertia)
+    done = convert_full(path, args=args, package_paths=package_paths, options=options, env=env)
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)

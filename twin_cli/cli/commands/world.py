@@ -76,8 +76,16 @@ def spawn(
     view: Annotated[
         bool, typer.Option("--view", help="Also show the world in the web viewer (twin view).")
     ] = False,
+    repair_inertia: Annotated[
+        bool,
+        typer.Option("--repair-inertia", help="Bound non-physical inertias instead of failing."),
+    ] = False,
 ) -> None:
-    """Spawn a robot or model; prints its name once it exists in the world."""
+    """Spawn a robot or model; prints its name once it exists in the world.
+
+    Packages (`$(find)`, `package://`, `model://`) resolve with this shell's ROS_PACKAGE_PATH,
+    AMENT_PREFIX_PATH, GAZEBO_MODEL_PATH and GZ_SIM_RESOURCE_PATH, as `twin convert` would.
+    """
     with usage_errors():
         act.spawn(
             file=file,
@@ -99,6 +107,7 @@ def spawn(
             at=at,
             names=names,
             view=view,
+            repair_inertia=repair_inertia,
         )
 
 

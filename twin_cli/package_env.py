@@ -1,0 +1,25 @@
+"""The environment variables that steer package and model lookup (`$(find pkg)`, `package://`,
+`model://`), which a client sends with a spawn.
+
+A spawn converts on the server, whose environment is the one it started with; a user who
+exported `ROS_PACKAGE_PATH` in another shell expects `twin spawn` to resolve packages as
+`twin convert` does there. So the client sends its own values of these variables, the server
+resolves with them, and the conversion cache keys on them. Light on purpose: client commands
+import it.
+"""
+
+from __future__ import annotations
+
+import os
+
+PACKAGE_ENVS = (
+    "ROS_PACKAGE_PATH",
+    "AMENT_PREFIX_PATH",
+    "GAZEBO_MODEL_PATH",
+    "GZ_SIM_RESOURCE_PATH",
+)
+
+
+def package_env() -> dict[str, str]:
+    """This process's values of PACKAGE_ENVS (unset ones left out)."""
+    return {name: os.environ[name] for name in PACKAGE_ENVS if name in os.environ}
