@@ -7,6 +7,7 @@ Every value read goes through `SdfContext`, so a bad number or a missing element
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -130,6 +131,23 @@ def describe(element: Any) -> str:
     return f"<{element.tag} name='{name}'>" if name else f"<{element.tag}>"
 
 
+_COMMENT = re.compile(r"<!--(.*?)-->", re.DOTALL)
+_DECLARATION = re.compile(r"<\?xml\b[^>]*\?>")
+
+
+def _as_tinyxml_reads(text: str) -> str:
+    """`text` with what tinyxml2 (sdformat's parser) tolerates made well-formed: comments that
+    contain `--` (gz-sim's own `empty.sdf` quotes a `gz service --reqtype ...` command in one)
+    and an XML declaration after a leading comment (gazebo-classic's `cafe.world`). Comments
+    keep their line breaks, so error positions stay on their lines."""
+    text = _COMMENT.sub(lambda m: "<!--" + "\n" * m.group(1).count("\n") + "-->", text)
+    start = len(text) - len(text.lstrip())
+    if text.startswith("<?xml", start):  # the one declaration allowed: keep it
+        end = text.index("?>", start) + 2
+        return text[:end] + _DECLARATION.sub("", text[end:])
+    return _DECLARATION.sub("", text)
+
+
 def parse_document(text: str, source: str) -> Any:
     """The `<sdf>` root element of `text`, with line numbers; namespaces stripped.
 
@@ -143,8 +161,11 @@ def parse_document(text: str, source: str) -> Any:
     try:
         root = etree.fromstring(text.encode(), parser)
     except etree.XMLSyntaxError as exc:
-        line, column = exc.position
-        raise MalformedXMLError(source, line, column, exc.msg) from exc
+        try:  # what sdformat's tinyxml2 accepts and a strict parser does not
+            root = etree.fromstring(_as_tinyxml_reads(text).encode(), parser)
+        except etree.XMLSyntaxError as real:  # a problem tinyxml2 refuses too: name it
+            line, column = real.position
+            raise MalformedXMLError(source, line, column, real.msg) from exc
     for element in root.iter():
         if isinstance(element.tag, str) and element.tag.startswith("{"):
             element.tag = element.tag.split("}", 1)[1]

@@ -211,3 +211,22 @@ def test_an_unknown_version_is_refused_with_the_versions_twin_reads(tmp_path: Pa
     path = _model(tmp_path, '<model name="m"><link name="a"/></model>', version="2.0")
     with pytest.raises(SDFError, match=r"'2\.0'.*1\.4.*1\.11"):
         convert(path)
+
+
+TINYXML_TOLERATES = """<!-- a leading note -->
+<?xml version="1.0" ?>
+<!--
+  Spawn one with: gz service -s /world/w/create --reqtype gz.msgs.EntityFactory --timeout 300
+  --req '"<?xml version=\\"1.0\\" ?><sdf version=\\"1.6\\">...'
+-->
+<sdf version="1.6"><world name="w"><gravity>0 0 -1.62</gravity></world></sdf>"""
+
+
+def test_sdf_that_sdformats_tinyxml2_reads_is_read(tmp_path):
+    # gz-sim's empty.sdf quotes a `gz service --reqtype` command in a comment ('--' is not
+    # allowed there); gazebo-classic's cafe.world puts its XML declaration after a comment.
+    world = read_sdf_world(TINYXML_TOLERATES, "w.world", tmp_path)
+    assert world.gravity == pytest.approx((0.0, 0.0, -1.62))
+    broken = TINYXML_TOLERATES.replace("</world>", "</wrold>")
+    with pytest.raises(ConversionError, match=r"w\.world:7:.*malformed XML"):
+        read_sdf_world(broken, "w.world", tmp_path)
