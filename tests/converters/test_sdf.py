@@ -230,3 +230,15 @@ def test_sdf_that_sdformats_tinyxml2_reads_is_read(tmp_path):
     broken = TINYXML_TOLERATES.replace("</world>", "</wrold>")
     with pytest.raises(ConversionError, match=r"w\.world:7:.*malformed XML"):
         read_sdf_world(broken, "w.world", tmp_path)
+
+
+def test_a_link_named_world_is_refused_at_its_line(tmp_path):
+    # sdformat reserves the name; twin used to loop on it, allocating without bound.
+    path = tmp_path / "m.sdf"
+    path.write_text(
+        '<sdf version="1.7"><model name="m">\n<link name="world"/>\n<link name="a"/></model></sdf>'
+    )
+    with pytest.raises(
+        SDFError, match=r"m\.sdf:2: <link name='world'>: .*reserves it\); rename it"
+    ):
+        convert(path)
