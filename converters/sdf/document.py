@@ -205,6 +205,8 @@ def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
             element, f"has {len(raw)} numbers", f"write {expected} numbers: x y z and the rotation"
         )
     values = tuple(ctx.parse_number(element, v) for v in raw) or (0.0,) * 6
+    if quat and not raw:  # an empty pose is the identity in either format
+        values = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
     if quat:
         T = np.eye(4)
         T[:3, :3] = quat_matrix(values[3:])

@@ -117,3 +117,23 @@ def test_bad_tcp_address_is_refused_with_an_example(text):
 
     with pytest.raises(RequestError, match="--tcp"):
         parse_tcp(text)
+
+
+def test_a_world_file_serve_refuses_ends_in_order_not_as_a_death(rtdir, tmp_path):
+    # The run record stayed behind, so every later command said the world had died by SIGKILL.
+    def twin(*args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", "refused"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+
+    served = twin("serve", str(tmp_path / "missing.world"), "--no-autosave")
+    assert served.returncode == 2, served.stderr
+    assert "missing.world: no such file" in served.stderr and "Traceback" not in served.stderr
+    listed = twin("list")
+    assert listed.returncode == 1 and "not running" in listed.stderr, listed.stderr
+    assert "died" not in listed.stderr and "SIGKILL" not in listed.stderr, listed.stderr
+    logged = twin("logs")
+    assert "not served: " in logged.stdout and "missing.world" in logged.stdout, logged.stdout

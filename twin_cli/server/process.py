@@ -170,6 +170,8 @@ def run_recorded(paths: runtime.WorldPaths, opts: ServeOptions) -> Iterator[Path
     Yields:
         The autosave file, or None when autosave is off.
     """
+    from converters.errors import ConversionError
+    from twin_cli.errors import TwinError
     from twin_cli.server import lifecycle
 
     autosave = lifecycle.autosave_path(paths) if opts.autosave > 0 else None
@@ -179,6 +181,10 @@ def run_recorded(paths: runtime.WorldPaths, opts: ServeOptions) -> Iterator[Path
     except (KeyboardInterrupt, SystemExit) as exc:
         if not isinstance(exc, SystemExit) or exc.code in (0, None):
             lifecycle.ended_in_order(paths)
+        raise
+    except (ConversionError, TwinError) as exc:  # refused its world or options: an orderly end
+        log.error("world [%s] not served: %s", opts.world, exc)
+        lifecycle.ended_in_order(paths)
         raise
     else:
         lifecycle.ended_in_order(paths)

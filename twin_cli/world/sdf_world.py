@@ -35,13 +35,19 @@ def world_from_sdf(
         converters.ConversionError: the file or a model in it cannot be read (file:line).
         SpawnError, EntityExistsError: a model cannot be placed.
     """
+    from converters.errors import InputFileError
     from converters.pipeline import build_description
     from converters.resources.packages import PackageResolver
     from converters.sdf import read_sdf_world
 
     path = Path(path).resolve()
     resolver = PackageResolver.create(path, package_paths)
-    description = read_sdf_world(path.read_text(), str(path), path.parent, resolver)
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        problem = "no such file" if isinstance(exc, FileNotFoundError) else f"unreadable ({exc})"
+        raise InputFileError(str(path), problem, "give the path of an SDF world file") from exc
+    description = read_sdf_world(text, str(path), path.parent, resolver)
     settings = WorldSettings(
         timestep=description.timestep,
         rate=description.rate,
