@@ -242,3 +242,15 @@ def test_a_link_named_world_is_refused_at_its_line(tmp_path):
         SDFError, match=r"m\.sdf:2: <link name='world'>: .*reserves it\); rename it"
     ):
         convert(path)
+
+
+def test_an_empty_quat_xyzw_pose_is_the_identity(tmp_path):
+    path = tmp_path / "m.sdf"
+    path.write_text(
+        '<sdf version="1.9"><model name="m"><link name="l"><pose rotation_format="quat_xyzw"/>'
+        "<inertial><mass>2</mass></inertial></link></model></sdf>"
+    )
+    spec, _ = convert(path)
+    model = spec.compile()
+    assert model.body("l").pos == pytest.approx([0.0, 0.0, 0.0])
+    assert model.body("l").quat == pytest.approx([1.0, 0.0, 0.0, 0.0])
