@@ -15,7 +15,7 @@ from twin_cli.errors import (
     PartNotFoundError,
     SpawnError,
 )
-from twin_cli.world import Pose, World
+from twin_cli.world import Pose, World, WorldSettings
 
 
 @pytest.fixture(scope="module")
@@ -257,3 +257,27 @@ def test_spawn_joints_posture_survives_save_and_load_and_on_ground_placement(tmp
     loaded.reset()
     after = {j.name: j.position for j in loaded.joint_states("pincer")}
     assert after == pytest.approx(start, abs=1e-12), "a loaded world resets to the -J posture"
+
+
+TWO_ROOTS = """<sdf version="1.8"><model name="M">
+<link name="A"><collision name="c"><geometry><box><size>0.2 0.2 0.2</size></box></geometry>
+</collision></link>
+<link name="B"><pose>3 2 0 0 0 0</pose><collision name="c"><geometry><box><size>0.2 0.2 0.2</size>
+</box></geometry></collision></link></model></sdf>"""
+
+
+def test_a_model_of_unjoined_links_is_placed_and_posed_by_its_model_frame(tmp_path):
+    # Both links float; the spawn frame moved only the first link's pose, and that twice.
+    import math
+
+    path = tmp_path / "two_roots.sdf"
+    path.write_text(TWO_ROOTS)
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
+    world.spawn(path, name="M", pose=Pose(x=1.0, z=2.0, yaw=0.5))
+    mujoco.mj_kinematics(world.model, world.data)
+    c, s = math.cos(0.5), math.sin(0.5)
+    where = {b: world.data.xpos[world.model.body(f"M/{b}").id] for b in "AB"}
+    assert where["A"] == pytest.approx([1.0, 0.0, 2.0], abs=1e-9)
+    assert where["B"] == pytest.approx([1.0 + 3 * c - 2 * s, 3 * s + 2 * c, 2.0], abs=1e-9)
+    pose = world.get_pose("M")
+    assert (pose.x, pose.y, pose.z, pose.yaw) == pytest.approx((1.0, 0.0, 2.0, 0.5), abs=1e-9)

@@ -36,8 +36,10 @@ def root_pose(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, sp
 
     The root's pose is its free joint's qpos, else its fixed root body's pose.
     """
-    if index.model_site >= 0 and index.free_qpos < 0:
-        return spawn  # a fixed model stays where its attach frame (the model frame) was put
+    if index.model_site >= 0 and (index.free_qpos < 0 or model.site_bodyid[index.model_site] == 0):
+        # A fixed model, or one of several unjoined links (each floats; the site marking the
+        # model frame is on the world): the model frame stays where its attach frame was put.
+        return spawn
     if index.free_qpos >= 0:
         q = data.qpos[index.free_qpos : index.free_qpos + 7]
         root = Pose.from_quat(q[0], q[1], q[2], q[3:7])

@@ -389,17 +389,19 @@ def initial_qpos(
 ) -> np.ndarray:
     """The entity's own initial configuration at its spawn pose, at rest.
 
-    Without a home key this is the compiled `qpos0` (the free joint's part already includes the
-    attach frame). With one, the key's joint values are used and its free-joint pose (expressed
-    in the child's own world) is composed with the attach frame `pose`.
+    Without a home key this is the compiled `qpos0` (free joints' parts already include the
+    attach frame). With one, the key's joint values are used and each free joint's pose
+    (expressed in the child's own world) is composed with the attach frame `pose`: the root's,
+    and those of an SDF model's other unjoined links, which float on their own.
     """
     q0 = model.qpos0[index.qpos].copy()
     if home is None or len(home) != len(q0):
         return q0
     q = np.array(home, dtype=float)
-    if index.free_qpos >= 0:
-        at = int(np.flatnonzero(index.qpos == index.free_qpos)[0])
-        frame_quat = pose.quat()
+    frame_quat = pose.quat()
+    free = [j for j in index.joints if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+    for address in (int(model.jnt_qposadr[j]) for j in free):
+        at = int(np.flatnonzero(index.qpos == address)[0])
         key_pos = (float(home[at]), float(home[at + 1]), float(home[at + 2]))
         q[at : at + 3] = np.add(pose.position(), rotate(frame_quat, key_pos))
         q[at + 3 : at + 7] = quat_multiply(
