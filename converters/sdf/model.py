@@ -7,6 +7,7 @@ joint), or is welded when the model is `<static>`; a joint to `world` anchors it
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from types import MappingProxyType
 from typing import Any
 
@@ -63,7 +64,9 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         if _has_values(extension):
             ext_joints[joint.name] = extension
     static = ctx.flag(model, "static", False)
-    base, base_pose, anchors = _base(graph, [link.name for link in links], joints, static)
+    names = [link.name for link in links]
+    welded = _in_static_models(ctx, scopes, names)
+    base, base_pose, anchors = _base(graph, names, joints, static, welded)
     _report_ignored(ctx, model)
     gazebo = GazeboExtensions(
         source=ctx.source,
@@ -121,24 +124,37 @@ def _scopes(model: Any, prefix: str):
         yield from _scopes(nested, prefix + nested.get("name", "") + SEP)
 
 
+def _in_static_models(ctx: SdfContext, scopes: list, links: list[str]) -> set[str]:
+    """Links of nested models that are `<static>` themselves (or inside a static one): Gazebo
+    keeps them in place whatever their enclosing model does (a wrapper around included
+    furniture, as the AWS worlds write)."""
+    prefixes = [prefix for element, prefix in scopes[1:] if ctx.flag(element, "static", False)]
+    return {name for name in links if any(name.startswith(p) for p in prefixes)}
+
+
 def _base(
-    graph: PoseGraph, links: list[str], joints: list[Joint], static: bool
+    graph: PoseGraph,
+    links: list[str],
+    joints: list[Joint],
+    static: bool,
+    welded: Collection[str] = (),
 ) -> tuple[str, np.ndarray, list[Joint]]:
     """The base link, its pose in the model frame, and joints that anchor extra roots.
 
     One root link and no joint to the world: that link is the base (floating unless static).
-    Otherwise the world is the base: roots weld to it when the model is static, else each
-    gets a `floating` joint (a free joint in MuJoCo), as separate SDF bodies move freely.
+    Otherwise the world is the base: roots weld to it when the model is static or they belong
+    to a static nested model (`welded`), else each gets a `floating` joint (a free joint in
+    MuJoCo), as separate SDF bodies move freely.
     """
     children = {j.child for j in joints}
     roots = [name for name in links if name not in children]
     to_world = any(j.parent == WORLD_LINK for j in joints)
-    if len(roots) == 1 and not to_world:
+    if len(roots) == 1 and not to_world and roots[0] not in welded:
         return roots[0], graph.pose(roots[0]), []
-    kind = "fixed" if static else "floating"
-    anchors = [
-        Joint(f"{root}_{kind}", kind, WORLD_LINK, root, origin=graph.pose(root)) for root in roots
-    ]
+    anchors = []
+    for root in roots:
+        kind = "fixed" if static or root in welded else "floating"
+        anchors.append(Joint(f"{root}_{kind}", kind, WORLD_LINK, root, origin=graph.pose(root)))
     return WORLD_LINK, np.eye(4), anchors
 
 

@@ -187,3 +187,21 @@ def test_included_model_is_nested_with_its_name_and_pose(tmp_path: Path, monkeyp
     assert_pose(body_pose(model, data, "left::finger"), X(0.2, 0, 1.1, 0, 0, HALF_PI), "finger")
     assert_pose(site_pose(model, data, "left::pad"), X(0.2, 0.02, 1.1, 0, 0, HALF_PI), "pad")
     assert site_body(model, "left::pad") == "left::finger", "pad is attached to the finger"
+
+
+WRAPPED_STATIC = f"""<model name="wrapper">
+  <link name="loose"><pose>0 0 1 0 0 0</pose>{INERTIAL}</link>
+  <model name="shelf"><static>true</static>
+    <link name="board"><pose>2 0 1 0 0 0</pose>{INERTIAL}</link></model>
+</model>"""
+
+
+def test_a_static_model_nested_in_a_moving_one_stays_put(tmp_path):
+    # The AWS worlds wrap static furniture in non-static models; it fell and scattered.
+    import mujoco
+
+    model, data = kinematics(write(tmp_path, WRAPPED_STATIC, version="1.6"))
+    mujoco.mj_step(model, data, nstep=500)  # 0.5 s of free fall for what is not static
+    board, loose = model.body("shelf::board").id, model.body("loose").id
+    assert np.allclose(data.xpos[board], [2.0, 0.0, 1.0], atol=1e-12), data.xpos[board]
+    assert data.xpos[loose][2] < 1.0 - 0.5 * 9.8 * 0.5**2 * 0.9, "the rest still falls"
