@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote
 
 from converters.errors import PackageNotFoundError
 from converters.sdf.document import (
@@ -24,6 +25,8 @@ SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 INCLUDED_SOURCE = "_twin_source"
 # What an <include> may bring in (a Gazebo model directory holds one of these).
 INCLUDABLE = ("model", "light", "actor")
+# Fuel models twin ships an equivalent of (OpenRobotics' "Ground Plane" and "Sun").
+FUEL_SHIPPED = ("ground plane", "sun")
 
 
 def expand_includes(ctx: SdfContext, parent: Any) -> None:
@@ -56,6 +59,8 @@ def included_element(ctx: SdfContext, include: Any) -> Any:
 
 
 def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
+    if uri.startswith(("https://", "http://")):
+        return _fuel_model(ctx, include, uri)
     element = f"{source_of(include, ctx.source)}:{line_of(include)}: <include>"
     base = directory_of(ctx, include)
     try:
@@ -70,6 +75,48 @@ def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
     if not target.is_file():
         raise ctx.error(include, f"{uri} resolves to {target}, which does not exist", "fix the uri")
     return target
+
+
+def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
+    """A Gazebo Fuel model (`https://fuel.gazebosim.org/1.0/OWNER/models/NAME[/VERSION]`) from
+    the local Fuel cache, where `gz fuel download` and Gazebo put it; Gazebo's own ground plane
+    and sun fall back to the ones twin ships. twin never downloads."""
+    parts = [unquote(p) for p in uri.split("://", 1)[1].split("/") if p]
+    if "models" not in parts[1:-1]:
+        raise ctx.error(include, f"{uri} is not a Fuel model URI", "write model://NAME")
+    at = parts.index("models")
+    host, owner, name = parts[0], parts[at - 1], parts[at + 1]
+    version = parts[at + 2] if len(parts) > at + 2 and parts[at + 2].isdigit() else None
+    for cache in _fuel_caches():
+        versions = cache / host / owner.lower() / "models" / name.lower()
+        found = sorted(
+            (d for d in versions.glob("*") if d.is_dir() and d.name.isdigit()),
+            key=lambda d: int(d.name),
+        )
+        chosen = [d for d in found if version is None or d.name == version]
+        if chosen:
+            return _from_config(ctx, include, chosen[-1])
+    shipped = SHIPPED_MODELS / name.lower().replace(" ", "_")
+    if name.lower() in FUEL_SHIPPED and shipped.is_dir():
+        return _from_config(ctx, include, shipped)
+    raise ctx.error(
+        include,
+        f"{uri} is a Gazebo Fuel model that is not in the local Fuel cache "
+        f"({', '.join(str(c) for c in _fuel_caches())}); twin does not download",
+        f"run `gz fuel download -u '{uri}'` where there is internet, or put the model in a "
+        "directory on GZ_SIM_RESOURCE_PATH and write model://NAME",
+    )
+
+
+def _fuel_caches() -> list[Path]:
+    """Where Gazebo keeps downloaded Fuel models: GZ_FUEL_CACHE_PATH, else ~/.gz/fuel (and
+    Ignition's ~/.ignition/fuel)."""
+    import os
+
+    if os.environ.get("GZ_FUEL_CACHE_PATH"):
+        return [Path(os.environ["GZ_FUEL_CACHE_PATH"]).expanduser()]
+    home = Path.home()
+    return [home / ".gz" / "fuel", home / ".ignition" / "fuel"]
 
 
 def _shipped(uri: str) -> Path | None:

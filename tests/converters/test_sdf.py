@@ -254,3 +254,29 @@ def test_an_empty_quat_xyzw_pose_is_the_identity(tmp_path):
     model = spec.compile()
     assert model.body("l").pos == pytest.approx([0.0, 0.0, 0.0])
     assert model.body("l").quat == pytest.approx([1.0, 0.0, 0.0, 0.0])
+
+
+FUEL = "https://fuel.gazebosim.org/1.0/OpenRobotics/models"
+
+
+def _fuel_world(*names: str) -> str:
+    includes = "".join(f"<include><uri>{FUEL}/{n}</uri></include>" for n in names)
+    return f'<sdf version="1.8"><world name="w">{includes}</world></sdf>'
+
+
+def test_fuel_models_come_from_the_local_fuel_cache_or_twins_own(tmp_path, monkeypatch):
+    # gz-sim's examples and the TurtleBot3 worlds include Fuel URIs; twin never downloads.
+    cache = tmp_path / "fuel"
+    monkeypatch.setenv("GZ_FUEL_CACHE_PATH", str(cache))
+    crate = cache / "fuel.gazebosim.org" / "openrobotics" / "models" / "wooden crate" / "2"
+    crate.mkdir(parents=True)
+    (crate / "model.sdf").write_text(
+        '<sdf version="1.6"><model name="crate"><static>true</static><link name="l">'
+        "<collision name='c'><geometry><box><size>1 1 1</size></box></geometry></collision>"
+        "</link></model></sdf>"
+    )
+    world = read_sdf_world(_fuel_world("Ground Plane", "Sun", "Wooden%20Crate"), "w", tmp_path)
+    assert [m.robot.name for m in world.models] == ["ground_plane", "crate"]
+    assert [light.name for light in world.lights] == ["sun"]
+    with pytest.raises(SDFError, match=r"Cafe Table is a Gazebo Fuel model .*`gz fuel download"):
+        read_sdf_world(_fuel_world("Cafe Table"), "w", tmp_path)
