@@ -69,9 +69,19 @@ def read_world(ctx: SdfContext, world: Any, text: str = "") -> WorldDescription:
         source=ctx.source,
         models=tuple(models),
         lights=tuple(_light(ctx, light) for light in world.findall("light")),
-        gravity=ctx.vector(world, "gravity", 3, DEFAULT_GRAVITY),  # type: ignore[arg-type]
+        gravity=_gravity(ctx, world),
         **physics,
     )
+
+
+def _gravity(ctx: SdfContext, world: Any) -> tuple[float, float, float]:
+    """`<world><gravity>` (SDF 1.5+), else the first `<physics><gravity>` (where SDF 1.4 has
+    it), else SDF's default."""
+    if world.find("gravity") is None:
+        holder = next((p for p in world.findall("physics") if p.find("gravity") is not None), None)
+        if holder is not None:
+            return ctx.vector(holder, "gravity", 3, DEFAULT_GRAVITY)  # type: ignore[return-value]
+    return ctx.vector(world, "gravity", 3, DEFAULT_GRAVITY)  # type: ignore[return-value]
 
 
 def _physics(ctx: SdfContext, world: Any) -> dict[str, Any]:

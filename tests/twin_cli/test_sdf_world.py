@@ -152,3 +152,23 @@ def test_quaternion_and_rpy_poses_agree() -> None:
     quat = Pose(0, 0, 0.25, 0.0, 0.0, 0.7).quat()
     from_quat = Pose.from_quat(0.0, 0.0, 0.25, quat)
     assert from_quat.yaw == pytest.approx(0.7, abs=1e-12), "yaw from (w, x, y, z)"
+
+
+SDF14_WORLD = """<?xml version="1.0"?>
+<sdf version="1.4"><world name="moon">
+<physics type="ode"><gravity>0 0 -1.62</gravity><max_step_size>0.001</max_step_size></physics>
+<model name="plinth"><static>true</static><link name="l"><inertial><mass>80</mass>
+<inertia><ixx>14.6</ixx><iyy>0</iyy><izz>14.6</izz></inertia></inertial>
+<collision name="c"><geometry><box><size>1 1 1</size></box></geometry></collision></link></model>
+</world></sdf>"""
+
+
+def test_an_sdf_1_4_world_with_a_static_model_of_bad_inertia_loads(tmp_path: Path) -> None:
+    # SDF 1.4 keeps gravity in <physics>; the AWS small house has static models whose
+    # inertias are not physical, which Gazebo loads (a static model never moves).
+    path = tmp_path / "moon.world"
+    path.write_text(SDF14_WORLD)
+    world = world_from_sdf(path)
+    assert tuple(world.model.opt.gravity) == pytest.approx((0.0, 0.0, -1.62))
+    world.step(200)
+    assert world.get_pose("plinth").z == pytest.approx(0.0, abs=1e-12), "static: never moves"

@@ -36,6 +36,7 @@ def world_from_sdf(
         SpawnError, EntityExistsError: a model cannot be placed.
     """
     from converters.errors import InputFileError
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import build_description
     from converters.resources.packages import PackageResolver
     from converters.sdf import read_sdf_world
@@ -59,7 +60,10 @@ def world_from_sdf(
     world = World(settings, name=name)
     world.set_lights(description.lights)
     for placed in description.models:
-        spec = build_description(placed.robot).spec
+        # A static model never moves, so its inertia is never used; Gazebo loads the AWS
+        # worlds' static furniture with non-physical inertias, and so does twin (repaired).
+        options = ConvertOptions(repair_inertia=placed.robot.gazebo.static)
+        spec = build_description(placed.robot, options).spec
         world.spawn(spec, name=placed.robot.name, pose=pose_of(placed.pose))
     return world
 
