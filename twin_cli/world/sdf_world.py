@@ -59,12 +59,15 @@ def world_from_sdf(
     )
     world = World(settings, name=name)
     world.set_lights(description.lights)
+    items = []
     for placed in description.models:
         # A static model never moves, so its inertia is never used; Gazebo loads the AWS
         # worlds' static furniture with non-physical inertias, and so does twin (repaired).
         options = ConvertOptions(repair_inertia=placed.robot.gazebo.static)
         spec = build_description(placed.robot, options).spec
-        world.spawn(spec, name=placed.robot.name, pose=pose_of(placed.pose))
+        items.append((spec, placed.robot.name, pose_of(placed.pose)))
+    if items:
+        world.spawn_specs(items)  # one compile for all of them
     return world
 
 
