@@ -85,7 +85,7 @@ BROKEN = [
         {"kp": 1000.0},
         ["--only", "ground_contact"],
         "ground_contact",
-        "kp 1e+03 N/m is too soft for 5 kg",
+        "kp 1e+03 N/m is too soft for the load on it",
     ),
 ]
 

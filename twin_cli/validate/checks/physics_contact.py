@@ -41,17 +41,30 @@ def geom_kp(run: ScenarioRun, geom: int) -> float | None:
 
 
 def _sink_hint(run: ScenarioRun, geom: int, depth: float, limit: float) -> str:
-    body = int(run.world.model.geom_bodyid[geom])
-    mass = float(run.world.model.body_mass[body])
+    """How to stop a link sinking. The load on a link is often more than its own weight (a
+    wheel under a chassis), so the kp asked for is what the measured sinkage says: kp·depth is
+    the load, load/limit the stiffness that holds it within the limit."""
+    from converters.gazebo.contact import max_contact_stiffness
+
+    model = run.world.model
+    body = int(model.geom_bodyid[geom])
+    mass = float(model.body_mass[body])
     kp = geom_kp(run, geom)
     text = f"{_link(run, body)} sinks {fmt_len(depth)} (limit {fmt_len(limit)})"
-    if kp is not None:
-        needed = mass * G / limit
+    if kp is None:
+        return f"{text}: the contact is too soft for {mass:.3g} kg; set <kp>/<kd> on the link"
+    step = float(model.opt.timestep)
+    if -float(model.geom_solref[geom][0]) >= 0.999 * max_contact_stiffness(step):
         return (
-            f"{text}: kp {kp:.3g} N/m is too soft for {mass:.3g} kg; raise <kp> in its "
-            f"<gazebo> block to ≥ {needed:.2g} N/m (m·g/kp ≤ {fmt_len(limit)})"
+            f"{text}: its contact is already as stiff as a {step:g} s step resolves (kp "
+            f"{kp:.3g} N/m on {mass:.3g} kg); a smaller step, or the load spread over more "
+            "contacts, sinks less"
         )
-    return f"{text}: the contact is too soft for {mass:.3g} kg; set <kp>/<kd> on the link"
+    needed = max(mass * G, kp * depth) / limit
+    return (
+        f"{text}: kp {kp:.3g} N/m is too soft for the load on it; raise <kp> in its <gazebo> "
+        f"block to ≥ {needed:.2g} N/m (load/kp ≤ {fmt_len(limit)})"
+    )
 
 
 def skip_fixed(check: str) -> CheckResult:
