@@ -84,11 +84,9 @@ class ResourceNotFoundError(ConversionError):
 class XacroError(ConversionError):
     """xacro failed on the input; carries xacro's own message."""
 
-    def __init__(self, path: str, message: str) -> None:
-        super().__init__(
-            f"{path}: xacro failed: {message}; fix the xacro file or pass the missing "
-            "argument with --arg NAME:=VALUE"
-        )
+    def __init__(self, path: str, message: str, fix: str | None = None) -> None:
+        fix = fix or "fix the xacro file or pass the missing argument with --arg NAME:=VALUE"
+        super().__init__(f"{path}: xacro failed: {message}; {fix}")
         self.path = path
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import io
 import threading
 import xml.dom.minidom
@@ -18,6 +19,8 @@ _LOCK = threading.Lock()
 
 XACRO_SUFFIXES = (".xacro",)
 XACRO_MARKERS = ("xmlns:xacro", "<xacro:")  # in a file with another suffix: written in xacro
+FOUND: contextvars.ContextVar[dict[str, str]] = contextvars.ContextVar("xacro_found")
+"""Packages `$(find)` resolved in the current expansion: name → directory (for messages)."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +63,9 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
     from xacro import substitution_args as subst
 
     def find(pkg: str) -> str:
-        return str(resolver.find_package(pkg, uri=f"$(find {pkg})", element="xacro $(find)"))
+        found = resolver.find_package(pkg, uri=f"$(find {pkg})", element="xacro $(find)")
+        FOUND.get()[pkg] = str(found)
+        return str(found)
 
     macro_names: list[str] = []
     original_grab = xacro.grab_macro
@@ -92,6 +97,36 @@ def _conversion_cause(exc: BaseException) -> ConversionError | None:
     return None
 
 
+def _xacro_error(path: Path, exc: BaseException) -> XacroError:
+    """xacro's failure, said once; a missing include names the package it was looked for in
+    (a source checkout or another version of the package lacks files its install has)."""
+    missing = _missing_file(exc)
+    if missing is None:
+        return XacroError(str(path), str(exc) or type(exc).__name__)
+    owner = next(
+        ((pkg, root) for pkg, root in FOUND.get().items() if missing.startswith(root + "/")), None
+    )
+    if owner is None:
+        return XacroError(str(path), f"{missing} does not exist", "fix the include's filename")
+    pkg, root = owner
+    return XacroError(
+        str(path),
+        f"{missing} does not exist in package '{pkg}', found at {root}",
+        f"that copy of '{pkg}' lacks the file (a source checkout, or a version other than the "
+        f"robot was written for); give the right one with --package {pkg}=PATH",
+    )
+
+
+def _missing_file(exc: BaseException) -> str | None:
+    seen: BaseException | None = exc
+    while seen is not None:
+        if isinstance(seen, FileNotFoundError) and seen.filename:
+            return str(seen.filename)
+        inner = getattr(seen, "exc", None)
+        seen = inner if isinstance(inner, BaseException) else (seen.__cause__ or seen.__context__)
+    return None
+
+
 def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver) -> XacroResult:
     """Run xacro on `path` with `args` (the `NAME:=VALUE` mappings).
 
@@ -102,6 +137,7 @@ def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver)
     import xacro
 
     stderr = io.StringIO()
+    FOUND.set({})
     with _LOCK, _patched_find(resolver) as macro_names, contextlib.redirect_stderr(stderr):
         try:
             doc = xacro.process_file(str(path), mappings=dict(args))
@@ -109,7 +145,7 @@ def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver)
             ours = _conversion_cause(exc)
             if ours is not None:
                 raise ours from exc
-            raise XacroError(str(path), str(exc) or type(exc).__name__) from exc
+            raise _xacro_error(path, exc) from exc
         finally:
             xacro.init_stacks(None)
     unexpanded = _unexpanded_calls(doc, set(macro_names))

@@ -71,3 +71,15 @@ def test_a_xacro_file_with_a_urdf_suffix_is_expanded(robot: Path, tmp_path: Path
         renamed, args={"size": "3"}, package_paths={"helper": robot.parent / "helper"}
     )
     assert sorted(link.name for link in result.description.links) == ["base_3", "from_include"]
+
+
+def test_an_include_missing_from_a_found_package_names_the_package(robot: Path) -> None:
+    # A source checkout or another version of a package lacks files its install has.
+    robot.write_text(XACRO.replace("$(find helper)/inc.xacro", "$(find helper)/gone.xacro"))
+    helper = robot.parent / "helper"
+    with pytest.raises(XacroError) as caught:
+        expand_xacro(robot, {}, PackageResolver.create(robot, {"helper": helper}, env={}))
+    message = str(caught.value)
+    assert f"gone.xacro does not exist in package 'helper', found at {helper}" in message
+    assert "--package helper=PATH" in message and "--arg" not in message
+    assert message.count("gone.xacro") == 1, message
