@@ -172,3 +172,17 @@ def test_an_sdf_1_4_world_with_a_static_model_of_bad_inertia_loads(tmp_path: Pat
     assert tuple(world.model.opt.gravity) == pytest.approx((0.0, 0.0, -1.62))
     world.step(200)
     assert world.get_pose("plinth").z == pytest.approx(0.0, abs=1e-12), "static: never moves"
+
+
+def test_what_a_world_file_holds_that_twin_does_not_simulate_is_said(tmp_path: Path) -> None:
+    # A <population> or an unsupported <cone> vanished without a word.
+    path = tmp_path / "w.world"
+    path.write_text(
+        '<sdf version="1.6"><world name="w"><population name="p"><model_count>3</model_count>'
+        '</population><model name="cone"><link name="l"><collision name="c"><geometry><cone>'
+        "<radius>0.1</radius><length>0.2</length></cone></geometry></collision></link></model>"
+        "</world></sdf>"
+    )
+    notes = "\n".join(world_from_sdf(path).file_notes)
+    assert "world <population>: not simulated" in notes, notes
+    assert "<cone> geometry is not supported" in notes, notes

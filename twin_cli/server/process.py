@@ -107,6 +107,9 @@ def write_private(path: Path, text: str) -> None:
         handle.write(text)
 
 
+MAX_NOTES = 20  # world-file notes printed by a foreground serve; all go to the log
+
+
 def build_world(opts: ServeOptions) -> Any:
     """The world to serve, loaded or empty, with the requested rate, step and pause state."""
     from twin_cli.world import World, WorldSettings
@@ -115,6 +118,13 @@ def build_world(opts: ServeOptions) -> Any:
     changes = {k: v for k, v in (("timestep", opts.step), ("rate", opts.rate)) if v is not None}
     if opts.world_file:
         world = load_world(opts.world_file, name=opts.world)
+        for k, note in enumerate(world.file_notes):  # in the log, and where the user looks
+            log.warning("%s: %s", opts.world_file, note)
+            if not opts.background and k < MAX_NOTES:
+                sys.stderr.write(f"twin: {note}\n")
+        if not opts.background and len(world.file_notes) > MAX_NOTES:
+            more = len(world.file_notes) - MAX_NOTES
+            sys.stderr.write(f"twin: … {more} more notes on the world file: twin logs\n")
         if changes:
             world.set_physics(**changes)
     else:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,7 @@ def world_from_sdf(
     from converters.errors import InputFileError
     from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import build_description
+    from converters.report import Report
     from converters.resources.packages import PackageResolver
     from converters.sdf import read_sdf_world
 
@@ -48,7 +50,8 @@ def world_from_sdf(
     except (OSError, UnicodeDecodeError) as exc:
         problem = "no such file" if isinstance(exc, FileNotFoundError) else f"unreadable ({exc})"
         raise InputFileError(str(path), problem, "give the path of an SDF world file") from exc
-    description = read_sdf_world(text, str(path), path.parent, resolver)
+    report = Report(source=str(path))
+    description = read_sdf_world(text, str(path), path.parent, resolver, report)
     settings = WorldSettings(
         timestep=description.timestep,
         rate=description.rate,
@@ -59,16 +62,31 @@ def world_from_sdf(
     )
     world = World(settings, name=name)
     world.set_lights(description.lights)
-    items = []
+    items, notes = [], _notes(report, "")
     for placed in description.models:
         # A static model never moves, so its inertia is never used; Gazebo loads the AWS
         # worlds' static furniture with non-physical inertias, and so does twin (repaired).
         options = ConvertOptions(repair_inertia=placed.robot.gazebo.static)
-        spec = build_description(placed.robot, options).spec
-        items.append((spec, placed.robot.name, pose_of(placed.pose)))
+        done = build_description(placed.robot, options)
+        items.append((done.spec, placed.robot.name, pose_of(placed.pose)))
+        notes += _notes(done.report, f"model '{placed.robot.name}': ")
     if items:
         world.spawn_specs(items)  # one compile for all of them
+    world.file_notes = notes
     return world
+
+
+def _notes(report: Any, prefix: str) -> list[str]:
+    """What a conversion left out or could only warn about, one line each (`twin serve` says
+    them: a world's populations, actors and unsupported shapes would otherwise vanish)."""
+    from converters.report import Outcome
+
+    kept = (Outcome.IGNORED, Outcome.WARNING)
+    return [
+        f"{e.outcome.value}: {prefix}{e.subject}: {e.detail}"
+        for e in report.entries
+        if e.outcome in kept
+    ]
 
 
 def load_world(path: str | os.PathLike, *, name: str = "default") -> World:
