@@ -96,6 +96,7 @@ GRAMMARS: dict[str, Grammar] = {
             Opt(("--at",), "at", str, multiple=True),
             Opt(("--names",), "names", str),
             _flag("--view", dest="view"),
+            _flag("--repair-inertia", dest="repair_inertia"),
         ),
     ),
     "delete": Grammar("delete", (NAME,), (WORLD,)),
