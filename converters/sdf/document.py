@@ -141,11 +141,16 @@ def _as_tinyxml_reads(text: str) -> str:
     and an XML declaration after a leading comment (gazebo-classic's `cafe.world`). Comments
     keep their line breaks, so error positions stay on their lines."""
     text = _COMMENT.sub(lambda m: "<!--" + "\n" * m.group(1).count("\n") + "-->", text)
-    start = len(text) - len(text.lstrip())
-    if text.startswith("<?xml", start):  # the one declaration allowed: keep it
-        end = text.index("?>", start) + 2
-        return text[:end] + _DECLARATION.sub("", text[end:])
-    return _DECLARATION.sub("", text)
+    text = text.lstrip()  # tinyxml2 also takes blank lines before the declaration
+    if text.startswith("<?xml") and "?>" in text:  # the one declaration allowed: keep it
+        end = text.index("?>") + 2
+        return text[:end] + _DECLARATION.sub(_blank, text[end:])
+    return _DECLARATION.sub(_blank, text)
+
+
+def _blank(match: re.Match) -> str:
+    """A removed span's line breaks, so the lines after it keep their numbers."""
+    return "\n" * match.group(0).count("\n")
 
 
 def parse_document(text: str, source: str) -> Any:

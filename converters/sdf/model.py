@@ -46,10 +46,6 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
     links, ext_links, surfaces = [], {}, []
     for element, prefix in ((el, p) for m, p in scopes for el in m.findall("link")):
         link, extension, inline = read_link(ctx, graph, element, prefix)
-        if link.name == WORLD_LINK:  # sdformat reserves it: the frame joints attach to
-            raise ctx.error(
-                element, "a link may not be named 'world' (SDFormat reserves it)", "rename it"
-            )
         links.append(link)
         if extension != LinkExtension(link.name):
             ext_links[link.name] = extension

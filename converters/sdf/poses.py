@@ -87,6 +87,10 @@ class PoseGraph:
     def _add(self, name: str, kind: str, element: Any, prefix: str, default: str) -> None:
         if not element.get("name"):
             raise self.ctx.error(element, "has no name", "give it a name attribute")
+        if element.get("name") == "world" and kind != "joint":  # the frame joints attach to
+            raise self.ctx.error(
+                element, f"a {kind} may not be named 'world' (SDFormat reserves it)", "rename it"
+            )
         if name in self.nodes:
             raise self.ctx.error(
                 element,

@@ -18,7 +18,7 @@ from converters.resources.packages import PackageResolver
 _LOCK = threading.Lock()
 
 XACRO_SUFFIXES = (".xacro",)
-XACRO_MARKERS = ("xmlns:xacro", "<xacro:")  # in a file with another suffix: written in xacro
+XACRO_MARKERS = ("<xacro:",)  # in a file with another suffix: written in xacro
 FOUND: contextvars.ContextVar[dict[str, str]] = contextvars.ContextVar("xacro_found")
 """Packages `$(find)` resolved in the current expansion: name → directory (for messages)."""
 
@@ -42,10 +42,10 @@ def needs_xacro(path: Path) -> bool:
     """True for `.xacro` files (incl. `.urdf.xacro`) and for any other file written in xacro.
 
     ROS launch files run xacro on whatever file they are given, so packages ship xacro under
-    other names (gz_ros2_control_demos' `test_pendulum_effort.xacro.urdf`); such a file declares
-    xacro's namespace or uses its tags. A URDF that xacro already expanded may keep the
-    namespace declaration; expanding it again changes nothing. Text placeholders without xacro
-    (turtlebot3's `${namespace}`, which its launch file replaces) do not count.
+    other names (gz_ros2_control_demos' `test_pendulum_effort.xacro.urdf`); such a file uses
+    xacro's tags. The namespace declaration alone does not count: URDFs that xacro already
+    expanded keep it, and some carry text placeholders (turtlebot3's `${namespace}`, which its
+    launch file replaces) that xacro would refuse.
     """
     if path.suffix.lower() in XACRO_SUFFIXES:
         return True
@@ -103,9 +103,8 @@ def _xacro_error(path: Path, exc: BaseException) -> XacroError:
     missing = _missing_file(exc)
     if missing is None:
         return XacroError(str(path), str(exc) or type(exc).__name__)
-    owner = next(
-        ((pkg, root) for pkg, root in FOUND.get().items() if missing.startswith(root + "/")), None
-    )
+    owners = [(pkg, root) for pkg, root in FOUND.get().items() if missing.startswith(root + "/")]
+    owner = max(owners, key=lambda o: len(o[1]), default=None)  # the innermost package
     if owner is None:
         return XacroError(str(path), f"{missing} does not exist", "fix the include's filename")
     pkg, root = owner

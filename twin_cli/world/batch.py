@@ -29,14 +29,17 @@ def batch_names(base: str, count: int) -> list[str]:
     return [f"{base}_{i}" for i in range(count)]
 
 
-def check_batch(names: Sequence[str], poses: Sequence[Pose], taken: Sequence[str]) -> None:
-    """Refuses a batch before anything is attached.
+def check_batch(
+    names: Sequence[str], poses: Sequence[Pose], taken: Sequence[str], limit: int = MAX_BATCH
+) -> None:
+    """Refuses a batch before anything is attached (`limit`: most poses; a world file's models
+    have none).
 
     Raises:
         InvalidRequestError: no poses, counts differ, a name repeats, a pose is not finite.
         EntityExistsError: a name is already an entity of the world.
     """
-    if not poses or len(poses) > MAX_BATCH:
+    if not poses or len(poses) > limit:
         raise InvalidRequestError(
             "batch spawn", f"{len(poses)} poses", f"give 1 to {MAX_BATCH} poses (--at X,Y)"
         )
@@ -109,14 +112,14 @@ class BatchSpawning:
         the square of their number (800 boxes: 77 s). All or nothing, as `spawn_batch`."""
         names = [spawn.check_entity_name(name) for _, name, _ in items]
         poses = [pose for _, _, pose in items]
-        check_batch(names, poses, list(self._entities))
+        check_batch(names, poses, list(self._entities), limit=len(items) or 1)
         loaded = [spawn.load_source(spec, None, None) for spec, _, _ in items]  # type: ignore[arg-type]
         return self._spawn_loaded(loaded, names, poses, False, None, {})
 
     def _spawn_loaded(self, loaded, names, poses, on_ground, joints, inputs):  # noqa: ANN001, ANN202
         """Attaches each loaded source as its name at its pose, compiles once, seeds each."""
         with self.lock:
-            check_batch(names, poses, list(self._entities))
+            check_batch(names, poses, list(self._entities), limit=max(MAX_BATCH, len(poses)))
             try:
                 homes = [
                     self._attach(one, n, p) for one, n, p in zip(loaded, names, poses, strict=True)

@@ -64,9 +64,10 @@ def world_from_sdf(
     world.set_lights(description.lights)
     items, notes = [], _notes(report, "")
     for placed in description.models:
-        # A static model never moves, so its inertia is never used; Gazebo loads the AWS
-        # worlds' static furniture with non-physical inertias, and so does twin (repaired).
-        options = ConvertOptions(repair_inertia=placed.robot.gazebo.static)
+        # One model's non-physical inertia does not refuse a world: Gazebo loads the AWS
+        # worlds' furniture with such inertias (mostly static, where inertia is never used),
+        # and so does twin, repaired and said (`file_notes`).
+        options = ConvertOptions(repair_inertia=True)
         done = build_description(placed.robot, options)
         items.append((done.spec, placed.robot.name, pose_of(placed.pose)))
         notes += _notes(done.report, f"model '{placed.robot.name}': ")
@@ -81,7 +82,7 @@ def _notes(report: Any, prefix: str) -> list[str]:
     them: a world's populations, actors and unsupported shapes would otherwise vanish)."""
     from converters.report import Outcome
 
-    kept = (Outcome.IGNORED, Outcome.WARNING)
+    kept = (Outcome.IGNORED, Outcome.WARNING, Outcome.REPAIRED)
     return [
         f"{e.outcome.value}: {prefix}{e.subject}: {e.detail}"
         for e in report.entries

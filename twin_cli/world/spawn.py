@@ -84,13 +84,15 @@ def load_source(
 ) -> LoadedSource:
     """Reads a URDF/xacro/SDF (through the converter), an MJCF file, a text or an MjSpec.
 
-    `env`: the caller's package search variables (twin_cli.package_env; None: this process's).
+    `env`: the caller's package search variables (twin_cli.package_env), over this process's.
     `repair_inertia`: bound non-physical inertias instead of refusing them (`--repair-inertia`).
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
         converters.ConversionError: the converter refused the description.
     """
+    if env is not None:  # the caller's values over this process's (unset ones: this process's)
+        env = {**os.environ, **env}
     if isinstance(source, mujoco.MjSpec):
         spec = source.copy()
         return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
