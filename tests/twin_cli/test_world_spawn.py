@@ -281,3 +281,24 @@ def test_a_model_of_unjoined_links_is_placed_and_posed_by_its_model_frame(tmp_pa
     assert where["B"] == pytest.approx([1.0 + 3 * c - 2 * s, 3 * s + 2 * c, 2.0], abs=1e-9)
     pose = world.get_pose("M")
     assert (pose.x, pose.y, pose.z, pose.yaw) == pytest.approx((1.0, 0.0, 2.0, 0.5), abs=1e-9)
+
+
+def test_a_model_of_unjoined_links_moves_and_lands_as_one(tmp_path):
+    # set_pose moved only the first link (to z 0) and --on-ground lowered only the first.
+    import math
+
+    path = tmp_path / "two_roots.sdf"
+    path.write_text(TWO_ROOTS)
+    world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
+    world.spawn(path, name="M", pose=Pose(z=2.0, yaw=0.5), on_ground=True)
+    mujoco.mj_kinematics(world.model, world.data)
+    heights = [world.data.xpos[world.model.body(f"M/{b}").id][2] for b in "AB"]
+    assert heights == pytest.approx([0.1, 0.1], abs=1e-9), "both boxes rest on the ground"
+    world.set_pose("M", Pose(x=-1.0, y=2.0, z=3.0, yaw=1.5))
+    mujoco.mj_kinematics(world.model, world.data)
+    c, s = math.cos(1.5), math.sin(1.5)
+    where = {b: world.data.xpos[world.model.body(f"M/{b}").id] for b in "AB"}
+    assert where["A"] == pytest.approx([-1.0, 2.0, 3.0], abs=1e-9)
+    assert where["B"] == pytest.approx([-1.0 + 3 * c - 2 * s, 2.0 + 3 * s + 2 * c, 3.0], abs=1e-9)
+    pose = world.get_pose("M")
+    assert (pose.x, pose.y, pose.z, pose.yaw) == pytest.approx((-1.0, 2.0, 3.0, 1.5), abs=1e-9)

@@ -43,7 +43,7 @@ from twin_cli.world.entities import (
 from twin_cli.world.loop import SteppingLoop, WorldLock
 from twin_cli.world.observers import Observers
 from twin_cli.world.physics import PhysicsSettings
-from twin_cli.world.pose import Pose
+from twin_cli.world.pose import Pose, quat_multiply, rotate
 from twin_cli.world.queries import JointState
 from twin_cli.world.respec import SpecRenewal
 from twin_cli.world.running import STATE, RunControl
@@ -264,7 +264,8 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
         pose = replace(pose, z=pose.z - low)
         if ix.free_qpos >= 0:
             q = q.copy()
-            q[int(np.flatnonzero(ix.qpos == ix.free_qpos)[0]) + 2] -= low
+            for at in spawn.free_offsets(model, ix):  # every free link, not only the root
+                q[at + 2] -= low
             return pose, q, (model, data, index)
         spawn.move_frame(self._spec, name, pose)
         model, data, index = self._rebuild(self._spec, name, "on-ground placement")
@@ -330,12 +331,31 @@ class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThr
                 self._entities[name] = replace(self._entities[name], pose=pose)
                 self._commit(trial, *self._rebuild(trial, None, self._entities[name].source))
                 return
+            if ix.model_site >= 0 and self.model.site_bodyid[ix.model_site] == 0:
+                self._move_free_links(name, ix, pose)  # unjoined links: all move with the frame
+                return
             if ix.model_site >= 0:
                 pose = queries.root_from_model(self.model, ix, pose)
             self.data.qpos[ix.free_qpos : ix.free_qpos + 3] = pose.position()
             self.data.qpos[ix.free_qpos + 3 : ix.free_qpos + 7] = pose.quat()
             self.data.qvel[ix.dofs] = 0.0
             self.data.qacc_warmstart[ix.dofs] = 0.0
+
+    def _move_free_links(self, name: str, ix: EntityIndex, pose: Pose) -> None:
+        """Moves every free link of a model of unjoined links rigidly, so that its model frame
+        goes from where it is (its spawn or last set pose) to `pose`; at rest."""
+        old = self._entities[name].pose
+        w, x, y, z = old.quat()
+        turn = quat_multiply(pose.quat(), (w, -x, -y, -z))
+        for at in spawn.free_offsets(self.model, ix):
+            a = int(ix.qpos[at])
+            offset = tuple(float(v) for v in self.data.qpos[a : a + 3] - old.position())
+            self.data.qpos[a : a + 3] = np.add(pose.position(), rotate(turn, offset))  # type: ignore[arg-type]
+            link_quat = tuple(float(v) for v in self.data.qpos[a + 3 : a + 7])
+            self.data.qpos[a + 3 : a + 7] = quat_multiply(turn, link_quat)  # type: ignore[arg-type]
+        self.data.qvel[ix.dofs] = 0.0
+        self.data.qacc_warmstart[ix.dofs] = 0.0
+        self._entities[name] = replace(self._entities[name], pose=pose)
 
     def joint_states(self, name: str) -> list[JointState]:
         """Position, velocity and actuator effort of each joint (free joint excluded)."""

@@ -386,6 +386,13 @@ def remove_entity(world: mujoco.MjSpec, name: str) -> None:
     shared_meshes.prune(world)
 
 
+def free_offsets(model: mujoco.MjModel, index: EntityIndex) -> list[int]:
+    """Where each free joint of the entity starts in its own qpos (`index.qpos` order): the
+    root's, and those of an SDF model's other unjoined links."""
+    free = [j for j in index.joints if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+    return [int(np.flatnonzero(index.qpos == model.jnt_qposadr[j])[0]) for j in free]
+
+
 def initial_qpos(
     model: mujoco.MjModel, index: EntityIndex, home: np.ndarray | None, pose: Pose
 ) -> np.ndarray:
@@ -401,9 +408,7 @@ def initial_qpos(
         return q0
     q = np.array(home, dtype=float)
     frame_quat = pose.quat()
-    free = [j for j in index.joints if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
-    for address in (int(model.jnt_qposadr[j]) for j in free):
-        at = int(np.flatnonzero(index.qpos == address)[0])
+    for at in free_offsets(model, index):
         key_pos = (float(home[at]), float(home[at + 1]), float(home[at + 2]))
         q[at : at + 3] = np.add(pose.position(), rotate(frame_quat, key_pos))
         q[at + 3 : at + 7] = quat_multiply(
