@@ -70,6 +70,8 @@ def test_the_viewer_port_is_not_reachable_on_a_non_loopback_address_by_default(
         assert twin("list", world="viewbind").returncode == 0, "the world died"
         assert twin("stop", world="viewbind").returncode == 0
     # The probe can fail: asked for all interfaces, the same address answers, with a warning.
+    # A fresh port: the first one may still be held by the probes' closing connections.
+    port = free_port()
     with serve_world(tmp_path, "viewpublic"):
         public = twin("view", "--host", "0.0.0.0", "--port", str(port), world="viewpublic")
         assert public.returncode == 0, public.stderr
