@@ -188,3 +188,27 @@ def test_what_a_world_file_holds_that_twin_does_not_simulate_is_said(tmp_path: P
     notes = "\n".join(world_from_sdf(path).file_notes)
     assert "world <population>: not simulated" in notes, notes
     assert "<cone> geometry is not supported" in notes, notes
+
+
+def test_a_served_worlds_models_are_found_with_package_paths(tmp_path: Path) -> None:
+    # `twin serve WORLD --package NAME=PATH`: the fix the missing-model message names.
+    from converters.errors import PackageNotFoundError
+    from twin_cli.world.sdf_world import load_world
+
+    model = tmp_path / "elsewhere" / "shelf"  # not above the world file: found only if given
+    model.mkdir(parents=True)
+    (model / "model.sdf").write_text(
+        '<sdf version="1.6"><model name="shelf"><static>true</static><link name="l"><collision '
+        'name="c"><geometry><box><size>1 1 1</size></box></geometry></collision></link></model>'
+        "</sdf>"
+    )
+    path = tmp_path / "world" / "w.world"
+    path.parent.mkdir()
+    path.write_text(
+        '<sdf version="1.6"><world name="w"><include><uri>model://shelf</uri>'
+        "<pose>1 2 0.5 0 0 0</pose></include></world></sdf>"
+    )
+    with pytest.raises(PackageNotFoundError, match="--package shelf=PATH"):
+        load_world(path)
+    pose = load_world(path, package_paths={"shelf": str(model)}).get_pose("shelf")
+    assert (pose.x, pose.y, pose.z) == pytest.approx((1.0, 2.0, 0.5))

@@ -39,6 +39,8 @@ class ServeOptions:
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
         autosave: seconds between autosaves to `<world>.autosave.json`; 0 turns it off.
         view: serve MuJoCo's web viewer on 127.0.0.1 from the start.
+        package_paths: package or model name → directory for an SDF world's `model://` and
+            `package://` (`--package`), searched before GAZEBO_MODEL_PATH and the rest.
     """
 
     world: str = runtime.DEFAULT_WORLD
@@ -52,6 +54,7 @@ class ServeOptions:
     foxglove: int | None = None
     autosave: float = 10.0
     view: bool = False
+    package_paths: dict[str, str] | None = None
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -117,7 +120,7 @@ def build_world(opts: ServeOptions) -> Any:
 
     changes = {k: v for k, v in (("timestep", opts.step), ("rate", opts.rate)) if v is not None}
     if opts.world_file:
-        world = load_world(opts.world_file, name=opts.world)
+        world = load_world(opts.world_file, name=opts.world, package_paths=opts.package_paths)
         for k, note in enumerate(world.file_notes):  # in the log, and where the user looks
             log.warning("%s: %s", opts.world_file, note)
             if not opts.background and k < MAX_NOTES:

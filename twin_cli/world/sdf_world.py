@@ -90,13 +90,15 @@ def _notes(report: Any, prefix: str) -> list[str]:
     ]
 
 
-def load_world(path: str | os.PathLike, *, name: str = "default") -> World:
-    """A world from a file: a Gazebo SDF world (`.sdf`, `.world`), an MJCF scene, or one that
-    `twin save` wrote."""
+def load_world(
+    path: str | os.PathLike, *, name: str = "default", package_paths: dict[str, str] | None = None
+) -> World:
+    """A world from a file: a Gazebo SDF world (`.sdf`, `.world`; `package_paths` for its
+    `model://` and `package://`), an MJCF scene, or one that `twin save` wrote."""
     from twin_cli.world.mjcf_world import is_mjcf_file, world_from_mjcf
 
     if is_world_file(path):
-        return world_from_sdf(path, name=name)
+        return world_from_sdf(path, name=name, package_paths=package_paths)
     if is_mjcf_file(path):
         return world_from_mjcf(path, name=name)
     return World.load(path)

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from twin_cli.cli.options import WorldOpt
+from twin_cli.cli.options import PackageOpt, WorldOpt, usage_errors
 
 
 def serve(
@@ -49,11 +49,19 @@ def serve(
     view: Annotated[
         bool, typer.Option("--view", help="Serve MuJoCo's web viewer on 127.0.0.1 too.")
     ] = False,
+    package: PackageOpt = None,
 ) -> None:
-    """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it."""
+    """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it.
+
+    An SDF world's `model://NAME` is found with `--package NAME=PATH`, then GAZEBO_MODEL_PATH /
+    GZ_SIM_RESOURCE_PATH, then the directories above the file.
+    """
+    from twin_cli.cli.pairs import parse_pairs
     from twin_cli.server.process import ServeOptions
     from twin_cli.server.process import serve as run_server
 
+    with usage_errors():
+        packages = parse_pairs(package, "=", "--package")
     opts = ServeOptions(
         world,
         str(world_file) if world_file else None,
@@ -66,6 +74,7 @@ def serve(
         foxglove,
         view=view,
         autosave=0.0 if no_autosave else autosave,
+        package_paths=packages or None,
     )
     run_server(opts)
 
