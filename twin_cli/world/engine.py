@@ -66,7 +66,7 @@ _Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads, SpecRenewal):
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
-    file_notes: list[str] = []  # what a world file held that twin does not simulate (sdf_world)
+    file_notes: tuple[str, ...] = ()  # what a world file held that twin does not simulate
 
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
         self.settings = settings or WorldSettings()

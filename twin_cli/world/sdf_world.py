@@ -73,7 +73,7 @@ def world_from_sdf(
         notes += _notes(done.report, f"model '{placed.robot.name}': ")
     if items:
         world.spawn_specs(items)  # one compile for all of them
-    world.file_notes = notes
+    world.file_notes = tuple(notes)
     return world
 
 
