@@ -17,8 +17,8 @@ import time
 from typing import Any
 
 NICE = 10  # added niceness of the encoder process
-IDLE_S = 0.002  # [s] poll period when the ring is empty
-BATCH = 32  # records taken from the ring between looks at the pipe (sensor readings)
+IDLE_S = 0.01  # [s] poll period when the ring is empty: fewer, longer runs of warm encoding
+BATCH = 64  # records taken from the ring between looks at the pipe (sensor readings)
 
 
 def main(argv: list[str]) -> None:
@@ -74,14 +74,14 @@ class _Encoder:
     """Turns records into messages with the layouts the parent sent."""
 
     def __init__(self, writer: Any, times: Any) -> None:
-        from twin_cli.record.sampler import Kinematics
+        from twin_cli.record.recorder import Publisher
 
         self.writer = writer
         self.times = times
         self.samples = 0
         self._layouts: dict[int, Any] = {}
         self._epoch = -1
-        self._kinematics = Kinematics()
+        self._publisher = Publisher()
         self._stop: dict | None = None
 
     def poll(self, conn: Any) -> dict | None:
@@ -109,8 +109,6 @@ class _Encoder:
             self._stop = message[1]
 
     def encode(self, record: Any, conn: Any) -> None:
-        from twin_cli.record.recorder import publish_sample
-
         epoch = int(record[1])
         while epoch not in self._layouts:
             self._take(conn.recv())
@@ -118,7 +116,7 @@ class _Encoder:
         sample = _sample(record, layout)
         new = epoch != self._epoch
         self._epoch = epoch
-        if publish_sample(sample, self._kinematics, self.writer, new_layout=new):
+        if self._publisher.publish(sample, self.writer, new_layout=new):
             if self.samples == 0:
                 self.times[0] = sample.time
             self.times[1] = sample.time

@@ -18,11 +18,12 @@ from typing import Any, Protocol
 from twin_cli.errors import InvalidRequestError
 from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
+from twin_cli.record.live_messages import LiveMessages
 from twin_cli.record.sampler import Kinematics, Sample, Sampler
 from twin_cli.record.sensor_feed import KEPT, SensorFeed
 from twin_cli.record.sensor_messages import sensor_message
 from twin_cli.record.sensor_pump import SensorPump
-from twin_cli.record.topics import Message, Topic, latched_messages, live_messages, topics
+from twin_cli.record.topics import Message, Topic, latched_messages, topics
 
 log = logging.getLogger("twin.record")
 HEARTBEAT_S = 0.5  # [s] wall: how often a live view republishes a world that is not stepping
@@ -34,7 +35,8 @@ class Sink(Protocol):
 
     def set_topics(self, topics: list[Topic]) -> None: ...
 
-    def write(self, message: Message) -> None: ...
+    def write(self, message: Message) -> None:
+        """Encodes or copies `message` now: its object is refilled for the next sample."""
 
     def close(self) -> None: ...
 
@@ -192,14 +194,14 @@ class Recording(Follows):
 
     # ------------------------------------------------------------ worker thread
     def _work(self) -> None:
-        kinematics, layout = Kinematics(), None
+        publisher, layout = Publisher(), None
         try:
             while (sample := self._next()) is not None:
                 if isinstance(sample, list):
                     self._publish_readings(sample)
                     continue
                 while sample is not None:
-                    layout = self._publish(sample, layout, kinematics)
+                    layout = self._publish(sample, layout, publisher)
                     sample = self._next_newest()
             self._pump.close()  # its last readings, then those still queued
             while not self._queue.empty():
@@ -214,13 +216,13 @@ class Recording(Follows):
         finally:
             self._close_sinks()
 
-    def _publish(self, sample: Sample, layout: Layout | None, kinematics: Kinematics) -> Layout:
+    def _publish(self, sample: Sample, layout: Layout | None, publisher: Publisher) -> Layout:
         sink = _Fanout(self._sinks)
         if sample.layout is not layout:
             self._layout_topics = topics(sample.layout)
         extra = list(self._sensor_topics.values())
         new = sample.layout is not layout
-        if publish_sample(sample, kinematics, sink, new_layout=new, extra_topics=extra):
+        if publisher.publish(sample, sink, new_layout=new, extra_topics=extra):
             self._count(sample.time)
             return sample.layout
         return layout
@@ -286,26 +288,30 @@ class _Fanout:
             sink.write(message)
 
 
-def publish_sample(
-    sample: Sample,
-    kinematics: Kinematics,
-    sink: Any,
-    *,
-    new_layout: bool,
-    extra_topics: Sequence[Topic] = (),
-) -> bool:
-    """Hands one sample's messages to `sink` (its topics and latched messages first when the
-    layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
-    if not sample.finite():
-        return False
-    if new_layout:
-        sink.set_topics(topics(sample.layout) + list(extra_topics))
-        for message in latched_messages(sample.layout, sample.time):
+class Publisher:
+    """Turns samples into messages: link poses on scratch data, and the reusable live messages
+    of the current layout (`live_messages`). One per consumer thread or process."""
+
+    def __init__(self) -> None:
+        self._kinematics = Kinematics()
+        self._live: LiveMessages | None = None
+
+    def publish(
+        self, sample: Sample, sink: Any, *, new_layout: bool, extra_topics: Sequence[Topic] = ()
+    ) -> bool:
+        """Hands one sample's messages to `sink` (its topics and latched messages first when the
+        layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
+        if not sample.finite():
+            return False
+        if new_layout:
+            sink.set_topics(topics(sample.layout) + list(extra_topics))
+            for message in latched_messages(sample.layout, sample.time):
+                sink.write(message)
+        if self._live is None or self._live.layout is not sample.layout:
+            self._live = LiveMessages(sample.layout)
+        for message in self._live.fill(sample, *self._kinematics.poses(sample)):
             sink.write(message)
-    xpos, xquat = kinematics.poses(sample)
-    for message in live_messages(sample, xpos, xquat):
-        sink.write(message)
-    return True
+        return True
 
 
 class BagSink:

@@ -101,14 +101,15 @@ class Sampler:
 
 
 class Kinematics:
-    """Body and site poses of samples, on scratch data of the sample's model (consumer side)."""
+    """Body poses of samples, on scratch data of the sample's model (consumer side)."""
 
     def __init__(self) -> None:
         self._model: Any = None
         self._data: Any = None
 
-    def poses(self, sample: Sample) -> tuple[np.ndarray, np.ndarray]:
-        """World positions [m] (nbody×3) and quaternions w,x,y,z (nbody×4) of every body."""
+    def poses(self, sample: Sample) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World positions [m] (nbody×3), quaternions w,x,y,z (nbody×4) and rotation matrices
+        (nbody×9) of every body: views of the scratch data, valid until the next call."""
         model = sample.layout.model
         if model is not self._model:
             self._model, self._data = model, mujoco.MjData(model)
@@ -117,4 +118,4 @@ class Kinematics:
         d.mocap_pos[:] = sample.mocap_pos
         d.mocap_quat[:] = sample.mocap_quat
         mujoco.mj_kinematics(model, d)
-        return d.xpos.copy(), d.xquat.copy()
+        return d.xpos, d.xquat, d.xmat

@@ -60,6 +60,7 @@ class Observers:
         self._handles = itertools.count(1)
         self._due = math.inf  # [s] the earliest entry's due time
         self._time = -math.inf  # [s] at the end of the last split: later time before it, a reset
+        self._version = 0  # changes with the set of entries or their grid (ends a stride run)
 
     def __bool__(self) -> bool:
         return bool(self._entries)
@@ -97,11 +98,37 @@ class Observers:
             now = self._time = data.time
             if now >= due - late:  # is_due
                 self._notify(now, timestep)
+                n = self._stride(n, step, data, timestep)
                 if not self._entries:
-                    step(n)
+                    if n:
+                        step(n)
                     return
 
+    def _stride(self, n: int, step: Callable[[int], None], data: Any, timestep: float) -> int:
+        """Right after a call: while a lone observer's period is a whole number K of steps,
+        steps K and calls it, with no sim-time arithmetic in between (it cost a 100 Hz
+        recording of an unthrottled humanoid about 1 % of the loop). The due time is brought
+        up to date once at the end; a callback that adds or removes observers ends the run.
+        Returns the steps left."""
+        if len(self._entries) != 1:
+            return n
+        (entry,) = self._entries.values()
+        ratio = entry.period / timestep
+        stride = round(ratio)
+        if stride < 1 or abs(ratio - stride) > DUE_TOLERANCE or n < stride:
+            return n
+        callback, version = entry.callback, self._version
+        while n >= stride and self._version == version:
+            step(stride)
+            n -= stride
+            callback()
+        if self._version == version:
+            now = self._time = data.time
+            entry.due = self._due = next_due(now, entry.origin, entry.period, timestep)
+        return n
+
     def _summarize(self) -> None:
+        self._version += 1
         entries = self._entries.values()
         self._due = min((e.due for e in entries), default=math.inf)
 
