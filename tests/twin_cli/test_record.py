@@ -23,27 +23,30 @@ QUAT_TOL = 1e-9
 
 
 @pytest.fixture(scope="module")
-def falling(tmp_path_factory) -> tuple[Path, dict[float, dict], dict[float, list]]:
+def falling(tmp_path_factory) -> tuple[Path, dict[float, dict], dict[float, list], dict]:
     """2 s of the humanoid falling from 1 m, sampled at 100 Hz; the world's own link poses and
-    joint states at each sample time, read through World's API as `twin links/joints` do."""
+    joint states at each sample time, read through World's API as `twin links/joints` do, and
+    the free joint's velocity (world-frame linear, body-frame angular: MuJoCo's qvel)."""
     world = World()
     world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
     path = tmp_path_factory.mktemp("rec") / "fall.mcap"
     recording = BagRecording(world, path, rate=RATE).start()  # encoded in another process
     links, joints = {0.0: world.link_poses("h")}, {0.0: world.joint_states("h")}
+    velocities = {0.0: world.data.qvel[:6].copy()}  # the only entity: its free joint comes first
     for _ in range(SAMPLES):
         world.step(STEPS_PER_SAMPLE)
         if not hasattr(world, "add_observer"):
             recording.capture_now()
         t = round(float(world.data.time), 9)
         links[t], joints[t] = world.link_poses("h"), world.joint_states("h")
+        velocities[t] = world.data.qvel[:6].copy()
     status = recording.stop()
     assert status.error is None and status.samples == SAMPLES + 1, status
-    return path, links, joints
+    return path, links, joints, velocities
 
 
 def test_every_message_deserializes_and_clock_ticks_at_the_rate(falling):
-    path, _, _ = falling
+    path, *_ = falling
     bag = read_bag(path)
     assert {"/clock", "/tf", "/tf_static", "/h/joint_states", "/h/odom"} <= set(bag)
     clock = np.array([seconds(m.clock) for _, m in bag["/clock"]])
@@ -54,7 +57,7 @@ def test_every_message_deserializes_and_clock_ticks_at_the_rate(falling):
 
 
 def test_tf_composes_to_the_worlds_link_poses(falling):
-    path, links, _ = falling
+    path, links, *_ = falling
     bag = read_bag(path)
     ((_, tf_static),) = bag["/tf_static"]
     assert {t.child_frame_id for t in tf_static.transforms} == {"h/imu_link"}, "lumped link frame"
@@ -70,7 +73,7 @@ def test_tf_composes_to_the_worlds_link_poses(falling):
 
 
 def test_joint_states_equal_the_worlds(falling):
-    path, _, joints = falling
+    path, _, joints, _ = falling
     for _, message in read_bag(path)["/h/joint_states"]:
         t = round(seconds(message.header.stamp), 9)
         expected = joints[t]
@@ -82,7 +85,7 @@ def test_joint_states_equal_the_worlds(falling):
 
 
 def test_odometry_is_the_root_pose(falling):
-    path, links, _ = falling
+    path, links, *_ = falling
     for _, message in read_bag(path)["/h/odom"][::20]:
         t = round(seconds(message.header.stamp), 9)
         p, q = message.pose.pose.position, message.pose.pose.orientation
@@ -92,10 +95,36 @@ def test_odometry_is_the_root_pose(falling):
         assert message.child_frame_id == "h/torso" and message.header.frame_id == "world"
 
 
+def test_odometry_twist_is_the_root_velocity_in_the_root_frame(falling):
+    """nav_msgs/Odometry's twist is in child_frame_id: the linear velocity is the world-frame
+    one rotated into the torso's frame (Rᵀ v, R from the recorded orientation, composed here
+    with its own formula), the angular one MuJoCo's body-frame rate."""
+    path, _, _, velocities = falling
+    moving = 0
+    for _, message in read_bag(path)["/h/odom"]:
+        t = round(seconds(message.header.stamp), 9)
+        o, twist = message.pose.pose.orientation, message.twist.twist
+        w, x, y, z = o.w, o.x, o.y, o.z
+        rotation = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+        v = velocities[t]
+        linear = np.array([twist.linear.x, twist.linear.y, twist.linear.z])
+        angular = np.array([twist.angular.x, twist.angular.y, twist.angular.z])
+        assert np.allclose(linear, rotation.T @ v[:3], atol=1e-9), f"linear twist at t={t}"
+        assert np.array_equal(angular, v[3:6]), f"angular twist at t={t}"
+        moving += np.linalg.norm(v[:3]) > 0.1 and not np.allclose(rotation, np.eye(3), atol=1e-2)
+    assert moving > 10, "the check saw the torso moving and turned"
+
+
 def test_robot_description_is_the_urdf_whose_links_are_the_frames(falling):
     import yourdfpy
 
-    path, links, _ = falling
+    path, links, *_ = falling
     ((_, message),) = read_bag(path)["/h/robot_description"]
     urdf = yourdfpy.URDF.load(io.StringIO(message.data), load_meshes=False)
     assert set(links[0.0]) | {"imu_link"} == set(urdf.link_map), "URDF links vs recorded frames"
@@ -106,7 +135,7 @@ def test_mcap_library_validates_chunks_summary_and_rosbag2_metadata(falling):
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
-    path, _, joints = falling
+    path, _, joints, _ = falling
     with path.open("rb") as stream:
         reader = make_reader(stream, validate_crcs=True, decoder_factories=[DecoderFactory()])
         summary = reader.get_summary()
