@@ -293,3 +293,40 @@ def test_two_observers_at_unrelated_rates_each_fire_on_their_own_grid():
     assert fast == pytest.approx([0.01 * k for k in range(1, 101)], abs=1e-12)
     expected = [math.ceil(round(k / 30 / 0.001, 9)) * 0.001 for k in range(1, 31)]
     assert slow == pytest.approx(expected, abs=1e-12)
+
+
+def test_ring_records_keep_their_layout_across_wraps_and_model_changes():
+    """The ring's records have no header: writer and reader agree on each model's record length
+    and on where a new model's records start, through a wrap that leaves the end unused."""
+    import mujoco
+
+    from twin_cli.record import ring
+
+    body = '<body><freejoint/><geom size="0.1"/></body>'
+    models = [
+        mujoco.MjModel.from_xml_string(
+            f'<mujoco><worldbody>{body * n}<body mocap="true"/></worldbody></mujoco>'
+        )
+        for n in (1, 3)
+    ]
+    data, header, _ = ring.views(ring.allocate(211)[1])  # no record length (27, 65) divides it
+    writer, reader = ring.RingWriter(data, header, lambda: True), ring.RingReader(data, header)
+    written, read = [], []
+    for k in range(40):
+        model = models[(k // 7) % 2]
+        if k % 7 == 0:
+            reader.add_layout(writer.start_layout(model), k // 7, model)
+            d = mujoco.MjData(model)
+        d.time, d.qpos[:] = 0.01 * k, np.arange(model.nq) + k
+        d.qvel[:], d.qfrc_actuator[:] = -k, 0.5 * k
+        d.mocap_pos[:] = k
+        assert writer.put(d)
+        mocap = [d.mocap_pos.ravel(), d.mocap_quat.ravel()]
+        state = np.concatenate([[d.time], d.qpos, d.qvel, *mocap, d.qfrc_actuator])
+        written.append((k // 7, state))
+        if k % 2 == 1:  # the reader lags a record behind (two always fit, with a wrap's skip)
+            read += reader.read(int(header[ring.WRITE]), limit=100)
+    read += reader.read(int(header[ring.WRITE]), limit=100)
+    assert len(read) == len(written)
+    for (epoch, record), (want_epoch, want) in zip(read, written, strict=True):
+        assert epoch == want_epoch and np.array_equal(record, want)

@@ -107,6 +107,45 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
     assert np.all(np.diff(stamps) == 10_000_000), "consecutive 100 Hz samples up to the cut"
 
 
+def test_the_encoder_of_a_sigkilled_server_finishes_the_file_and_exits(tmp_path, serve_world):
+    """Only the server is killed: its encoder process sees the pipe close, encodes what the
+    ring still holds, writes the summary and the rosbag2 metadata, and exits (it used to poll
+    the closed pipe forever and leave the file without its index)."""
+    import yaml
+    from mcap.reader import make_reader
+
+    out = tmp_path / "orphan.mcap"
+    with serve_world(tmp_path, "recorphan") as (client, proc):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        client.request("POST", "/record", body={"path": str(out), "rate": 100})
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and (not out.exists() or out.stat().st_size < 50_000):
+            time.sleep(0.2)
+        (encoder,) = [c for c in _children(proc.pid) if b"record.encoder" in _cmdline(c)]
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline and Path(f"/proc/{encoder}").exists():
+        time.sleep(0.1)
+    assert not Path(f"/proc/{encoder}").exists(), "the encoder outlived its server"
+    with out.open("rb") as stream:
+        reader = make_reader(stream, validate_crcs=True)
+        summary = reader.get_summary()
+        (meta,) = [m for m in reader.iter_metadata() if m.name == "rosbag2"]
+        stamps = [m.log_time for _, c, m in reader.iter_messages() if c.topic == "/clock"]
+    info = yaml.safe_load(meta.metadata["serialized_metadata"])
+    assert info["custom_data"] == {"parent": "gone"}
+    assert summary.statistics.message_count == info["message_count"] > 0
+    assert len(stamps) >= 50 and np.all(np.diff(stamps) == 10_000_000), "every sample, in order"
+
+
+def _cmdline(pid: int) -> bytes:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return b""
+
+
 def _children(pid: int) -> list[int]:
     """Process ids of `pid`'s children (Linux /proc)."""
     out = []

@@ -1,7 +1,7 @@
 """A rosbag2 MCAP recording whose encoding runs in another process (see `ring`, `encoder`).
 
-The stepping thread's share per sample is one copy of qpos, qvel, qfrc_actuator and the mocap
-poses into shared memory (a few µs); the encoder process builds and writes the messages. Sensor
+The stepping thread's share per sample is MuJoCo's state and qfrc_actuator, copied into shared
+memory by two C calls (a few µs); the encoder process builds and writes the messages. Sensor
 readings are copied at the sensors' rates and built by a `SensorPump` thread of this process (ray
 casting, rendering), which sends them to the encoder; the loop's waits for a full ring or a
 backlogged pump are `blocked_s`. The interface is `Recording`'s: `start`, `stop`, `wait`,
@@ -165,7 +165,7 @@ class BagRecording(Follows):
         if world.model is not self._model:  # a spawn or delete: new layout, maybe new sensors
             self._watch_sensors()
             self._send_layout()
-        if not self._writer.put(self._epoch, world.data):
+        if not self._writer.put(world.data):
             self._error = "the encoder process ended; the recording stopped"
             self._finish_sampling()
             return
@@ -181,7 +181,8 @@ class BagRecording(Follows):
         view = world_view(self._world)
         index, descriptions = self._sampler.selection(view)
         self._epoch += 1
-        self._send(("layout", self._epoch, view.model, index, descriptions))
+        start = self._writer.start_layout(view.model)  # sent before the layout's first record
+        self._send(("layout", self._epoch, view.model, index, descriptions, start))
         self._model = view.model
 
     def _finish_sampling(self) -> None:

@@ -40,20 +40,22 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
     from twin_cli.record.recorder import BagSink
 
     buf, head, times = ring.views(memory)
-    encoder = _Encoder(BagSink(path, overwrite=True), times)
+    reader = ring.RingReader(buf, head)
+    encoder = _Encoder(BagSink(path, overwrite=True), times, reader)
     conn.send(("ready", None))
     error = None
     try:
         stop = None
         while True:
+            write = int(head[ring.WRITE])  # first: the layouts of these records are sent
             stop = encoder.poll(conn)  # layouts, sensor readings, stop
-            records = ring.read_records(buf, head, BATCH)
-            for record in records:
-                encoder.encode(record, conn)
+            records = reader.read(write, BATCH)
+            for epoch, record in records:
+                encoder.encode(epoch, record)
             head[ring.SAMPLES] = encoder.samples
             if records:
                 continue
-            if stop is not None and not conn_pending(conn):
+            if stop is not None and (encoder.parent_gone or not conn_pending(conn)):
                 break
             time.sleep(IDLE_S)
     except Exception as exc:  # disk full...: report it to the parent
@@ -73,16 +75,18 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
 class _Encoder:
     """Turns records into messages with the layouts the parent sent."""
 
-    def __init__(self, writer: Any, times: Any) -> None:
+    def __init__(self, writer: Any, times: Any, reader: Any) -> None:
         from twin_cli.record.recorder import Publisher
 
         self.writer = writer
         self.times = times
+        self.reader = reader
         self.samples = 0
         self._layouts: dict[int, Any] = {}
         self._epoch = -1
         self._publisher = Publisher()
         self._stop: dict | None = None
+        self.parent_gone = False  # its pipe closed without "stop": finish with what is in the ring
 
     def poll(self, conn: Any) -> dict | None:
         """Takes waiting control messages; the stop figures once the parent said stop."""
@@ -91,14 +95,16 @@ class _Encoder:
                 self._take(conn.recv())
         except (EOFError, OSError):  # the parent is gone: finish the file
             self._stop = self._stop or {"parent": "gone"}
+            self.parent_gone = True
         return self._stop
 
     def _take(self, message: tuple) -> None:
         from twin_cli.record.layout import make_layout
 
         if message[0] == "layout":
-            _, epoch, model, index, descriptions = message
+            _, epoch, model, index, descriptions, start = message
             self._layouts[epoch] = make_layout(model, index, descriptions)
+            self.reader.add_layout(start, epoch, model)
         elif message[0] == "readings":
             from twin_cli.record.sensor_messages import sensor_message
 
@@ -108,10 +114,7 @@ class _Encoder:
         elif message[0] == "stop":
             self._stop = message[1]
 
-    def encode(self, record: Any, conn: Any) -> None:
-        epoch = int(record[1])
-        while epoch not in self._layouts:
-            self._take(conn.recv())
+    def encode(self, epoch: int, record: Any) -> None:
         layout = self._layouts[epoch]
         sample = _sample(record, layout)
         new = epoch != self._epoch
@@ -136,18 +139,19 @@ def conn_pending(conn: Any) -> bool:
 
 
 def _sample(record: Any, layout: Any) -> Any:
-    """The `Sample` a record holds (views into the record's copy)."""
+    """The `Sample` a record holds (views into the record's copy): MuJoCo's state vector
+    (time, qpos, qvel, mocap_pos, mocap_quat, in `mjtState` order) and then qfrc_actuator."""
     from twin_cli.record.sampler import Sample
 
     m = layout.model
-    sizes = (m.nq, m.nv, m.nv, 3 * m.nmocap, 4 * m.nmocap)
-    parts, at = [], 3
+    sizes = (m.nq, m.nv, 3 * m.nmocap, 4 * m.nmocap, m.nv)
+    parts, at = [], 1
     for n in sizes:
         parts.append(record[at : at + n])
         at += n
-    qpos, qvel, qfrc, mpos, mquat = parts
+    qpos, qvel, mpos, mquat, qfrc = parts
     return Sample(
-        float(record[2]), layout, qpos, qvel, qfrc, mpos.reshape(-1, 3), mquat.reshape(-1, 4)
+        float(record[0]), layout, qpos, qvel, qfrc, mpos.reshape(-1, 3), mquat.reshape(-1, 4)
     )
 
 

@@ -7,8 +7,12 @@ state vectors into this ring (no Python object per sample) and an encoder proces
 (`encoder`) reads them. The memory is an unlinked file in /dev/shm whose descriptor the
 process inherits (no named segment to leak).
 
-A record is a run of doubles `[length, epoch, time, qpos, qvel, qfrc_actuator, mocap_pos,
-mocap_quat]`; a record that does not fit before the end leaves a -1 marker and starts at 0.
+A record is MuJoCo's state `[time, qpos, qvel, mocap_pos, mocap_quat]` (`mj_getState`, one C
+call) followed by `qfrc_actuator`: two copies, because after `mj_step` every Python operation
+meets caches that the step has emptied (~2-4 µs each). Records carry no header: all records of
+one compiled model have its `record_length`, and the writer tells the reader (over the pipe,
+before the first such record) the position from which they start (`start_layout`). A record that
+does not fit before the end of the ring starts at 0; both sides know the length, so both skip.
 Positions are absolute counts of doubles (never wrapped), so `write - read` is what is in use.
 The writer never overwrites unread data: when the ring is full it waits, and the recording
 reports that time (`RecordingStatus.blocked_s`). x86-64 keeps stores in order, so the reader
@@ -17,19 +21,32 @@ that sees the new write position also sees the record.
 
 from __future__ import annotations
 
+import collections
 import mmap
 import os
 import tempfile
 import time
 from typing import Any
 
+import mujoco
 import numpy as np
 
-WRAP = -1.0
 HEADER = 8  # int64 slots: write, read, samples, done, ...
 WRITE, READ, SAMPLES, DONE = 0, 1, 2, 3
 SPAN = 2  # doubles: first and last sample time [s]
 WAIT_S = 0.0005  # [s] the writer's poll period while the ring is full
+STATE = int(
+    mujoco.mjtState.mjSTATE_TIME
+    | mujoco.mjtState.mjSTATE_QPOS
+    | mujoco.mjtState.mjSTATE_QVEL
+    | mujoco.mjtState.mjSTATE_MOCAP_POS
+    | mujoco.mjtState.mjSTATE_MOCAP_QUAT
+)
+
+
+def record_length(model: Any) -> int:
+    """Doubles in one record of `model`: its `STATE` and then `qfrc_actuator`."""
+    return int(mujoco.mj_stateSize(model, STATE)) + int(model.nv)
 
 
 def allocate(doubles: int) -> tuple[int, Any]:
@@ -57,8 +74,8 @@ def views(memory: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 class RingWriter:
-    """The stepping thread's side: copies one state into the next record (~2 µs: one
-    `np.concatenate` into the ring; the read position is re-read only when room runs short)."""
+    """The stepping thread's side: copies one state into the next record (two C calls; the read
+    position is re-read only when room runs short)."""
 
     def __init__(self, data: np.ndarray, header: np.ndarray, alive: Any) -> None:
         """Args: data, header: ring views; alive: () -> bool, whether the reader still runs."""
@@ -66,58 +83,47 @@ class RingWriter:
         self._capacity = data.size
         self._write = int(header[WRITE])  # only this side writes it: a Python mirror
         self._limit = int(header[READ]) + data.size  # write may grow to here without a look
-        self._d: Any = None  # the MjData whose views are cached
-        self._head = np.zeros(3)  # [length, epoch, time] of the record being written
-        self._views: tuple = ()
-        self._length = 0
+        self._model: Any = None
+        self._d: Any = None  # the MjData whose qfrc_actuator view is cached
+        self._forces: Any = None
+        self._state = self._length = 0
         self.blocked_s = 0.0  # [s] waited for room (the reader fell behind)
         self.waits = 0
 
-    def put(self, epoch: int, d: Any) -> bool:
-        """Writes MjData `d`'s state as a record of `epoch`; False if the reader is gone."""
+    def start_layout(self, model: Any) -> int:
+        """Records from now on are of `model`; the position they start at, for the reader."""
+        self._model, self._d = model, None
+        self._state = int(mujoco.mj_stateSize(model, STATE))
+        self._length = record_length(model)
+        return self._write
+
+    def put(self, d: Any) -> bool:
+        """Writes MjData `d`'s state (of the model of the last `start_layout`) as a record;
+        False if the reader is gone."""
         if d is not self._d:
-            self._bind(d)
+            self._d, self._forces = d, d.qfrc_actuator  # each attribute access costs ~0.5 µs
         length, write = self._length, self._write
         pos = write % self._capacity
         if pos + length > self._capacity or write + length > self._limit:
             pos = self._make_room(length)
             if pos < 0:
                 return False
-        head = self._head
-        head[1], head[2] = epoch, d.time
-        np.concatenate(self._views, out=self._data[pos : pos + length])
-        self._write += length
-        self._header[WRITE] = self._write
+        middle = pos + self._state
+        mujoco.mj_getState(self._model, d, self._data[pos:middle], STATE)
+        np.copyto(self._data[middle : pos + length], self._forces)
+        self._write = write = self._write + length
+        self._header[WRITE] = write
         return True
 
-    def _bind(self, d: Any) -> None:
-        """numpy views of `d`, made once: each attribute access costs ~0.5 µs."""
-        self._d = d
-        self._views = (
-            self._head,
-            d.qpos,
-            d.qvel,
-            d.qfrc_actuator,
-            d.mocap_pos.ravel(),
-            d.mocap_quat.ravel(),
-        )
-        nq, nv, nmocap = d.qpos.size, d.qvel.size, d.mocap_pos.size
-        self._length = 3 + nq + 2 * nv + nmocap * 7 // 3
-        self._head[0] = self._length
-
     def _make_room(self, length: int) -> int:
-        """Wraps to the start when the record does not fit before the end, then waits until
-        the reader has freed `length` doubles; the record's position, or -1 (reader gone)."""
-        capacity = self._capacity
-        pos = self._write % capacity
-        if pos + length > capacity:
-            if not self._room(capacity - pos):
-                return -1
-            self._data[pos] = WRAP
-            self._write += capacity - pos
-            self._header[WRITE] = self._write
-            pos = 0
-        return pos if self._room(length) else -1
+        """Waits until the reader has freed room for the record (and for the unused end of the
+        ring when the record starts over at 0); the record's position, or -1 (reader gone)."""
+        pos = self._write % self._capacity
+        skip = self._capacity - pos if pos + length > self._capacity else 0
+        if not self._room(skip + length):
+            return -1
+        self._write += skip
+        return 0 if skip else pos
 
     def _room(self, needed: int) -> bool:
         if self._write + needed <= self._limit:
@@ -139,19 +145,33 @@ class RingWriter:
         return True
 
 
-def read_records(data: np.ndarray, header: np.ndarray, limit: int) -> list[np.ndarray]:
-    """Up to `limit` unread records (copies), and marks them read."""
-    capacity = data.size
-    read, write = int(header[READ]), int(header[WRITE])
-    out = []
-    while read < write and len(out) < limit:
-        pos = read % capacity
-        length = data[pos]
-        if length == WRAP:
-            read += capacity - pos
-            continue
-        n = int(length)
-        out.append(data[pos : pos + n].copy())
-        read += n
-    header[READ] = read
-    return out
+class RingReader:
+    """The encoder's side: the records between the read and a write position, each with the
+    layout (epoch) it was written in."""
+
+    def __init__(self, data: np.ndarray, header: np.ndarray) -> None:
+        self._data, self._header = data, header
+        self._layouts: collections.deque[tuple[int, int, int]] = collections.deque()
+
+    def add_layout(self, start: int, epoch: int, model: Any) -> None:
+        """Records from position `start` on are of `model`, tagged `epoch`."""
+        self._layouts.append((start, epoch, record_length(model)))
+
+    def read(self, write: int, limit: int) -> list[tuple[int, np.ndarray]]:
+        """Up to `limit` unread records before position `write` (read before the layouts sent
+        with them were taken), as (epoch, copy); marks them read."""
+        data, layouts, capacity = self._data, self._layouts, self._data.size
+        read = int(self._header[READ])
+        out = []
+        while read < write and len(out) < limit:
+            while len(layouts) > 1 and layouts[1][0] <= read:
+                layouts.popleft()
+            _, epoch, length = layouts[0]
+            pos = read % capacity
+            if pos + length > capacity:
+                read += capacity - pos
+                pos = 0
+            out.append((epoch, data[pos : pos + length].copy()))
+            read += length
+        self._header[READ] = read
+        return out
