@@ -219,6 +219,11 @@ class BagRecording(Follows):
         self._error = self._error or error
         return self._started
 
+    @property
+    def encoder_pid(self) -> int | None:
+        """The encoder process's id once started (benchmarks read its CPU time)."""
+        return None if self._process is None else self._process.pid
+
     def _alive(self) -> bool:
         return self._process is not None and self._process.poll() is None
 
