@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -330,3 +331,99 @@ def test_ring_records_keep_their_layout_across_wraps_and_model_changes():
     assert len(read) == len(written)
     for (epoch, record), (want_epoch, want) in zip(read, written, strict=True):
         assert epoch == want_epoch and np.array_equal(record, want)
+
+
+def test_an_observer_that_outlives_another_keeps_its_own_grid():
+    """Two observers on different grids; the first removes itself (a follower that finishes):
+    the survivor, which was not due at that step, is still called on its own grid only."""
+    from twin_cli.world.observers import Observers
+
+    clock = FakeClock()
+    observers = Observers()
+    survivor: list[float] = []
+    handles = {}
+    handles["a"] = observers.add(lambda: observers.remove(handles["a"]), 100.0, 0.0, 0.001)
+    clock.step(5)
+    observers.add(lambda: survivor.append(clock.time), 100.0, clock.time, 0.001)
+    observers.run(60, clock.step, clock, 0.001)
+    observers.run(20, clock.step, clock, 0.001)
+    assert survivor == pytest.approx([0.015 + 0.01 * k for k in range(8)], abs=1e-12)
+
+
+def test_an_observer_added_by_a_callback_leaves_the_first_on_its_grid():
+    """A 100 Hz observer's callback adds a 7 Hz one on its third call: the first observer is
+    still called exactly every 10 steps (no extra call from a due time left behind)."""
+    from twin_cli.world.observers import Observers
+
+    clock = FakeClock()
+    observers = Observers()
+    seen: list[float] = []
+
+    def first() -> None:
+        seen.append(clock.time)
+        if len(seen) == 3:
+            observers.add(lambda: None, 7.0, clock.time, 0.001)
+
+    observers.add(first, 100.0, 0.0, 0.001)
+    observers.run(100, clock.step, clock, 0.001)
+    assert seen == pytest.approx([0.01 * k for k in range(1, 11)], abs=1e-12)
+
+
+def test_the_encoder_takes_a_record_written_while_it_reads_the_pipe(tmp_path):
+    """The encoder reads the write position, then the pipe (layouts, readings, stop). A last
+    sample written in between, just before "stop", is still encoded: the encoder looks at the
+    ring again before it ends. The pipe is real; a wrapper holds one poll until the test has
+    written that sample and sent stop."""
+    import threading
+
+    from twin_cli.record import encoder, ring
+    from twin_cli.record.bag_recording import _pipe
+    from twin_cli.record.sampler import Sampler
+    from twin_cli.world.observers import world_view
+
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    memory = ring.allocate(1 << 16)[1]
+    data, header, _ = ring.views(memory)
+    parent, child = _pipe()
+    entered, release = threading.Event(), threading.Event()
+
+    class HeldPipe:
+        held = False
+
+        def poll(self, *args: float) -> bool:
+            if self.held:
+                self.held = False
+                entered.set()
+                release.wait()
+            return child.poll(*args)
+
+        def recv(self):  # noqa: ANN202
+            return child.recv()
+
+        def send(self, message: tuple) -> None:
+            child.send(message)
+
+    pipe = HeldPipe()
+    thread = threading.Thread(
+        target=encoder.encode_main, args=(memory, pipe, str(tmp_path / "r.mcap"))
+    )
+    thread.start()
+    assert parent.recv()[0] == "ready"
+    writer = ring.RingWriter(data, header, lambda: True)
+    index, descriptions = Sampler(world).selection(world_view(world))
+    start = writer.start_layout(world.model)
+    parent.send(("layout", 0, world.model, index, descriptions, start))
+    for _ in range(5):
+        world.step(10)
+        assert writer.put(world.data)
+    while header[ring.READ] != header[ring.WRITE]:
+        time.sleep(0.001)
+    pipe.held = True
+    assert entered.wait(10.0)  # the encoder has read the write position and polls the pipe
+    world.step(10)
+    assert writer.put(world.data)
+    parent.send(("stop", {}))
+    release.set()
+    thread.join(30.0)
+    assert int(header[ring.SAMPLES]) == 6 and header[ring.READ] == header[ring.WRITE]

@@ -1,13 +1,13 @@
 """The encoder process of a bag recording: raw records from the ring → ROS messages → MCAP.
 
 Runs in its own interpreter (a fresh `python -m`, so the server's threads are not forked and
-no script is re-imported), so
-computing link poses (`mj_kinematics` on its own MjData), building messages and CDR-encoding
-them (rosbags) and writing chunks (mcap) never hold the stepping loop's GIL. The parent sends
-each layout (compiled model, entity index, URDF texts; MjModel pickles) over a pipe before the
-first record of that layout, tagged with an epoch that every record carries; then "stop" with
-its figures (time the writer waited for room), after which the ring is drained and the file
-closed. A parent that dies closes the pipe: the file is finished with what was written.
+no script is re-imported), so computing link poses (`mj_kinematics` on its own MjData),
+building messages, CDR-encoding them (rosbags) and writing chunks (foxglove-sdk's MCAP writer)
+never hold the stepping loop's GIL. The parent sends each layout (compiled model, entity index,
+URDF texts; MjModel pickles) over a pipe before the first record of that layout, with an epoch
+and the ring position where its records start; then "stop" with its figures (time the writer
+waited for room), after which the ring is drained and the file closed. A parent that dies
+closes the pipe: the file is finished with what the ring holds.
 """
 
 from __future__ import annotations
@@ -55,6 +55,8 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
             head[ring.SAMPLES] = encoder.samples
             if records:
                 continue
+            if stop is not None and int(head[ring.READ]) < int(head[ring.WRITE]):
+                continue  # records written after `write` was read, before "stop"
             if stop is not None and (encoder.parent_gone or not conn_pending(conn)):
                 break
             time.sleep(IDLE_S)

@@ -116,14 +116,18 @@ class RingWriter:
         return True
 
     def _make_room(self, length: int) -> int:
-        """Waits until the reader has freed room for the record (and for the unused end of the
-        ring when the record starts over at 0); the record's position, or -1 (reader gone)."""
-        pos = self._write % self._capacity
-        skip = self._capacity - pos if pos + length > self._capacity else 0
-        if not self._room(skip + length):
-            return -1
-        self._write += skip
-        return 0 if skip else pos
+        """Skips to the start of the ring when the record does not fit before the end (the
+        reader skips the same way), then waits until the reader has freed `length` doubles;
+        the record's position, or -1 (reader gone)."""
+        capacity = self._capacity
+        pos = self._write % capacity
+        if pos + length > capacity:
+            if not self._room(capacity - pos):
+                return -1
+            self._write += capacity - pos
+            self._header[WRITE] = self._write  # so the reader can pass the unused end
+            pos = 0
+        return pos if self._room(length) else -1
 
     def _room(self, needed: int) -> bool:
         if self._write + needed <= self._limit:
@@ -168,9 +172,9 @@ class RingReader:
                 layouts.popleft()
             _, epoch, length = layouts[0]
             pos = read % capacity
-            if pos + length > capacity:
+            if pos + length > capacity:  # the writer started this record over at 0
                 read += capacity - pos
-                pos = 0
+                continue
             out.append((epoch, data[pos : pos + length].copy()))
             read += length
         self._header[READ] = read
