@@ -427,3 +427,28 @@ def test_the_encoder_takes_a_record_written_while_it_reads_the_pipe(tmp_path):
     release.set()
     thread.join(30.0)
     assert int(header[ring.SAMPLES]) == 6 and header[ring.READ] == header[ring.WRITE]
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+def test_a_full_disk_stops_the_recording_with_the_file_and_the_cause(tmp_path):
+    """Every write to /dev/full fails with ENOSPC. foxglove-sdk's MCAP writer only logs its
+    write errors, so twin keeps the file's own: the recording ends with it, naming the file."""
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    out = tmp_path / "full.mcap"
+    out.symlink_to("/dev/full")
+    recording = BagRecording(world, out, rate=RATE, overwrite=True).start()
+    deadline = time.monotonic() + 60.0
+    while not _ended(recording.encoder_pid) and time.monotonic() < deadline:
+        world.step(100)
+        time.sleep(0.01)
+    status = recording.stop()
+    assert "No space left on device" in str(status.error) and str(out) in str(status.error)
+
+
+def _ended(pid: int) -> bool:
+    """Whether process `pid` has exited (a zombie not yet reaped counts; Linux /proc)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in "ZX"
+    except OSError:
+        return True

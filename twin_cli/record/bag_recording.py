@@ -130,9 +130,12 @@ class BagRecording(Follows):
             figures = {"blocked_s": round(self._writer.blocked_s, 6), "waits": self._writer.waits}
             try:
                 self._send(("stop", figures))
+            except OSError:
+                pass  # the encoder has ended (a full disk): its "done" may wait in the pipe
+            try:
                 while self._conn.poll(START_TIMEOUT_S + self._backlog_s()):
                     kind, error = self._conn.recv()
-                    self._error = self._error or error
+                    self._error = error or self._error  # the encoder's cause comes first
                     if kind == "done":
                         break
             except (EOFError, OSError):

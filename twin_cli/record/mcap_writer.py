@@ -13,8 +13,10 @@ handed to the OS, so a server killed with SIGKILL leaves a file readable up to i
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -80,7 +82,7 @@ class BagWriter:
         from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
         self.path = Path(path).expanduser()
-        open_output(self.path, overwrite=overwrite).close()  # its errors, in twin's words
+        self._file = _CheckedFile(open_output(self.path, overwrite=overwrite), self.path)
         self._foxglove = foxglove
         self._context = foxglove.Context()  # this file's channels only (not a live server's)
         options = MCAPWriteOptions(
@@ -89,9 +91,11 @@ class BagWriter:
             chunk_size=CHUNK_SIZE,
             compression_threads=0,  # compress in this thread: the encoder stays one core
         )
-        self._writer = foxglove.open_mcap(
-            self.path, allow_overwrite=True, context=self._context, writer_options=options
-        )
+        with self._file.cause():
+            self._writer = foxglove.open_mcap(
+                self._file, context=self._context, writer_options=options
+            )
+        self._file.check()
         self._channels: dict[str, Any] = {}
         self._topics: dict[str, Topic] = {}
         self._counts: dict[str, int] = {}
@@ -124,6 +128,7 @@ class BagWriter:
         stamp = ros.nanoseconds(message.time)
         data = ros.encode(message.message, message.type)
         self._channels[message.topic].log(data, log_time=stamp)
+        self._file.check()
         self._counts[message.topic] += 1
         span = self._span
         if stamp < span[0]:
@@ -135,7 +140,9 @@ class BagWriter:
 
     def flush(self) -> None:
         """Closes the chunk in progress and hands everything written so far to the OS."""
-        self._writer.flush()
+        with self._file.cause():
+            self._writer.flush()
+        self._file.check()
         self._flushed = time.monotonic()
 
     @property
@@ -145,11 +152,17 @@ class BagWriter:
     def close(self) -> None:
         """Writes the rosbag2 metadata record, the summary and the footer; closes the file."""
         try:
-            self._writer.write_metadata(
-                "rosbag2", {"serialized_metadata": self._metadata(), "ROS_DISTRO": ros.DISTRO}
-            )
+            with self._file.cause():
+                self._writer.write_metadata(
+                    "rosbag2", {"serialized_metadata": self._metadata(), "ROS_DISTRO": ros.DISTRO}
+                )
         finally:
-            self._writer.close()
+            try:
+                with self._file.cause():
+                    self._writer.close()
+            finally:
+                self._file.close()
+        self._file.check()
 
     def _metadata(self) -> str:
         """rosbag2's BagMetadata (what `ros2 bag info` prints) as YAML."""
@@ -189,3 +202,50 @@ class BagWriter:
             "ros_distro": ros.DISTRO,
         }
         return yaml.safe_dump(info, sort_keys=False)
+
+
+class _CheckedFile:
+    """The output file as foxglove's writer sees it. That writer only logs a failed write (a
+    full disk) and goes on, so this keeps the first error, and `check` raises it: the recording
+    then stops and reports it instead of ending with a silently cut file."""
+
+    def __init__(self, raw: Any, path: Path) -> None:
+        self._raw, self._path = raw, path
+        self.error: OSError | None = None
+
+    def write(self, data: bytes) -> int:
+        return self._keep(self._raw.write, data)
+
+    def flush(self) -> None:
+        self._keep(self._raw.flush)
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        return self._keep(self._raw.seek, offset, whence)  # (a buffered file flushes first)
+
+    def tell(self) -> int:
+        return self._keep(self._raw.tell)
+
+    def _keep(self, method: Any, *args: Any) -> Any:
+        try:
+            return method(*args)
+        except OSError as exc:
+            self.error = self.error or exc
+            raise
+
+    def close(self) -> None:
+        self._raw.close()
+
+    @contextlib.contextmanager
+    def cause(self) -> Iterator[None]:
+        """Around a call into the writer: its RuntimeError ("a write method failed") becomes
+        the file's own error when there is one."""
+        try:
+            yield
+        except RuntimeError:
+            self.check()
+            raise
+
+    def check(self) -> None:
+        """Raises the first write error, if any (OSError: names the file and the cause)."""
+        if self.error is not None:
+            raise OSError(self.error.errno, self.error.strerror, str(self._path))
