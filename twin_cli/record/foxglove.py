@@ -93,11 +93,7 @@ class LiveStream:
                 self._channels[name] = self._open(topic)
 
     def _open(self, topic: Topic) -> Any:
-        d = ros.definition(topic.type)
-        schema = self._foxglove.Schema(name=d.name, encoding="ros2msg", data=d.text.encode())
-        return self._foxglove.Channel(
-            topic.name, schema=schema, message_encoding="cdr", context=self._context
-        )
+        return ros2_channel(topic, self._context)
 
     def write(self, message: Message) -> None:
         """Sends one message (and any latched message a new subscriber has not had)."""
@@ -125,6 +121,18 @@ class LiveStream:
             channel.close()
         self._channels.clear()
         self._server.stop()
+
+
+def ros2_channel(topic: Topic, context: Any, metadata: dict[str, str] | None = None) -> Any:
+    """A foxglove-sdk channel of `topic` in `context`: its `ros2msg` schema (rosbags'
+    definition) and CDR messages, as Foxglove and rosbag2 expect them (live or in a file)."""
+    import foxglove
+
+    d = ros.definition(topic.type)
+    schema = foxglove.Schema(name=d.name, encoding="ros2msg", data=d.text.encode())
+    return foxglove.Channel(
+        topic.name, schema=schema, message_encoding="cdr", context=context, metadata=metadata
+    )
 
 
 def _check_address(host: str, port: int) -> None:

@@ -18,6 +18,7 @@ from twin_cli.record import messages as ros
 from twin_cli.record.layout import WORLD_FRAME, EntityLayout, Layout
 from twin_cli.record.sampler import Sample
 from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
+from twin_cli.world.pose import rotate
 
 # conj(q) ⊗ r as a matrix product M(q) r: M's entries are q's components, permuted and signed.
 _CONJ_LEFT_INDEX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
@@ -70,7 +71,7 @@ class LiveMessages:
     ) -> list[Message]:
         """The sample's messages (the same objects as the last call's, refilled)."""
         t = sample.time
-        self._stamp.sec, self._stamp.nanosec = divmod(round(t * 1e9), 1_000_000_000)
+        self._stamp.sec, self._stamp.nanosec = divmod(ros.nanoseconds(t), 1_000_000_000)
         pos, quat = relative_poses(xpos, xquat, xmat, self._bodies, self._parents)
         for v, xyz in zip(self._translations, pos.tolist(), strict=True):
             v.x, v.y, v.z = xyz
@@ -143,19 +144,6 @@ class _Odometry:
         p, o = self._pose.position, self._pose.orientation
         p.x, p.y, p.z, o.w, o.x, o.y, o.z = x, y, z, qw, qx, qy, qz
         linear, angular = self._twist.linear, self._twist.angular
-        linear.x, linear.y, linear.z = _unrotate((qw, qx, qy, qz), (vx, vy, vz))
+        linear.x, linear.y, linear.z = rotate((qw, -qx, -qy, -qz), (vx, vy, vz))  # Rᵀ v
         angular.x, angular.y, angular.z = wx, wy, wz
         return Message(self._topic, ros.ODOMETRY, sample.time, self._message)
-
-
-def _unrotate(q: tuple, v: tuple) -> tuple[float, float, float]:
-    """Vector v rotated by the inverse of unit quaternion q (w, x, y, z): Rᵀ v (plain floats:
-    numpy costs more than the arithmetic for one vector)."""
-    w, ux, uy, uz = q[0], -q[1], -q[2], -q[3]
-    vx, vy, vz = v
-    tx, ty, tz = 2.0 * (uy * vz - uz * vy), 2.0 * (uz * vx - ux * vz), 2.0 * (ux * vy - uy * vx)
-    return (
-        vx + w * tx + uy * tz - uz * ty,
-        vy + w * ty + uz * tx - ux * tz,
-        vz + w * tz + ux * ty - uy * tx,
-    )

@@ -83,7 +83,6 @@ class BagWriter:
 
         self.path = Path(path).expanduser()
         self._file = _CheckedFile(open_output(self.path, overwrite=overwrite), self.path)
-        self._foxglove = foxglove
         self._context = foxglove.Context()  # this file's channels only (not a live server's)
         options = MCAPWriteOptions(
             compression=MCAPCompression.Zstd,
@@ -91,11 +90,10 @@ class BagWriter:
             chunk_size=CHUNK_SIZE,
             compression_threads=0,  # compress in this thread: the encoder stays one core
         )
-        with self._file.cause():
+        with self._file.checked():
             self._writer = foxglove.open_mcap(
                 self._file, context=self._context, writer_options=options
             )
-        self._file.check()
         self._channels: dict[str, Any] = {}
         self._topics: dict[str, Topic] = {}
         self._counts: dict[str, int] = {}
@@ -107,19 +105,13 @@ class BagWriter:
         """Registers a topic (with its schema) unless known."""
         if topic.name in self._channels:
             return
-        d = ros.definition(topic.type)
-        schema = self._foxglove.Schema(name=d.name, encoding="ros2msg", data=d.text.encode())
+        from twin_cli.record.foxglove import ros2_channel
+
         metadata = {
             "offered_qos_profiles": yaml.safe_dump(qos_profiles(topic.latched), sort_keys=False),
-            "topic_type_hash": d.rihs01,
+            "topic_type_hash": ros.definition(topic.type).rihs01,
         }
-        self._channels[topic.name] = self._foxglove.Channel(
-            topic.name,
-            schema=schema,
-            message_encoding="cdr",
-            context=self._context,
-            metadata=metadata,
-        )
+        self._channels[topic.name] = ros2_channel(topic, self._context, metadata)
         self._topics[topic.name] = topic
         self._counts[topic.name] = 0
 
@@ -140,9 +132,8 @@ class BagWriter:
 
     def flush(self) -> None:
         """Closes the chunk in progress and hands everything written so far to the OS."""
-        with self._file.cause():
+        with self._file.checked():
             self._writer.flush()
-        self._file.check()
         self._flushed = time.monotonic()
 
     @property
@@ -152,17 +143,16 @@ class BagWriter:
     def close(self) -> None:
         """Writes the rosbag2 metadata record, the summary and the footer; closes the file."""
         try:
-            with self._file.cause():
+            with self._file.checked():
                 self._writer.write_metadata(
                     "rosbag2", {"serialized_metadata": self._metadata(), "ROS_DISTRO": ros.DISTRO}
                 )
         finally:
             try:
-                with self._file.cause():
+                with self._file.checked():
                     self._writer.close()
             finally:
                 self._file.close()
-        self._file.check()
 
     def _metadata(self) -> str:
         """rosbag2's BagMetadata (what `ros2 bag info` prints) as YAML."""
@@ -236,14 +226,15 @@ class _CheckedFile:
         self._raw.close()
 
     @contextlib.contextmanager
-    def cause(self) -> Iterator[None]:
-        """Around a call into the writer: its RuntimeError ("a write method failed") becomes
-        the file's own error when there is one."""
+    def checked(self) -> Iterator[None]:
+        """Around a call into the writer: raises the file's own error, if one happened, in
+        place of the SDK's RuntimeError ("a write method failed") or its silence."""
         try:
             yield
         except RuntimeError:
             self.check()
             raise
+        self.check()
 
     def check(self) -> None:
         """Raises the first write error, if any (OSError: names the file and the cause)."""
