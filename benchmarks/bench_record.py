@@ -8,7 +8,9 @@ On this 2-vCPU VM single pairs range 0.8-1.1 (the machine's speed drifts by ±25
 seconds), so 100 pairs are summed: repeated runs agree within about ±1.5 %. The wall ratio
 counts the encoder process's CPU against the loop (a second core kept busy slows `mj_step` by up
 to 9 % on this VM, a quarter-busy one not measurably); the loop-CPU ratio is what sampling adds
-to the stepping thread. The encoder's CPU per sample is read from /proc.
+to the stepping thread. The encoder's CPU per sample is read from /proc. After each sampled
+arm, the next plain arm waits (untimed) until the encoder has written that arm's samples: else
+the encoder's last ~10 ms of work would run beside the plain arm and flatter the ratio.
 """
 
 from __future__ import annotations
@@ -57,10 +59,20 @@ def throughput(tmp: Path) -> dict:
     plain_rate = WINDOW * 4 / (time.perf_counter() - plain_s)
     per_window = round(WINDOW * world.model.opt.timestep * RATE)  # samples in a sampled arm
     encoder_cpu, samples = _process_cpu(recording), recording.status().samples
-    wall = interleaved_ratio(arm(False), arm(True), pairs=PAIRS)
-    cpu = interleaved_ratio(arm(False), arm(True), pairs=PAIRS, clock=time.thread_time)
+    expected = [samples]
+
+    def settle() -> None:  # the encoder's last samples must not run beside the next plain arm
+        expected[0] += per_window
+        deadline = time.monotonic() + 5.0
+        while recording.status().samples < expected[0] and time.monotonic() < deadline:
+            time.sleep(0.0005)
+
+    wall = interleaved_ratio(arm(False), arm(True), pairs=PAIRS, settle=settle)
+    cpu = interleaved_ratio(
+        arm(False), arm(True), pairs=PAIRS, clock=time.thread_time, settle=settle
+    )
     recording.set_sampling(False)
-    while recording.status().samples < samples + 2 * PAIRS * per_window:  # all encoded
+    while recording.status().samples < expected[0]:  # all encoded
         time.sleep(0.05)
     encoder_cpu = _process_cpu(recording) - encoder_cpu
     status = recording.stop()

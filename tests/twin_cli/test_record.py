@@ -326,8 +326,8 @@ def test_ring_records_keep_their_layout_across_wraps_and_model_changes():
         state = np.concatenate([[d.time], d.qpos, d.qvel, *mocap, d.qfrc_actuator])
         written.append((k // 7, state))
         if k % 2 == 1:  # the reader lags a record behind (two always fit, with a wrap's skip)
-            read += reader.read(int(header[ring.WRITE]), limit=100)
-    read += reader.read(int(header[ring.WRITE]), limit=100)
+            read += [(e, r) for e, run in reader.read(int(header[ring.WRITE]), 100) for r in run]
+    read += [(e, r) for e, run in reader.read(int(header[ring.WRITE]), 100) for r in run]
     assert len(read) == len(written)
     for (epoch, record), (want_epoch, want) in zip(read, written, strict=True):
         assert epoch == want_epoch and np.array_equal(record, want)
@@ -452,3 +452,147 @@ def _ended(pid: int) -> bool:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in "ZX"
     except OSError:
         return True
+
+
+class _Collect:
+    """A sink that keeps each message's topic, time and CDR bytes."""
+
+    def __init__(self) -> None:
+        self.messages: list[tuple[str, float, bytes]] = []
+
+    def set_topics(self, topics: list) -> None:
+        pass
+
+    def write(self, message) -> None:  # noqa: ANN001
+        self.messages.append((message.topic, message.time, message.cdr()))
+
+    def close(self) -> None:
+        pass
+
+
+PENDULUM = """<mujoco><worldbody><body name="upper" pos="0 0 1">
+  <joint name="shoulder" type="ball"/><geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>
+  <body name="lower" pos="0.3 0 0"><joint name="elbow" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/></body>
+</body></worldbody><actuator><motor joint="elbow" gear="2"/></actuator></mujoco>"""
+
+
+def test_a_batch_of_samples_encodes_as_each_sample_alone_and_skips_a_diverged_one():
+    """The encoder turns up to 64 records at once into messages (vectorised poses, joint
+    states and twists; reused message objects; serialization into kept buffers). Its bytes
+    equal those of each sample published alone, a diverged sample is left out, and a ball
+    joint's angle and speed decode to `World.joint_states`."""
+    from rosbags.typesys import Stores, get_typestore
+    from world_helpers import spec_of
+
+    from twin_cli.record.recorder import Publisher
+    from twin_cli.record.sampler import Sampler, Samples
+
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    world.spawn(spec_of(PENDULUM), name="p")
+    quat = np.array([-0.9, 0.3, 0.3, 0.1])  # w < 0: the angle is 2 acos |w|
+    world.data.qpos[-5:-1] = quat / np.linalg.norm(quat)  # the pendulum: ball joint, elbow
+    world.data.qvel[-4:] = [1.0, -2.0, 0.5, 3.0]
+    world.data.ctrl[:] = 0.3
+    sampler, samples, states = Sampler(world), [], []
+    for _ in range(12):
+        world.step(7)
+        with world.lock:
+            samples.append(sampler.capture())
+        states.append(world.joint_states("p"))
+    samples[5].qpos[0] = np.nan  # diverged: the world is resetting it
+    batch = Samples(
+        samples[0].layout,
+        np.array([s.time for s in samples]),
+        *(np.stack([getattr(s, k) for s in samples]) for k in ("qpos", "qvel", "qfrc_actuator")),
+        np.stack([s.mocap_pos for s in samples]),
+        np.stack([s.mocap_quat for s in samples]),
+    )
+    together, alone = _Collect(), _Collect()
+    sent = Publisher().publish(batch, together, new_layout=True)
+    one = Publisher()
+    for k, sample in enumerate(samples):
+        one.publish(Samples.of(sample), alone, new_layout=k == 0)
+    assert len(sent) == 11 and samples[5].time not in sent.times.tolist()
+    assert together.messages == alone.messages, "a batch encodes as its samples one by one"
+    store = get_typestore(Stores.ROS2_JAZZY)  # rosbags' own, not twin's
+    joints = [
+        (t, store.deserialize_cdr(data, "sensor_msgs/msg/JointState"))
+        for topic, t, data in together.messages
+        if topic == "/p/joint_states"
+    ]
+    assert [t for t, _ in joints] == [s.time for k, s in enumerate(samples) if k != 5]
+    for (_, message), want in zip(joints, [s for k, s in enumerate(states) if k != 5], strict=True):
+        assert list(message.name) == [j.name for j in want]
+        assert np.allclose(message.position, [j.position for j in want], atol=1e-12)
+        assert np.allclose(message.velocity, [j.velocity for j in want], atol=1e-12)
+        assert np.allclose(message.effort, [j.effort for j in want], atol=1e-12)
+    assert joints[3][1].position[0] > 0.05 and joints[3][1].effort[1] != 0, "it moved, driven"
+
+
+def test_a_reencoded_message_that_changes_size_is_encoded_anew():
+    """`Reencoder` serializes a refilled message into the buffer of its first encoding; a
+    message whose size changed (a longer frame id, fewer joints) gets rosbags' full encoding."""
+    from twin_cli.record import messages as ros
+
+    T = ros.types()
+    stamp = T["builtin_interfaces/msg/Time"](sec=1, nanosec=2)
+    message = T[ros.JOINT_STATE](
+        header=T["std_msgs/msg/Header"](stamp=stamp, frame_id="a"),
+        name=["j1", "j2"],
+        position=np.array([1.0, 2.0]),
+        velocity=np.array([3.0, 4.0]),
+        effort=np.array([5.0, 6.0]),
+    )
+    reencoder = ros.Reencoder(message, ros.JOINT_STATE)
+    for change in (
+        lambda: setattr(stamp, "sec", 7),
+        lambda: setattr(message.header, "frame_id", "a much longer frame id"),
+        lambda: setattr(message, "name", ["j1"]),
+        lambda: setattr(message, "position", np.array([9.0])),
+        lambda: (
+            setattr(message, "velocity", np.array([8.0])),
+            setattr(message, "effort", np.zeros(1)),
+        ),
+    ):
+        change()
+        assert reencoder() == ros.encode(message, ros.JOINT_STATE)
+
+
+def test_the_ring_reads_runs_of_records_of_one_layout_up_to_the_limit():
+    """The encoder takes runs: consecutive records of one model as one array, split where a new
+    layout starts and where the ring wraps, and no more records than the limit."""
+    import mujoco
+
+    from twin_cli.record import ring
+
+    body = '<body><freejoint/><geom size="0.1"/></body>'
+    models = [
+        mujoco.MjModel.from_xml_string(f"<mujoco><worldbody>{body * n}</worldbody></mujoco>")
+        for n in (1, 2)
+    ]
+    lengths = [ring.record_length(m) for m in models]
+    assert lengths == [20, 39]  # time, qpos, qvel, qfrc_actuator
+    data, header, _ = ring.views(ring.allocate(500)[1])
+    writer, reader = ring.RingWriter(data, header, lambda: True), ring.RingReader(data, header)
+    times: list[float] = []
+
+    def put(d: mujoco.MjData, count: int) -> None:
+        for _ in range(count):
+            d.time = len(times)
+            times.append(d.time)
+            assert writer.put(d)
+
+    for epoch, count in ((0, 4), (1, 2)):
+        reader.add_layout(writer.start_layout(models[epoch]), epoch, models[epoch])
+        put(mujoco.MjData(models[epoch]), count)
+    runs = reader.read(int(header[ring.WRITE]), limit=3)
+    assert [(e, r.shape) for e, r in runs] == [(0, (3, 20))]
+    runs += reader.read(int(header[ring.WRITE]), limit=100)
+    assert [(e, len(r)) for e, r in runs] == [(0, 3), (0, 1), (1, 2)]
+    # from 158, eight records of 39 reach 470; the ninth does not fit the end: it starts at 0
+    put(mujoco.MjData(models[1]), 10)
+    runs += reader.read(int(header[ring.WRITE]), limit=100)
+    assert [(e, len(r)) for e, r in runs[3:]] == [(1, 8), (1, 2)]
+    assert [float(t) for _, r in runs for t in r[:, 0]] == times

@@ -18,7 +18,7 @@ from typing import Any
 
 NICE = 10  # added niceness of the encoder process
 IDLE_S = 0.01  # [s] poll period when the ring is empty: fewer, longer runs of warm encoding
-BATCH = 64  # records taken from the ring between looks at the pipe (sensor readings)
+BATCH = 64  # records taken from the ring between looks at the pipe, encoded as one batch
 
 
 def main(argv: list[str]) -> None:
@@ -49,11 +49,11 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
         while True:
             write = int(head[ring.WRITE])  # first: the layouts of these records are sent
             stop = encoder.poll(conn)  # layouts, sensor readings, stop
-            records = reader.read(write, BATCH)
-            for epoch, record in records:
-                encoder.encode(epoch, record)
+            runs = reader.read(write, BATCH)
+            for epoch, records in runs:
+                encoder.encode(epoch, records)
             head[ring.SAMPLES] = encoder.samples
-            if records:
+            if runs:
                 continue
             if stop is not None and int(head[ring.READ]) < int(head[ring.WRITE]):
                 continue  # records written after `write` was read, before "stop"
@@ -116,16 +116,16 @@ class _Encoder:
         elif message[0] == "stop":
             self._stop = message[1]
 
-    def encode(self, epoch: int, record: Any) -> None:
-        layout = self._layouts[epoch]
-        sample = _sample(record, layout)
-        new = epoch != self._epoch
-        self._epoch = epoch
-        if self._publisher.publish(sample, self.writer, new_layout=new):
+    def encode(self, epoch: int, records: Any) -> None:
+        """Writes the messages of consecutive records (n × record length) of one layout."""
+        samples = _samples(records, self._layouts[epoch])
+        sent = self._publisher.publish(samples, self.writer, new_layout=epoch != self._epoch)
+        if len(sent):
+            self._epoch = epoch  # (a layout whose first records all diverged is not new yet)
             if self.samples == 0:
-                self.times[0] = sample.time
-            self.times[1] = sample.time
-            self.samples += 1
+                self.times[0] = sent.times[0]
+            self.times[1] = sent.times[-1]
+            self.samples += len(sent)
 
     def close(self, figures: dict) -> None:
         self.writer.writer.custom_data = {k: str(v) for k, v in figures.items()}
@@ -140,20 +140,20 @@ def conn_pending(conn: Any) -> bool:
         return False
 
 
-def _sample(record: Any, layout: Any) -> Any:
-    """The `Sample` a record holds (views into the record's copy): MuJoCo's state vector
-    (time, qpos, qvel, mocap_pos, mocap_quat, in `mjtState` order) and then qfrc_actuator."""
-    from twin_cli.record.sampler import Sample
+def _samples(records: Any, layout: Any) -> Any:
+    """The `Samples` that records hold (column views): MuJoCo's state vector (time, qpos, qvel,
+    mocap_pos, mocap_quat, in `mjtState` order) and then qfrc_actuator."""
+    from twin_cli.record.sampler import Samples
 
-    m = layout.model
+    m, n = layout.model, len(records)
     sizes = (m.nq, m.nv, 3 * m.nmocap, 4 * m.nmocap, m.nv)
     parts, at = [], 1
-    for n in sizes:
-        parts.append(record[at : at + n])
-        at += n
+    for size in sizes:
+        parts.append(records[:, at : at + size])
+        at += size
     qpos, qvel, mpos, mquat, qfrc = parts
-    return Sample(
-        float(record[0]), layout, qpos, qvel, qfrc, mpos.reshape(-1, 3), mquat.reshape(-1, 4)
+    return Samples(
+        layout, records[:, 0], qpos, qvel, qfrc, mpos.reshape(n, -1, 3), mquat.reshape(n, -1, 4)
     )
 
 

@@ -105,7 +105,7 @@ class LiveStream:
         channel = self._channels.get(message.topic)
         if channel is None:
             return
-        data = ros.encode(message.message, message.type)
+        data = message.cdr()
         if message.topic in ("/tf_static",) or message.topic.endswith("/robot_description"):
             self._latched[message.topic] = data
         channel.log(data, log_time=stamp)

@@ -3,22 +3,24 @@
 A recording of an unthrottled world makes thousands of samples per wall second, and building a
 fresh rosbags object for every header, vector and quaternion of every sample cost the encoder
 two thirds of its time (~190 of ~290 µs per humanoid sample). So the message objects of a layout
-are built once, all headers share one stamp, and each sample only writes its numbers into them:
-the relative link poses of every entity in one vectorised pass, then plain float assignments.
-The objects are reused, so a sink must encode a message within `write` (both sinks do).
+are built once, all headers share one stamp, and each sample only writes its numbers into them.
+The numbers of a whole batch of samples (the encoder reads up to 64 at a time) are computed in
+one vectorised pass first: relative link poses, joint states, odometry twists. The objects are
+reused, so a sink must encode a message within `write` (both sinks do), and each message carries
+its `messages.Reencoder`, which serializes the refilled object without re-measuring it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
 from twin_cli.record import messages as ros
 from twin_cli.record.layout import WORLD_FRAME, EntityLayout, Layout
-from twin_cli.record.sampler import Sample
+from twin_cli.record.sampler import Samples
 from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
-from twin_cli.world.pose import rotate
 
 # conj(q) ⊗ r as a matrix product M(q) r: M's entries are q's components, permuted and signed.
 _CONJ_LEFT_INDEX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
@@ -34,24 +36,27 @@ def relative_poses(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each body's pose in its parent's frame: p = R_parentᵀ (x − x_parent), q = q̄_parent ⊗ q.
 
-    Args: world positions (nbody×3), quaternions w,x,y,z (nbody×4) and rotation matrices
-    (nbody×9) of every body; the bodies and their parents (index arrays of one length).
+    Args: world positions (…×nbody×3), quaternions w,x,y,z (…×nbody×4) and rotation matrices
+    (…×nbody×9) of every body, with any leading (batch) axes; the bodies and their parents
+    (index arrays of one length). Returns positions (…×m×3) and quaternions (…×m×4).
     """
-    offset = (xpos[bodies] - xpos[parents])[:, None, :]
-    pos = (offset @ xmat[parents].reshape(-1, 3, 3))[:, 0, :]  # row vector · R = (Rᵀ v)ᵀ
-    left = xquat[parents][:, _CONJ_LEFT_INDEX] * _CONJ_LEFT_SIGN
-    quat = (left @ xquat[bodies][:, :, None])[:, :, 0]
+    offset = (xpos[..., bodies, :] - xpos[..., parents, :])[..., None, :]
+    rotations = xmat[..., parents, :].reshape(*xmat.shape[:-2], len(parents), 3, 3)
+    pos = (offset @ rotations)[..., 0, :]  # row vector · R = (Rᵀ v)ᵀ
+    left = xquat[..., parents, :][..., _CONJ_LEFT_INDEX] * _CONJ_LEFT_SIGN
+    quat = (left @ xquat[..., bodies, :, None])[..., 0]
     return pos, quat
 
 
 class LiveMessages:
-    """The reusable live messages of one layout; `fill` writes a sample into them."""
+    """The reusable live messages of one layout; `messages` refills them sample by sample."""
 
     def __init__(self, layout: Layout) -> None:
         T = ros.types()
         self.layout = layout
         self._stamp = T["builtin_interfaces/msg/Time"](sec=0, nanosec=0)
         self._clock = T[ros.CLOCK](clock=self._stamp)
+        self._clock_cdr = ros.Reencoder(self._clock, ros.CLOCK)
         entities = layout.entities
         self._bodies = np.concatenate([e.moving for e in entities] or [np.zeros(0, int)])
         self._parents = np.concatenate([e.moving_parents for e in entities] or [np.zeros(0, int)])
@@ -63,27 +68,38 @@ class LiveMessages:
         self._translations = [t.transform.translation for t in transforms]
         self._rotations = [t.transform.rotation for t in transforms]
         self._tf = T[ros.TF](transforms=transforms)
+        self._tf_cdr = ros.Reencoder(self._tf, ros.TF)
         self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities]
         self._odometry = [_Odometry(T, e, self._stamp) for e in entities if e.free_qpos >= 0]
 
-    def fill(
-        self, sample: Sample, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray
-    ) -> list[Message]:
-        """The sample's messages (the same objects as the last call's, refilled)."""
-        t = sample.time
-        self._stamp.sec, self._stamp.nanosec = divmod(ros.nanoseconds(t), 1_000_000_000)
+    def messages(
+        self, samples: Samples, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray
+    ) -> Iterator[tuple[Message, ...]]:
+        """Each sample's messages in turn, from its body poses (n×nbody×3, ×4, ×9): the same
+        objects refilled, so write one sample's messages before taking the next."""
         pos, quat = relative_poses(xpos, xquat, xmat, self._bodies, self._parents)
-        for v, xyz in zip(self._translations, pos.tolist(), strict=True):
-            v.x, v.y, v.z = xyz
-        for q, wxyz in zip(self._rotations, quat.tolist(), strict=True):
-            q.w, q.x, q.y, q.z = wxyz
-        out = [
-            Message(CLOCK.name, ros.CLOCK, t, self._clock),
-            Message(TF.name, ros.TF, t, self._tf),
-        ]
-        out += [joints.fill(sample) for joints in self._joints]
-        out += [odometry.fill(sample) for odometry in self._odometry]
-        return out
+        return zip(
+            self._clocks(samples),  # first: it sets the stamp that every header shares
+            self._transforms(samples, pos, quat),
+            *(joints.messages(samples) for joints in self._joints),
+            *(odometry.messages(samples, xmat) for odometry in self._odometry),
+            strict=True,
+        )
+
+    def _clocks(self, samples: Samples) -> Iterator[Message]:
+        stamp = self._stamp
+        for t in samples.times.tolist():
+            stamp.sec, stamp.nanosec = divmod(ros.nanoseconds(t), 1_000_000_000)
+            yield Message(CLOCK.name, ros.CLOCK, t, self._clock, self._clock_cdr)
+
+    def _transforms(self, samples: Samples, pos: np.ndarray, quat: np.ndarray) -> Iterator[Message]:
+        translations, rotations = self._translations, self._rotations
+        for t, xyzs, wxyzs in zip(samples.times.tolist(), pos.tolist(), quat.tolist(), strict=True):
+            for v, (x, y, z) in zip(translations, xyzs, strict=True):
+                v.x, v.y, v.z = x, y, z
+            for q, (w, x, y, z) in zip(rotations, wxyzs, strict=True):
+                q.w, q.x, q.y, q.z = w, x, y, z
+            yield Message(TF.name, ros.TF, t, self._tf, self._tf_cdr)
 
 
 class _JointStates:
@@ -99,20 +115,28 @@ class _JointStates:
         self._message = T[ros.JOINT_STATE](
             header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=""),
             name=list(e.joint_names),
-            position=np.zeros(0),
-            velocity=np.zeros(0),
-            effort=np.zeros(0),
+            position=np.zeros(len(e.joint_names)),
+            velocity=np.zeros(len(e.joint_names)),
+            effort=np.zeros(len(e.joint_names)),
         )
+        self._cdr = ros.Reencoder(self._message, ros.JOINT_STATE)
 
-    def fill(self, sample: Sample) -> Message:
-        m, qa, da = self._message, self._qpos, self._dofs
-        m.position, m.velocity = sample.qpos[qa], sample.qvel[da]
-        m.effort = sample.qfrc_actuator[da]
+    def messages(self, samples: Samples) -> Iterator[Message]:
+        qa, da = self._qpos, self._dofs
+        # rows must be contiguous for the CDR encoder; indexing column views may give F order
+        position, velocity, effort = (
+            np.ascontiguousarray(a[:, i])
+            for a, i in ((samples.qpos, qa), (samples.qvel, da), (samples.qfrc_actuator, da))
+        )
         for k in self._balls:
-            m.position[k] = 2.0 * np.arccos(min(1.0, abs(float(sample.qpos[qa[k]]))))
-            m.velocity[k] = np.linalg.norm(sample.qvel[da[k] : da[k] + 3])
-            m.effort[k] = 0.0
-        return Message(self._topic, ros.JOINT_STATE, sample.time, m)
+            position[:, k] = 2.0 * np.arccos(np.minimum(1.0, np.abs(samples.qpos[:, qa[k]])))
+            velocity[:, k] = np.linalg.norm(samples.qvel[:, da[k] : da[k] + 3], axis=1)
+            effort[:, k] = 0.0
+        m = self._message
+        rows = zip(samples.times.tolist(), position, velocity, effort, strict=True)
+        for t, p, v, e in rows:  # row views: each is encoded before the next is set
+            m.position, m.velocity, m.effort = p, v, e
+            yield Message(self._topic, ros.JOINT_STATE, t, m, self._cdr)
 
 
 class _Odometry:
@@ -120,7 +144,7 @@ class _Odometry:
     (MuJoCo's free-joint linear velocity is global and its angular velocity local)."""
 
     def __init__(self, T: Any, e: EntityLayout, stamp: Any) -> None:
-        self._qpos, self._dof = e.free_qpos, e.free_dof
+        self._qpos, self._dof, self._root = e.free_qpos, e.free_dof, int(e.moving[0])
         self._topic = f"/{e.name}/odom"
         vector, zeros = T["geometry_msgs/msg/Vector3"], np.zeros(36)
         pose = T["geometry_msgs/msg/Pose"](
@@ -137,13 +161,22 @@ class _Odometry:
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros),
             twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros),
         )
+        self._cdr = ros.Reencoder(self._message, ros.ODOMETRY)
 
-    def fill(self, sample: Sample) -> Message:
-        x, y, z, qw, qx, qy, qz = sample.qpos[self._qpos : self._qpos + 7].tolist()
-        vx, vy, vz, wx, wy, wz = sample.qvel[self._dof : self._dof + 6].tolist()
+    def messages(self, samples: Samples, xmat: np.ndarray) -> Iterator[Message]:
+        """From the root body's rotation R (n×9) of each sample: the linear twist is Rᵀ v."""
+        poses = samples.qpos[:, self._qpos : self._qpos + 7]
+        velocity = samples.qvel[:, self._dof : self._dof + 6]
+        rotation = xmat[:, self._root].reshape(-1, 3, 3)
+        linear = (velocity[:, None, :3] @ rotation)[:, 0, :]  # row vector · R = (Rᵀ v)ᵀ
         p, o = self._pose.position, self._pose.orientation
-        p.x, p.y, p.z, o.w, o.x, o.y, o.z = x, y, z, qw, qx, qy, qz
-        linear, angular = self._twist.linear, self._twist.angular
-        linear.x, linear.y, linear.z = rotate((qw, -qx, -qy, -qz), (vx, vy, vz))  # Rᵀ v
-        angular.x, angular.y, angular.z = wx, wy, wz
-        return Message(self._topic, ros.ODOMETRY, sample.time, self._message)
+        v, w = self._twist.linear, self._twist.angular
+        rows = zip(
+            samples.times.tolist(), poses.tolist(), linear.tolist(), velocity[:, 3:].tolist(),
+            strict=True,
+        )  # fmt: skip
+        for t, pose, vs, ws in rows:
+            p.x, p.y, p.z, o.w, o.x, o.y, o.z = pose
+            v.x, v.y, v.z = vs
+            w.x, w.y, w.z = ws
+            yield Message(self._topic, ros.ODOMETRY, t, self._message, self._cdr)

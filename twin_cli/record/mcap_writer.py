@@ -118,7 +118,7 @@ class BagWriter:
     def write(self, message: Message) -> None:
         """Encodes and writes one message (its topic must have been added)."""
         stamp = ros.nanoseconds(message.time)
-        data = ros.encode(message.message, message.type)
+        data = message.cdr()
         self._channels[message.topic].log(data, log_time=stamp)
         self._file.check()
         self._counts[message.topic] += 1

@@ -7,6 +7,8 @@ definitions are Jazzy's (the LTS distribution); the types used are unchanged sin
 
 from __future__ import annotations
 
+import struct
+import sys
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -62,6 +64,39 @@ def types() -> Any:
 def encode(message: Any, name: str) -> bytes:
     """The CDR bytes of `message` (a `types()[name]` instance)."""
     return bytes(typestore().serialize_cdr(message, name))
+
+
+class Reencoder:
+    """The CDR encoding of one message object that is refilled in place and keeps its size.
+
+    The live messages of a layout (`live_messages`) keep their names, frame ids and array
+    lengths; only numbers change. `encode` sizes every message before serializing it (for a
+    humanoid's `/tf`, a fifth of its time), so this keeps the buffer of the first encoding and
+    calls rosbags' generated serializer of the type into it. A message whose size did change is
+    encoded again the usual way, with a new buffer.
+    """
+
+    def __init__(self, message: Any, name: str) -> None:
+        self._message, self._name = message, name
+        self._store = typestore()
+        msgdef = self._store.get_msgdef(name)
+        little = sys.byteorder == "little"
+        self._serialize = msgdef.serialize_cdr_le if little else msgdef.serialize_cdr_be
+        self._resize()
+
+    def __call__(self) -> bytes:
+        """The CDR bytes of the message as it is now."""
+        try:
+            end = self._serialize(self._body, 0, self._message, self._store)
+        except (struct.error, ValueError):  # grew: it no longer fits the buffer
+            end = -1
+        if end != len(self._body):
+            self._resize()
+        return bytes(self._buffer)
+
+    def _resize(self) -> None:
+        self._buffer = bytearray(encode(self._message, self._name))  # header and size: rosbags'
+        self._body = memoryview(self._buffer)[4:]
 
 
 def stamp(time: float) -> Any:

@@ -19,7 +19,7 @@ from twin_cli.errors import InvalidRequestError
 from twin_cli.record.follow import Follows
 from twin_cli.record.layout import Layout
 from twin_cli.record.live_messages import LiveMessages
-from twin_cli.record.sampler import Kinematics, Sample, Sampler
+from twin_cli.record.sampler import Kinematics, Sample, Sampler, Samples
 from twin_cli.record.sensor_feed import KEPT, SensorFeed
 from twin_cli.record.sensor_messages import sensor_message
 from twin_cli.record.sensor_pump import SensorPump
@@ -222,7 +222,7 @@ class Recording(Follows):
             self._layout_topics = topics(sample.layout)
         extra = list(self._sensor_topics.values())
         new = sample.layout is not layout
-        if publisher.publish(sample, sink, new_layout=new, extra_topics=extra):
+        if len(publisher.publish(Samples.of(sample), sink, new_layout=new, extra_topics=extra)):
             self._count(sample.time)
             return sample.layout
         return layout
@@ -297,21 +297,25 @@ class Publisher:
         self._live: LiveMessages | None = None
 
     def publish(
-        self, sample: Sample, sink: Any, *, new_layout: bool, extra_topics: Sequence[Topic] = ()
-    ) -> bool:
-        """Hands one sample's messages to `sink` (its topics and latched messages first when the
-        layout is new); False for a diverged state (its entity is being reset: nothing sent)."""
-        if not sample.finite():
-            return False
+        self, samples: Samples, sink: Any, *, new_layout: bool, extra_topics: Sequence[Topic] = ()
+    ) -> Samples:
+        """Hands the samples' messages to `sink`, sample by sample (the layout's topics and
+        latched messages first when it is new); returns the samples sent: diverged states (an
+        entity being reset) are left out."""
+        samples = samples.finite()
+        if not len(samples):
+            return samples
+        layout = samples.layout
         if new_layout:
-            sink.set_topics(topics(sample.layout) + list(extra_topics))
-            for message in latched_messages(sample.layout, sample.time):
+            sink.set_topics(topics(layout) + list(extra_topics))
+            for message in latched_messages(layout, float(samples.times[0])):
                 sink.write(message)
-        if self._live is None or self._live.layout is not sample.layout:
-            self._live = LiveMessages(sample.layout)
-        for message in self._live.fill(sample, *self._kinematics.poses(sample)):
-            sink.write(message)
-        return True
+        if self._live is None or self._live.layout is not layout:
+            self._live = LiveMessages(layout)
+        for messages in self._live.messages(samples, *self._kinematics.poses(samples)):
+            for message in messages:
+                sink.write(message)
+        return samples
 
 
 class BagSink:

@@ -163,11 +163,12 @@ class RingReader:
 
     def read(self, write: int, limit: int) -> list[tuple[int, np.ndarray]]:
         """Up to `limit` unread records before position `write` (read before the layouts sent
-        with them were taken), as (epoch, copy); marks them read."""
+        with them were taken), as runs of consecutive records of one layout: (epoch, a copy of
+        n records × their length); marks them read."""
         data, layouts, capacity = self._data, self._layouts, self._data.size
         read = int(self._header[READ])
-        out = []
-        while read < write and len(out) < limit:
+        out, taken = [], 0
+        while read < write and taken < limit:
             while len(layouts) > 1 and layouts[1][0] <= read:
                 layouts.popleft()
             _, epoch, length = layouts[0]
@@ -175,7 +176,9 @@ class RingReader:
             if pos + length > capacity:  # the writer started this record over at 0
                 read += capacity - pos
                 continue
-            out.append((epoch, data[pos : pos + length].copy()))
-            read += length
+            end = write if len(layouts) == 1 else min(write, layouts[1][0])
+            n = min((end - read) // length, (capacity - pos) // length, limit - taken)
+            out.append((epoch, data[pos : pos + n * length].reshape(n, length).copy()))
+            read, taken = read + n * length, taken + n
         self._header[READ] = read
         return out

@@ -37,10 +37,6 @@ class Sample:
     mocap_pos: np.ndarray
     mocap_quat: np.ndarray
 
-    def finite(self) -> bool:
-        """False for a diverged state (its entity is being reset by the world)."""
-        return bool(np.isfinite(self.qpos).all() and np.isfinite(self.qvel).all())
-
 
 class Sampler:
     """Copies the state of some (or all) entities of a world, re-reading its layout on change."""
@@ -100,22 +96,66 @@ class Sampler:
         self._model = view.model
 
 
+@dataclass(frozen=True)
+class Samples:
+    """Consecutive samples of one layout as rows: what a consumer turns into messages at once.
+
+    The encoder's rows are views into the records it read from its ring (no copies); a single
+    `Sample` is a batch of one (`of`).
+
+    Attributes:
+        layout: the frames and joints of `layout.model`; times: sim times [s] (n).
+        qpos (n×nq), qvel, qfrc_actuator (n×nv), mocap_pos (n×nmocap×3), mocap_quat (n×nmocap×4).
+    """
+
+    layout: Layout
+    times: np.ndarray
+    qpos: np.ndarray
+    qvel: np.ndarray
+    qfrc_actuator: np.ndarray
+    mocap_pos: np.ndarray
+    mocap_quat: np.ndarray
+
+    @classmethod
+    def of(cls, sample: Sample) -> Samples:
+        """One sample as a batch of one (views)."""
+        s = sample
+        rows = (s.qpos, s.qvel, s.qfrc_actuator, s.mocap_pos, s.mocap_quat)
+        return cls(s.layout, np.array([s.time]), *(a[None] for a in rows))
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+    def finite(self) -> Samples:
+        """The samples without the diverged ones (an entity being reset by the world)."""
+        keep = np.isfinite(self.qpos).all(axis=1) & np.isfinite(self.qvel).all(axis=1)
+        if keep.all():
+            return self
+        rows = (self.times, self.qpos, self.qvel, self.qfrc_actuator)
+        return Samples(self.layout, *(a[keep] for a in (*rows, self.mocap_pos, self.mocap_quat)))
+
+
 class Kinematics:
-    """Body poses of samples, on scratch data of the sample's model (consumer side)."""
+    """Body poses of samples, on scratch data of the samples' model (consumer side)."""
 
     def __init__(self) -> None:
         self._model: Any = None
         self._data: Any = None
 
-    def poses(self, sample: Sample) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """World positions [m] (nbody×3), quaternions w,x,y,z (nbody×4) and rotation matrices
-        (nbody×9) of every body: views of the scratch data, valid until the next call."""
-        model = sample.layout.model
+    def poses(self, samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World positions [m] (n×nbody×3), quaternions w,x,y,z (n×nbody×4) and rotation
+        matrices (n×nbody×9) of every body in each sample."""
+        model = samples.layout.model
         if model is not self._model:
             self._model, self._data = model, mujoco.MjData(model)
-        d = self._data
-        d.qpos[:] = sample.qpos
-        d.mocap_pos[:] = sample.mocap_pos
-        d.mocap_quat[:] = sample.mocap_quat
-        mujoco.mj_kinematics(model, d)
-        return d.xpos, d.xquat, d.xmat
+        d, n = self._data, len(samples)
+        xpos, xquat = np.empty((n, model.nbody, 3)), np.empty((n, model.nbody, 4))
+        xmat = np.empty((n, model.nbody, 9))
+        qpos, mocap_pos, mocap_quat = d.qpos, d.mocap_pos, d.mocap_quat  # views, looked up once
+        for i in range(n):
+            qpos[:] = samples.qpos[i]
+            if model.nmocap:
+                mocap_pos[:], mocap_quat[:] = samples.mocap_pos[i], samples.mocap_quat[i]
+            mujoco.mj_kinematics(model, d)
+            xpos[i], xquat[i], xmat[i] = d.xpos, d.xquat, d.xmat
+        return xpos, xquat, xmat

@@ -10,7 +10,7 @@
   `World.joint_states`; `/<entity>/robot_description` std_msgs/String, the URDF after xacro,
   latched; `/<entity>/odom` nav_msgs/Odometry for floating bases (pose in `world`, twist in the
   root link's frame, as ROS defines it).
-Every stamp is sim time. Messages are rosbags objects; encoding is `messages.encode`. This
+Every stamp is sim time. Messages are rosbags objects; `Message.cdr` encodes them. This
 module names the topics and builds the latched messages; `live_messages` refills the per-sample
 ones.
 """
@@ -35,12 +35,20 @@ class Topic:
 
 @dataclass(frozen=True)
 class Message:
-    """One message to publish: topic, type, sim time [s] and the rosbags message object."""
+    """One message to publish: topic, type, sim time [s] and the rosbags message object (with
+    its `ros.Reencoder` when the object is refilled and re-sent: the live messages)."""
 
     topic: str
     type: str
     time: float
     message: Any
+    reencoder: ros.Reencoder | None = None
+
+    def cdr(self) -> bytes:
+        """The message's CDR bytes."""
+        if self.reencoder is not None:
+            return self.reencoder()
+        return ros.encode(self.message, self.type)
 
 
 CLOCK = Topic("/clock", ros.CLOCK)

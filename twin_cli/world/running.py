@@ -7,9 +7,9 @@ start with "_" expect the caller to hold the lock (the loop thread and `step`).
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import replace
+from time import perf_counter
 
 import mujoco
 
@@ -26,6 +26,7 @@ from twin_cli.world.sensor_rings import align_sensor_ticks, shift_sensor_history
 from twin_cli.world.values import Stats
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+mj_step = mujoco.mj_step  # one global lookup per split instead of two
 
 
 class RunControl:
@@ -184,17 +185,21 @@ class RunControl:
                 self._step_chunk(1)
 
     def _mj_steps(self, n: int) -> None:
-        """n MuJoCo steps, with velocity decay (dampingFactor) after each when any is set."""
-        m, d = self.model, self.data
-        start = time.perf_counter()
+        """n MuJoCo steps, with velocity decay (dampingFactor) after each when any is set.
+
+        Called between observer calls with the interpreter's caches cold from the last step
+        (design.md §7), so it makes as few lookups as it can: each costs ~0.5 µs there.
+        """
+        start = perf_counter()
         if self._damping is None:
-            mujoco.mj_step(m, d, nstep=n)
+            mj_step(self.model, self.data, n)
         else:
+            m, d = self.model, self.data
             dofs, keep = self._damping.dofs, self._damping.keep
             for _ in range(n):
-                mujoco.mj_step(m, d)
+                mj_step(m, d)
                 d.qvel[dofs] *= keep
-        self._stepping_time += time.perf_counter() - start
+        self._stepping_time += perf_counter() - start
 
     def _recover(self, bad: dict[str, str]) -> None:
         """Resets the offending entities to their spawn state; the others keep their state.
