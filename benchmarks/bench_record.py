@@ -10,7 +10,8 @@ counts the encoder process's CPU against the loop (a second core kept busy slows
 to 9 % on this VM, a quarter-busy one not measurably); the loop-CPU ratio is what sampling adds
 to the stepping thread. The encoder's CPU per sample is read from /proc. After each sampled
 arm, the next plain arm waits (untimed) until the encoder has written that arm's samples: else
-the encoder's last ~10 ms of work would run beside the plain arm and flatter the ratio.
+the encoder's last run (up to 50 ms of samples) would run beside the plain arm and flatter the
+ratio.
 """
 
 from __future__ import annotations

@@ -17,8 +17,8 @@ import time
 from typing import Any
 
 NICE = 10  # added niceness of the encoder process
-IDLE_S = 0.01  # [s] poll period when the ring is empty: fewer, longer runs of warm encoding
-BATCH = 64  # records taken from the ring between looks at the pipe, encoded as one batch
+IDLE_S = 0.05  # [s] poll period when the ring is empty: fewer, longer runs of warm encoding
+BATCH = 256  # records taken from the ring between looks at the pipe, encoded as one batch
 
 
 def main(argv: list[str]) -> None:

@@ -4,7 +4,7 @@ A recording of an unthrottled world makes thousands of samples per wall second, 
 fresh rosbags object for every header, vector and quaternion of every sample cost the encoder
 two thirds of its time (~190 of ~290 µs per humanoid sample). So the message objects of a layout
 are built once, all headers share one stamp, and each sample only writes its numbers into them.
-The numbers of a whole batch of samples (the encoder reads up to 64 at a time) are computed in
+The numbers of a whole batch of samples (the encoder reads up to 256 at a time) are computed in
 one vectorised pass first: relative link poses, joint states, odometry twists. The objects are
 reused, so a sink must encode a message within `write` (both sinks do), and each message carries
 its `messages.Reencoder`, which serializes the refilled object without re-measuring it.

@@ -57,7 +57,9 @@ def allocate(doubles: int) -> tuple[int, Any]:
     with tempfile.TemporaryFile(dir=folder) as handle:
         os.ftruncate(handle.fileno(), size)
         fd = os.dup(handle.fileno())
-    return fd, mmap.mmap(fd, size)
+    # populated now: else the loop would take the page faults, one per 4 kB of records
+    flags = mmap.MAP_SHARED | getattr(mmap, "MAP_POPULATE", 0)
+    return fd, mmap.mmap(fd, size, flags=flags)
 
 
 def attach(fd: int) -> Any:
