@@ -8,10 +8,14 @@ On this 2-vCPU VM single pairs range 0.8-1.1 (the machine's speed drifts by ±25
 seconds), so 100 pairs are summed: repeated runs agree within about ±1.5 %. The wall ratio
 counts the encoder process's CPU against the loop (a second core kept busy slows `mj_step` by up
 to 9 % on this VM, a quarter-busy one not measurably); the loop-CPU ratio is what sampling adds
-to the stepping thread. The encoder's CPU per sample is read from /proc. After each sampled
-arm, the next plain arm waits (untimed) until the encoder has written that arm's samples: else
-the encoder's last run (up to 50 ms of samples) would run beside the plain arm and flatter the
-ratio.
+to the stepping thread. The encoder's CPU per sample is read from /proc.
+
+The encoder works in cycles (it waits up to 50 ms for the ring to fill, then encodes what it
+holds), so a 0.1 s window is not a long run in small: its work may start late and end after the
+window. Each sampled window is therefore framed by ROLL untimed steps that also sample, before
+(the encoder is in its cycle when timing starts) and after (its tail runs beside sampling, as
+in a long run); then sampling stops and the next plain window waits, untimed, until the encoder
+has written everything, so none of its work runs beside a plain window.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from twin_cli.world import Pose, World, WorldSettings
 HUMANOID = Path(__file__).parents[1] / "scenarios" / "robots" / "humanoid.urdf.xacro"
 RATE = 100.0  # [Hz] of sim time
 WINDOW = 2000  # [steps] per arm: 2 s of sim time, ~0.1 s of wall
+ROLL = 3000  # [steps] sampled, untimed, before and after a sampled arm: > the encoder's cycle
 PAIRS = 100  # alternations per ratio (benchmarks/paired.py)
 REALTIME_SECONDS = 10.0  # [s]
 TARGETS = {"record_vs_plain": 0.95, "realtime_factor": (0.99, 1.01)}
@@ -45,37 +50,38 @@ def throughput(tmp: Path) -> dict:
     against the loop when the machine has no idle core, and the stepping thread's own CPU."""
     world = _world()
     world.step(2000)  # settled on the ground: the same contacts in every window
-    recording = BagRecording(world, tmp / "bench.mcap", rate=RATE).start()
+    recording = BagRecording(world, tmp / "bench.mcap", rate=RATE).start()  # one sample now
     recording.ready()  # the steady state: not the encoder's imports
+    recording.set_sampling(False)
+    taken = [1]  # samples taken so far, all of which the encoder is to write
+    per_window = round(WINDOW * world.model.opt.timestep * RATE)  # samples in WINDOW steps
+    per_roll = round(ROLL * world.model.opt.timestep * RATE)
 
-    def arm(on: bool):  # noqa: ANN202
-        def run() -> None:
-            recording.set_sampling(on)
-            world.step(WINDOW)
+    def plain() -> None:
+        world.step(WINDOW)
 
-        return run
+    def prepare() -> None:  # the encoder in its steady cycle when the sampled window starts
+        recording.set_sampling(True)
+        world.step(ROLL)
+
+    def sampled() -> None:
+        world.step(WINDOW)
+
+    def settle() -> None:  # the encoder's tail runs beside more sampling, then ends, untimed
+        world.step(ROLL)
+        recording.set_sampling(False)
+        taken[0] += 2 * per_roll + per_window
+        _wait_encoded(recording, taken[0])
 
     plain_s = time.perf_counter()
     world.step(WINDOW * 4)
     plain_rate = WINDOW * 4 / (time.perf_counter() - plain_s)
-    per_window = round(WINDOW * world.model.opt.timestep * RATE)  # samples in a sampled arm
-    encoder_cpu, samples = _process_cpu(recording), recording.status().samples
-    expected = [samples]
-
-    def settle() -> None:  # the encoder's last samples must not run beside the next plain arm
-        expected[0] += per_window
-        deadline = time.monotonic() + 5.0
-        while recording.status().samples < expected[0] and time.monotonic() < deadline:
-            time.sleep(0.0005)
-
-    wall = interleaved_ratio(arm(False), arm(True), pairs=PAIRS, settle=settle)
-    cpu = interleaved_ratio(
-        arm(False), arm(True), pairs=PAIRS, clock=time.thread_time, settle=settle
-    )
-    recording.set_sampling(False)
-    while recording.status().samples < expected[0]:  # all encoded
-        time.sleep(0.05)
-    encoder_cpu = _process_cpu(recording) - encoder_cpu
+    _wait_encoded(recording, taken[0])
+    encoder_cpu, first = _process_cpu(recording), taken[0]
+    paired = {"pairs": PAIRS, "prepare": prepare, "settle": settle}
+    wall = interleaved_ratio(plain, sampled, **paired)
+    cpu = interleaved_ratio(plain, sampled, clock=time.thread_time, **paired)
+    encoder_cpu = (_process_cpu(recording) - encoder_cpu) / (taken[0] - first)
     status = recording.stop()
     return {
         "record_vs_plain": wall,
@@ -84,8 +90,17 @@ def throughput(tmp: Path) -> dict:
         "samples_per_wall_s": plain_rate / 1000.0 * RATE,
         "recorded_samples": status.samples,
         "recorder_blocked_s": status.blocked_s,
-        "encoder_cpu_per_sample_us": encoder_cpu / (2 * PAIRS * per_window) * 1e6,
+        "encoder_cpu_per_sample_us": encoder_cpu * 1e6,
     }
+
+
+def _wait_encoded(recording: BagRecording, samples: int) -> None:
+    """Until the encoder has written `samples` samples (a sampled arm takes an exact number)."""
+    deadline = time.monotonic() + 30.0
+    while recording.status().samples < samples:
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"the encoder wrote {recording.status().samples} of {samples}")
+        time.sleep(0.0005)
 
 
 def _process_cpu(recording: BagRecording) -> float:

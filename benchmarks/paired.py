@@ -21,22 +21,28 @@ def interleaved_ratio(
     pairs: int = PAIRS,
     clock: Callable[[], float] = time.perf_counter,
     settle: Callable[[], None] | None = None,
+    prepare: Callable[[], None] | None = None,
 ) -> float:
     """Throughput of `variant` over that of `plain` (each call does the same work).
 
     Returns summed plain time / summed variant time over `pairs` alternations, so 1.0 means
     no cost and 0.95 a 5 % cost. Pass `clock=time.thread_time` for the calling thread's CPU.
     `settle`, untimed after each variant call, waits for work the variant left to another
-    thread, so that the next plain window does not share the machine with it.
+    thread, so that the next plain window does not share the machine with it. `prepare`,
+    untimed before each variant call, brings such a thread to its steady state (running
+    beside the variant as it would in a long run), so the variant's window is not the quiet
+    start of its work.
     """
     plain_s = variant_s = 0.0
     for _ in range(pairs):
         start = clock()
         plain()
-        middle = clock()
+        plain_s += clock() - start
+        if prepare is not None:
+            prepare()
+        start = clock()
         variant()
-        plain_s += middle - start
-        variant_s += clock() - middle
+        variant_s += clock() - start
         if settle is not None:
             settle()
     return plain_s / variant_s

@@ -429,6 +429,41 @@ def test_the_encoder_takes_a_record_written_while_it_reads_the_pipe(tmp_path):
     assert int(header[ring.SAMPLES]) == 6 and header[ring.READ] == header[ring.WRITE]
 
 
+def test_the_encoder_wakes_for_the_parent_at_once_not_after_its_idle_wait(tmp_path, monkeypatch):
+    """Between runs of records the encoder waits for the ring to fill, but a layout, sensor
+    readings (a camera image is larger than the pipe's buffer: its send blocks until read) or
+    stop wake it at once. With a 30 s idle wait, both messages are taken within seconds."""
+    import threading
+
+    from twin_cli.record import encoder, ring
+    from twin_cli.record.bag_recording import _pipe
+    from twin_cli.record.sampler import Sampler
+    from twin_cli.world.observers import world_view
+
+    monkeypatch.setattr(encoder, "IDLE_S", 30.0)
+    world = World()
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    memory = ring.allocate(1 << 16)[1]
+    data, header, _ = ring.views(memory)
+    parent, child = _pipe()
+    thread = threading.Thread(
+        target=encoder.encode_main, args=(memory, child, str(tmp_path / "r.mcap")), daemon=True
+    )
+    thread.start()
+    assert parent.recv()[0] == "ready"
+    time.sleep(0.2)  # the encoder is in its idle wait
+    writer = ring.RingWriter(data, header, lambda: True)
+    index, descriptions = Sampler(world).selection(world_view(world))
+    parent.send(("layout", 0, world.model, index, descriptions, writer.start_layout(world.model)))
+    assert writer.put(world.data)
+    time.sleep(0.2)
+    parent.send(("stop", {}))
+    assert parent.poll(10.0), "the encoder answered stop within 10 s, not after its idle wait"
+    assert parent.recv() == ("done", None)
+    thread.join(10.0)
+    assert int(header[ring.SAMPLES]) == 1
+
+
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
 def test_a_full_disk_stops_the_recording_with_the_file_and_the_cause(tmp_path):
     """Every write to /dev/full fails with ENOSPC. foxglove-sdk's MCAP writer only logs its
@@ -478,7 +513,7 @@ PENDULUM = """<mujoco><worldbody><body name="upper" pos="0 0 1">
 
 
 def test_a_batch_of_samples_encodes_as_each_sample_alone_and_skips_a_diverged_one():
-    """The encoder turns up to 64 records at once into messages (vectorised poses, joint
+    """The encoder turns up to 256 records at once into messages (vectorised poses, joint
     states and twists; reused message objects; serialization into kept buffers). Its bytes
     equal those of each sample published alone, a diverged sample is left out, and a ball
     joint's angle and speed decode to `World.joint_states`."""

@@ -17,7 +17,7 @@ import time
 from typing import Any
 
 NICE = 10  # added niceness of the encoder process
-IDLE_S = 0.05  # [s] poll period when the ring is empty: fewer, longer runs of warm encoding
+IDLE_S = 0.05  # [s] wait when the ring is empty: fewer, longer runs of warm encoding
 BATCH = 256  # records taken from the ring between looks at the pipe, encoded as one batch
 
 
@@ -59,7 +59,10 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
                 continue  # records written after `write` was read, before "stop"
             if stop is not None and (encoder.parent_gone or not conn_pending(conn)):
                 break
-            time.sleep(IDLE_S)
+            if stop is None:
+                wait_for_parent(conn, IDLE_S)  # the ring fills meanwhile
+            else:
+                time.sleep(IDLE_S)
     except Exception as exc:  # disk full...: report it to the parent
         error = f"{type(exc).__name__}: {exc}"
     finally:
@@ -130,6 +133,16 @@ class _Encoder:
     def close(self, figures: dict) -> None:
         self.writer.writer.custom_data = {k: str(v) for k, v in figures.items()}
         self.writer.close()
+
+
+def wait_for_parent(conn: Any, timeout: float) -> None:
+    """Until the parent sends something (a layout, sensor readings, stop) or `timeout` [s]
+    passes: its sends must not wait for the encoder's idle period (a camera image is larger than
+    the pipe's buffer, so its send blocks until it is read). A closed pipe returns at once."""
+    try:
+        conn.poll(timeout)
+    except (EOFError, OSError):
+        pass
 
 
 def conn_pending(conn: Any) -> bool:

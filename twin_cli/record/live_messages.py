@@ -70,7 +70,9 @@ class LiveMessages:
         self._tf = T[ros.TF](transforms=transforms)
         self._tf_cdr = ros.Reencoder(self._tf, ros.TF)
         self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities]
-        self._odometry = [_Odometry(T, e, self._stamp) for e in entities if e.free_qpos >= 0]
+        self._odometry = [
+            _Odometry(T, layout, e, self._stamp) for e in entities if e.free_qpos >= 0
+        ]
 
     def messages(
         self, samples: Samples, xpos: np.ndarray, xquat: np.ndarray, xmat: np.ndarray
@@ -143,8 +145,9 @@ class _Odometry:
     """`/<entity>/odom` of a floating base: its pose in the world and its twist in its own frame
     (MuJoCo's free-joint linear velocity is global and its angular velocity local)."""
 
-    def __init__(self, T: Any, e: EntityLayout, stamp: Any) -> None:
-        self._qpos, self._dof, self._root = e.free_qpos, e.free_dof, int(e.moving[0])
+    def __init__(self, T: Any, layout: Layout, e: EntityLayout, stamp: Any) -> None:
+        self._qpos, self._dof = e.free_qpos, e.free_dof
+        self._root = int(layout.model.dof_bodyid[e.free_dof])  # the free joint's body
         self._topic = f"/{e.name}/odom"
         vector, zeros = T["geometry_msgs/msg/Vector3"], np.zeros(36)
         pose = T["geometry_msgs/msg/Pose"](

@@ -73,7 +73,9 @@ class Reencoder:
     lengths; only numbers change. `encode` sizes every message before serializing it (for a
     humanoid's `/tf`, a fifth of its time), so this keeps the buffer of the first encoding and
     calls rosbags' generated serializer of the type into it. A message whose size did change is
-    encoded again the usual way, with a new buffer.
+    encoded again the usual way, with a new buffer. Strings must not change: rosbags writes
+    neither their terminating NUL nor padding (its fresh buffers are zeroed), so a string
+    changed to another of the same length could leave a stale byte.
     """
 
     def __init__(self, message: Any, name: str) -> None:

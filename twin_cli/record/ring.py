@@ -180,6 +180,8 @@ class RingReader:
                 continue
             end = write if len(layouts) == 1 else min(write, layouts[1][0])
             n = min((end - read) // length, (capacity - pos) // length, limit - taken)
+            if n < 1:  # only if writer and reader disagree on a layout's start or length
+                raise RuntimeError(f"ring: no whole record at {read} (layout {epoch})")
             out.append((epoch, data[pos : pos + n * length].reshape(n, length).copy()))
             read, taken = read + n * length, taken + n
         self._header[READ] = read
