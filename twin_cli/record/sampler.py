@@ -119,9 +119,8 @@ class Samples:
     @classmethod
     def of(cls, sample: Sample) -> Samples:
         """One sample as a batch of one (views)."""
-        s = sample
-        rows = (s.qpos, s.qvel, s.qfrc_actuator, s.mocap_pos, s.mocap_quat)
-        return cls(s.layout, np.array([s.time]), *(a[None] for a in rows))
+        rows = (sample.qpos, sample.qvel, sample.qfrc_actuator, sample.mocap_pos, sample.mocap_quat)
+        return cls(sample.layout, np.array([sample.time]), *(a[None] for a in rows))
 
     def __len__(self) -> int:
         return len(self.times)
@@ -131,8 +130,10 @@ class Samples:
         keep = np.isfinite(self.qpos).all(axis=1) & np.isfinite(self.qvel).all(axis=1)
         if keep.all():
             return self
-        rows = (self.times, self.qpos, self.qvel, self.qfrc_actuator)
-        return Samples(self.layout, *(a[keep] for a in (*rows, self.mocap_pos, self.mocap_quat)))
+        return Samples(
+            self.layout, self.times[keep], self.qpos[keep], self.qvel[keep],
+            self.qfrc_actuator[keep], self.mocap_pos[keep], self.mocap_quat[keep],
+        )  # fmt: skip
 
 
 class Kinematics:
