@@ -60,7 +60,7 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
             if stop is not None and (encoder.parent_gone or not conn_pending(conn)):
                 break
             if stop is None:
-                wait_for_parent(conn, IDLE_S)  # the ring fills meanwhile
+                conn_pending(conn, IDLE_S)  # the ring fills meanwhile; a message wakes it
             else:
                 time.sleep(IDLE_S)
     except Exception as exc:  # disk full...: report it to the parent
@@ -135,20 +135,13 @@ class _Encoder:
         self.writer.close()
 
 
-def wait_for_parent(conn: Any, timeout: float) -> None:
-    """Until the parent sends something (a layout, sensor readings, stop) or `timeout` [s]
-    passes: its sends must not wait for the encoder's idle period (a camera image is larger than
-    the pipe's buffer, so its send blocks until it is read). A closed pipe returns at once."""
+def conn_pending(conn: Any, timeout: float = 0.0) -> bool:
+    """Whether the parent sent something not yet taken, waiting up to `timeout` [s] for it
+    (False once the pipe is closed). The encoder's idle wait is this: the parent's sends must
+    not wait for it (a camera image is larger than the pipe's buffer, so its send blocks until
+    it is read)."""
     try:
-        conn.poll(timeout)
-    except (EOFError, OSError):
-        pass
-
-
-def conn_pending(conn: Any) -> bool:
-    """Whether the parent sent something not yet taken (False once the pipe is closed)."""
-    try:
-        return bool(conn.poll())
+        return bool(conn.poll(timeout))
     except (EOFError, OSError):
         return False
 

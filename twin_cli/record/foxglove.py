@@ -52,7 +52,6 @@ class LiveStream:
         from foxglove.websocket import Capability
 
         _check_address(host, port)
-        self._foxglove = foxglove
         self._context = foxglove.Context()
         self._listener = _Subscriptions()
         try:
