@@ -29,7 +29,7 @@ demo: $(STAMP)
 BROWSER_TESTS = tests/twin_cli/test_view_browser.py
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -n 2 --timeout 300 -q --ignore=$(BROWSER_TESTS)
+	$(BIN)/python -m pytest -n 2 --dist loadgroup --timeout 300 -q --ignore=$(BROWSER_TESTS)
 	$(BIN)/python -m pytest --timeout 300 -q $(BROWSER_TESTS)
 
 fuzz: $(STAMP)

@@ -9,12 +9,34 @@ from typing import Any
 import pytest
 from corpus_registry import (
     CORPUS,
+    CORPUS_MISSING,
     CORPUS_ROOT,
     NON_PHYSICAL_INERTIA,
     PACKAGES_ROOT,
     REPO_ROOT,
     package_paths,
 )
+
+pytest_plugins = ["reaper"]
+CORPUS_FIXTURES = {"corpus_root", "converted_corpus"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Without the corpus, tests that use its fixtures are skipped as they are collected."""
+    if CORPUS:
+        return
+    skip = pytest.mark.skip(reason=CORPUS_MISSING)
+    for item in items:
+        if CORPUS_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(skip)
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """One line that says how many tests the missing corpus skipped, and why."""
+    skipped = terminalreporter.stats.get("skipped", [])
+    missing = [r for r in skipped if CORPUS_MISSING in str(getattr(r, "longrepr", ""))]
+    if missing:
+        terminalreporter.write_line(f"{len(missing)} tests skipped: {CORPUS_MISSING}", yellow=True)
 
 
 @pytest.fixture(scope="session")
@@ -25,7 +47,7 @@ def repo_root() -> Path:
 @pytest.fixture(scope="session")
 def corpus_root() -> Path:
     if not CORPUS_ROOT.is_dir():
-        pytest.skip(f"corpus not found at {CORPUS_ROOT}")
+        pytest.skip(CORPUS_MISSING)
     return CORPUS_ROOT
 
 

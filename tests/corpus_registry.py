@@ -1,15 +1,25 @@
-"""The corpus of real robot packages (../shared/corpus): where it is and what robots.toml lists."""
+"""The corpus of real robot packages (../shared/corpus): where it is and what robots.toml lists.
+
+A clone on its own has no `../shared`: every test that needs the corpus is then skipped while
+pytest collects, with `CORPUS_MISSING` as its reason, and the run's summary counts them.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
+import pytest
 import tomllib
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 CORPUS_ROOT = REPO_ROOT.parent / "shared" / "corpus"
 PACKAGES_ROOT = CORPUS_ROOT / "packages"
+CORPUS_MISSING = (
+    f"corpus: {CORPUS_ROOT} not found (the real robot packages the project is tested with; "
+    "CI has them)"
+)
 
 
 def corpus_robots() -> list[dict[str, Any]]:
@@ -23,6 +33,19 @@ def corpus_robots() -> list[dict[str, Any]]:
 CORPUS = {robot["id"]: robot for robot in corpus_robots()}
 # Robots whose upstream inertias are non-physical: they must fail, then convert with repair.
 NON_PHYSICAL_INERTIA = ("abb_irb2400_12_155", "anymal_c", "hyq")
+# Marks a test (or a module, as `pytestmark`) that reads the corpus.
+needs_corpus = pytest.mark.skipif(not CORPUS, reason=CORPUS_MISSING)
+
+
+def corpus_ids(ids: Iterable[str] | None = None) -> list[Any]:
+    """Parameters over corpus robot ids (all of them by default).
+
+    Without the corpus: one placeholder, skipped with `CORPUS_MISSING`, so that the test is
+    reported as skipped rather than silently collected as nothing.
+    """
+    if not CORPUS:
+        return [pytest.param(None, id="no-corpus", marks=pytest.mark.skip(reason=CORPUS_MISSING))]
+    return sorted(CORPUS) if ids is None else list(ids)
 
 
 def package_paths(robot: dict[str, Any]) -> dict[str, Path]:

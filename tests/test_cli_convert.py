@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from corpus_registry import CORPUS, PACKAGES_ROOT
+from corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus
 
 from scenarios import HUMANOID
 
@@ -110,6 +110,7 @@ def test_bad_input_exits_2_with_one_message_naming_the_culprit(case: str, tmp_pa
     assert not (tmp_path / "out").exists(), f"{case}: a failed conversion wrote output"
 
 
+@needs_corpus
 def test_xacro_error_names_the_file_and_xacros_message(tmp_path: Path) -> None:
     robot = CORPUS["aliengo"]
     result = twin("convert", str(PACKAGES_ROOT / robot["entry"]), "-o", str(tmp_path / "o"))
@@ -117,6 +118,7 @@ def test_xacro_error_names_the_file_and_xacros_message(tmp_path: Path) -> None:
     assert "robot.xacro" in result.stderr and "DEBUG" in result.stderr, result.stderr
 
 
+@needs_corpus
 def test_non_physical_inertia_exits_2_naming_the_link(tmp_path: Path) -> None:
     robot = CORPUS["hyq"]
     result = twin(
@@ -141,6 +143,7 @@ def _digest(directory: Path) -> dict[str, str]:
     }
 
 
+@needs_corpus
 def test_convert_writes_a_loadable_scene_byte_identical_on_repeat(tmp_path: Path) -> None:
     import mujoco
 

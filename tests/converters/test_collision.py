@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from collision_models import CUP_FLOOR, CUP_INNER_R, CUP_RIM, box_mesh, cup_mesh, request
+from corpus_registry import CORPUS, PACKAGES_ROOT, corpus_ids
 
 from converters.collision import hulls
 from converters.collision.plan import (
@@ -227,7 +226,6 @@ def test_ball_stays_inside_heavy_cup_decomposed_by_the_default_auto_plan(tmp_pat
     assert widest < CUP_INNER_R, f"heavy cup: ball centre {widest:.4f} m off the axis"
 
 
-CORPUS = Path(__file__).resolve().parents[2].parent / "shared" / "corpus"
 # Robots whose converted model must also step 1 s without a MuJoCo warning (issue 3).
 MESH_ROBOTS = {"booster_t1", "solo12", "anymal_c", "open_manipulator_x", "robotiq_2f_85"}
 # CI keeps CoACD cold runs short: fast preset, and a mesh that needs longer than this falls
@@ -237,25 +235,18 @@ MESH_ROBOTS = {"booster_t1", "solo12", "anymal_c", "open_manipulator_x", "roboti
 CORPUS_TIME_LIMIT = 8.0  # [s]
 
 
-def _corpus_robots() -> list[dict]:
-    import tomllib
-
-    return tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]
-
-
 @pytest.fixture(scope="module")
 def corpus_cache(tmp_path_factory):
     """One cache for the module, so robots sharing meshes (the two R2-D2s) decompose once."""
     return tmp_path_factory.mktemp("corpus_cache")
 
 
-@pytest.mark.parametrize("robot", _corpus_robots(), ids=lambda r: r["id"])
-def test_corpus_robot_converts_with_auto_collision(robot, corpus_cache, monkeypatch):
-
+@pytest.mark.parametrize("robot_id", corpus_ids())
+def test_corpus_robot_converts_with_auto_collision(robot_id, corpus_cache, monkeypatch):
     from converters import ConvertOptions, convert
 
     monkeypatch.setenv("TWIN_CACHE_DIR", str(corpus_cache))
-    packages = CORPUS / "packages"
+    robot, packages = CORPUS[robot_id], PACKAGES_ROOT
     settings = CollisionSettings(preset="fast", jobs=2, time_limit=CORPUS_TIME_LIMIT)
     # Inertia repair is the core converter's concern (anymal_c, abb need it); this test is
     # about collision meshes.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from corpus_registry import CORPUS, NON_PHYSICAL_INERTIA, PACKAGES_ROOT, package_paths
+from corpus_registry import CORPUS, NON_PHYSICAL_INERTIA, PACKAGES_ROOT, corpus_ids, package_paths
 
 # Control drawn in ctrlrange, except where the URDF's effort is non-physical. solo12 gives
 # 1000 N·m to 38 g legs (no-load ≈1.8e6 rad/s²); the free-floating base then spins at > 1000 rad/s
@@ -14,7 +14,7 @@ CONTROL_SCALE = {"solo12": 0.01}
 STEPS = 1000  # 1 s at the 1 ms timestep
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_corpus_robot_steps_one_second_with_random_control_without_warnings(
     robot_id: str, converted_corpus
 ) -> None:
@@ -37,7 +37,7 @@ def test_corpus_robot_steps_one_second_with_random_control_without_warnings(
     assert data.time == pytest.approx(1.0), f"{robot_id}: simulated time {data.time} s"
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_corpus_robot_converts_through_ros_package_path(
     robot_id: str, converted_corpus, monkeypatch
 ) -> None:
@@ -61,7 +61,7 @@ def test_corpus_robot_converts_through_ros_package_path(
     ), f"{robot_id}: bodies/joints/actuators/equalities, ROS_PACKAGE_PATH vs --package"
 
 
-@pytest.mark.parametrize("robot_id", NON_PHYSICAL_INERTIA)
+@pytest.mark.parametrize("robot_id", corpus_ids(NON_PHYSICAL_INERTIA))
 def test_non_physical_inertia_fails_with_link_named_and_converts_with_repair(
     robot_id: str, converted_corpus
 ) -> None:
@@ -84,7 +84,7 @@ def test_non_physical_inertia_fails_with_link_named_and_converts_with_repair(
     assert any(caught.value.link in e.subject for e in repaired), f"{robot_id}: repair not reported"
 
 
-@pytest.mark.parametrize("robot_id", sorted(set(CORPUS) - set(NON_PHYSICAL_INERTIA)))
+@pytest.mark.parametrize("robot_id", corpus_ids(sorted(set(CORPUS) - set(NON_PHYSICAL_INERTIA))))
 def test_link_masses_and_total_mass_equal_the_urdf_after_lumping(
     robot_id: str, converted_corpus
 ) -> None:
@@ -104,7 +104,7 @@ def test_link_masses_and_total_mass_equal_the_urdf_after_lumping(
     assert model.body_mass.sum() == pytest.approx(urdf_total, rel=1e-12), f"{robot_id}: total [kg]"
 
 
-@pytest.mark.parametrize("robot_id", ["aliengo", "robotiq_2f_85"])
+@pytest.mark.parametrize("robot_id", corpus_ids(["aliengo", "robotiq_2f_85"]))
 def test_converted_robot_compiles_after_attach_with_prefix(robot_id: str, converted_corpus) -> None:
     import mujoco
 

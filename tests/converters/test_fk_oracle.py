@@ -6,7 +6,7 @@ import io
 
 import numpy as np
 import pytest
-from corpus_registry import CORPUS
+from corpus_registry import corpus_ids
 
 CONFIGURATIONS = 20
 TOLERANCE = 1e-9  # [m] for positions; rotation-matrix entries likewise
@@ -52,7 +52,7 @@ def _mujoco_frame(model: object, data: object, done: object, link: str) -> np.nd
     return T
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_forward_kinematics_matches_yourdfpy_at_random_configurations(
     robot_id: str, converted_corpus
 ) -> None:

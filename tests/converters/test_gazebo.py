@@ -8,6 +8,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from corpus_registry import PACKAGES_ROOT, needs_corpus
 
 from converters.errors import GazeboTagError
 from converters.gazebo.apply import DAMPING_FACTOR_PREFIX
@@ -20,8 +21,6 @@ from converters.gazebo.contact import (
 )
 from converters.pipeline import convert_full
 from converters.report import Outcome
-
-CORPUS = Path(__file__).resolve().parents[3] / "shared" / "corpus" / "packages"
 
 BASE_MASS = 2.0
 ARM_MASS = 0.5
@@ -382,10 +381,9 @@ def test_reference_to_missing_link_is_a_warning(tmp_path):
     assert not [e for e in done.report.of(Outcome.MAPPED) if "camera_link" in e.subject]
 
 
+@needs_corpus
 def test_corpus_hyq_tags_parse_with_sdformat_meanings():
-    urdf = CORPUS / "example-robot-data/robots/hyq_description/robots/hyq_no_sensors.urdf"
-    if not urdf.is_file():
-        pytest.skip(f"corpus not found at {urdf}")
+    urdf = PACKAGES_ROOT / "example-robot-data/robots/hyq_description/robots/hyq_no_sensors.urdf"
     ext = parse_gazebo(ET.parse(urdf).getroot(), urdf.name)
     assert len([j for j in ext.joints.values() if j.provide_feedback]) == 12, "12 joints"
     upper = ext.link("lf_upperleg").surface

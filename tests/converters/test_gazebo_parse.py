@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from corpus_registry import needs_corpus
 from models import write_urdf
 
 from converters.collision.plan import CollisionSettings
@@ -80,6 +81,7 @@ def test_a_moving_link_without_inertial_names_what_gazebo_would_drop(tmp_path: P
     assert "base_only" not in message, "only the link's own subtree"
 
 
+@needs_corpus
 def test_robotiq_fingertips_get_what_gazebo_simulates_unless_as_written() -> None:
     """robotiq_2f_85 writes μ 1e5, kp 1e5 inline in its fingertip collisions; Gazebo ignores
     them (μ 1, kp 1e12 there), and so does twin unless asked."""
@@ -87,9 +89,7 @@ def test_robotiq_fingertips_get_what_gazebo_simulates_unless_as_written() -> Non
 
     from converters.gazebo.contact import CONTACT_MU_MAX
 
-    robot = CORPUS.get("robotiq_2f_85")
-    if robot is None:
-        pytest.skip("the shared corpus is not present")
+    robot = CORPUS["robotiq_2f_85"]
     path = PACKAGES_ROOT / robot["entry"]
     inputs = {"args": robot["xacro_args"], "package_paths": package_paths(robot)}
     mesh = {"collision": CollisionSettings(mode="hull")}

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from corpus_registry import PACKAGES_ROOT
+from corpus_registry import PACKAGES_ROOT, needs_corpus
 
 from converters.errors import MeshError
 from converters.mjcf.writer import stl_bytes
@@ -63,16 +63,19 @@ def assert_same_mesh(ours: MeshData, oracle: MeshData, subject: str) -> None:
     assert (ours.rgba, ours.textured) == (oracle.rgba, oracle.textured), f"{subject}: colour"
 
 
-@pytest.mark.skipif(not CORPUS_STL, reason="corpus not found")
-@pytest.mark.parametrize("path", CORPUS_STL, ids=lambda p: str(p.relative_to(PACKAGES_ROOT)))
+@needs_corpus
+@pytest.mark.parametrize(
+    "path",
+    CORPUS_STL or [None],
+    ids=lambda p: str(p.relative_to(PACKAGES_ROOT)) if p else "no-corpus",
+)
 def test_every_corpus_stl_reads_as_trimesh_reads_it(path: Path) -> None:
     ours = read_mesh_file(path, "link")
     assert_same_mesh(ours, read_with_trimesh(path, "link"), path.name)
 
 
+@needs_corpus
 def test_corpus_has_binary_stl_files_for_the_numpy_reader() -> None:
-    if not CORPUS_STL:
-        pytest.skip("corpus not found")
     binary = [p for p in CORPUS_STL if read_binary_stl(p, "link") is not None]
     assert len(binary) >= 10, f"only {len(binary)} of {len(CORPUS_STL)} corpus STL are binary"
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from corpus_registry import CORPUS, PACKAGES_ROOT, package_paths
+from corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus, package_paths
 from models import write_urdf
 from sensor_models import hanging_load, imu_box, lidar_post
 
@@ -192,10 +192,9 @@ def test_sdf_link_sensors_are_read_too(tmp_path: Path) -> None:
     np.testing.assert_allclose(data.site("sensor:lidar").xpos - data.body("l").xpos, [0, 0, 0.2])
 
 
+@needs_corpus
 def test_turtlebot3_gets_its_lidar_and_imu_with_the_tags_values() -> None:
-    robot = CORPUS.get("turtlebot3_burger")
-    if robot is None:
-        pytest.skip("corpus absent")
+    robot = CORPUS["turtlebot3_burger"]
     done = convert_full(PACKAGES_ROOT / robot["entry"], package_paths=package_paths(robot))
     sensors = {s.name: s for s in done.sensors}
     lidar, imu = sensors["lds_lfcd_sensor"], sensors["imu"]

@@ -7,7 +7,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from corpus_registry import CORPUS
+from corpus_registry import corpus_ids
 
 from converters.mjcf.writer import stl_bytes, write_model
 
@@ -89,7 +89,7 @@ def test_a_users_scene_can_include_the_robot_and_add_a_geom_only_body(tmp_path: 
     assert np.isfinite(data.qpos).all(), "the combined scene steps"
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_written_mjcf_reads_back_bit_for_bit(tmp_path: Path, converted_corpus, robot_id) -> None:
     """Masses, inertias, frames, joint ranges and primitive sizes survive the file exactly."""
     done = converted_corpus(robot_id)

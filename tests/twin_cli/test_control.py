@@ -6,7 +6,7 @@ import math
 import re
 
 import pytest
-from corpus_registry import CORPUS, package_paths
+from corpus_registry import CORPUS, needs_corpus, package_paths
 from models import CONTROL_RIG as WHEEL_URDF
 from models import ball_on_plane, wheeled_cart, write_urdf
 
@@ -97,7 +97,7 @@ def ur5e_fixed(tmp_path):
     return convert_full(path, package_paths=paths, options=options).spec
 
 
-@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
+@needs_corpus
 def test_ur5e_reaches_half_a_radian_on_every_joint_within_2_s_and_holds_1_mrad(tmp_path):
     world = World()
     world.spawn(ur5e_fixed(tmp_path), name="ur", pose=Pose(z=1.0))  # on a 1 m pedestal
@@ -134,7 +134,7 @@ points:
 """
 
 
-@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
+@needs_corpus
 def test_ur5e_follows_a_five_point_trajectory_with_a_bounded_tracking_error(tmp_path):
     from twin_cli.control import follow_trajectory, read_trajectory, sample, tracking_report
 

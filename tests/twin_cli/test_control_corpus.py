@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from corpus_registry import CORPUS
+from corpus_registry import corpus_ids
 
 from twin_cli.world import World
 from twin_cli.world.joint_control import allowed_range, limits_of
@@ -44,7 +44,7 @@ def _random_targets(world: World, name: str, mode: str, rng, scale: float) -> di
     return out
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_corpus_robot_on_the_ground_takes_random_commands_in_every_mode_without_warnings(
     robot_id: str, converted_corpus
 ) -> None:

@@ -11,7 +11,7 @@ import dataclasses
 import math
 
 import pytest
-from corpus_registry import CORPUS, package_paths
+from corpus_registry import CORPUS, needs_corpus, package_paths
 from world_helpers import full_state
 
 from twin_cli.control import controller_of, drive, odometry
@@ -26,7 +26,7 @@ SPEED_TOLERANCE = 1.05  # a wheel never turns faster than 5 % over its commanded
 BOX = """<sdf version="1.6"><model name="box"><link name="l"><collision name="c">
 <geometry><box><size>0.2 0.2 0.2</size></box></geometry></collision></link></model></sdf>"""
 
-pytestmark = pytest.mark.skipif(ROBOT is None, reason="corpus (../shared/corpus) not present")
+pytestmark = needs_corpus
 
 
 def _spawn(world: World) -> None:

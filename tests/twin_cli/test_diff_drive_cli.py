@@ -9,14 +9,14 @@ import sys
 from pathlib import Path
 
 import pytest
-from corpus_registry import CORPUS, PACKAGES_ROOT
+from corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus
 
 WORLD_NAME = "drive_cli"
 ROBOT = CORPUS.get("turtlebot3_burger")
 BOX = '<sdf version="1.6"><model name="box"><link name="l"><collision name="c"><geometry><box>'
 BOX += "<size>0.2 0.2 0.2</size></box></geometry></collision></link></model></sdf>"
 
-pytestmark = pytest.mark.skipif(ROBOT is None, reason="corpus (../shared/corpus) not present")
+pytestmark = needs_corpus
 
 
 def _twin(runtime: Path, *args: str) -> subprocess.CompletedProcess:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from corpus_registry import CORPUS
+from corpus_registry import CORPUS, corpus_ids
 
 from twin_cli.validate.checks.base import Status
 from twin_cli.validate.runner import robot_from_conversion, run_check
@@ -53,7 +53,7 @@ def scenarios():
 def _cases():
     return [
         pytest.param(robot_id, check, id=f"{robot_id}-{check}")
-        for robot_id in sorted(CORPUS)
+        for robot_id in corpus_ids()
         for check in CHECKS
     ]
 

@@ -10,7 +10,7 @@ import math
 
 import pytest
 import validate_robots as robots
-from corpus_registry import CORPUS
+from corpus_registry import CORPUS, corpus_ids
 
 from twin_cli.validate.checks import MODEL_CHECKS
 from twin_cli.validate.checks.base import Status
@@ -149,7 +149,7 @@ CORPUS_EXPECTED_FAILURES: dict[str, set[str]] = {
 }
 
 
-@pytest.mark.parametrize("robot_id", sorted(CORPUS))
+@pytest.mark.parametrize("robot_id", corpus_ids())
 def test_corpus_robot_model_checks(robot_id, converted_corpus):
     done = converted_corpus(robot_id)
     robot = robot_from_conversion(done, CORPUS[robot_id]["entry"], repair_inertia=False)

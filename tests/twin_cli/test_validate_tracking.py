@@ -4,7 +4,7 @@ names the joint where its limits cannot (a position step and a 1 Hz sine, scenar
 from __future__ import annotations
 
 import pytest
-from corpus_registry import CORPUS
+from corpus_registry import CORPUS, corpus_ids
 from models import CONTROL_RIG, write_urdf
 
 from twin_cli.validate.checks.base import Status
@@ -17,8 +17,7 @@ def tracking():
     return next(s for s in load_builtin() if s.check == "tracking")
 
 
-@pytest.mark.skipif("ur5e" not in CORPUS, reason="corpus not found (../shared/corpus)")
-@pytest.mark.parametrize("robot_id", ["ur5e", "anymal_c"])
+@pytest.mark.parametrize("robot_id", corpus_ids(["ur5e", "anymal_c"]))
 def test_corpus_robot_tracks_a_step_and_a_sine_within_its_limits(
     robot_id, tracking, converted_corpus
 ):

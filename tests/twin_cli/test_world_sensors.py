@@ -8,7 +8,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from corpus_registry import CORPUS, PACKAGES_ROOT, package_paths
+from corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus, package_paths
 from models import write_urdf
 from sensor_models import bumper_ball, hanging_load, imu_box, lidar_post
 
@@ -269,10 +269,9 @@ def test_a_bad_sensor_name_lists_the_entitys_sensors(tmp_path: Path) -> None:
 
 
 # ---------------------------------------------------------------------------------- turtlebot3
+@needs_corpus
 def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
-    robot = CORPUS.get("turtlebot3_burger")
-    if robot is None:
-        pytest.skip("corpus absent")
+    robot = CORPUS["turtlebot3_burger"]
     world = World()
     world.spawn(
         PACKAGES_ROOT / robot["entry"], name="tb3", package_paths=package_paths(robot)
