@@ -1,4 +1,8 @@
-"""The fast path reads world commands exactly as the Typer app does, or leaves them to it."""
+"""The fast path reads world commands exactly as the Typer app does, or leaves them to it.
+
+Both are built from one table (`twin_cli.cli.world_table`); these tests hold the two builders to
+the same grammar, parse for parse.
+"""
 
 from __future__ import annotations
 
@@ -15,7 +19,9 @@ import typer
 
 from twin_cli.cli.app import app
 from twin_cli.cli.commands.world import COMMANDS
-from twin_cli.cli.fast import GRAMMARS, Grammar, parse
+from twin_cli.cli.fast import parse
+from twin_cli.cli.world_table import COMMANDS as TABLE
+from twin_cli.cli.world_table import Command
 
 GROUP = typer.main.get_command(app)
 SAMPLE = {float: "-1.5", int: "7", str: "name_1", Path: "robot.urdf"}
@@ -40,31 +46,29 @@ _KINDS[click.types.StringParamType] = str
 
 
 def _typer_grammar(name: str) -> dict[str, tuple]:
-    """dest → (kind, flags, default, multiple) as the Typer app declares command `name`."""
+    """dest → (kind, nargs, min, flags, default, multiple, required, envvar) as Typer declares."""
     out = {}
     for p in GROUP.commands[name].params:
         convert, nargs, minimum = _click_kind(p)
         flags = tuple(p.opts) if isinstance(p, click.Option) else ()
         default = None if p.multiple else p.default
-        if p.name == "world":
-            default = None  # resolved from $TWIN_WORLD or "default", checked by the parses below
-        out[p.name] = (convert, nargs, minimum, flags, default, p.multiple, p.required)
+        out[p.name] = (convert, nargs, minimum, flags, default, p.multiple, p.required, p.envvar)
     return out
 
 
-def _fast_grammar(grammar: Grammar) -> dict[str, tuple]:
+def _fast_grammar(spec: Command) -> dict[str, tuple]:
     out = {}
-    for a in grammar.args:
-        out[a.dest] = (a.convert, 1, a.minimum, (), a.default, False, a.required)
-    for o in grammar.opts:
-        out[o.dest] = (o.convert, o.nargs, None, o.flags, o.default, o.multiple, False)
+    for a in spec.args:
+        out[a.dest] = (a.convert, 1, a.minimum, (), a.default, False, a.required, None)
+    for o in spec.opts:
+        out[o.dest] = (o.convert, o.nargs, None, o.flags, o.default, o.multiple, False, o.envvar)
     return out
 
 
 @pytest.mark.parametrize("name", sorted(COMMANDS))
 def test_fast_grammar_declares_the_typer_commands_options(name: str) -> None:
-    assert name in GRAMMARS, f"`twin {name}` has no fast-path grammar"
-    fast, declared = _fast_grammar(GRAMMARS[name]), _typer_grammar(name)
+    assert name in TABLE, f"`twin {name}` is not in the world command table"
+    fast, declared = _fast_grammar(TABLE[name]), _typer_grammar(name)
     assert fast == declared, f"`twin {name}`: fast {fast} != Typer {declared}"
 
 
@@ -84,9 +88,9 @@ def _typer_parse(argv: list[str]) -> dict[str, Any]:
 
 def _full_argv(name: str, rng: random.Random) -> list[str]:
     """`twin NAME` with every argument and option given, options in random order."""
-    grammar = GRAMMARS[name]
-    words = [SAMPLE[a.convert] for a in grammar.args]
-    for opt in grammar.opts:
+    spec = TABLE[name]
+    words = [SAMPLE[a.convert] for a in spec.args]
+    for opt in spec.opts:
         flag = rng.choice(opt.flags)
         if opt.convert is None:
             words.append(flag)
@@ -151,7 +155,7 @@ def test_fast_path_leaves_help_and_unusual_command_lines_to_typer(argv: list[str
     assert parse(argv) is None, f"fast path should leave {argv} to Typer"
 
 
-@pytest.mark.parametrize("name", sorted(GRAMMARS))
+@pytest.mark.parametrize("name", sorted(TABLE))
 def test_fast_path_reads_every_option_of_every_command_as_typer_does(
     name: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -163,7 +167,7 @@ def test_fast_path_reads_every_option_of_every_command_as_typer_does(
         assert call is not None, f"fast path declined {argv}"
         fast = {k: _normal(v) for k, v in call.kwargs.items()}
         assert fast == _typer_parse(argv), f"twin {argv}"
-    bare = [name, *(SAMPLE[a.convert] for a in GRAMMARS[name].args if a.required)]
+    bare = [name, *(SAMPLE[a.convert] for a in TABLE[name].args if a.required)]
     call = parse(bare)
     assert call is not None and _typer_parse(bare) == {
         k: _normal(v) for k, v in call.kwargs.items()
@@ -188,6 +192,7 @@ def _twin(*args: str, runtime_dir: Path) -> subprocess.CompletedProcess:
         (["spawn", "robot.urdf", "-J", "lead"], "must look like NAME=VALUE"),
         (["spawn", "robot.urdf", "-J", "lead=half"], "is not a number"),
         (["step", "0"], "0 is not in the range"),
+        (["physics", "--sleep", "--no-sleep"], "give --sleep or --no-sleep, not both"),
     ],
 )
 def test_a_value_the_command_refuses_is_a_usage_error_with_exit_code_2(

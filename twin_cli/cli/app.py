@@ -2,14 +2,15 @@
 
 `main` first offers the command line to `twin_cli.cli.fast`, which runs plain world commands
 without importing Typer; everything else (help, usage errors, convert, validate, serve) goes
-to the Typer app, built on first use. `from twin_cli.cli.app import app` still gives that app.
+to the Typer app, built on first use. Errors of either path, usage errors included, end in
+`main`'s one boundary. `from twin_cli.cli.app import app` still gives that app.
 """
 
 from __future__ import annotations
 
 import sys
 from functools import cache
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 if TYPE_CHECKING:
     import typer
@@ -71,13 +72,16 @@ def _known(exc: Exception) -> bool:
 
 # Exit code of an unexpected failure (sysexits' EX_SOFTWARE): a bug, never bad input.
 INTERNAL_ERROR = 70
+PROG = "twin"  # the program name usage lines show, however the entry point was started
 
 
 def main() -> None:
-    """Console entry point: known errors become one message on stderr and exit code 2; anything
-    else is a bug: one line saying where its traceback was written, exit code 70.
+    """Console entry point and the CLI's one error boundary.
 
-    `--debug` anywhere on the command line re-raises with the traceback instead.
+    Usage errors (a BadOption an action raises, on either path, or click's own) print the
+    command's usage and one message, exit code 2; other known errors one message and their exit
+    code; anything else is a bug: one line saying where its traceback was written, exit code 70.
+    `--debug` anywhere on the command line re-raises the others with their traceback instead.
     """
     debug = "--debug" in sys.argv
     if debug:
@@ -88,21 +92,74 @@ def main() -> None:
 
     try:
         if not fast.run(sys.argv[1:]):
-            build_app()()  # standalone: typer itself turns usage errors into exit code 2
+            _run_app(sys.argv[1:])
     except Exception as exc:
-        if debug:
-            raise
-        from twin_cli.cli.output import error
-        from twin_cli.errors import NotRunningError
+        _fail(exc, debug)
 
-        if isinstance(exc, NotRunningError):  # gz's readiness-probe line as it is, exit code 1
-            sys.stderr.write(f"{exc}\n")
-            sys.exit(exc.exit_code)
-        if _known(exc):
-            error(str(exc))
-            sys.exit(getattr(exc, "exit_code", 2))
-        error(_internal_error(exc))
-        sys.exit(INTERNAL_ERROR)
+
+def _run_app(argv: list[str]) -> None:
+    """Runs the Typer app, its click errors left to `main`'s boundary (not standalone mode)."""
+    code = build_app()(args=argv, prog_name=PROG, standalone_mode=False)
+    if isinstance(code, int) and code:  # click's Exit (an exit code, e.g. 130 after Ctrl-C)
+        sys.exit(code)
+
+
+def _fail(exc: Exception, debug: bool) -> NoReturn:
+    """Print `exc` as the user needs it and exit with its code (`debug`: re-raise all but usage)."""
+    from twin_cli.cli.output import error
+    from twin_cli.cli.pairs import BadOption
+    from twin_cli.errors import NotRunningError
+
+    if isinstance(exc, BadOption) or _from_click(exc):
+        _click_error(exc)
+    if debug:
+        raise exc
+    if isinstance(exc, NotRunningError):  # gz's readiness-probe line as it is, exit code 1
+        sys.stderr.write(f"{exc}\n")
+        sys.exit(exc.exit_code)
+    if _known(exc):
+        error(str(exc))
+        sys.exit(getattr(exc, "exit_code", 2))
+    error(_internal_error(exc))
+    sys.exit(INTERNAL_ERROR)
+
+
+def _from_click(exc: Exception) -> bool:
+    """Whether `exc` is click's (a usage error, Abort); click is imported only if Typer ran."""
+    click = sys.modules.get("click")
+    return click is not None and isinstance(exc, click.ClickException | click.Abort)
+
+
+def _click_error(exc: Exception) -> NoReturn:
+    """A usage error as Typer prints one (the command's usage, the message), or click's Abort.
+
+    A BadOption becomes a usage error of the command it came from (exit code 2).
+    """
+    import click
+
+    if isinstance(exc, click.Abort):
+        sys.stderr.write("Aborted!\n")
+        sys.exit(1)
+    if not isinstance(exc, click.ClickException):
+        exc = click.UsageError(str(exc), _command_context(sys.argv[1:]))
+    try:
+        from typer import rich_utils
+    except ImportError:  # Typer without rich prints click's plain form
+        exc.show()
+    else:
+        rich_utils.rich_format_error(exc)
+    sys.exit(exc.exit_code)
+
+
+def _command_context(argv: list[str]) -> Any:
+    """A click context of the command `argv` names, for its usage line (the app's if none)."""
+    import click
+    import typer
+
+    group = typer.main.get_command(build_app())
+    root = click.Context(group, info_name=PROG)
+    command = group.get_command(root, argv[0]) if argv else None
+    return root if command is None else click.Context(command, info_name=argv[0], parent=root)
 
 
 def _internal_error(exc: Exception) -> str:

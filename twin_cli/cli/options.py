@@ -1,42 +1,56 @@
-"""Options shared by several commands, defined once (Gazebo's names where Gazebo has them)."""
+"""Options shared by several commands, defined once (Gazebo's names where Gazebo has them).
+
+The world commands' options are declared in `world_table` (plain Python, for the fast path);
+`annotation` turns one of them into the `Annotated[type, typer.Option(...)]` Typer reads, so the
+options other command modules share (--world, --json, --arg, --package, -J) come from there too.
+"""
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from twin_cli.cli import pairs
+from twin_cli.cli import world_table as table
 
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print machine-readable JSON.")]
-WorldOpt = Annotated[
-    str,
-    typer.Option("--world", envvar="TWIN_WORLD", help="Name of the world to talk to."),
-]
-ArgOpt = Annotated[
-    list[str] | None,
-    typer.Option("--arg", help="xacro argument NAME:=VALUE (repeatable)."),
-]
-PackageOpt = Annotated[
-    list[str] | None,
-    typer.Option("--package", help="Package location NAME=PATH (repeatable)."),
-]
-JointOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "-J",
-        "--joint",
-        help="Initial joint position NAME=POS [rad or m] (repeatable; Gazebo's -J NAME POS).",
-    ),
-]
-XOpt = Annotated[float, typer.Option("-x", help="Spawn x [m].")]
-YOpt = Annotated[float, typer.Option("-y", help="Spawn y [m].")]
-ZOpt = Annotated[float, typer.Option("-z", help="Spawn z [m].")]
-RollOpt = Annotated[float, typer.Option("-R", help="Spawn roll [rad].")]
-PitchOpt = Annotated[float, typer.Option("-P", help="Spawn pitch [rad].")]
-YawOpt = Annotated[float, typer.Option("-Y", help="Spawn yaw [rad].")]
+
+def _kind(param: table.Arg | table.Opt) -> Any:
+    """The Python type Typer infers the click type from: bool, a tuple, a list, or Optional."""
+    if isinstance(param, table.Opt) and param.convert is None:
+        return bool
+    kind: Any = param.convert
+    if isinstance(param, table.Opt) and param.nargs > 1:
+        kind = tuple[(kind,) * param.nargs]
+    if isinstance(param, table.Opt) and param.multiple:
+        kind = list[kind]
+    return kind | None if param.default is None else kind
+
+
+def annotation(param: table.Arg | table.Opt) -> Any:
+    """`Annotated[type, typer.Option(...)]` (or `typer.Argument`) for a table parameter."""
+    if isinstance(param, table.Arg):
+        return Annotated[_kind(param), typer.Argument(help=param.help, min=param.minimum)]
+    info = typer.Option(*param.flags, help=param.help, envvar=param.envvar)
+    return Annotated[_kind(param), info]
+
+
+def parameter(param: table.Arg | table.Opt) -> inspect.Parameter:
+    """A keyword-only parameter of a command function's signature, as Typer reads it."""
+    required = isinstance(param, table.Arg) and param.required
+    default = inspect.Parameter.empty if required else param.default
+    kind = inspect.Parameter.KEYWORD_ONLY
+    return inspect.Parameter(param.dest, kind, default=default, annotation=annotation(param))
+
+
+JsonOpt = annotation(table.JSON)
+WorldOpt = annotation(table.WORLD)
+ArgOpt = annotation(table.ARG)
+PackageOpt = annotation(table.PACKAGE)
+JointOpt = annotation(table.JOINT)
 
 
 def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:
@@ -59,7 +73,10 @@ def source_inputs(arg: list[str] | None, package: list[str] | None) -> dict[str,
 
 @contextmanager
 def usage_errors() -> Iterator[None]:
-    """Turns BadOption into typer.BadParameter: usage, the message, exit code 2."""
+    """Turns BadOption into typer.BadParameter (click's "Invalid value: ..." usage error).
+
+    Only a wording: `app.main` prints a BadOption as a usage error (exit code 2) without it.
+    """
     try:
         yield
     except pairs.BadOption as exc:

@@ -22,12 +22,6 @@ MODULES = (
 
 
 def register_all(app: typer.Typer) -> None:
-    """Register every command module that exists (modules are added as features land)."""
+    """Register every command module; a module that fails to import is a bug, raised as such."""
     for name in MODULES:
-        try:
-            module = importlib.import_module(f"twin_cli.cli.commands.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"twin_cli.cli.commands.{name}":
-                continue
-            raise
-        module.register(app)
+        importlib.import_module(f"twin_cli.cli.commands.{name}").register(app)
