@@ -1,6 +1,6 @@
 """CoACD convex decomposition in worker processes: parallel, time-limited, crash-proof.
 
-CoACD is C++ that can abort the whole process on some inputs (design.md §3), so every mesh is
+CoACD is C++ that can abort the whole process on some inputs, so every mesh is
 decomposed in its own child process (`converters.collision.worker`), started with
 `subprocess` rather than `multiprocessing`: no re-import of the caller's `__main__`, no fork
 of a process that may run server threads. Job and result travel as .npz files in a private

@@ -81,7 +81,3 @@ class JointControl:
     def modes(self) -> tuple[str, ...]:
         """The modes, in the tag's order, without repeats."""
         return tuple(dict.fromkeys(i.mode for i in self.interfaces))
-
-    def gains_of(self, mode: str) -> PidGains | None:
-        """The tag's PID gains for `mode`, or None."""
-        return dict(self.gains).get(mode)

@@ -140,7 +140,8 @@ class GazeboExtensions:
     What Gazebo's URDF parser (sdformat) drops is kept apart, so the Gazebo stage can say so:
     `dropped_surfaces` are `<surface>` blocks written inside a URDF `<collision>` (sdformat
     ignores them), `named_collisions` the (link, index) of collisions with a `name` attribute,
-    which receive none of their link's `<gazebo>` surface values (sdformat issue 333).
+    which receive none of their link's `<gazebo>` surface values (sdformat matches those only
+    to the collision names it generates itself).
     """
 
     source: str

@@ -17,6 +17,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import Any
 
+from converters.control_text import set_control_record
 from converters.description.gazebo import Blob
 from converters.errors import GazeboTagError
 from converters.report import Report
@@ -164,8 +165,6 @@ def add_drive_motors(spec: Any, drives: tuple[DiffDrive, ...], report: Report) -
 
 def _velocity_only(spec: Any, joint: str, drive: DiffDrive) -> None:
     """The plugin drives its wheels by velocity only (its joints' only command interface)."""
-    from converters.mjcf.control_data import set_control_record
-
     record = {
         "modes": ["velocity"],
         "source": "diff_drive",

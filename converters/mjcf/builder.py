@@ -21,7 +21,7 @@ from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joints
 from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
 from converters.provenance import GeomOrigin, Provenance
 from converters.report import Report
-from converters.resources.meshes import MeshData
+from converters.resources.mesh_data import MeshData
 
 # Menagerie conventions and Gazebo's default world step (SDF physics max_step_size 0.001 s).
 TIMESTEP = 0.001

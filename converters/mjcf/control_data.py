@@ -12,12 +12,9 @@ so a delete's cost would otherwise grow with the robot's motor count.
 
 from __future__ import annotations
 
-import json
-
+from converters.control_text import set_control_record
 from converters.description import CONTROL_PLUGINS, MODES, Joint, JointControl, RobotDescription
 from converters.report import Report
-
-CONTROL_TEXT = "control"
 
 
 def control_record(joint: Joint, control: JointControl | None, enabled: str | None) -> dict:
@@ -55,16 +52,6 @@ def add_control_data(
         record = control_record(joint, controls.get(joint.name), enabled)
         set_control_record(spec, joint.name, record)
         report.mapped(f"joint '{joint.name}' command modes", _rule_text(record))
-
-
-def set_control_record(spec: object, joint: str, record: dict) -> None:
-    """Writes `joint`'s record into the spec's `control` text (created on first use)."""
-    text = spec.text(CONTROL_TEXT)
-    if text is None:
-        text = spec.add_text(name=CONTROL_TEXT, data="{}")
-    records = json.loads(text.data)
-    records[joint] = record
-    text.data = json.dumps(records)
 
 
 def _rule_text(record: dict) -> str:

@@ -10,9 +10,8 @@ from converters.description import Geometry, RobotDescription
 from converters.mjcf.lumping import BodyPlan
 from converters.mjcf.materials import VisualColour, visual_colour
 from converters.report import Report
-from converters.resources.meshes import MeshCache, MeshData, mesh_problem
-
-ROLES = ("visual", "collision")
+from converters.resources.mesh_data import MeshData
+from converters.resources.meshes import MeshCache, mesh_problem
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ INTEGRATORS = {
 TIMESTEP_S = 0.001  # [s]
 UPDATE_RATE_HZ = 1000.0  # [Hz]
 ITERATIONS = 50
-# twin's --earth preset [m/s²] (design.md §2.7; Gazebo's empty.world has 9.8).
+# twin's --earth preset [m/s²] (standard gravity, rounded; Gazebo's empty.world has 9.8).
 GRAVITY = (0.0, 0.0, -9.81)
 # implicitfast integrates joint damping and the PD gains of joint commands implicitly, so they
 # stay stable at the 1 ms step; Euler would need much smaller gains (MuJoCo doc "Numerical

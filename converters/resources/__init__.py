@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from converters.resources.meshes import MeshCache, MeshData, load_mesh, mesh_problem
+from converters.resources.mesh_data import MeshData
+from converters.resources.meshes import MeshCache, load_mesh, mesh_problem
 from converters.resources.packages import PackageResolver
 
 __all__ = ["MeshCache", "MeshData", "PackageResolver", "load_mesh", "mesh_problem"]

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from converters.resources.meshes import MeshData
+from converters.resources.mesh_data import MeshData
 
 SUBDIR = "meshes"
 # Bump when what load_mesh returns for the same bytes changes (units, merging, colours).

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from converters.errors import MeshError
+from converters.resources.mesh_data import MeshData
 
 # Relative size below which a mesh counts as flat: smallest/largest principal extent.
 FLAT_RATIO = 1e-6
@@ -18,24 +19,6 @@ MIN_VOLUME = 1e-12
 # corners (little-endian float32) and a 2-byte attribute (the STL format; trimesh's `_stl_dtype`).
 STL_HEADER_BYTES = 84
 STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
-
-
-@dataclass(frozen=True)
-class MeshData:
-    """A triangle mesh in metres: vertices (N, 3) float64, faces (M, 3) int32.
-
-    `rgba` is the file's own main colour (COLLADA/OBJ/GLB materials; None when it has none) and
-    `textured` says whether the file's materials carry an image that twin does not carry.
-    """
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    rgba: tuple[float, float, float, float] | None = None
-    textured: bool = False
-
-    @property
-    def triangles(self) -> int:
-        return len(self.faces)
 
 
 @dataclass

@@ -26,8 +26,6 @@ from converters.sdf.poses import PoseGraph, scoped
 
 # SDF's defaults for a link without <inertial>: 1 kg and a unit inertia (sdformat's Inertial).
 DEFAULT_MASS = 1.0
-# Shapes SDF has that twin does not build (reported, not an error: the link stays).
-UNSUPPORTED_SHAPES = ("heightmap", "polyline", "image", "cone")
 # Link children that only rendering, sensing or other engines use.
 LINK_IGNORED = ("kinematic", "must_be_base_link", "enable_wind", "light", "audio_sink")
 

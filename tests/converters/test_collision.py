@@ -226,7 +226,8 @@ def test_ball_stays_inside_heavy_cup_decomposed_by_the_default_auto_plan(tmp_pat
     assert widest < CUP_INNER_R, f"heavy cup: ball centre {widest:.4f} m off the axis"
 
 
-# Robots whose converted model must also step 1 s without a MuJoCo warning (issue 3).
+# Robots whose converted model must also step 1 s without a MuJoCo warning (MuJoCo Menagerie's
+# gate for a usable model).
 MESH_ROBOTS = {"booster_t1", "solo12", "anymal_c", "open_manipulator_x", "robotiq_2f_85"}
 # CI keeps CoACD cold runs short: fast preset, and a mesh that needs longer than this falls
 # back to its hull (reported). With the heavy-mesh caps open_manipulator_x's 13-21k-triangle

@@ -233,7 +233,7 @@ def test_sdf_that_sdformats_tinyxml2_reads_is_read(tmp_path):
 
 
 def test_a_link_named_world_is_refused_at_its_line(tmp_path):
-    # sdformat reserves the name; twin used to loop on it, allocating without bound.
+    # SDFormat reserves the name for the world frame, which poses and joints resolve against.
     path = tmp_path / "m.sdf"
     path.write_text(
         '<sdf version="1.7"><model name="m">\n<link name="world"/>\n<link name="a"/></model></sdf>'

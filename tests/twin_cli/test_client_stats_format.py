@@ -10,7 +10,7 @@ from twin_cli.cli.stats_format import CSV_HEADER, sample_times, stats_csv_row, s
 from twin_cli.errors import EntityExistsError, EntityNotFoundError, RequestError
 from twin_cli.server.client import rebuild_error
 
-# The line format scripts rely on (issue 5, gz-cli.md §2).
+# `gz stats`' line, which scripts parse: `Factor[%4.2f] SimTime[%4.2f] RealTime[%4.2f] Paused[%c]`.
 GZ_LINE = re.compile(
     r"^Factor\[\d+\.\d\d\] SimTime\[\d+\.\d\d\] RealTime\[\d+\.\d\d\] Paused\[[TF]\]$"
 )

@@ -38,7 +38,7 @@ def test_sync_point_pacer_holds_factor_one_despite_oversleep():
 
 
 def test_wake_up_timed_pacer_loses_time_to_oversleep():
-    # The counter-example style.md cites: timing each step from wake-up loses the oversleep.
+    # The counter-example: timing each step from wake-up loses the oversleep.
     factor = simulate(oversleep=1e-4, seconds=2.0, sync_point=False)
     assert factor == pytest.approx(1 / 1.1, abs=0.002), f"wake-up-timed factor {factor:.4f}"
 

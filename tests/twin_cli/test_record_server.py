@@ -19,7 +19,7 @@ import numpy as np
 from record_helpers import read_bag, seconds
 
 HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
-# foxglove/ws-protocol docs/spec.md names the first; foxglove-sdk ≥ 0.x servers answer the second.
+# The Foxglove WebSocket protocol's spec names the first; foxglove-sdk servers answer the second.
 FOXGLOVE_SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 MESSAGE_DATA, TIME = 0x01, 0x02  # binary opcodes, server → client
 
@@ -109,8 +109,8 @@ def test_a_sigkilled_server_leaves_a_file_readable_up_to_its_last_chunk(tmp_path
 
 def test_the_encoder_of_a_sigkilled_server_finishes_the_file_and_exits(tmp_path, serve_world):
     """Only the server is killed: its encoder process sees the pipe close, encodes what the
-    ring still holds, writes the summary and the rosbag2 metadata, and exits (it used to poll
-    the closed pipe forever and leave the file without its index)."""
+    ring still holds, writes the summary and the rosbag2 metadata, and exits (an encoder that
+    polled the closed pipe would run forever and leave the file without its index)."""
     import yaml
     from mcap.reader import make_reader
 

@@ -67,7 +67,7 @@ def test_soft_contact_fails_ground_contact_with_kp_hint(tmp_path):
     needed = float(re.search(r"to ≥ ([0-9.e+]+) N/m", hint).group(1))
     limit = float(re.search(r"\(limit ([0-9.]+) mm\)", hint).group(1)) * 1e-3
     assert needed >= 1000.0 * outcome.value / limit, hint
-    # Oracle (design.md §2.2): a box rests on 4 contact points, each a kp spring: M·g / (4 kp).
+    # Oracle: a box rests on 4 contact points, each a kp spring as in Gazebo: M·g / (4 kp).
     expected = 5.5 * G / (4 * 1000.0)
     assert math.isclose(outcome.value, expected, rel_tol=0.15), "crate sinkage [m]"
 

@@ -1,6 +1,6 @@
 """Recording and streaming a running world as ROS 2 data: rosbag2 MCAP files and Foxglove.
 
-A consumer of the world (design.md §7): it observes the stepping loop at its own rate through
+A consumer of the world: it observes the stepping loop at its own rate through
 `World.add_observer`, copies what it needs under the world's lock and encodes outside it. The
 world never imports this package. Modules: `layout` (frames and joints per entity), `sampler`
 (the copy, the kinematics), `topics` (the ROS topics and messages), `messages` (types and CDR,

@@ -4,9 +4,10 @@ Frames are named as a namespaced robot_state_publisher with `frame_prefix=<entit
 the world's element names ("<entity>/<link>"), which are the URDF link names with that prefix.
 A body's transform to its parent moves (goes on `/tf`) when the body has a joint, and is fixed
 (`/tf_static`) otherwise; the world → root transform always goes on `/tf` (gazebo_ros publishes
-model poses live). Sites are the converter's lumped links and SDF frames (design.md §2.4):
-fixed to their body, so they go on `/tf_static`. Element ids change at every recompile, so a new
-layout is made whenever the world's model object changes (spawn, delete, reset).
+model poses live). Sites are the converter's lumped links and SDF frames (kept so they can still
+be named): fixed to their body, so they go on `/tf_static`. Element ids change at every
+recompile, so a new layout is made whenever the world's model object changes (spawn, delete,
+reset).
 """
 
 from __future__ import annotations

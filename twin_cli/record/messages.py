@@ -13,6 +13,8 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
+from twin_cli.record.contact_types import register_contact_types
+
 CLOCK = "rosgraph_msgs/msg/Clock"
 TF = "tf2_msgs/msg/TFMessage"
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -40,8 +42,6 @@ class Definition:
 def typestore() -> Any:
     """rosbags' typestore of the ROS 2 distribution twin writes for (built once, ~0.1 s)."""
     from rosbags.typesys import Stores, get_typestore
-
-    from twin_cli.record.sensor_messages import register_contact_types
 
     store = get_typestore(Stores.ROS2_JAZZY)
     register_contact_types(store)  # gazebo_msgs, for contact sensors

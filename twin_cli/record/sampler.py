@@ -1,6 +1,6 @@
 """One copy of the world's state under its lock; the kinematics of that copy outside it.
 
-`Sampler.capture` runs in the stepping thread between batches (design.md §7): it copies time,
+`Sampler.capture` runs in the stepping thread between batches (the loop waits): it copies time,
 qpos, qvel, actuator forces and mocap poses (about 5 µs for a humanoid) and nothing else. Link
 poses are recomputed from the copied qpos with `mj_kinematics` on the consumer's own scratch
 data, exactly as `World.link_poses` does (after `mj_step` the live `xpos` is one step old).

@@ -8,9 +8,9 @@ sensors need, or, for a sensor whose samples MuJoCo keeps (an IMU: `twin_cli.sen
 every sample since the last look: that observer runs POLLS_PER_HISTORY times per history
 length instead of at every period, and each sample keeps its own sim time. The recorder's own
 thread calls `build`, which casts the lidar rays, renders the cameras and draws the noise there,
-off the stepping thread (design.md §7). A sensor that cannot be read in this process (a camera
-without offscreen GL) is left out of the recording from then on, with one warning naming it and
-the fix; the other sensors go on. Suites are rebuilt when the world's model changes.
+off the stepping thread, which they would slow. A sensor that cannot be read in this process (a
+camera without offscreen GL) is left out of the recording from then on, with one warning naming
+it and the fix; the other sensors go on. Suites are rebuilt when the world's model changes.
 """
 
 from __future__ import annotations

@@ -3,11 +3,9 @@
 IMU → sensor_msgs/Imu, ray → sensor_msgs/LaserScan (one row: the first vertical row), force/torque
 → geometry_msgs/WrenchStamped, contact/bumper → gazebo_msgs/ContactsState, camera and depth →
 sensor_msgs/Image (rgb8, or 32FC1 metres as gazebo_ros' depth camera; little-endian rows).
-rosbags ships no gazebo_msgs (Gazebo classic's package is not part of any ROS 2 distribution it
-carries), so the two contact types are registered in its typestore from their definitions below
-(the interface of gazebo_ros_bumper); the bag stores the definitions with the messages, so every
-reader decodes them. Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name);
-images go to `/<entity>/<topic>/image_raw`, as gazebo_ros' cameras publish them.
+The contact types are gazebo_msgs', which rosbags lacks (`contact_types` registers them).
+Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name); images go to
+`/<entity>/<topic>/image_raw`, as gazebo_ros' cameras publish them.
 """
 
 from __future__ import annotations
@@ -17,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from twin_cli.record import messages as ros
+from twin_cli.record.contact_types import CONTACTS
 from twin_cli.record.topics import Message, Topic
 from twin_cli.sensors import (
     ContactReading,
@@ -30,22 +29,7 @@ from twin_cli.sensors import (
 IMU = "sensor_msgs/msg/Imu"
 SCAN = "sensor_msgs/msg/LaserScan"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
-CONTACTS = "gazebo_msgs/msg/ContactsState"
 IMAGE = "sensor_msgs/msg/Image"
-CONTACT_DEFINITIONS = {
-    "gazebo_msgs/msg/ContactState": """string info
-string collision1_name
-string collision2_name
-geometry_msgs/Wrench[] wrenches
-geometry_msgs/Wrench total_wrench
-geometry_msgs/Vector3[] contact_positions
-geometry_msgs/Vector3[] contact_normals
-float64[] depths
-""",
-    CONTACTS: """std_msgs/Header header
-gazebo_msgs/ContactState[] states
-""",
-}
 TYPES = {
     ImuReading: IMU,
     ScanReading: SCAN,
@@ -55,18 +39,6 @@ TYPES = {
 }
 PIXEL_BYTES = {"rgb8": 3, "32FC1": 4}
 _UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
-
-
-def register_contact_types(store: Any) -> None:
-    """Adds gazebo_msgs' ContactState and ContactsState to a rosbags typestore (idempotent)."""
-    if CONTACTS in store.types:
-        return
-    from rosbags.typesys import get_types_from_msg
-
-    types: dict = {}
-    for name, text in CONTACT_DEFINITIONS.items():
-        types.update(get_types_from_msg(text, name))
-    store.register(types)
 
 
 def sensor_topic(entity: str, name: str, topic: str, reading: Reading) -> Topic | None:

@@ -15,7 +15,8 @@ from twin_cli.lazy import lazy_getattr
 if TYPE_CHECKING:
     from twin_cli.validate.runner import ValidationRun, validate
     from twin_cli.validate.scenario import Scenario, load_scenario
-    from twin_cli.validate.sweep import Axis, SweepError, SweepRun, VariantRun, parse_axis
+    from twin_cli.validate.sweep import Axis, SweepRun, VariantRun, parse_axis
+    from twin_cli.validate.sweep_errors import SweepError
     from twin_cli.validate.variants import PARAMETERS
 
 __all__ = [
@@ -39,7 +40,7 @@ __getattr__ = lazy_getattr(
         "ValidationRun": "twin_cli.validate.runner",
         "validate": "twin_cli.validate.runner",
         "Axis": "twin_cli.validate.sweep",
-        "SweepError": "twin_cli.validate.sweep",
+        "SweepError": "twin_cli.validate.sweep_errors",
         "SweepRun": "twin_cli.validate.sweep",
         "VariantRun": "twin_cli.validate.sweep",
         "parse_axis": "twin_cli.validate.sweep",

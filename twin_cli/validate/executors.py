@@ -12,7 +12,7 @@ import socket
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
-from twin_cli.validate.sweep import SweepError
+from twin_cli.validate.sweep_errors import SweepError
 
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 """Environment of the pool's workers: one BLAS thread each. A worker already is one per core;

@@ -17,15 +17,9 @@ from pathlib import Path
 
 from twin_cli.errors import TwinError
 from twin_cli.validate.checks.base import CheckResult
+from twin_cli.validate.margins import MARGINS
+from twin_cli.validate.sweep_errors import SweepError
 from twin_cli.validate.variants import PARAMETERS, ROBOT_PARAMETERS
-
-
-class SweepError(TwinError):
-    """A `--sweep`, `--jobs` or `--ray` value that cannot run; the message names the fix."""
-
-    def __init__(self, given: str, problem: str, fix: str) -> None:
-        super().__init__(f"{given}: {problem}; {fix}")
-        self.given = given
 
 
 class VariantError(TwinError):
@@ -182,9 +176,8 @@ def _run_task(task: Task) -> VariantRun:
 
 
 def _limits(todo) -> dict[str, float]:
-    """Each check's threshold that its `value` is judged against (see `sweep_report.MARGINS`)."""
+    """Each check's threshold that its `value` is judged against (see `margins.MARGINS`)."""
     from twin_cli.validate.checks import CHECKS
-    from twin_cli.validate.sweep_report import MARGINS
 
     out = {}
     for sc in todo:

@@ -7,35 +7,14 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from twin_cli.validate.checks.base import CheckResult, Status
+from twin_cli.validate.margins import MARGINS, margin
 from twin_cli.validate.report import MD_MARK, label
 from twin_cli.validate.sweep import SweepRun, VariantRun
-
-MARGINS: dict[str, tuple[str, str]] = {
-    "friction_standing": ("max_slip_m", "max"),
-    "ground_contact": ("max_penetration_m", "max"),
-    "collision": ("max_intrusion_m", "max"),
-    "stability": ("max_energy_gain", "max"),
-    "realtime": ("min_factor", "min"),
-    "gravity": ("rel_tol", "max"),
-    "zero_gravity": ("max_com_drift_m", "max"),
-    "inertia": ("rel_tol", "max"),
-}
-"""Check → (the threshold its `value` is judged against, "max" = value ≤ it, "min" = value ≥ it).
-Checks not listed have no single number to compare; the plot shows them as pass (1) / fail (0)."""
 
 
 def variant_name(run: VariantRun) -> str:
     """`foot_mu=0.3 gravity=9.81` (or "nominal" when nothing is swept)."""
     return " ".join(f"{k}={v:g}" for k, v in run.values.items()) or "nominal"
-
-
-def margin(r: CheckResult, limit: float | None) -> float | None:
-    """Threshold minus measured (a "max" check) or measured minus threshold (a "min" check),
-    in the check's own unit: positive passes, negative fails; None without a number."""
-    rule = MARGINS.get(r.check)
-    if rule is None or limit is None or r.value is None:
-        return None
-    return limit - r.value if rule[1] == "max" else r.value - limit
 
 
 def junit_xml(sweep: SweepRun) -> str:

@@ -1,6 +1,6 @@
 """Seeing a running world: MuJoCo's web viewer on the served world, and offscreen snapshots.
 
-A consumer of the world (design.md §7), like `twin_cli.record`: it reads the world under its lock
+A consumer of the world, like `twin_cli.record`: it reads the world under its lock
 and acts on it only through `World`'s methods. Modules: `bridge` (the page's actions → World),
 `host` (the viewer thread, its bind address, the sync thread), `service` (the server's one
 viewer), `offscreen` (PNG snapshots with mujoco.Renderer on EGL). Exports load lazily, so that

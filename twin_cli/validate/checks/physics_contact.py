@@ -1,7 +1,7 @@
 """Physics checks on contact: resting on the ground, and pushed into a box without passing through.
 
 Penetration oracle: Gazebo's contact is a spring per contact point, so a link of mass m resting
-on kp sinks about m·g/kp (design.md §2.2). twin maps kp to MuJoCo's direct solref
+on kp sinks about m·g/kp. twin maps kp to MuJoCo's direct solref
 S = (1 − d)·kp/m (converters.gazebo.contact), so kp is recovered from a compiled geom as S·m/(1 − d)
 and named in the hint when a link sinks too deep.
 """

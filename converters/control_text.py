@@ -1,0 +1,18 @@
+"""The model's `control` text, one JSON record per motor: written by the MJCF builder and by the
+Gazebo plugin stage, so it lives outside both packages and neither imports the other for it."""
+
+from __future__ import annotations
+
+import json
+
+CONTROL_TEXT = "control"
+
+
+def set_control_record(spec: object, joint: str, record: dict) -> None:
+    """Writes `joint`'s record into the spec's `control` text (created on first use)."""
+    text = spec.text(CONTROL_TEXT)
+    if text is None:
+        text = spec.add_text(name=CONTROL_TEXT, data="{}")
+    records = json.loads(text.data)
+    records[joint] = record
+    text.data = json.dumps(records)
