@@ -4,8 +4,8 @@ and the speed-up from --jobs on the heaviest mesh robot (open_manipulator_x).
 Each cold run uses a fresh cache directory; the warm run repeats the conversion against the
 cache the cold run filled (no CoACD call: `coacd_runs` is 0, fallbacks included). Times include
 the whole `converters.convert()` (xacro, URDF, meshes, build, Gazebo tags) and the compile.
-Targets: a cold default conversion under ~60 s on 2 cores (issue 3); a warm conversion of a
-30-link mesh robot under 0.5 s (design.md §5).
+Targets: a cold default conversion under ~60 s on 2 cores; a warm conversion of a 30-link mesh
+robot under 0.5 s.
 """
 
 from __future__ import annotations

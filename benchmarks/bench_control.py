@@ -1,14 +1,14 @@
-"""What Gazebo's limits and an active trajectory cost the loop, as ratios in one run (issue 11).
+"""What Gazebo's limits and an active trajectory cost the loop, as ratios in one run.
 
 Copies of the bundled humanoid float at zero gravity (no contacts) and step the same sim time in
 alternating rounds:
 - limits: every joint in effort mode under Gazebo's velocity rule (a velocity servo with an
   asymmetric force range per joint, evaluated by mj_step) against the same efforts on plain
-  motors (what the world did before), each window from the same saved state;
+  motors (no velocity rule), each window from the same saved state;
 - trajectory: every joint following a trajectory at 100 Hz (the follower runs as a world
   observer: the batches split every 10 steps and Python writes the next reference) against a
   copy holding a position command.
-Target: limits ≥ 0.95 of plain (the issue's goal); the trajectory's ratio is reported.
+Target: limits ≥ 0.95 of plain; the trajectory's ratio is reported.
 """
 
 from __future__ import annotations
@@ -52,13 +52,13 @@ def _efforts(world: World, rule: bool) -> None:
     world.command_joints(
         "h", {r["name"]: 0.05 * (r["effort_limit"] or 1.0) for r in rows}, mode="effort"
     )
-    if not rule:  # the same efforts on plain motors (what the world did before)
+    if not rule:  # the same efforts on plain motors (no velocity rule)
         with world.lock:
-            for key, cmd in list(world._commands.items()):
+            for key, cmd in list(world.commands().items()):
                 plain = replace(cmd, velocity_limit=math.inf)
                 a = world.model.actuator(key).id
                 actuation.apply_command(world.model, world.data, a, plain)
-                world._commands[key] = plain
+                world._state.commands[key] = plain
 
 
 def _trajectory(world: World, follow: bool) -> None:

@@ -1,4 +1,4 @@
-"""What an active diff drive costs the loop, in one run (issue 11).
+"""What an active diff drive costs the loop, in one run.
 
 One world holds turtlebot3 (from the corpus) driving in circles and the bundled humanoid. Plain
 windows step it with the diff-drive controller stopped (its last wheel targets stay in force);
@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 from twin_cli.control import controller_of, drive
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 
 ROOT = Path(__file__).parents[1]
@@ -28,8 +29,8 @@ V, W = 0.2, 0.5  # [m/s], [rad/s]
 def _world() -> World:
     world = World()
     paths = {"turtlebot3_description": str(PACKAGES / "turtlebot3_description")}
-    world.spawn(str(TURTLEBOT), name="tb3", package_paths=paths, on_ground=True)
-    world.spawn(HUMANOID, name="h", pose=Pose(x=3.0), on_ground=True)
+    world.spawn(SpawnRequest(str(TURTLEBOT), package_paths=paths, on_ground=True), name="tb3")
+    world.spawn(SpawnRequest(HUMANOID, on_ground=True), name="h", pose=Pose(x=3.0))
     world.step(300)
     return world
 

@@ -1,5 +1,5 @@
 """Recording figures in one run: what a 100 Hz recording costs the unthrottled loop, and the
-real-time factor while recording and streaming to Foxglove (issue 12).
+real-time factor while recording and streaming to Foxglove.
 
 Targets: the unthrottled world steps at ≥ 0.95 of its speed without a recording, and real time
 holds 1.00 ± 0.01 while a recording and a Foxglove stream run. The throughput ratio alternates

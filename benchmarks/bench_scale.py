@@ -1,4 +1,4 @@
-"""Many robots in one world (issue 16): real-time factor against the robot count with and without
+"""Many robots in one world: real-time factor against the robot count with and without
 MuJoCo's engine thread pool and sleeping, spawn cost in a full world, and the conversion cache.
 
 Targets: 64 humanoids at a factor ≥ 1.0 in real-time mode; the pool's speed-up ≥ 1.6× at 32
@@ -13,6 +13,8 @@ import os
 import statistics
 import time
 from pathlib import Path
+
+from twin_cli.spawn_request import SpawnRequest
 
 ROBOT_COUNTS = (1, 8, 32, 64)
 WINDOW_S = 1.0  # [s] wall time per unthrottled window
@@ -33,7 +35,7 @@ def _standing(count: int, rate: float = 0.0):  # noqa: ANN202
     world = World(WorldSettings(rate=rate))
     side = max(1, round(count**0.5))
     poses = [Pose(x=1.5 * (k % side), y=1.5 * (k // side), z=1.3) for k in range(count)]
-    results = world.spawn_batch(HUMANOID, base="h", poses=poses, on_ground=True)
+    results = world.spawn_batch(SpawnRequest(HUMANOID, on_ground=True), base="h", poses=poses)
     for r in results:
         for joint in world.joint_states(r.name):
             world.command(r.name, joint.name, mode="position", value=0.0)
@@ -132,7 +134,7 @@ def _spawn_latency() -> dict:
         boxes = World()
         side = round(SPAWN_WORLD**0.5)
         poses = [Pose(x=1.0 * (k % side), y=1.0 * (k // side), z=0.5) for k in range(SPAWN_WORLD)]
-        boxes.spawn_batch(box, base="b", poses=poses, on_ground=True)
+        boxes.spawn_batch(SpawnRequest(box, on_ground=True), base="b", poses=poses)
         return {
             "humanoids": _spawn_delete(_standing(SPAWN_WORLD), HUMANOID),
             "boxes": _spawn_delete(boxes, HUMANOID),
@@ -152,7 +154,7 @@ def _spawn_delete(world, source: Path) -> dict:  # noqa: ANN001
         world.delete("extra")
         deletes.append(time.perf_counter() - start)
     start = time.perf_counter()
-    world._spec.compile()  # MuJoCo alone, the floor under a spawn
+    world._state.spec.compile()  # MuJoCo alone, the floor under a spawn
     return {
         "spawn_ms": round(1e3 * statistics.median(spawns), 1),
         "delete_ms": round(1e3 * statistics.median(deletes), 1),

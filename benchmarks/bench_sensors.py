@@ -1,4 +1,4 @@
-"""Sensor figures in one run: what a 10 Hz 360-ray lidar and a 200 Hz IMU cost the loop (issue 14).
+"""Sensor figures in one run: what a 10 Hz 360-ray lidar and a 200 Hz IMU cost the loop.
 
 Every reading is taken at its rate in sim time, as a recording takes them, on one world: the
 bundled humanoid lying on the ground, a sensor post and a wall. Arms, each a 200-step window

@@ -1,6 +1,6 @@
 """World server figures: client command wall time; the server loop's steps vs raw mj_step.
 
-Targets (design.md §5, issue 17): a client command against a running world returns in under
+Targets: a client command against a running world returns in under
 150 ms median wall (250 ms is the floor to hold); the unthrottled server loop keeps at least 0.97
 of raw `mj_step` throughput on the same model, options and state without a reader and 0.95 while
 a `twin stats` client reads (the server's world saved here; raw steps the same steps from the
@@ -102,7 +102,7 @@ def _server_window(client: Client, env: dict[str, str], pid: int, reader: bool) 
 
 def _throughput(client: Client, env: dict[str, str], pid: int, saved: Path) -> dict:
     """Server loop vs raw mj_step on the same steps from the same saved world, in pairs."""
-    from twin_cli.world import World
+    from twin_cli.world import savefile
 
     client.set_physics(rate=0.0)
     client.pause()
@@ -112,7 +112,7 @@ def _throughput(client: Client, env: dict[str, str], pid: int, saved: Path) -> d
         for case in sorted(RATIO_TARGETS, reverse=k % 2 == 1):  # alternate which case goes first
             client.load(saved)
             window = _server_window(client, env, pid, case == "stats_reader")
-            fresh = World.load(saved)
+            fresh = savefile.load(saved)
             pairs[case].append(window.ratios([raw_profile(fresh.model, fresh.data, window.last)]))
     out: dict = {}
     for case, target in RATIO_TARGETS.items():

@@ -1,6 +1,6 @@
 """Validation sweep throughput: 20 variants of the humanoid on `--jobs 1` and `--jobs 2`.
 
-Goal (issue 16): `--jobs 2` at least 1.7× faster than `--jobs 1` on 20 variants. Both runs
+Goal: `--jobs 2` at least 1.7× faster than `--jobs 1` on 20 variants. Both runs
 include starting the pool's processes; each variant converts the robot and runs the checklist
 (less `realtime`, whose verdict depends on the machine's load). The two runs must also agree
 check for check: the sweep is deterministic whatever the worker count.

@@ -1,5 +1,5 @@
 """Web viewer figures in one run: what a connected viewer costs the unthrottled loop, and the
-real-time factor with one (issue 10).
+real-time factor with one.
 
 Targets: with a browser showing the world, the unthrottled loop keeps ≥ 0.95 of its steps/s
 without a viewer (alternating windows on the same world), and real-time mode holds a factor of

@@ -57,7 +57,7 @@ def test_a_mode_the_tags_do_not_offer_or_a_value_outside_the_interface_is_refuse
     with pytest.raises(PartNotFoundError, match="spin"):  # lists the actuated joints
         rig.command_joints("rig", {"elbow": 0.0}, mode="effort")
     assert (rig.data.ctrl == before[0]).all() and (rig.model.actuator_gainprm == before[1]).all()
-    assert rig._commands == {}, "no command was kept after refused requests"
+    assert not rig.commands(), "no command was kept after refused requests"
 
 
 def test_position_interface_servo_reaches_its_target_below_the_velocity_limit(rig):
@@ -184,7 +184,7 @@ def test_malformed_trajectory_is_refused_and_leaves_the_world_unchanged(rig, tex
     name = "bad.csv" if text.startswith("time_from_start") else "bad.yaml"
     with pytest.raises((InvalidRequestError, PartNotFoundError), match=re.escape(words)):
         follow_trajectory(rig, "rig", read_trajectory(text, name))
-    assert rig._commands == {} and not rig._observers, "no command or controller was kept"
+    assert not rig.commands() and not rig._state.observers, "no command or controller was kept"
 
 
 @pytest.mark.parametrize("fields", ["positions", "velocities", "accelerations"])

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from corpus_registry import corpus_ids
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 from twin_cli.world.joint_control import allowed_range, limits_of
 
@@ -29,7 +30,7 @@ def _random_targets(world: World, name: str, mode: str, rng, scale: float) -> di
         if mode not in limits.modes:
             continue
         j = model.joint(f"{name}/{state.name}").id
-        a = [i for i in world._index[name].actuators if model.actuator_trnid[i][0] == j]
+        a = [i for i in world.index_of(name).actuators if model.actuator_trnid[i][0] == j]
         if not a:
             continue
         effort = float(np.max(np.abs(model.actuator_ctrlrange[a[0]])))
@@ -51,7 +52,7 @@ def test_corpus_robot_on_the_ground_takes_random_commands_in_every_mode_without_
     spec = converted_corpus(robot_id).spec
     for mode in ("position", "velocity", "effort"):
         world = World()
-        world.spawn(spec.copy(), name="robot", on_ground=True)
+        world.spawn(SpawnRequest(spec.copy(), on_ground=True), name="robot")
         rng = np.random.default_rng(0)
         driven = 0
         for _ in range(1000 // HOLD_STEPS):

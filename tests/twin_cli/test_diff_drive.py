@@ -16,8 +16,8 @@ from world_helpers import full_state
 
 from twin_cli.control import controller_of, drive, odometry
 from twin_cli.errors import EntityNotFoundError, InvalidRequestError
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
-from twin_cli.world.spawn import DescriptionText
 
 ROBOT = CORPUS.get("turtlebot3_burger")
 V, W, T = 0.2, 0.5, 5.0  # [m/s], [rad/s], [s]: the issue's command
@@ -34,7 +34,7 @@ def _spawn(world: World) -> None:
 
     paths = {k: str(v) for k, v in package_paths(ROBOT).items()}
     entry = str(PACKAGES_ROOT / ROBOT["entry"])
-    world.spawn(entry, name="tb3", package_paths=paths, on_ground=True)
+    world.spawn(SpawnRequest(entry, package_paths=paths, on_ground=True), name="tb3")
     world.step(300)  # settle on the ground [ms]
 
 
@@ -114,9 +114,9 @@ def test_encoder_odometry_tracks_the_world_pose_without_slip() -> None:
     """Encoder odometry integrates wheel travel: within 5 % of the path on a no-slip drive."""
     world = World()
     _spawn(world)
-    entity = world._entities["tb3"]
+    entity = world.entity("tb3")
     encoder = dataclasses.replace(entity.plugins[0], odometry_source="encoder")
-    world._entities["tb3"] = dataclasses.replace(entity, plugins=(encoder,))
+    world._state.entities["tb3"] = dataclasses.replace(entity, plugins=(encoder,))
     drive(world, "tb3", V, W, 3.0)
     world.step(3500)
     odom, pose = odometry(world, "tb3"), world.get_pose("tb3")
@@ -141,9 +141,9 @@ def test_bad_drive_requests_leave_the_world_unchanged(
 ) -> None:
     world = World()
     _spawn(world)
-    world.spawn(DescriptionText(BOX), pose=Pose(1.0, 0.0, 0.1))
+    world.spawn(SpawnRequest(xml=BOX), pose=Pose(1.0, 0.0, 0.1))
     before = full_state(world)
     with pytest.raises(error, match=needle):
         drive(world, entity, linear, 0.0, duration)
     assert (full_state(world) == before).all(), "state, controls and time unchanged"
-    assert not world._commands and not world._observers, "no command and no controller added"
+    assert not world.commands() and not world._state.observers, "no command and no controller added"

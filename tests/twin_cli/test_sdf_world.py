@@ -8,9 +8,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 from twin_cli.world.sdf_world import world_from_sdf
-from twin_cli.world.spawn import DescriptionText
 
 ROOT = Path(__file__).resolve().parents[2]
 HUMANOID = ROOT / "scenarios" / "robots" / "humanoid.urdf.xacro"
@@ -110,7 +110,7 @@ def test_the_ground_plane_model_holds_a_box_at_rest(world_file: Path) -> None:
 
 def test_lesson_box_spawned_from_text_is_static_and_red() -> None:
     world = World()
-    result = world.spawn(DescriptionText(LESSON_BOX), pose=Pose(2.0, 0.0, 0.25))
+    result = world.spawn(SpawnRequest(xml=LESSON_BOX), pose=Pose(2.0, 0.0, 0.25))
     assert result.name == "test_box", "the model's own name"
     world.step(500)
     assert world.get_pose("test_box") == Pose(2.0, 0.0, 0.25), "static: it never moves"
@@ -122,7 +122,7 @@ def test_lesson_box_spawned_from_text_is_static_and_red() -> None:
 def test_a_pushed_robot_does_not_pass_through_the_sdf_box() -> None:
     """The collision check's physics against the lesson's box: 15 N/kg for 0.3 s towards it."""
     world = World()
-    world.spawn(HUMANOID, name="robot", pose=Pose(0.0, 0.0, 0.0), on_ground=True)
+    world.spawn(SpawnRequest(HUMANOID, on_ground=True), name="robot", pose=Pose(0.0, 0.0, 0.0))
     mujoco.mj_forward(world.model, world.data)
     front = max(
         world.data.geom_xpos[g][0] + world.model.geom_rbound[g]
@@ -130,7 +130,7 @@ def test_a_pushed_robot_does_not_pass_through_the_sdf_box() -> None:
         if world.model.geom(g).name.startswith("robot/")
     )
     near_face = front + 0.1
-    world.spawn(DescriptionText(LESSON_BOX), pose=Pose(near_face + 0.25, 0.0, 0.25))
+    world.spawn(SpawnRequest(xml=LESSON_BOX), pose=Pose(near_face + 0.25, 0.0, 0.25))
     mass = sum(world.model.body_mass[b] for b in range(world.model.nbody))
     world.push("robot", force=(15.0 * mass, 0.0, 0.0), duration=0.3)
     robot = [b for b in range(world.model.nbody) if world.model.body(b).name.startswith("robot/")]
@@ -148,7 +148,7 @@ def test_a_pushed_robot_does_not_pass_through_the_sdf_box() -> None:
 
 def test_quaternion_and_rpy_poses_agree() -> None:
     world = World()
-    world.spawn(DescriptionText(LESSON_BOX), name="a", pose=Pose(0, 0, 0.25, 0.0, 0.0, 0.7))
+    world.spawn(SpawnRequest(xml=LESSON_BOX), name="a", pose=Pose(0, 0, 0.25, 0.0, 0.0, 0.7))
     quat = Pose(0, 0, 0.25, 0.0, 0.0, 0.7).quat()
     from_quat = Pose.from_quat(0.0, 0.0, 0.25, quat)
     assert from_quat.yaw == pytest.approx(0.7, abs=1e-12), "yaw from (w, x, y, z)"

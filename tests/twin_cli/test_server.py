@@ -145,11 +145,11 @@ def test_openapi_schema_is_served(server):
 
 
 def test_serve_a_saved_world_paused_then_sigterm_ends_cleanly(tmp_path, files, serve_world):
-    from twin_cli.world import Pose, World
+    from twin_cli.world import Pose, World, savefile
 
     saved = World()
     saved.spawn(str(files / "box.urdf"), name="crate", pose=Pose(z=3.0))
-    saved.save(tmp_path / "saved.twin")
+    savefile.save(saved, tmp_path / "saved.twin")
     args = (str(tmp_path / "saved.twin"), "--paused", "--rate", "500")
     with serve_world(tmp_path, "t", *args) as (client, proc):
         assert [e["name"] for e in client.entities()] == ["crate"], "saved entities not served"

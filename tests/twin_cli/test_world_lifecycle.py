@@ -187,3 +187,31 @@ def test_delete_and_spawn_that_outlive_the_clients_patience_are_unknown_and_repe
     assert names == ["b2"], f"after the repeats: {names}"
     third = twin("delete", "box", check=False)  # no outcome pending: an ordinary missing entity
     assert third.returncode == 2 and "Entity [box] does not exist" in third.stderr, third.stderr
+
+
+def test_a_different_spawn_after_an_unknown_outcome_happens_and_a_repeat_is_replayed(twin):
+    """The kept key belongs to the exact request: another pose of the same file is a new spawn,
+    the same command line again gets the first one's outcome; a stopped world keeps no keys."""
+    twin("spawn", twin.box, "--name", "box", "-z", "1")
+    twin("pause")
+    busy = _busy_world(twin, 6.0)
+    time.sleep(0.5)  # the step request holds the world's lock now
+    impatient = {**twin.env, "TWIN_TIMEOUT": "1"}
+    first = subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", "spawn", twin.box, "-x", "2", "-z", "1"],
+        env=impatient,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert first.returncode == 75, f"exit {first.returncode}: {first.stderr}"
+    assert busy.wait(timeout=120) == 0, busy.stderr.read()
+    other = twin("spawn", twin.box, "-x", "3", "-z", "1")  # same file, another pose
+    repeat = twin("spawn", twin.box, "-x", "2", "-z", "1")  # the unknown one, typed again
+    assert (other.stdout.strip(), repeat.stdout.strip()) == ("box_2", "box_1"), (other, repeat)
+    listed = {e["name"]: e["position"][0] for e in json.loads(twin("list", "--json").stdout)}
+    assert listed == pytest.approx({"box": 0.0, "box_1": 2.0, "box_2": 3.0}, abs=1e-6), listed
+    twin("spawn", twin.box, "-x", "4", "-z", "1", check=True)  # a spawn after the repeat: new
+    assert len(json.loads(twin("list", "--json").stdout)) == 4
+    twin("stop")
+    assert not list(twin.dir.glob("*.pending-*")), "idempotency keys left after the world ended"

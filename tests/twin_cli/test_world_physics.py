@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from models import mjcf_arm, mjcf_ball, mjcf_box
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import GRAVITY_PRESETS, Pose, World
 
 DT = 0.001  # [s] the default world step
@@ -48,7 +49,7 @@ def test_free_fall_follows_half_g_t_squared_until_first_contact():
 def measured_acceleration(world: World, steps: int = 200) -> float:
     """Vertical acceleration [m/s²] of the entity 'ball' from its velocity after `steps`."""
     world.step(steps)
-    return world.data.qvel[world._index["ball"].dofs[2]] / (steps * DT)
+    return world.data.qvel[world.index_of("ball").dofs[2]] / (steps * DT)
 
 
 def test_moon_gravity_gives_1_62_over_9_81_of_earth_acceleration():
@@ -89,7 +90,7 @@ def hold_posture(world: World, name: str) -> None:
 
 def test_humanoid_standing_on_mu_1_feet_slips_less_than_1_cm_in_2_s(humanoid_spec):
     world = World()  # the humanoid's feet default to Gazebo mu1 = mu2 = 1.0 (≥ 0.8)
-    world.spawn(humanoid_spec, on_ground=True)
+    world.spawn(SpawnRequest(humanoid_spec, on_ground=True))
     hold_posture(world, "humanoid")
     feet = {k: v for k, v in world.link_poses("humanoid").items() if "foot" in k}
     world.step(2000)
@@ -104,14 +105,14 @@ def test_humanoid_standing_on_mu_1_feet_slips_less_than_1_cm_in_2_s(humanoid_spe
 def test_humanoid_pushed_toward_a_static_half_metre_box_does_not_pass_through(humanoid_spec):
     world = World()
     centre, half = (0.7, 0.0, 0.25), 0.25  # [m] a 0.5 m cube resting on the ground
-    world.spawn(humanoid_spec, on_ground=True)
+    world.spawn(SpawnRequest(humanoid_spec, on_ground=True))
     world.spawn(
         mujoco.MjSpec.from_string(mjcf_box(half=(half,) * 3, free=False)),
         pose=Pose(*centre),
     )
     hold_posture(world, "humanoid")
     world.push("humanoid", force=(200.0, 0.0, 0.0), duration=0.4)  # [N] on the torso: 80 N s
-    box_geoms = set(world._index["box"].geoms.tolist())
+    box_geoms = set(world.index_of("box").geoms.tolist())
     deepest, touched = 0.0, False
     for _ in range(150):
         world.step(10)

@@ -12,6 +12,7 @@ from models import block, two_wheel_bot
 
 import scenarios
 from twin_cli.errors import EntityExistsError, InvalidRequestError
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 from twin_cli.world.conversion_cache import CACHE, cache_key
 
@@ -38,7 +39,7 @@ def test_batch_spawns_at_every_pose_in_one_recompile():
 def test_a_refused_batch_leaves_the_world_as_it_was():
     world = World()
     world.spawn(scenarios.HUMANOID, name="r_1", pose=Pose(z=1.3))
-    before = world._spec.to_xml()
+    before = world._state.spec.to_xml()
     with pytest.raises(EntityExistsError, match=r"r_1"):
         world.spawn_batch(scenarios.HUMANOID, names=["a", "r_1"], poses=[Pose(), Pose(x=1)])
     with pytest.raises(InvalidRequestError, match=r"pose 1 of entity \[b\]"):
@@ -46,7 +47,7 @@ def test_a_refused_batch_leaves_the_world_as_it_was():
             scenarios.HUMANOID, names=["a", "b"], poses=[Pose(), Pose(x=float("nan"))]
         )
     assert [e.name for e in world.entities()] == ["r_1"]
-    assert world._spec.to_xml() == before
+    assert world._state.spec.to_xml() == before
 
 
 def test_second_spawn_skips_conversion_until_an_included_file_changes(tmp_path):
@@ -61,7 +62,7 @@ def test_second_spawn_skips_conversion_until_an_included_file_changes(tmp_path):
     first = world.spawn(main, name="a")
     second = world.spawn(main, name="b", pose=Pose(x=1))
     assert (first.cached, second.cached) == (False, True)
-    assert str(include) in CACHE.files_of(cache_key(main.resolve(), None, None))
+    assert str(include) in CACHE.files_of(cache_key(main.resolve(), SpawnRequest(main), None))
     include.write_text(_parts(0.4))  # same file names, new content
     third = world.spawn(main, name="c", pose=Pose(x=2))
     assert third.cached is False
@@ -104,7 +105,9 @@ def test_a_pushed_sleeping_box_wakes_and_slides_as_an_awake_one(tmp_path):
     for sleep in (False, True):
         world = World()
         world.set_engine(sleep=sleep, sleep_tolerance=SLEEP_TOL)
-        world.spawn(tmp_path / "box.urdf", name="box", pose=Pose(z=0.1), on_ground=True)
+        world.spawn(
+            SpawnRequest(tmp_path / "box.urdf", on_ground=True), name="box", pose=Pose(z=0.1)
+        )
         world.step(300)
         assert world.data.ntree_awake == (0 if sleep else 1)
         x0 = world.get_pose("box").x
@@ -143,7 +146,7 @@ def test_instances_of_a_robot_share_its_meshes_in_the_world(tmp_path):
     assert world.model.nmesh == one and len(mesh_geoms) == 2 and (mesh_geoms >= 0).all()
     world.delete("b_0")
     world.delete("b_1")
-    assert world.model.nmesh == 0 and len(world._spec.meshes) == 0  # none left behind
+    assert world.model.nmesh == 0 and len(world._state.spec.meshes) == 0  # none left behind
 
 
 DIFF_DRIVE_BOT = two_wheel_bot(

@@ -16,6 +16,7 @@ from twin_cli.errors import PartNotFoundError
 from twin_cli.sensors import Reading, SensorSuite
 from twin_cli.sensors.history import SensorHistory
 from twin_cli.sensors.suite import period_slot
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 
 STATIC = "<gazebo><static>true</static></gazebo>\n</robot>"
@@ -274,8 +275,8 @@ def test_turtlebot3_lidar_sees_a_box_one_metre_ahead() -> None:
     robot = CORPUS["turtlebot3_burger"]
     world = World()
     world.spawn(
-        PACKAGES_ROOT / robot["entry"], name="tb3", package_paths=package_paths(robot)
-    )  # fmt: skip
+        SpawnRequest(PACKAGES_ROOT / robot["entry"], package_paths=package_paths(robot)), name="tb3"
+    )
     world.step(10)
     scan_origin = world.data.site("tb3/sensor:lds_lfcd_sensor").xpos.copy()
     world.spawn(_wall(float(scan_origin[0]) + 1.0, "box"), name="box")

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import scenarios
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 
 ROBOTS = 4
@@ -24,7 +25,9 @@ def _dropped(sleep: bool) -> World:
     world = World()
     world.set_engine(sleep=sleep, sleep_tolerance=TOLERANCE)
     poses = [Pose(x=1.5 * k, z=1.3) for k in range(ROBOTS)]
-    for r in world.spawn_batch(scenarios.HUMANOID, base="h", poses=poses, on_ground=True):
+    for r in world.spawn_batch(
+        SpawnRequest(scenarios.HUMANOID, on_ground=True), base="h", poses=poses
+    ):
         for joint in world.joint_states(r.name):
             world.command(r.name, joint.name, mode="position", value=0.0)
         p = world.get_pose(r.name)

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import mujoco
 import numpy as np
 import pytest
-from models import mimic_pincer, mjcf_arm, mjcf_ball, mjcf_box, mjcf_with_home, write_urdf
+from models import block, mimic_pincer, mjcf_arm, mjcf_ball, mjcf_box, mjcf_with_home, write_urdf
 from world_helpers import full_state, spec_of
 
 from twin_cli.errors import (
@@ -15,7 +17,8 @@ from twin_cli.errors import (
     PartNotFoundError,
     SpawnError,
 )
-from twin_cli.world import Pose, World, WorldSettings
+from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import Pose, World, WorldSettings, savefile
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +41,7 @@ def falling_trajectory(humanoid_spec: mujoco.MjSpec, spawn_second: bool) -> np.n
         if spawn_second and k == 100:
             world.spawn(humanoid_spec, name="second", pose=Pose(x=3.0, z=0.96))
         world.step(1)
-        rows.append(world.data.qpos[world._index["first"].qpos].copy())
+        rows.append(world.data.qpos[world.index_of("first").qpos].copy())
     return np.array(rows)
 
 
@@ -60,7 +63,7 @@ def test_new_entity_starts_at_rest_at_its_pose_in_its_home_configuration():
     assert (pose.x, pose.z) == pytest.approx((1.0, 1.5)), "home key z composed with spawn pose"
     assert pose.yaw == pytest.approx(0.5), "spawn yaw"
     assert world.joint_states("homed")[0].position == pytest.approx(0.7), "home key hinge"
-    assert not np.any(world.data.qvel[world._index["homed"].dofs]), "new entity at rest"
+    assert not np.any(world.data.qvel[world.index_of("homed").dofs]), "new entity at rest"
     world.spawn(spec_of(mjcf_with_home()), name="homed_again", pose=Pose(x=-1.0, z=1.0))
     assert world.joint_states("homed_again")[0].position == pytest.approx(0.7), "second home"
 
@@ -73,7 +76,7 @@ def test_spawn_keeps_applied_forces_and_controls_of_existing_entities():
     world.step(50)
     world.spawn(spec_of(mjcf_box()), pose=Pose(x=5.0, z=1.0))
     world.step(100)
-    vx = world.data.qvel[world._index["ball"].dofs[0]]
+    vx = world.data.qvel[world.index_of("ball").dofs[0]]
     assert vx == pytest.approx(0.1, rel=1e-9), f"push impulse survived the spawn: vx = {vx}"
 
 
@@ -86,7 +89,7 @@ def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
     world.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
     world.push("ball", force=(3.0, 0.0, 0.0), duration=1.0)
     world.step(20)
-    before, xml_before = full_state(world), world._spec.to_xml()
+    before, xml_before = full_state(world), world._state.spec.to_xml()
     broken = tmp_path / "broken.xml"
     broken.write_text(
         '<mujoco><worldbody><body><geom type="mesh" mesh="nope"/></body></worldbody></mujoco>'
@@ -97,11 +100,15 @@ def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
         "compile error": (lambda: world.spawn(broken), SpawnError),
         "bad name": (lambda: world.spawn(spec_of(mjcf_box()), name="a/b"), InvalidRequestError),
         "joint out of range": (
-            lambda: world.spawn(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"shoulder": 1.2}),
+            lambda: world.spawn(
+                SpawnRequest(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"shoulder": 1.2})
+            ),
             InvalidRequestError,
         ),
         "joint name": (
-            lambda: world.spawn(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"elbow": 0.0}),
+            lambda: world.spawn(
+                SpawnRequest(spec_of(mjcf_arm(-1.0, 1.0, 5.0)), joints={"elbow": 0.0})
+            ),
             PartNotFoundError,
         ),
     }
@@ -109,7 +116,7 @@ def test_failed_spawn_leaves_the_world_bit_identical(bad, tmp_path):
     with pytest.raises(error) as caught:
         attempt()
     assert np.array_equal(full_state(world), before), f"state changed by a failed spawn ({bad})"
-    assert world._spec.to_xml() == xml_before, f"world spec changed by a failed spawn ({bad})"
+    assert world._state.spec.to_xml() == xml_before, f"world spec changed by a failed spawn ({bad})"
     assert [e.name for e in world.entities()] == ["ball"], "entity list unchanged"
     assert "ball" in str(caught.value) or bad != "taken name", "message names the entity"
     reference = World()
@@ -135,25 +142,30 @@ def test_spawn_inside_the_ground_warns_with_depth_and_clearing_height():
 
 def test_on_ground_puts_the_lowest_point_on_the_ground():
     world = World()
-    world.spawn(spec_of(mjcf_box(half=(0.1, 0.2, 0.3))), pose=Pose(z=5.0, roll=0.3), on_ground=True)
+    world.spawn(
+        SpawnRequest(spec_of(mjcf_box(half=(0.1, 0.2, 0.3))), on_ground=True),
+        pose=Pose(z=5.0, roll=0.3),
+    )
     scratch = mujoco.MjData(world.model)
     scratch.qpos[:] = world.data.qpos
     mujoco.mj_kinematics(world.model, scratch)
     corners = np.array(
         [[sx, sy, sz] for sx in (-0.1, 0.1) for sy in (-0.2, 0.2) for sz in (-0.3, 0.3)]
     )
-    g = world._index["box"].geoms[0]
+    g = world.index_of("box").geoms[0]
     z_corners = scratch.geom_xpos[g][2] + corners @ scratch.geom_xmat[g].reshape(3, 3)[2]
     assert z_corners.min() == pytest.approx(0.0, abs=1e-12), "lowest corner on the ground"
     fixed = world.spawn(
-        spec_of(mjcf_box(free=False)), name="post", pose=Pose(x=2, z=3), on_ground=True
+        SpawnRequest(spec_of(mjcf_box(free=False)), on_ground=True),
+        name="post",
+        pose=Pose(x=2, z=3),
     )
     assert world.get_pose(fixed.name).z == pytest.approx(0.1), "fixed-base entity placed too"
 
 
 def test_humanoid_on_ground_rests_its_soles_on_the_ground(humanoid_spec):
     world = World()
-    result = world.spawn(humanoid_spec, pose=Pose(z=3.0), on_ground=True)
+    result = world.spawn(SpawnRequest(humanoid_spec, on_ground=True), pose=Pose(z=3.0))
     assert result.warnings == [], f"no overlap at rest: {result.warnings}"
     assert world.get_pose("humanoid").z == pytest.approx(0.95, abs=1e-9), "soles 0.95 m below"
 
@@ -183,11 +195,13 @@ def test_default_names_are_made_unique():
 def test_spawn_then_delete_restores_the_world_spec_exactly(humanoid_spec):
     world = World()
     world.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
-    xml_before = world._spec.to_xml()
+    xml_before = world._state.spec.to_xml()
     world.spawn(humanoid_spec, name="h", pose=Pose(x=2.0, z=1.0))
-    assert "h/main" in world._spec.to_xml(), "the humanoid's default classes were attached"
+    assert "h/main" in world._state.spec.to_xml(), "the humanoid's default classes were attached"
     world.delete("h")
-    assert world._spec.to_xml() == xml_before, "frame, elements and default classes all removed"
+    assert world._state.spec.to_xml() == xml_before, (
+        "frame, elements and default classes all removed"
+    )
 
 
 @pytest.mark.parametrize("stage", ["attach", "compile"])
@@ -195,7 +209,7 @@ def test_failed_humanoid_spawn_leaves_the_spec_as_it_was(humanoid_spec, stage):
     """The spawn attaches to the live spec; a failure in attach or compile must undo it all."""
     world = World()
     world.spawn(humanoid_spec, name="h0", pose=Pose(z=1.0))
-    xml_before, state_before = world._spec.to_xml(), full_state(world)
+    xml_before, state_before = world._state.spec.to_xml(), full_state(world)
     broken = humanoid_spec.copy()
     bad = broken.worldbody.add_body(name="bad")
     if stage == "attach":  # MuJoCo resolves mesh names when attaching
@@ -208,7 +222,7 @@ def test_failed_humanoid_spawn_leaves_the_spec_as_it_was(humanoid_spec, stage):
     message = {"attach": "cannot be attached", "compile": "does not compile"}[stage]
     with pytest.raises(SpawnError, match=rf"h1.*{message}"):
         world.spawn(broken, name="h1", pose=Pose(x=2.0, z=1.0))
-    assert world._spec.to_xml() == xml_before, "attached elements and defaults removed again"
+    assert world._state.spec.to_xml() == xml_before, "attached elements and defaults removed again"
     assert np.array_equal(full_state(world), state_before), "state untouched"
     world.spawn(humanoid_spec, name="h1", pose=Pose(x=2.0, z=1.0))
     assert [e.name for e in world.entities()] == ["h0", "h1"], "the name is free after rollback"
@@ -223,8 +237,8 @@ def test_entity_index_matches_per_joint_addresses_after_spawns_and_deletes(human
     world.delete("b")
     m = world.model
     qpos_width, dof_width = {0: 7, 1: 4, 2: 1, 3: 1}, {0: 6, 1: 3, 2: 1, 3: 1}
-    assert set(world._index) == {"a", "c", "ball"}, "deleted entity not indexed"
-    for name, ix in world._index.items():
+    assert set(world.entity_names()) == {"a", "c", "ball"}, "deleted entity not indexed"
+    for name, ix in ((n, world.index_of(n)) for n in world.entity_names()):
         joints = [j for j in range(m.njnt) if m.joint(j).name.startswith(f"{name}/")]
         kinds = [int(m.jnt_type[j]) for j in joints]
         qpos = [
@@ -247,12 +261,14 @@ def test_entity_index_matches_per_joint_addresses_after_spawns_and_deletes(human
 def test_spawn_joints_posture_survives_save_and_load_and_on_ground_placement(tmp_path):
     urdf = write_urdf(tmp_path, mimic_pincer(offset=0.2, multiplier=-1.0))
     world = World()
-    world.spawn(urdf, joints={"lead": -0.5}, on_ground=True)  # fixed base: the frame moves
+    world.spawn(
+        SpawnRequest(urdf, joints={"lead": -0.5}, on_ground=True)
+    )  # fixed base: the frame moves
     start = {j.name: j.position for j in world.joint_states("pincer")}
     assert start == pytest.approx({"lead": -0.5, "follow": 0.7}, abs=1e-12), "posture on ground"
     world.step(200)
-    world.save(tmp_path / "w.json")
-    loaded = World.load(tmp_path / "w.json")
+    savefile.save(world, tmp_path / "w.json")
+    loaded = savefile.load(tmp_path / "w.json")
     assert np.array_equal(full_state(loaded), full_state(world)), "loaded state bit for bit"
     loaded.reset()
     after = {j.name: j.position for j in loaded.joint_states("pincer")}
@@ -290,7 +306,7 @@ def test_a_model_of_unjoined_links_moves_and_lands_as_one(tmp_path):
     path = tmp_path / "two_roots.sdf"
     path.write_text(TWO_ROOTS)
     world = World(WorldSettings(gravity=(0.0, 0.0, 0.0)))
-    world.spawn(path, name="M", pose=Pose(z=2.0, yaw=0.5), on_ground=True)
+    world.spawn(SpawnRequest(path, on_ground=True), name="M", pose=Pose(z=2.0, yaw=0.5))
     mujoco.mj_kinematics(world.model, world.data)
     heights = [world.data.xpos[world.model.body(f"M/{b}").id][2] for b in "AB"]
     assert heights == pytest.approx([0.1, 0.1], abs=1e-9), "both boxes rest on the ground"
@@ -302,3 +318,54 @@ def test_a_model_of_unjoined_links_moves_and_lands_as_one(tmp_path):
     assert where["B"] == pytest.approx([-1.0 + 3 * c - 2 * s, 2.0 + 3 * s + 2 * c, 3.0], abs=1e-9)
     pose = world.get_pose("M")
     assert (pose.x, pose.y, pose.z, pose.yaw) == pytest.approx((-1.0, 2.0, 3.0, 1.5), abs=1e-9)
+
+
+def _entity_fields(world: World, name: str) -> dict:
+    """An entity's record with its spawn state's arrays as lists (comparable with ==)."""
+    entity = world.entity(name)
+    record = {f: getattr(entity, f) for f in entity.__dataclass_fields__ if f != "spawn_state"}
+    state = entity.spawn_state
+    return record | {f: getattr(state, f).tolist() for f in state.__dataclass_fields__}
+
+
+@pytest.mark.parametrize("robot", ["floating", "fixed"])
+def test_spawn_and_a_batch_of_one_give_identical_entities_and_worlds(tmp_path, robot):
+    from twin_cli.world.respec import model_bytes
+
+    if robot == "fixed":  # on-ground placement moves its attach frame: a second compile
+        request = SpawnRequest(write_urdf(tmp_path, mimic_pincer()), joints={"lead": -0.5})
+    else:
+        request = SpawnRequest(write_urdf(tmp_path, block(name="crate")), joints={})
+    request = replace(request, on_ground=True)
+    pose = Pose(x=1.0, y=-0.5, z=0.7, yaw=0.4)
+    one, batch = World(), World()
+    for world in (one, batch):
+        world.spawn(spec_of(mjcf_ball()), name="ball", pose=Pose(z=2.0))  # a neighbour
+    one.spawn(request, name="r", pose=pose)
+    batch.spawn_batch(request, poses=[pose], names=["r"])
+    assert _entity_fields(one, "r") == _entity_fields(batch, "r"), "entity records"
+    assert model_bytes(one.model) == model_bytes(batch.model), "compiled models"
+    np.testing.assert_array_equal(full_state(one), full_state(batch), err_msg="world states")
+    one.step(200)
+    batch.step(200)
+    np.testing.assert_array_equal(full_state(one), full_state(batch), err_msg="after 0.2 s")
+
+
+def test_a_failed_fixed_base_move_leaves_the_entity_as_it_was(tmp_path):
+    """Moving a fixed base recompiles the world; when that fails, the entity's record (its
+    spawn pose) and the world's state stay as they were."""
+    world = World()
+    world.spawn(SpawnRequest(write_urdf(tmp_path, mimic_pincer())), name="p", pose=Pose(x=1.0))
+    with pytest.raises(InvalidRequestError, match="not finite"):
+        world.set_pose("p", Pose(x=float("nan")))
+    before, state = world.entity("p"), full_state(world)
+    bad = world._state.spec.worldbody.add_body(name="bad")  # the next compile of the spec fails
+    bad.add_geom(size=[0.1, 0.0, 0.0])
+    bad.add_joint(range=[1.0, -1.0], limited=mujoco.mjtLimited.mjLIMITED_TRUE)
+    with pytest.raises(SpawnError, match="does not compile"):
+        world.set_pose("p", Pose(x=2.0))
+    assert world.entity("p") == before, "the entity's record after the failed move"
+    np.testing.assert_array_equal(full_state(world), state, err_msg="world state")
+    world._state.spec.delete(bad)
+    world.set_pose("p", Pose(x=2.0))
+    assert world.get_pose("p").x == pytest.approx(2.0) and world.entity("p").pose.x == 2.0

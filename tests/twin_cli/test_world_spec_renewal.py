@@ -11,6 +11,7 @@ import os
 from models import block, mjcf_arm, mjcf_ball, write_urdf
 from world_helpers import full_state, spec_of
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 from twin_cli.world.respec import RENEW_EVERY, model_bytes
 
@@ -52,8 +53,11 @@ def _populated(tmp_path) -> World:
     world = World()
     world.spawn(spec_of(mjcf_ball()), pose=Pose(z=2.0))
     world.spawn(spec_of(mjcf_arm(-2.0, 2.0, 5.0)), name="arm", pose=Pose(x=1.0))
-    world.spawn(str(write_urdf(tmp_path, block(name="box"))), name="box", on_ground=True,
-                pose=Pose(x=-1.0, z=0.5, yaw=0.3))  # fmt: skip
+    world.spawn(
+        SpawnRequest(str(write_urdf(tmp_path, block(name="box"))), on_ground=True),
+        name="box",
+        pose=Pose(x=-1.0, z=0.5, yaw=0.3),
+    )
     world.spawn(str(write_urdf(tmp_path, block(name="gone"), "gone.urdf")), name="gone")
     world.set_gravity((0.5, 0.0, -9.0))
     world.set_pose("arm", Pose(x=1.2, z=0.1, yaw=0.4))  # a fixed base: its attach frame moves
@@ -78,4 +82,4 @@ def test_a_renewed_spec_steps_and_recompiles_exactly_like_the_old_one(tmp_path):
         w.step(200)
     assert model_bytes(world.model) == model_bytes(reference.model)
     assert full_state(world).tobytes() == full_state(reference).tobytes()
-    assert world._spec.to_xml() == reference._spec.to_xml()
+    assert world._state.spec.to_xml() == reference._state.spec.to_xml()

@@ -1,11 +1,12 @@
 """What each world command does, without Typer: check the values, one client call, the output.
 
-Called by the Typer commands (`commands/world.py`, which declare the options and help) and by
-the fast path (`fast.py`, which parses the same options without importing Typer). Parameters keep
-the Typer functions' names. Imports stay client-side: no mujoco, numpy, fastapi or typer.
+Each function is named by a `world_table` entry and called with the keywords its parameters
+declare (their `dest`), by the Typer commands built from that table (`commands/world.py`) and by
+the fast path (`fast.py`). Imports stay client-side: no mujoco, numpy, fastapi or typer.
 
 Raises:
-    BadOption: a value that does not parse (both callers turn it into a usage error, exit 2).
+    BadOption: a value that does not parse (the error boundary, `app.main`, prints it as a usage
+        error, exit 2).
     SystemExit(1): no world runs, for the commands that must not start one (gz's wording).
 """
 
@@ -14,10 +15,13 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.cli import pairs
 from twin_cli.cli.output import Output
+
+if TYPE_CHECKING:
+    from twin_cli.spawn_request import SpawnRequest
 
 POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
 GRAVITY_PRESETS = ("earth", "moon", "mars", "zero")
@@ -92,6 +96,39 @@ def stop(*, world: str) -> None:
     sys.stderr.write(f"twin: stopped world [{world}] (pid {pid})\n")
 
 
+def spawn_request(
+    file: Path | None,
+    xml: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    joint: list[str] | None,
+    on_ground: bool,
+    repair_inertia: bool,
+) -> SpawnRequest:
+    """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
+
+    Raises:
+        BadOption: neither or both of FILE and --xml, or an option that does not parse.
+    """
+    from twin_cli.spawn_request import SpawnRequest
+
+    if (file is None) == (xml is None):
+        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
+    if file is not None and str(file) == "-":
+        file, xml = None, sys.stdin.read()
+    inputs = pairs.source_inputs(arg, package)
+    return SpawnRequest(
+        source=None if file is None else str(file),
+        xml=xml,
+        base_dir=str(Path.cwd()) if xml is not None else None,
+        args=inputs.get("args") or {},
+        package_paths=inputs.get("package_paths") or {},
+        joints=pairs.joint_positions(joint) or {},
+        on_ground=on_ground,
+        repair_inertia=repair_inertia,
+    )
+
+
 def spawn(
     *,
     file: Path | None,
@@ -135,19 +172,10 @@ def spawn(
             repair_inertia=repair_inertia,
         )  # fmt: skip
         return
-    inputs = pairs.source_inputs(arg, package)
-    joints = pairs.joint_positions(joint)
     pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
-    if (file is None) == (xml is None):
-        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
-    if file is not None and str(file) == "-":
-        file, xml = None, sys.stdin.read()
-    source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
+    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
     with _connect(world, start=True) as c:
-        result = c.spawn(
-            file, name=name, pose=pose, on_ground=on_ground, joints=joints,
-            repair_inertia=repair_inertia, **source, **inputs,
-        )  # fmt: skip
+        result = c.spawn(request, name=name, pose=pose)
         if view:
             url = c.request("POST", "/view", body={})["url"]
             sys.stderr.write(f"twin: viewer on {url}\n")
@@ -192,18 +220,9 @@ def spawn_many(
         raise pairs.BadOption("give positions with --at X,Y[,Z[,YAW]], not -x/-y/--quat")
     poses = [batch_poses.parse_at(text, z, roll, pitch, yaw) for text in at]
     listed = batch_poses.parse_names(names, len(poses))
-    inputs = pairs.source_inputs(arg, package)
-    joints = pairs.joint_positions(joint)
-    if (file is None) == (xml is None):
-        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
-    if file is not None and str(file) == "-":
-        file, xml = None, sys.stdin.read()
-    source = {"xml": xml, "base_dir": str(Path.cwd())} if xml is not None else {}
+    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
     with _connect(world, start=True) as c:
-        results = c.spawn_batch(
-            file, poses=poses, names=listed, name=name, on_ground=on_ground, joints=joints,
-            repair_inertia=repair_inertia, **source, **inputs,
-        )  # fmt: skip
+        results = c.spawn_batch(request, poses=poses, names=listed, base=name)
         if view:
             url = c.request("POST", "/view", body={})["url"]
             sys.stderr.write(f"twin: viewer on {url}\n")

@@ -88,7 +88,7 @@ class DiffDriveController:
     # ------------------------------------------------------------------ the update
     def _update(self) -> None:
         """One plugin update (world lock held): odometry, ramp, wheel velocity targets."""
-        if self.entity not in self.world._entities:
+        if self.entity not in self.world.entity_names():
             self.stop()
             return
         now = float(self.world.data.time)
@@ -108,7 +108,7 @@ class DiffDriveController:
         goals = rim_speeds(*self.target, self.plugin.wheel_separation)
         accel = self.plugin.max_wheel_acceleration
         rims = (ramp(self.rims[0], goals[0], accel, dt), ramp(self.rims[1], goals[1], accel, dt))
-        if rims != self.rims or self.updates == 0 or self.world._commands != self._written:
+        if rims != self.rims or self.updates == 0 or self.world.commands() != self._written:
             self.rims = rims
             self._write()  # only on a change: a held command costs the loop no writes
         self.updates += 1
@@ -121,7 +121,7 @@ class DiffDriveController:
         for joints, rim in sides:
             for joint in joints:
                 self.world.command(self.entity, joint, mode="velocity", value=rim / self.radius)
-        self._written = dict(self.world._commands)
+        self._written = dict(self.world.commands())
 
     def wheel_speeds(self) -> tuple[list[float], list[float]]:
         """Left and right wheel joint speeds [rad/s] now (world lock held)."""
@@ -156,7 +156,7 @@ class DiffDriveController:
 
     def _world_odometry(self) -> dict[str, Any]:
         pose = self.world.get_pose(self.entity)
-        ix = self.world._index[self.entity]
+        ix = self.world.index_of(self.entity)
         linear, angular = [0.0] * 3, [0.0] * 3
         if ix.free_qpos >= 0:
             d, dof = self.world.data, int(ix.dofs[0])

@@ -14,7 +14,7 @@ import weakref
 from typing import Any
 
 from twin_cli.control.diff_drive import DiffDriveController
-from twin_cli.errors import EntityNotFoundError, InvalidRequestError
+from twin_cli.errors import InvalidRequestError
 
 _CONTROLLERS: weakref.WeakKeyDictionary[Any, dict[str, DiffDriveController]] = (
     weakref.WeakKeyDictionary()
@@ -62,12 +62,10 @@ def controller_of(world: Any, entity: str) -> DiffDriveController:
         EntityNotFoundError, InvalidRequestError: see `drive`.
     """
     with world.lock, _GUARD:
-        found = world._entities.get(entity)
-        if found is None:
-            raise EntityNotFoundError(entity, list(world._entities))
+        found = world.entity(entity)  # raises EntityNotFoundError
         controllers = _CONTROLLERS.setdefault(world, {})
         controller = controllers.get(entity)
-        if controller is not None and world._entities.get(entity) is controller.entity_record:
+        if controller is not None and found is controller.entity_record:
             return controller
         drives = [p for p in found.plugins if type(p).__name__ == "DiffDrive"]
         if not drives:

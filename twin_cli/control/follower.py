@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import threading
 import weakref
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 from twin_cli.control.trajectory import Trajectory, TrajectoryPoint, sample, segment
@@ -91,7 +91,7 @@ class TrajectoryFollower:
 
         world = self.world
         t = float(world.data.time) - self.t0
-        if t < -1e-9 or not world._commands.keys() >= self._keyset:
+        if t < -1e-9 or not world.commands().keys() >= self._keyset:
             self.stop()  # the world was reset or the commands were replaced
             return
         reference, nxt, speed = self._block.at(t)
@@ -125,7 +125,7 @@ class TrajectoryFollower:
         if self._model is not world.model:
             self._model = world.model
             self._ids = np.array([world.model.actuator(k).id for k in self.keys])
-            commands = [world._commands[k] for k in self.keys]
+            commands = [world.commands()[k] for k in self.keys]
             gear = np.abs(world.model.actuator_gear[self._ids, 0])
             gear[gear == 0] = 1.0
             self._kv = np.array([c.kv for c in commands]) / gear
@@ -137,10 +137,8 @@ class TrajectoryFollower:
 
     def _record_last(self) -> None:
         positions, speeds = self._last
-        for key, p, v in zip(self.keys, positions.tolist(), speeds.tolist(), strict=True):
-            if key in self.world._commands:
-                cmd = self.world._commands[key]
-                self.world._commands[key] = replace(cmd, target=p, feedforward=v)
+        pairs = zip(positions.tolist(), speeds.tolist(), strict=True)
+        self.world.record_targets(dict(zip(self.keys, pairs, strict=True)))
 
     def stop(self) -> None:
         """Stops updating; the joints keep their last target."""
@@ -154,7 +152,7 @@ def _check_points(world: Any, entity: str, trajectory: Trajectory) -> None:
     """Refuses positions outside a joint's range or velocities past its limit (world unchanged)."""
     from twin_cli.world.joint_control import allowed_range, limits_of
 
-    world._require(entity)
+    world.index_of(entity)  # raises EntityNotFoundError
     model = world.model
     for i, joint in enumerate(trajectory.joint_names):
         j = model.joint(f"{entity}/{joint}").id if f"{entity}/{joint}" in _names(model) else -1

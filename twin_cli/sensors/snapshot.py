@@ -1,6 +1,6 @@
 """One copy of a world's state under its lock, and that state's dynamics evaluated outside it.
 
-Sensors must not slow the loop (design.md §7): `take` holds `world.lock` only for
+Sensors must not slow the loop: `take` holds `world.lock` only for
 `mj_getState` (time, qpos, qvel, act, controls, applied forces, warm start: a few µs) and the
 entity's sensor list; `Evaluator.evaluate` then rebuilds the full forward dynamics of that
 instant on scratch data (`mj_forward`, then `mj_rnePostConstraint` for body accelerations and
@@ -14,8 +14,6 @@ from typing import Any
 
 import mujoco
 import numpy as np
-
-from twin_cli.errors import EntityNotFoundError
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
 
@@ -42,10 +40,7 @@ def take(world: Any, name: str) -> Snapshot:
         EntityNotFoundError: the world has no entity `name`.
     """
     with world.lock:
-        # The entity records are the world's (engine.World._entities); read-only here.
-        entity = world._entities.get(name)
-        if entity is None:
-            raise EntityNotFoundError(name, list(world._entities))
+        entity = world.entity(name)  # the world's record: read-only here
         model = world.model
         state = np.empty(mujoco.mj_stateSize(model, STATE))
         mujoco.mj_getState(model, world.data, state, STATE)

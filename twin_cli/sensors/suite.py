@@ -27,7 +27,7 @@ from converters.description.sensors import (
     RaySpec,
     SensorSpec,
 )
-from twin_cli.errors import EntityNotFoundError, InvalidRequestError, PartNotFoundError
+from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.sensors.camera import CameraSensor
 from twin_cli.sensors.contact import ContactSensor
 from twin_cli.sensors.force_torque import ForceTorqueSensor
@@ -198,11 +198,12 @@ class SensorSuite:
         return out
 
     def _entity(self) -> Any:
-        """The entity's record (the world's; read-only); call with the lock held."""
-        record = self.world._entities.get(self.entity)
-        if record is None:
-            raise EntityNotFoundError(self.entity, list(self.world._entities))
-        return record
+        """The entity's record (the world's; read-only).
+
+        Raises:
+            EntityNotFoundError: the entity is gone.
+        """
+        return self.world.entity(self.entity)
 
     def _bind(self, model: Any) -> None:
         for sensor in self._sensors.values():

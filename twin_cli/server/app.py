@@ -88,20 +88,7 @@ def spawn(body: SpawnBody, world: WorldDep, request: Request) -> dict:
 
 
 def _spawn(body: SpawnBody, world: Any) -> dict:
-    from twin_cli.world.spawn import DescriptionText
-
-    source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
-    result = world.spawn(
-        source,
-        name=body.name,
-        pose=_pose(body.pose),
-        args=body.args,
-        package_paths=body.package_paths,
-        on_ground=body.on_ground,
-        joints=body.joints,
-        env=body.env,
-        repair_inertia=body.repair_inertia,
-    )
+    result = world.spawn(body.request(), name=body.name, pose=_pose(body.pose))
     log.info("spawned %s from %s", result.name, body.source or "<xml>")
     return _plain(result)
 
@@ -117,21 +104,8 @@ def spawn_batch(body: SpawnBatchBody, world: WorldDep, request: Request) -> list
 
 
 def _spawn_batch(body: SpawnBatchBody, world: Any) -> list[dict]:
-    from twin_cli.world.spawn import DescriptionText
-
-    source = body.source if body.xml is None else DescriptionText(body.xml, body.base_dir)
-    results = world.spawn_batch(
-        source,
-        poses=[_pose(p) for p in body.poses],
-        names=body.names,
-        base=body.name,
-        args=body.args,
-        package_paths=body.package_paths,
-        on_ground=body.on_ground,
-        joints=body.joints,
-        env=body.env,
-        repair_inertia=body.repair_inertia,
-    )
+    poses = [_pose(p) for p in body.poses]
+    results = world.spawn_batch(body.request(), poses=poses, names=body.names, base=body.name)
     log.info("spawned %d entities from %s", len(results), body.source or "<xml>")
     return _plain(results)
 
@@ -248,7 +222,9 @@ def reset(body: ResetBody, world: WorldDep) -> dict:
 
 @router.post("/save")
 def save(body: PathBody, world: WorldDep) -> dict:
-    world.save(body.path)
+    from twin_cli.world import savefile
+
+    savefile.save(world, body.path)
     return {"saved": body.path}
 
 

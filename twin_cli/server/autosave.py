@@ -43,8 +43,10 @@ class Autosaver:
 
     def save_now(self) -> bool:
         """One save; a failure is logged once (until it changes) and never ends the server."""
+        from twin_cli.world import savefile
+
         try:
-            self._current().save(self.path)
+            savefile.save(self._current(), self.path)
         except Exception as exc:  # noqa: BLE001 - an autosave must never take the world down
             message = f"{type(exc).__name__}: {exc}"
             if message != self._last_error:

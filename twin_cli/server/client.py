@@ -11,6 +11,7 @@ import os
 import signal
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,7 @@ from twin_cli.errors import NotRunningError, RequestError
 from twin_cli.package_env import package_env
 from twin_cli.server import runtime
 from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
+from twin_cli.spawn_request import SpawnRequest, as_request, body_key
 
 # Seconds: most requests are a lock and a copy; spawn, delete and load wait in `long_request`.
 DEFAULT_TIMEOUT_S = 10.0
@@ -116,15 +118,26 @@ class Client:
         return _decoded(reply)
 
     def long_request(
-        self, method: str, path: str, *, body: Any = None, what: str, operation: str, repeat: str
+        self,
+        method: str,
+        path: str,
+        *,
+        body: Any = None,
+        what: str,
+        repeat: str,
+        repeatable: bool = True,
     ) -> Any:
         """A request that may take long (spawn, delete, load, step): waited for while the server
         lives, up to `$TWIN_TIMEOUT` seconds if set (`twin_cli.server.patience`).
 
+        Its idempotency key is kept when the outcome is unknown, under the identity of the exact
+        request (method, path and body), so that the same command run again is answered with
+        the first one's outcome, and any other request is not.
+
         Args:
             what: the request for people, e.g. "delete [box]".
-            operation: its identity for the idempotency key, e.g. "DELETE /entities/box".
             repeat: the command line that repeats it.
+            repeatable: False for a request that, run again, is meant to act again (a step).
 
         Raises:
             OutcomeUnknownError: the limit passed without a reply; a repeat is safe.
@@ -133,6 +146,7 @@ class Client:
         from twin_cli.errors import OutcomeUnknownError
         from twin_cli.server import lifecycle, patience
 
+        operation = body_key(method, path, body) if repeatable else None
         key = patience.take_key(self.paths, operation)
         waiter = patience.Waiter(None if self._url else self.paths, what, patience.limit())
         try:
@@ -164,93 +178,55 @@ class Client:
 
     def spawn(
         self,
-        source: str | os.PathLike | None,
+        request: SpawnRequest | str | os.PathLike,
         *,
         name: str | None = None,
         pose: dict[str, Any] | None = None,
-        args: dict[str, str] | None = None,
-        package_paths: dict[str, str] | None = None,
-        on_ground: bool = False,
-        joints: dict[str, float] | None = None,
-        xml: str | None = None,
-        base_dir: str | None = None,
-        repair_inertia: bool = False,
     ) -> dict:
-        """Spawn a file, or a description given as text (`xml`, with `source` None).
+        """Spawn the request's file or text as `name` at `pose` (the server's reply).
 
-        Paths are made absolute here: the server has its own working directory, and this
-        process's package search variables go along (`twin_cli.package_env`). `joints`:
-        initial joint positions [rad] or [m] by joint name (Gazebo's `-J`). `base_dir`: where
-        relative mesh paths in `xml` start.
+        Paths are made absolute here (the server has its own working directory), and this
+        process's package search variables go along (`twin_cli.package_env`).
         """
-        where = {"source": str(Path(source).expanduser().absolute())} if source is not None else {}
-        if xml is not None:
-            where = {"xml": xml, "base_dir": str(Path(base_dir or ".").expanduser().absolute())}
-        body = {
-            **where,
-            "name": name,
-            "pose": pose or {},
-            "args": args or {},
-            "package_paths": {
-                k: str(Path(v).expanduser().absolute()) for k, v in (package_paths or {}).items()
-            },
-            "on_ground": on_ground,
-            "joints": joints or {},
-            "env": package_env(),
-            "repair_inertia": repair_inertia,
-        }
-        label = name or str(source or "<xml>")
+        body = {**self._request_body(request), "name": name, "pose": pose or {}}
+        label = name or as_request(request).label
         return self.long_request(
             "POST",
             "/entities",
             body=body,
             what=f"spawn [{label}]",
-            operation=f"spawn {label}",
-            repeat=f"twin spawn ... --name {label}" if name else "twin spawn ...",
+            repeat="the same twin spawn command",
         )
 
     def spawn_batch(
         self,
-        source: str | os.PathLike | None,
+        request: SpawnRequest | str | os.PathLike,
         *,
         poses: list[dict[str, Any]],
         names: list[str] | None = None,
-        **options: Any,
+        base: str | None = None,
     ) -> list[dict]:
-        """Spawn one file (or `xml` text) at every pose in one request, all or nothing.
-
-        `options` are `spawn`'s (name: the base of `name_0`, `name_1`, …); returns one result
-        per pose, in order.
-        """
-        xml, base_dir = options.pop("xml", None), options.pop("base_dir", None)
-        where = {"source": str(Path(source).expanduser().absolute())} if source is not None else {}
-        if xml is not None:
-            where = {"xml": xml, "base_dir": str(Path(base_dir or ".").expanduser().absolute())}
-        packages = options.pop("package_paths", None) or {}
-        body = {
-            **where,
-            **options,
-            "package_paths": {k: str(Path(v).expanduser().absolute()) for k, v in packages.items()},
-            "env": package_env(),
-            "poses": poses,
-            "names": names,
-        }
-        label = ",".join(names) if names else options.get("name") or "robot"
+        """Spawn the request at every pose in one request, all or nothing: entities `names`,
+        else `base_0`, `base_1`, … Returns one result per pose, in order."""
+        body = {**self._request_body(request), "name": base, "poses": poses, "names": names}
+        label = ",".join(names) if names else base or as_request(request).label
         return self.long_request(
             "POST",
             "/entities/batch",
             body=body,
             what=f"spawn of {len(poses)} entities [{label}]",
-            operation=f"spawn batch {label} {len(poses)}",
             repeat="the same twin spawn ... --at ... command",
         )
+
+    @staticmethod
+    def _request_body(request: SpawnRequest) -> dict[str, Any]:
+        return replace(as_request(request), env=package_env()).absolute().to_body()
 
     def delete(self, name: str) -> dict:
         return self.long_request(
             "DELETE",
             f"/entities/{_seg(name)}",
             what=f"delete [{name}]",
-            operation=f"DELETE /entities/{name}",
             repeat=f"twin delete {name} --world {self.world}",
         )
 
@@ -321,8 +297,8 @@ class Client:
             "/step",
             body={"n": n},
             what=f"step {n}",
-            operation=f"step {n} {time.time()}",  # a repeated step is a new step
             repeat=f"twin step {n}",
+            repeatable=False,  # a step run again is another step, never a replay
         )
 
     def reset(self, *, time_only: bool = False) -> dict:
@@ -338,7 +314,6 @@ class Client:
             "/load",
             body=body,
             what=f"load {body['path']}",
-            operation=f"load {body['path']}",
             repeat=f"twin load {body['path']}",
         )
 

@@ -52,11 +52,9 @@ def commands(name: str, body: CommandsBody, world: WorldDep) -> dict:
 @router.get("/entities/{name}/control")
 def control(name: str, world: WorldDep) -> list[dict]:
     """Each actuated joint: mode, target, position, velocity, effort, modes, gains, limits."""
-    from twin_cli.world.driving import joint_commands
-
     with world.lock:
         states = {s.name: s for s in world.joint_states(name)}
-        rows = joint_commands(world, name)
+        rows = world.joint_commands(name)
     return [
         {
             "name": joint,

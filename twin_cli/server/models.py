@@ -11,6 +11,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from twin_cli.names import name_message, name_problem
+from twin_cli.spawn_request import SpawnRequest
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Vector = tuple[Finite, Finite, Finite]
@@ -96,6 +97,10 @@ class SpawnBody(Body):
         if (self.source is None) == (self.xml is None):
             raise ValueError("give exactly one of 'source' (a file path) or 'xml' (its text)")
         return self
+
+    def request(self) -> SpawnRequest:
+        """The spawn request this body carries (everything but the names and poses)."""
+        return SpawnRequest.from_body(self.model_dump(exclude={"name", "pose", "poses", "names"}))
 
 
 class PushBody(Body):

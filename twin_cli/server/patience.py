@@ -6,8 +6,10 @@ error, while the server deleted the entity 23 s later). So the client waits as l
 server process is alive (it holds its pid lock) and the user's limit (`TWIN_TIMEOUT` [s], none
 by default) allows, with a progress line on a terminal. When the limit is reached the outcome is
 unknown, and the request's idempotency key is kept in the runtime directory under the
-operation's identity ("DELETE /entities/box"): the same command run again sends the same key,
-and the server answers it with the first request's outcome instead of doing it twice.
+operation's identity (a digest of the exact request): the same command run again sends the same
+key, and the server answers it with the first request's outcome instead of doing it twice. A
+key is taken back by that repeat; the keys a dead server can no longer answer go with its other
+runtime files (`runtime.clean_stale`).
 Standard library only (a client module).
 """
 
@@ -17,7 +19,6 @@ import hashlib
 import os
 import sys
 import uuid
-from collections.abc import Callable
 from pathlib import Path
 
 from twin_cli.server import runtime
@@ -39,11 +40,14 @@ def limit() -> float | None:
 
 def _pending_file(paths: runtime.WorldPaths, operation: str) -> Path:
     digest = hashlib.sha1(operation.encode("utf-8")).hexdigest()[:16]
-    return paths.directory / f"{paths.world}.pending-{digest}"
+    return paths.pending(digest)
 
 
-def take_key(paths: runtime.WorldPaths, operation: str) -> str:
-    """The key of an earlier request of this operation whose outcome is unknown, else a new one."""
+def take_key(paths: runtime.WorldPaths, operation: str | None) -> str:
+    """The key of an earlier request of this operation whose outcome is unknown, else a new one
+    (always a new one for an operation that is never replayed: None)."""
+    if operation is None:
+        return uuid.uuid4().hex
     path = _pending_file(paths, operation)
     try:
         key = path.read_text().strip()
@@ -53,8 +57,10 @@ def take_key(paths: runtime.WorldPaths, operation: str) -> str:
     return key or uuid.uuid4().hex
 
 
-def keep_key(paths: runtime.WorldPaths, operation: str, key: str) -> None:
+def keep_key(paths: runtime.WorldPaths, operation: str | None, key: str) -> None:
     """Remember `key` for the next request of this operation (its outcome is unknown)."""
+    if operation is None:
+        return
     path = _pending_file(paths, operation)
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "w") as handle:
@@ -85,8 +91,3 @@ class Waiter:
         if self.drawn:
             sys.stderr.write("\r\x1b[K")
             sys.stderr.flush()
-
-
-def patience_for(paths: runtime.WorldPaths | None, what: str) -> Callable[[float], bool]:
-    """A Waiter with the user's limit."""
-    return Waiter(paths, what, limit())

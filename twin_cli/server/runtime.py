@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import glob
 import os
 import re
 import stat
@@ -90,9 +91,15 @@ class WorldPaths:
         """Serialises starting and cleaning up, so two clients never start two servers."""
         return self._file("start.lock")
 
+    def pending(self, digest: str) -> Path:
+        """An idempotency key kept by a client whose request's outcome is unknown."""
+        return self._file(f"pending-{digest}")
+
     def transient(self) -> tuple[Path, ...]:
-        """Files that belong to a live server and are stale once it is gone."""
-        return (self.socket, self.token, self.tcp, self.pid)
+        """Files that belong to a live server and are stale once it is gone: a new server
+        cannot answer the old one's idempotency keys either."""
+        pending = tuple(self.directory.glob(f"{glob.escape(self.world)}.pending-*"))
+        return (self.socket, self.token, self.tcp, self.pid, *pending)
 
 
 def runtime_dir() -> Path:

@@ -137,7 +137,7 @@ def snapshot_png(world: Any, *, entity: str | None, width: int, height: int) -> 
     import mujoco
 
     with world.lock:
-        bodies = None if entity is None else world._require(entity).bodies
+        bodies = None if entity is None else world.index_of(entity).bodies
         model, data = world.model, copy.copy(world.data)
     mujoco.mj_forward(model, data)
     view = entity_view(model, data, bodies, width, height)

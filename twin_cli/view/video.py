@@ -53,7 +53,7 @@ class WorldVideo:
             self._renderer = offscreen.renderer(model, WIDTH, HEIGHT)
             self._model = model
         if self._view is None:
-            bodies = self.world._require(self.entity).bodies
+            bodies = self.world.index_of(self.entity).bodies
             self._view = offscreen.entity_view(model, data, bodies, WIDTH, HEIGHT)
         pixels = offscreen.render(model, data, self._view, self._renderer)
         frame = av.VideoFrame.from_ndarray(pixels, format="rgb24")

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from twin_cli.package_env import PACKAGE_ENVS
+from twin_cli.spawn_request import SpawnRequest
 
 MAX_ENTRIES = 32  # conversions kept (a booster_t1 spec holds ~8 MB of mesh arrays)
 _WRITE_MODES = ("w", "a", "x", "+")
@@ -95,22 +96,16 @@ def file_digest(path: str) -> str | None:
     return _digests[stamp]
 
 
-def cache_key(
-    path: Path,
-    args: dict[str, str] | None,
-    package_paths: dict[str, str] | None,
-    env: dict[str, str] | None = None,
-    repair_inertia: bool = False,
-) -> tuple:
-    """What, besides file contents, decides a conversion's result (`env`: the caller's package
-    variables, None: the server's own)."""
+def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> tuple:
+    """What, besides file contents, decides a conversion's result (`env`: the environment the
+    conversion resolves packages in, None: this process's own)."""
     lookup = os.environ if env is None else env
     return (
         str(path),
-        tuple(sorted((args or {}).items())),
-        tuple(sorted((package_paths or {}).items())),
+        tuple(sorted(request.args.items())),
+        tuple(sorted(request.package_paths.items())),
         tuple(lookup.get(name, "") for name in PACKAGE_ENVS),
-        repair_inertia,
+        request.repair_inertia,
     )
 
 

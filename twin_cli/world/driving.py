@@ -1,13 +1,14 @@
-"""Driving a World's entities: world-frame pushes on links and joint targets for motors.
+"""Driving a world's entities: world-frame pushes on links and joint targets for motors.
 
-A mixin of `twin_cli.world.engine.World` (it uses the world's lock, model, data, index, pushes and
-commands); the servo and push arithmetic lives in `twin_cli.world.actuation`.
+Functions of a world's state (`twin_cli.world.state`); the servo and push arithmetic lives in
+`twin_cli.world.actuation`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import mujoco
 
@@ -15,161 +16,177 @@ from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import actuation as control
 from twin_cli.world import joint_control
 from twin_cli.world.entities import EntityIndex, element_names
+from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
 
 
-class EntityControl:
-    """Pushes and joint commands (mixin; see module docstring)."""
+def push(
+    state: WorldState,
+    name: str,
+    force: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    torque: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    *,
+    link: str | None = None,
+    duration: float = 0.1,
+) -> None:
+    """Applies a world-frame force [N] and torque [N m] at a link's centre of mass.
 
-    def push(
-        self,
-        name: str,
-        force: tuple[float, float, float] = (0.0, 0.0, 0.0),
-        torque: tuple[float, float, float] = (0.0, 0.0, 0.0),
-        *,
-        link: str | None = None,
-        duration: float = 0.1,
-    ) -> None:
-        """Applies a world-frame force [N] and torque [N m] at a link's centre of mass.
-
-        Lasts `duration` [s] of sim time, rounded to whole steps (at least one); pushes on the
-        same link add up. `link` defaults to the entity's root body.
-        """
-        wrench = finite_vector("push force and torque", [*force, *torque], 6)
-        if not (math.isfinite(duration) and duration > 0):
-            raise InvalidRequestError(
-                "push duration", f"{duration} s is not positive", "give a duration > 0 s"
-            )
-        with self.lock:
-            ix = self._require(name)
-            body = self._link_name(name, ix, link)
-            steps = max(1, round(duration / self.model.opt.timestep))
-            self._pushes.append(control.Push(body, tuple(wrench), self._iterations + steps))
-            control.apply_pushes(self.model, self.data, self._pushes, {body}, self._perturbation)
-
-    def perturb(self, wrenches: dict[str, Sequence[float]]) -> None:
-        """Sets a viewer's mouse perturbation: world-frame wrench [N, N m] per full body name.
-
-        Replaces the previous perturbation (a drag is re-sent every frame; `{}` ends it) and is
-        added to the pushes of `push` on the same body, never written over them. Unknown bodies
-        are ignored (the viewer may still show a model from before a spawn or delete).
-        """
-        wrench = {b: tuple(finite_vector("perturbation", w, 6)) for b, w in wrenches.items()}
-        with self.lock:
-            touched = set(self._perturbation) | set(wrench)
-            self._perturbation = wrench
-            control.apply_pushes(self.model, self.data, self._pushes, touched, wrench)
-
-    def _link_name(self, name: str, ix: EntityIndex, link: str | None) -> str:
-        links = [
-            n.removeprefix(f"{name}/")
-            for n in element_names(self.model, self.model.name_bodyadr[ix.bodies])
-        ]
-        if link is None and links:
-            return f"{name}/{links[0]}"
-        if link not in links:
-            raise PartNotFoundError(name, "link", str(link), links)
-        return f"{name}/{link}"
-
-    def command(self, name: str, joint: str, *, mode: str, value: float) -> None:
-        """Sets a joint's target: "position" [rad|m], "velocity" [rad/s|m/s] or "effort" [N m|N].
-
-        Targets are clipped to what the joint allows (its range, velocity and effort limits and
-        its interface's min/max); `command_joints` refuses them instead. The position and
-        velocity servos never exceed the effort limit (see twin_cli.world.actuation).
-
-        Raises:
-            InvalidRequestError: unknown mode, or one the joint's control tags do not offer.
-        """
-        self.command_joints(name, {joint: value}, mode=mode, clip=True)
-
-    def command_joints(
-        self, name: str, targets: dict[str, float], *, mode: str, clip: bool = False
-    ) -> list[control.JointCommand]:
-        """Sets several joints' targets at once, all or none (`twin command`).
-
-        Raises:
-            EntityNotFoundError, PartNotFoundError: unknown entity or actuated joint.
-            InvalidRequestError: unknown mode, a mode the joint does not offer, or (unless
-                `clip`) a value outside the interface's min/max or the joint's limits. On any
-                error no command changes.
-        """
-        for joint, value in targets.items():
-            _check_command(joint, mode, value)
-        with self.lock:
-            ix = self._require(name)
-            checked = [self._checked(name, ix, j, mode, v, clip) for j, v in targets.items()]
-            positions = {
-                int(self.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
-            }
-            loads = joint_control.posture_loads(self.model, self.data, positions)
-            return [self._set_command(c, loads, ix.free_qpos < 0) for c in checked]
-
-    def _checked(
-        self, name: str, ix: EntityIndex, joint: str, mode: str, value: float, clip: bool
-    ) -> tuple:
-        a, j = self._motor_of(name, ix, joint)
-        limits = joint_control.limits_of(self.model, name, joint)
-        if mode not in limits.modes:
-            raise InvalidRequestError(
-                f"command mode [{mode}] of joint [{joint}] of [{name}]",
-                f"its {limits.source} tags offer only {', '.join(limits.modes)}",
-                f"use --mode {limits.modes[0]}",
-            )
-        key = element_names(self.model, self.model.name_actuatoradr[[a]])[0]
-        old = self._commands.get(key)
-        effort = old.effort if old else control.effort_limit(self.model, a)
-        low, high = joint_control.allowed_range(self.model, j, mode, limits, effort)
-        if clip:
-            value = min(max(value, low), high)
-        elif not low <= value <= high:
-            raise InvalidRequestError(
-                f"{mode} command for joint [{joint}] of [{name}]",
-                f"{value:g} is outside [{low:g}, {high:g}] (interface min/max, joint limits)",
-                "give a value inside that range",
-            )
-        return key, a, j, mode, float(value), effort, limits
-
-    def _set_command(self, checked: tuple, loads: tuple, fixed: bool) -> control.JointCommand:
-        """Writes one checked command; a fixed-base position servo holds its target's load."""
-        key, a, j, mode, value, effort, limits = checked
-        inertia, load = loads
-        dof = int(self.model.jnt_dofadr[j])
-        hold = float(load[dof]) if fixed and mode == "position" else 0.0
-        step = abs(value - float(self.data.qpos[self.model.jnt_qposadr[j]]))
-        kp, kv, rule = joint_control.servo_rule(
-            mode, limits, effort, float(inertia[dof]), self.model.opt.timestep, step
+    Lasts `duration` [s] of sim time, rounded to whole steps (at least one); pushes on the
+    same link add up. `link` defaults to the entity's root body.
+    """
+    wrench = finite_vector("push force and torque", [*force, *torque], 6)
+    if not (math.isfinite(duration) and duration > 0):
+        raise InvalidRequestError(
+            "push duration", f"{duration} s is not positive", "give a duration > 0 s"
         )
-        if math.isfinite(effort):
-            hold = min(max(hold, -effort), effort)
-        cmd = control.JointCommand(
-            key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold
-        )
-        control.apply_command(self.model, self.data, a, cmd)
-        self._commands[key] = cmd
-        return cmd
+    with state.lock:
+        ix = state.require(name)
+        body = _link_name(state, name, ix, link)
+        steps = max(1, round(duration / state.model.opt.timestep))
+        state.pushes.append(control.Push(body, tuple(wrench), state.iterations + steps))
+        control.apply_pushes(state.model, state.data, state.pushes, {body}, state.perturbation)
 
-    def _motor_of(self, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:
-        m = self.model
-        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{name}/{joint}")
-        actuated = {
-            int(m.actuator_trnid[a][0]): int(a)
-            for a in ix.actuators
-            if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+
+def perturb(state: WorldState, wrenches: dict[str, Sequence[float]]) -> None:
+    """Sets a viewer's mouse perturbation: world-frame wrench [N, N m] per full body name.
+
+    Replaces the previous perturbation (a drag is re-sent every frame; `{}` ends it) and is
+    added to the pushes of `push` on the same body, never written over them. Unknown bodies
+    are ignored (the viewer may still show a model from before a spawn or delete).
+    """
+    wrench = {b: tuple(finite_vector("perturbation", w, 6)) for b, w in wrenches.items()}
+    with state.lock:
+        touched = set(state.perturbation) | set(wrench)
+        state.perturbation = wrench
+        control.apply_pushes(state.model, state.data, state.pushes, touched, wrench)
+
+
+def _link_name(state: WorldState, name: str, ix: EntityIndex, link: str | None) -> str:
+    links = [
+        n.removeprefix(f"{name}/")
+        for n in element_names(state.model, state.model.name_bodyadr[ix.bodies])
+    ]
+    if link is None and links:
+        return f"{name}/{links[0]}"
+    if link not in links:
+        raise PartNotFoundError(name, "link", str(link), links)
+    return f"{name}/{link}"
+
+
+def command(state: WorldState, name: str, joint: str, *, mode: str, value: float) -> None:
+    """Sets a joint's target: "position" [rad|m], "velocity" [rad/s|m/s] or "effort" [N m|N].
+
+    Targets are clipped to what the joint allows (its range, velocity and effort limits and
+    its interface's min/max); `command_joints` refuses them instead. The position and
+    velocity servos never exceed the effort limit (see twin_cli.world.actuation).
+
+    Raises:
+        InvalidRequestError: unknown mode, or one the joint's control tags do not offer.
+    """
+    command_joints(state, name, {joint: value}, mode=mode, clip=True)
+
+
+def command_joints(
+    state: WorldState, name: str, targets: dict[str, float], *, mode: str, clip: bool = False
+) -> list[control.JointCommand]:
+    """Sets several joints' targets at once, all or none (`twin command`).
+
+    Raises:
+        EntityNotFoundError, PartNotFoundError: unknown entity or actuated joint.
+        InvalidRequestError: unknown mode, a mode the joint does not offer, or (unless
+            `clip`) a value outside the interface's min/max or the joint's limits. On any
+            error no command changes.
+    """
+    for joint, value in targets.items():
+        _check_command(joint, mode, value)
+    with state.lock:
+        ix = state.require(name)
+        checked = [_checked(state, name, ix, j, mode, v, clip) for j, v in targets.items()]
+        positions = {
+            int(state.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
         }
-        if j < 0 or j not in actuated:
-            known = [
-                n.removeprefix(f"{name}/") for n in element_names(m, m.name_jntadr[list(actuated)])
-            ]
-            raise PartNotFoundError(name, "actuated joint", joint, known)
-        return actuated[j], j
+        loads = joint_control.posture_loads(state.model, state.data, positions)
+        return [_set_command(state, c, loads, ix.free_qpos < 0) for c in checked]
 
-    def _reapply_commands(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-        """Writes every joint command into a (re)compiled model, by actuator name."""
-        for actuator, cmd in self._commands.items():
-            a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
-            if a >= 0:
-                control.apply_command(model, data, a, cmd)
+
+def _checked(
+    state: WorldState, name: str, ix: EntityIndex, joint: str, mode: str, value: float, clip: bool
+) -> tuple:
+    a, j = _motor_of(state, name, ix, joint)
+    limits = joint_control.limits_of(state.model, name, joint)
+    if mode not in limits.modes:
+        raise InvalidRequestError(
+            f"command mode [{mode}] of joint [{joint}] of [{name}]",
+            f"its {limits.source} tags offer only {', '.join(limits.modes)}",
+            f"use --mode {limits.modes[0]}",
+        )
+    key = element_names(state.model, state.model.name_actuatoradr[[a]])[0]
+    old = state.commands.get(key)
+    effort = old.effort if old else control.effort_limit(state.model, a)
+    low, high = joint_control.allowed_range(state.model, j, mode, limits, effort)
+    if clip:
+        value = min(max(value, low), high)
+    elif not low <= value <= high:
+        raise InvalidRequestError(
+            f"{mode} command for joint [{joint}] of [{name}]",
+            f"{value:g} is outside [{low:g}, {high:g}] (interface min/max, joint limits)",
+            "give a value inside that range",
+        )
+    return key, a, j, mode, float(value), effort, limits
+
+
+def _set_command(
+    state: WorldState, checked: tuple, loads: tuple, fixed: bool
+) -> control.JointCommand:
+    """Writes one checked command; a fixed-base position servo holds its target's load."""
+    key, a, j, mode, value, effort, limits = checked
+    inertia, load = loads
+    dof = int(state.model.jnt_dofadr[j])
+    hold = float(load[dof]) if fixed and mode == "position" else 0.0
+    step = abs(value - float(state.data.qpos[state.model.jnt_qposadr[j]]))
+    kp, kv, rule = joint_control.servo_rule(
+        mode, limits, effort, float(inertia[dof]), state.model.opt.timestep, step
+    )
+    if math.isfinite(effort):
+        hold = min(max(hold, -effort), effort)
+    cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold)
+    control.apply_command(state.model, state.data, a, cmd)
+    state.commands[key] = cmd
+    return cmd
+
+
+def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:
+    m = state.model
+    j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{name}/{joint}")
+    actuated = {
+        int(m.actuator_trnid[a][0]): int(a)
+        for a in ix.actuators
+        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+    }
+    if j < 0 or j not in actuated:
+        known = [
+            n.removeprefix(f"{name}/") for n in element_names(m, m.name_jntadr[list(actuated)])
+        ]
+        raise PartNotFoundError(name, "actuated joint", joint, known)
+    return actuated[j], j
+
+
+def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """Writes every joint command into a (re)compiled model, by actuator name."""
+    for actuator, cmd in state.commands.items():
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
+        if a >= 0:
+            control.apply_command(model, data, a, cmd)
+
+
+def record_targets(state: WorldState, targets: Mapping[str, tuple[float, float]]) -> None:
+    """Records where a controller left position servos (actuator → target, feedforward), so
+    `twin joints` and a save show them; commands that no longer exist are skipped."""
+    with state.lock:
+        for key, (target, feedforward) in targets.items():
+            cmd = state.commands.get(key)
+            if cmd is not None:
+                state.commands[key] = replace(cmd, target=target, feedforward=feedforward)
 
 
 def _check_command(joint: str, mode: str, value: float) -> None:
@@ -183,19 +200,19 @@ def _check_command(joint: str, mode: str, value: float) -> None:
         )
 
 
-def joint_commands(world: object, name: str) -> dict[str, dict]:
+def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
     """Each actuated joint's mode, target, gains and limits (`twin joints`); lock held by caller.
 
     Joints without a command report mode "none" (zero effort), with the modes they offer.
     """
-    model, ix = world.model, world._require(name)
+    model, ix = state.model, state.require(name)
     out = {}
     for a in ix.actuators:
         key = element_names(model, model.name_actuatoradr[[a]])[0]
         j = int(model.actuator_trnid[a][0])
         joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
         limits = joint_control.limits_of(model, name, joint)
-        cmd = world._commands.get(key)
+        cmd = state.commands.get(key)
         out[joint] = {
             "mode": cmd.mode if cmd else "none",
             "target": cmd.target if cmd else None,

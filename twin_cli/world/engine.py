@@ -1,57 +1,46 @@
-"""One simulated world: its spec, model, data and entities; spawning, deleting and queries.
+"""One simulated world: the engine's public face, composed of its state and the modules that act.
 
-The in-process engine under the server and `twin validate`. Every public method takes `lock`
-(also held by the stepping loop for one batch at a time) and raises TwinError subclasses whose
-messages name the entity and the fix. A spawn attaches to the world spec and compiles; on any
-failure it removes what it attached (frame, prefixed elements, default classes), so the world is
-left exactly as it was. Delete and fixed-base moves work on a copy of the spec. State always
-moves between models *by name* (`twin_cli.world.entities`), never by position.
-
-Concepts live in mixins: run control (`world_run`), physics settings (`world_physics`), pushes
-and joint commands (`world_control`).
+The in-process engine under the server and `twin validate`. `World` owns one `WorldState`
+(`state`) and one stepping thread (`loop`); every method hands the state to the function that
+does the job (`spawning`, `changes`, `running`, `physics`, `driving`, `engine_threads`,
+`respec`, `snapshot`) and each of those takes the lock. Errors are TwinError subclasses whose
+messages name the entity and the fix; a failed change leaves the world exactly as it was. State
+always moves between models by name (`twin_cli.world.entities`), never by position.
 """
 
 from __future__ import annotations
 
-import os
-from collections import deque
-from collections.abc import Sequence
-from dataclasses import replace
+from collections.abc import Callable, Mapping, Sequence
+from types import MappingProxyType
 from typing import Any
 
 import mujoco
-import numpy as np
 
-from twin_cli.errors import EntityExistsError, EntityNotFoundError, SpawnError
-from twin_cli.world import actuation as control
-from twin_cli.world import placement, posture, queries, shared_meshes, spawn
-from twin_cli.world.batch import BatchSpawning
-from twin_cli.world.contacts import cap_contact_stiffness
-from twin_cli.world.divergence import Divergence
-from twin_cli.world.driving import EntityControl
-from twin_cli.world.engine_threads import EngineThreads
-from twin_cli.world.entities import (
-    Entity,
-    EntityIndex,
-    EntityState,
-    element_names,
-    index_entities,
-    move_states,
-    rest_state,
-    write_state,
+from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import (
+    changes,
+    driving,
+    engine_threads,
+    physics,
+    queries,
+    respec,
+    running,
+    spawning,
 )
-from twin_cli.world.loop import SteppingLoop, WorldLock
-from twin_cli.world.observers import Observers
-from twin_cli.world.physics import PhysicsSettings
-from twin_cli.world.pose import Pose, quat_multiply, rotate
+from twin_cli.world import snapshot as snapshots
+from twin_cli.world.actuation import JointCommand
+from twin_cli.world.divergence import Divergence
+from twin_cli.world.entities import Entity, EntityIndex
+from twin_cli.world.loop import LoopFigures, SteppingLoop, WorldLock
+from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
-from twin_cli.world.respec import SpecRenewal
-from twin_cli.world.running import STATE, RunControl
-from twin_cli.world.scene import build_world_spec, replace_lights
-from twin_cli.world.sensor_rings import align_sensor_ticks
+from twin_cli.world.scene import build_world_spec
+from twin_cli.world.snapshot import WorldSnapshot
+from twin_cli.world.state import WorldState
 from twin_cli.world.values import (
     EntityInfo,
     SpawnResult,
+    Stats,
     WorldSettings,
     check_settings,
     scene_settings,
@@ -59,325 +48,337 @@ from twin_cli.world.values import (
 
 __all__ = ["World"]
 
-WARNINGS_KEPT = 100  # MuJoCo warning texts kept in World.mujoco_warnings
-_Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
-
-class World(RunControl, PhysicsSettings, EntityControl, BatchSpawning, EngineThreads, SpecRenewal):
+class World:
     """A MuJoCo world with Gazebo's defaults, entities spawned by name, and a real-time loop."""
 
-    file_notes: tuple[str, ...] = ()  # what a world file held that twin does not simulate
-
     def __init__(self, settings: WorldSettings | None = None, *, name: str = "default") -> None:
-        self.settings = settings or WorldSettings()
-        check_settings(self.settings)
-        self.name = name
-        self.lock = WorldLock()
-        self._spec = build_world_spec(scene_settings(self.settings))
-        self.model = self._spec.compile()
-        self.data = mujoco.MjData(self.model)
-        self._entities: dict[str, Entity] = {}
-        self._index: dict[str, EntityIndex] = {}
-        self._commands: dict[str, control.JointCommand] = {}
-        self._pushes: list[control.Push] = []
-        self._perturbation: dict[str, tuple[float, ...]] = {}  # a viewer's drag, by body
-        self._damping: control.Damping | None = None
-        self._iterations = 0
-        self._stepping_time = 0.0  # [s] inside mj_step (RunControl.stepping_time)
-        self._paused = False
-        self.divergences = 0
-        self.divergence_log: list[Divergence] = []
-        self.mujoco_warnings: deque[str] = deque(maxlen=WARNINGS_KEPT)
-        self._snapshot = np.empty(mujoco.mj_stateSize(self.model, STATE))
-        self._observers = Observers()  # recorder, live stream: called between batches
-        self._loop = SteppingLoop(self)
+        settings = settings or WorldSettings()
+        check_settings(settings)
+        spec = build_world_spec(scene_settings(settings))
+        model = spec.compile()
+        self._state = WorldState(name, settings, WorldLock(), spec, model, mujoco.MjData(model))
+        self._loop = SteppingLoop(self._state)
 
-    # ----------------------------------------------------------------- spawning and deleting
+    # ----------------------------------------------------------------- what it is
+    @property
+    def name(self) -> str:
+        return self._state.name
+
+    @property
+    def settings(self) -> WorldSettings:
+        """The physics settings (changed through `set_physics` and `set_gravity`)."""
+        return self._state.settings
+
+    @property
+    def lock(self) -> WorldLock:
+        """Held by the stepping loop for one batch at a time; hold it to read model and data."""
+        return self._state.lock
+
+    @property
+    def model(self) -> mujoco.MjModel:
+        """The compiled model (a new one after every spawn, delete or fixed-base move)."""
+        return self._state.model
+
+    @property
+    def data(self) -> mujoco.MjData:
+        return self._state.data
+
+    @property
+    def divergences(self) -> int:
+        """Entities reset to their spawn state after their state went bad."""
+        return self._state.divergences
+
+    @property
+    def divergence_log(self) -> list[Divergence]:
+        return list(self._state.divergence_log)
+
+    @property
+    def mujoco_warnings(self) -> list[str]:
+        """MuJoCo's warning texts, the last hundred."""
+        return list(self._state.mujoco_warnings)
+
+    @property
+    def file_notes(self) -> tuple[str, ...]:
+        """What a world file held that twin does not simulate."""
+        return self._state.file_notes
+
+    @file_notes.setter
+    def file_notes(self, notes: Sequence[str]) -> None:
+        self._state.file_notes = tuple(notes)
+
+    # ----------------------------------------------------------------- spawning, changing
     def spawn(
-        self,
-        source: str | os.PathLike | mujoco.MjSpec,
-        *,
-        name: str | None = None,
-        pose: Pose = Pose(),
-        args: dict[str, str] | None = None,
-        package_paths: dict[str, str] | None = None,
-        on_ground: bool = False,
-        joints: dict[str, float] | None = None,
-        env: dict[str, str] | None = None,
-        repair_inertia: bool = False,
+        self, request: SpawnRequest | Any, *, name: str | None = None, pose: Pose = Pose()
     ) -> SpawnResult:
-        """Adds an entity at `pose`; existing entities keep their exact state.
+        """Adds one entity (`spawning.spawn_one`): a request, or a bare path or MjSpec."""
+        return spawning.spawn_one(self._state, request, name=name, pose=pose)
 
-        The source is read (and converted) before the lock is taken, so a slow conversion does
-        not stall the loop. The new entity starts at rest in its own initial configuration
-        (its `home` key if it has one) with `joints` (Gazebo's `spawn_model -J`: joint name
-        without prefix → position [rad] or [m]) written over it; mimic followers follow their
-        leaders. That start is its spawn state (what `reset` returns to). Returns once the
-        entity is in the world.
-
-        Raises:
-            EntityExistsError: `name` is taken. SpawnError: unreadable source or compile error.
-            PartNotFoundError: a `joints` name is not a hinge/slide joint of the entity.
-            InvalidRequestError: a `joints` value is outside its joint's range (or sets a mimic
-                follower). On any error the world is unchanged.
-            converters.ConversionError: the converter refused the file.
-        """
-        if name is not None:
-            spawn.check_entity_name(name)
-        loaded = spawn.load_source(source, args, package_paths, env, repair_inertia)
-        with self.lock:
-            name = self._free_name(name, loaded.default_name)
-            try:
-                home = self._attach(loaded, name, pose)
-                pose, state, (model, data, index) = self._seed(
-                    loaded, name, pose, home, on_ground, joints or {}
-                )
-                warnings = [
-                    *loaded.notes,
-                    *placement.start_warnings(model, data, index, name, pose.z),
-                ]
-            except BaseException:
-                spawn.remove_entity(self._spec, name)  # the world spec as it was before
-                raise
-            self._entities[name] = Entity(
-                name,
-                loaded.source,
-                dict(args or {}),
-                dict(package_paths or {}),
-                pose,
-                on_ground,
-                state,
-                loaded.report,
-                loaded.xml,
-                dict(joints or {}),
-                loaded.description,
-                sensors=loaded.sensors,
-                plugins=loaded.plugins,
-                env=env,
-                repair_inertia=repair_inertia,
-            )
-            self._commit(self._spec, model, data, index)
-            return SpawnResult(name, loaded.source, warnings, loaded.report, loaded.cached)
-
-    def _attach(self, loaded: spawn.LoadedSource, name: str, pose: Pose) -> np.ndarray | None:
-        """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
-        try:
-            home = spawn.prepare_child(loaded.spec, self._spec)
-            self._keep_spec(name, loaded.spec, loaded.mesh_keys)  # for renew_spec
-            shared_meshes.prepare(loaded.spec, self._spec, loaded.mesh_keys)
-            spawn.attach(self._spec, loaded.spec, name, pose)
-        except ValueError as exc:
-            raise SpawnError(
-                name, loaded.source, f"cannot be attached ({exc})", "fix the model"
-            ) from exc
-        return home
-
-    def _seed(
+    def spawn_batch(
         self,
-        loaded: spawn.LoadedSource,
-        name: str,
-        pose: Pose,
-        home: np.ndarray | None,
-        on_ground: bool,
-        joints: dict[str, float],
-    ) -> tuple[Pose, EntityState, _Built]:
-        """Compiles the world with the attached entity and writes its initial state at rest."""
-        model, data, index = self._rebuild(self._spec, name, loaded.source)
-        ix = index[name]
-        targets = posture.joint_targets(model, ix.joints, f"{name}/", joints, name)
-        q = posture.apply_targets(spawn.initial_qpos(model, ix, home, pose), ix.qpos, targets)
-        if on_ground:
-            pose, q, (model, data, index) = self._ground(model, data, index, name, pose, q)
-        state = rest_state(model, index[name], q)
-        write_state(data, index[name], state)
-        return pose, state, (model, data, index)
+        request: SpawnRequest | Any,
+        *,
+        poses: Sequence[Pose],
+        names: Sequence[str] | None = None,
+        base: str | None = None,
+    ) -> list[SpawnResult]:
+        """Adds one entity per pose, one conversion and one compile (`spawning.spawn_batch`)."""
+        return spawning.spawn_batch(self._state, request, poses=poses, names=names, base=base)
+
+    def spawn_specs(self, items: Sequence[tuple[mujoco.MjSpec, str, Pose]]) -> list[SpawnResult]:
+        """Adds a world file's models in one compile (`spawning.spawn_specs`)."""
+        return spawning.spawn_specs(self._state, items)
 
     def delete(self, name: str) -> None:
         """Removes entity `name`; the others keep their exact state."""
-        with self.lock:
-            self._require(name)
-            trial = self._spec.copy()
-            spawn.remove_entity(trial, name)
-            entity = self._entities.pop(name)
-            try:
-                model, data, index = self._rebuild(trial, None, entity.source)
-            except SpawnError:
-                self._entities[name] = entity
-                raise
-            self._commands = {
-                k: c for k, c in self._commands.items() if not k.startswith(f"{name}/")
-            }
-            self._pushes = [p for p in self._pushes if not p.body.startswith(f"{name}/")]
-            self._perturbation = {
-                b: w for b, w in self._perturbation.items() if not b.startswith(f"{name}/")
-            }
-            self._commit(trial, model, data, index)
-            self._count_delete()  # every RENEW_EVERY deletes: a fresh spec (bounded memory)
-
-    def _free_name(self, name: str | None, default: str) -> str:
-        if name is not None:
-            if name in self._entities:
-                raise EntityExistsError(name)
-            return name
-        base = "".join(c if c.isalnum() or c in "-_." else "_" for c in default) or "model"
-        candidate, k = base, 0
-        while candidate in self._entities:
-            k += 1
-            candidate = f"{base}_{k}"
-        return candidate
+        changes.delete(self._state, name)
 
     def set_lights(self, lights: Sequence[Any]) -> None:
-        """Replace the world's lights (an SDF world's `<light>`s, its included `sun` among them)."""
-        with self.lock:
-            trial = self._spec.copy()
-            replace_lights(trial, lights)
-            self._commit(trial, *self._rebuild(trial, None, "<lights>"))
-            self._lights = list(lights)  # replayed by renew_spec
+        """Replace the world's lights (an SDF world's `<light>`s)."""
+        changes.set_lights(self._state, lights)
 
-    def _rebuild(self, trial: mujoco.MjSpec, new: str | None, source: str) -> _Built:
-        """Compiles `trial` into a new model and data carrying every existing entity's state."""
-        try:
-            model, data = trial.recompile(self.model, self.data)
-        except (ValueError, RuntimeError) as exc:
-            raise SpawnError(
-                new or "world",
-                source,
-                f"the world does not compile with it ({exc})",
-                "fix the model; the world is unchanged",
-            ) from exc
-        kept = [n for n in self._entities if n in self._index]
-        index = index_entities(model, kept + ([new] if new else []))
-        move_states(self.data, self._index, data, index, [n for n in kept if n in index])
-        data.time = self.data.time
-        self._reapply_commands(model, data)
-        return model, data, index
-
-    def _ground(self, model, data, index, name, pose, q):  # noqa: ANN001, ANN202
-        """Shifts the new entity so its lowest collision point rests on z = 0."""
-        ix = index[name]
-        full = data.qpos.copy()
-        full[ix.qpos] = q
-        scratch = placement.positioned(model, full)
-        low = placement.lowest_point(model, scratch, placement.collision_geoms(model, ix.geoms))
-        if low is None:
-            return pose, q, (model, data, index)
-        pose = replace(pose, z=pose.z - low)
-        if ix.free_qpos >= 0:
-            q = q.copy()
-            for at in spawn.free_offsets(model, ix):  # every free link, not only the root
-                q[at + 2] -= low
-            return pose, q, (model, data, index)
-        spawn.move_frame(self._spec, name, pose)
-        model, data, index = self._rebuild(self._spec, name, "on-ground placement")
-        return pose, q, (model, data, index)  # joint values keep their layout; only the frame moved
-
-    def _commit(
-        self,
-        spec: mujoco.MjSpec,
-        model: mujoco.MjModel,
-        data: mujoco.MjData,
-        index: dict[str, EntityIndex],
-    ) -> None:
-        self._spec, self.model, self.data, self._index = spec, model, data, index
-        align_sensor_ticks(model, data)
-        self._install_pool(model, data)
-        cap_contact_stiffness(model)
-        self._snapshot = np.empty(mujoco.mj_stateSize(model, STATE))
-        self._damping = control.damping_of(model, element_names(model, model.name_numericadr))
-        control.apply_pushes(
-            model,
-            data,
-            self._pushes,
-            {p.body for p in self._pushes} | set(self._perturbation),
-            self._perturbation,
-        )
+    def set_pose(self, name: str, pose: Pose) -> None:
+        """Teleports the entity's root to `pose`, at rest (`changes.set_pose`)."""
+        changes.set_pose(self._state, name, pose)
 
     # ----------------------------------------------------------------- entities
-    def _require(self, name: str) -> EntityIndex:
-        if name not in self._entities:
-            raise EntityNotFoundError(name, list(self._entities))
-        return self._index[name]
+    def entity(self, name: str) -> Entity:
+        """The record of entity `name`: its request, spawn pose and state, sensors, plugins.
+
+        Raises:
+            EntityNotFoundError: no such entity (the message lists the entities).
+        """
+        with self.lock:
+            self._state.require(name)
+            return self._state.entities[name]
+
+    def entity_names(self) -> list[str]:
+        """The entities' names, in spawn order."""
+        with self.lock:
+            return list(self._state.entities)
+
+    def index_of(self, name: str) -> EntityIndex:
+        """Where entity `name` lives in the current model (ids and addresses; they change at
+        every compile, so read them again after a spawn or delete).
+
+        Raises:
+            EntityNotFoundError: no such entity.
+        """
+        with self.lock:
+            return self._state.require(name)
 
     def entities(self) -> list[EntityInfo]:
         """Every entity: name, source, root position [m], number of joints (free excluded)."""
+        state = self._state
         with self.lock:
             return [
                 EntityInfo(
                     n,
                     e.source,
                     self.get_pose(n).position(),
-                    len(queries.joint_names(self.model, self._index[n], f"{n}/")),
+                    len(queries.joint_names(state.model, state.index[n], f"{n}/")),
                 )
-                for n, e in self._entities.items()
+                for n, e in state.entities.items()
             ]
 
     def get_pose(self, name: str) -> Pose:
         """The entity's root pose now."""
+        state = self._state
         with self.lock:
-            ix = self._require(name)
-            return queries.root_pose(self.model, self.data, ix, self._entities[name].pose)
-
-    def set_pose(self, name: str, pose: Pose) -> None:
-        """Teleports the entity's root to `pose`, at rest (its velocities are zeroed).
-
-        A fixed-base entity is moved by moving its attach frame (a recompile); that also becomes
-        its spawn pose.
-        """
-        with self.lock:
-            ix = self._require(name)
-            if ix.free_qpos < 0:
-                trial = self._spec.copy()
-                spawn.move_frame(trial, name, pose)
-                self._entities[name] = replace(self._entities[name], pose=pose)
-                self._commit(trial, *self._rebuild(trial, None, self._entities[name].source))
-                return
-            if ix.model_site >= 0 and self.model.site_bodyid[ix.model_site] == 0:
-                self._move_free_links(name, ix, pose)  # unjoined links: all move with the frame
-                return
-            if ix.model_site >= 0:
-                pose = queries.root_from_model(self.model, ix, pose)
-            self.data.qpos[ix.free_qpos : ix.free_qpos + 3] = pose.position()
-            self.data.qpos[ix.free_qpos + 3 : ix.free_qpos + 7] = pose.quat()
-            self.data.qvel[ix.dofs] = 0.0
-            self.data.qacc_warmstart[ix.dofs] = 0.0
-
-    def _move_free_links(self, name: str, ix: EntityIndex, pose: Pose) -> None:
-        """Moves every free link of a model of unjoined links rigidly, so that its model frame
-        goes from where it is (its spawn or last set pose) to `pose`; at rest."""
-        old = self._entities[name].pose
-        w, x, y, z = old.quat()
-        turn = quat_multiply(pose.quat(), (w, -x, -y, -z))
-        for at in spawn.free_offsets(self.model, ix):
-            a = int(ix.qpos[at])
-            offset = tuple(float(v) for v in self.data.qpos[a : a + 3] - old.position())
-            self.data.qpos[a : a + 3] = np.add(pose.position(), rotate(turn, offset))  # type: ignore[arg-type]
-            link_quat = tuple(float(v) for v in self.data.qpos[a + 3 : a + 7])
-            self.data.qpos[a + 3 : a + 7] = quat_multiply(turn, link_quat)  # type: ignore[arg-type]
-        self.data.qvel[ix.dofs] = 0.0
-        self.data.qacc_warmstart[ix.dofs] = 0.0
-        self._entities[name] = replace(self._entities[name], pose=pose)
+            ix = state.require(name)
+            return queries.root_pose(state.model, state.data, ix, state.entities[name].pose)
 
     def joint_states(self, name: str) -> list[JointState]:
         """Position, velocity and actuator effort of each joint (free joint excluded)."""
+        state = self._state
         with self.lock:
-            return queries.joint_states(self.model, self.data, self._require(name), f"{name}/")
+            return queries.joint_states(state.model, state.data, state.require(name), f"{name}/")
 
     def link_poses(self, name: str) -> dict[str, Pose]:
         """World pose of each of the entity's bodies (links), by name without prefix."""
+        state = self._state
         with self.lock:
-            return queries.link_poses(self.model, self.data, self._require(name), f"{name}/")
+            return queries.link_poses(state.model, state.data, state.require(name), f"{name}/")
 
-    # ----------------------------------------------------------------- files
-    def save(self, path: str | os.PathLike) -> None:
-        """Writes entities, sources, settings and the full state to `path` (atomically)."""
-        from twin_cli.world import savefile as worldfile
+    # ----------------------------------------------------------------- driving
+    def push(
+        self,
+        name: str,
+        force: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        torque: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        *,
+        link: str | None = None,
+        duration: float = 0.1,
+    ) -> None:
+        """A world-frame force [N] and torque [N m] on a link for `duration` [s] of sim time."""
+        driving.push(self._state, name, force, torque, link=link, duration=duration)
 
+    def perturb(self, wrenches: dict[str, Sequence[float]]) -> None:
+        """Sets a viewer's mouse drag: world-frame wrench [N, N m] per full body name."""
+        driving.perturb(self._state, wrenches)
+
+    def command(self, name: str, joint: str, *, mode: str, value: float) -> None:
+        """Sets one joint's target, clipped to what the joint allows (`driving.command`)."""
+        driving.command(self._state, name, joint, mode=mode, value=value)
+
+    def command_joints(
+        self, name: str, targets: dict[str, float], *, mode: str, clip: bool = False
+    ) -> list[JointCommand]:
+        """Sets several joints' targets at once, all or none (`driving.command_joints`)."""
+        return driving.command_joints(self._state, name, targets, mode=mode, clip=clip)
+
+    def commands(self) -> Mapping[str, JointCommand]:
+        """The joint commands held, by actuator name: a read-only live view (hold the lock
+        while reading it from another thread)."""
+        return MappingProxyType(self._state.commands)
+
+    def joint_commands(self, name: str) -> dict[str, dict]:
+        """Each actuated joint's mode, target, gains and limits (`twin joints`)."""
         with self.lock:
-            worldfile.save(self, path)
+            return driving.joint_commands(self._state, name)
 
-    @classmethod
-    def load(cls, path: str | os.PathLike) -> World:
-        """A new, stopped world rebuilt from a file written by `save`."""
-        from twin_cli.world import savefile as worldfile
+    def record_targets(self, targets: Mapping[str, tuple[float, float]]) -> None:
+        """Records where a controller left position servos: actuator name → (target [rad or
+        m], feedforward velocity); commands that no longer exist are skipped."""
+        driving.record_targets(self._state, targets)
 
-        return worldfile.load(cls, path)
+    # ----------------------------------------------------------------- running
+    @property
+    def paused(self) -> bool:
+        """Whether the real-time loop is paused (`step` still works)."""
+        return self._state.paused
+
+    def pause(self) -> None:
+        with self.lock:
+            self._state.paused = True
+
+    def resume(self) -> None:
+        """Resumes the real-time loop (the pacer re-anchors: no catch-up burst)."""
+        with self.lock:
+            self._state.paused = False
+            self._loop.reanchor()
+
+    def step(self, n: int = 1) -> None:
+        """Steps `n` times now (paused or not)."""
+        running.step(self._state, n)
+
+    def reset(self, *, time_only: bool = False) -> None:
+        """Every entity back to its spawn state and time to 0 (or only time and iterations)."""
+        running.reset(self._state, self._loop, time_only=time_only)
+
+    def stats(self) -> Stats:
+        """`gz stats` figures (factor averaged over the last 20 samples of 0.2 s)."""
+        return running.stats(self._state, self._loop)
+
+    @property
+    def stepping_time(self) -> float:
+        """Wall time [s] spent inside mj_step since the world was made.
+
+        Over a window of the unthrottled loop, its share of the window's wall time is the loop's
+        throughput against raw mj_step on the very same steps at the very same moment.
+        """
+        return self._state.stepping_time
+
+    def loop_figures(self) -> LoopFigures:
+        """The loop's own measurements (factor, real time, lateness, dropped steps)."""
+        return self._loop.figures()
+
+    def start(self) -> None:
+        """Starts the real-time stepping thread."""
+        self._loop.start()
+
+    def stop(self) -> None:
+        """Stops and joins the stepping thread."""
+        self._loop.stop()
+
+    @property
+    def running(self) -> bool:
+        return self._loop.running
+
+    def add_observer(self, callback: Callable[[], None], rate: float) -> int:
+        """Calls `callback()` every 1/`rate` [Hz] of sim time, between steps, lock held.
+
+        For consumers of the world (recorder, live stream, sensors): the stepping splits its
+        `mj_step(nstep)` calls where an observer is due, so there is no Python per physics step.
+        The callback must only copy what it needs. Returns a handle for `remove_observer`.
+        """
+        state = self._state
+        with self.lock:
+            return state.observers.add(
+                callback, rate, float(state.data.time), state.model.opt.timestep
+            )
+
+    def remove_observer(self, handle: int) -> None:
+        """Stops calling an observer (may be called from within its callback)."""
+        with self.lock:
+            self._state.observers.remove(handle)
+
+    # ----------------------------------------------------------------- physics and engine
+    def gravity(self) -> tuple[float, float, float]:
+        """The gravity vector [m/s²]."""
+        return physics.gravity(self._state)
+
+    def set_gravity(self, vector: tuple[float, float, float]) -> None:
+        """Sets gravity [m/s²]; takes effect on the next step."""
+        physics.set_gravity(self._state, vector)
+
+    def physics(self) -> dict:
+        """Timestep, rate, iterations, solver, integrator, gravity, threads, sleeping."""
+        return physics.physics(self._state)
+
+    def set_physics(self, **changes: Any) -> dict:
+        """Changes any of the physics settings (`physics.set_physics`); returns `physics()`."""
+        return physics.set_physics(self._state, self._loop, **changes)
+
+    def set_engine(
+        self,
+        *,
+        threads: int | None = None,
+        sleep: bool | None = None,
+        sleep_tolerance: float | None = None,
+    ) -> None:
+        """Sets the engine threads, sleeping and its tolerance [m/s] (None keeps a value)."""
+        engine_threads.set_engine(
+            self._state, threads=threads, sleep=sleep, sleep_tolerance=sleep_tolerance
+        )
+
+    @property
+    def threads(self) -> int:
+        """Engine threads asked for (the pool is installed when `pool_threads` > 0)."""
+        return engine_threads.threads_of(self._state)
+
+    @property
+    def pool_threads(self) -> int:
+        """Worker threads of the pool on the current data (0: no pool, single-threaded)."""
+        return self._state.pool_threads
+
+    @property
+    def sleeping(self) -> bool:
+        """Whether island sleeping is enabled."""
+        return engine_threads.sleeping(self._state.model)
+
+    def renew_spec(self) -> bool:
+        """Rebuilds the world spec from scratch if it compiles to exactly the running model."""
+        with self.lock:
+            return respec.renew_spec(self._state)
+
+    @property
+    def spec_renewals(self) -> int:
+        return self._state.spec_renewals
+
+    @property
+    def spec_renewals_refused(self) -> int:
+        return self._state.spec_renewals_refused
+
+    # ----------------------------------------------------------------- snapshots
+    def snapshot(self) -> WorldSnapshot:
+        """Settings, entities, commands and full state, copied under the lock."""
+        return snapshots.take(self._state)
+
+    def restore(self, snapshot: WorldSnapshot) -> None:
+        """Writes a snapshot into this world, which holds the same entities (`snapshot.restore`).
+
+        Raises:
+            InvalidRequestError: other entities, or another layout; the world is unchanged.
+        """
+        snapshots.restore(self._state, snapshot)

@@ -1,8 +1,8 @@
 """MuJoCo's engine thread pool and island sleeping for a World (`twin physics --threads/--sleep`).
 
-A mixin of `twin_cli.world.engine.World`. The pool (`mujoco.mju_threadpool`, MuJoCo ≥ 3.3)
-parallelises collision detection and the constraint solve across islands inside one `mj_step`;
-it belongs to an MjData, so it is installed again on every new data (spawn, delete, reset, load).
+The pool (`mujoco.mju_threadpool`, MuJoCo ≥ 3.3) parallelises collision detection and the
+constraint solve across islands inside one `mj_step`; it belongs to an MjData, so it is
+installed again on every new data (spawn, delete, reset, load).
 It only pays with several islands to share out, so it is installed when the world has at least
 `POOL_MIN_TREES` kinematic trees: a one-robot world steps as before. The pool changes no
 answer (a trajectory of 8 colliding humanoids is bit-equal with and without it), only speed;
@@ -26,6 +26,7 @@ import numpy as np
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.world.sleeping import allow_actuated
+from twin_cli.world.state import STATE, WorldState
 
 POOL_MIN_TREES = 4  # kinematic trees (robots, free objects) before the pool is worth its overhead
 MAX_THREADS = 64
@@ -60,73 +61,63 @@ def pool_size(threads: int, model: mujoco.MjModel) -> int:
     return threads if threads > 1 and model.ntree >= POOL_MIN_TREES else 0
 
 
-class EngineThreads:
-    """The thread pool and sleeping settings of a World (mixin)."""
+def threads_of(state: WorldState) -> int:
+    """Engine threads asked for (the pool is installed when `state.pool_threads` > 0)."""
+    return state.threads or default_threads()
 
-    _threads: int | None = None  # None: default_threads()
 
-    @property
-    def threads(self) -> int:
-        """Engine threads asked for (the pool is installed when `pool_threads` > 0)."""
-        return self._threads or default_threads()
+def sleeping(model: mujoco.MjModel) -> bool:
+    """Whether island sleeping is enabled."""
+    return bool(int(model.opt.enableflags) & SLEEP_BIT)
 
-    @property
-    def pool_threads(self) -> int:
-        """Worker threads of the pool on the current data (0: no pool, single-threaded)."""
-        return getattr(self, "_pool_threads", 0)
 
-    @property
-    def sleeping(self) -> bool:
-        """Whether island sleeping is enabled."""
-        return bool(int(self.model.opt.enableflags) & SLEEP_BIT)
+def install_pool(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """Gives a new MjData the pool the world's settings ask for (caller holds the lock)."""
+    allow_actuated(model)  # robots on their servos may sleep too (twin_cli.world.sleeping)
+    size = pool_size(threads_of(state), model)
+    if size and not data.threadpool:  # mj_recompile keeps the pool of the data it reuses
+        mujoco.mju_threadpool(data, size)
+    state.pool_threads = size
 
-    def _install_pool(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-        """Gives a new MjData the pool this world's settings ask for (caller holds the lock)."""
-        allow_actuated(model)  # robots on their servos may sleep too (twin_cli.world.sleeping)
-        size = pool_size(self.threads, model)
-        if size and not data.threadpool:  # mj_recompile keeps the pool of the data it reuses
-            mujoco.mju_threadpool(data, size)
-        self._pool_threads = size
 
-    def set_engine(
-        self,
-        *,
-        threads: int | None = None,
-        sleep: bool | None = None,
-        sleep_tolerance: float | None = None,
-    ) -> None:
-        """Sets the engine threads, sleeping and its tolerance [m/s] (None keeps a value)."""
+def set_engine(
+    state: WorldState,
+    *,
+    threads: int | None = None,
+    sleep: bool | None = None,
+    sleep_tolerance: float | None = None,
+) -> None:
+    """Sets the engine threads, sleeping and its tolerance [m/s] (None keeps a value)."""
+    if threads is not None:
+        check_threads(threads)
+    if sleep_tolerance is not None and not 0.0 < sleep_tolerance < 10.0:
+        raise InvalidRequestError(
+            "sleep tolerance", f"{sleep_tolerance!r} m/s", "give a speed above 0, e.g. 0.01"
+        )
+    with state.lock:
+        if sleep_tolerance is not None:
+            state.model.opt.sleep_tolerance = sleep_tolerance
+            state.spec.option.sleep_tolerance = sleep_tolerance
+        if sleep is not None:
+            for option in (state.model.opt, state.spec.option):
+                flags = int(option.enableflags)
+                option.enableflags = flags | SLEEP_BIT if sleep else flags & ~SLEEP_BIT
+        if threads is None and sleep is None:
+            return
         if threads is not None:
-            check_threads(threads)
-        if sleep_tolerance is not None and not 0.0 < sleep_tolerance < 10.0:
-            raise InvalidRequestError(
-                "sleep tolerance", f"{sleep_tolerance!r} m/s", "give a speed above 0, e.g. 0.01"
-            )
-        with self.lock:
-            if sleep_tolerance is not None:
-                self.model.opt.sleep_tolerance = sleep_tolerance
-                self._spec.option.sleep_tolerance = sleep_tolerance
-            if sleep is not None:
-                for option in (self.model.opt, self._spec.option):
-                    flags = int(option.enableflags)
-                    option.enableflags = flags | SLEEP_BIT if sleep else flags & ~SLEEP_BIT
-            if threads is None and sleep is None:
-                return
-            if threads is not None:
-                self._threads = threads
-            # A pool cannot be removed from an MjData, and sleep state is sized at creation:
-            # move the state to a fresh data (same model, same state: a bit-exact hand-over).
-            self._renew_data()
+            state.threads = threads
+        # A pool cannot be removed from an MjData, and sleep state is sized at creation:
+        # move the state to a fresh data (same model, same state: a bit-exact hand-over).
+        renew_data(state)
 
-    def _renew_data(self) -> None:
-        """Moves the whole integration state to a new MjData with the pool installed."""
-        from twin_cli.world.running import STATE
 
-        model, old = self.model, self.data
-        data = mujoco.MjData(model)
-        state = np.empty(mujoco.mj_stateSize(model, STATE))
-        mujoco.mj_getState(model, old, state, STATE)
-        mujoco.mj_setState(model, data, state, STATE)
-        mujoco.mj_forward(model, data)
-        self._install_pool(model, data)
-        self.data = data
+def renew_data(state: WorldState) -> None:
+    """Moves the whole integration state to a new MjData with the pool installed."""
+    model, old = state.model, state.data
+    data = mujoco.MjData(model)
+    vector = np.empty(mujoco.mj_stateSize(model, STATE))
+    mujoco.mj_getState(model, old, vector, STATE)
+    mujoco.mj_setState(model, data, vector, STATE)
+    mujoco.mj_forward(model, data)
+    install_pool(state, model, data)
+    state.data = data

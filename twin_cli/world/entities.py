@@ -7,11 +7,12 @@ each one and moves state by name, never by position.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import mujoco
 import numpy as np
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.pose import Pose
 
 _QPOS_WIDTH = np.array([7, 4, 1, 1])  # by mjtJoint: free, ball, slide, hinge
@@ -73,35 +74,27 @@ class Entity:
 
     Attributes:
         name: entity name (the prefix of its elements, without the "/").
-        source: absolute path of the file it came from, or "<MjSpec>".
-        args: xacro arguments; `package_paths`: package name → directory.
+        source: absolute path of the file it came from, `<xml>` or "<MjSpec>".
+        request: the spawn request it came from (args, packages, `-J`, on-ground, repair).
         pose: spawn pose (after `on_ground` placement).
-        on_ground: whether it was placed with its lowest point on the ground.
         spawn_state: the state `reset` returns it to.
         report: the converter's report as a dict (URDF/xacro sources), else None.
-        xml: MJCF text of an MjSpec source (for save/load), else None.
-        joints: initial joint positions given at spawn (`-J`), name → [rad] or [m].
+        xml: MJCF text of an MjSpec or text source (for save/load), else None.
         description: the URDF text after xacro (for `/robot_description`), else None.
         sensors: its Gazebo sensors (`converters.description.sensors.SensorSpec`), if any.
-        env: the spawning client's package search variables (None: the server's own).
-        repair_inertia: whether non-physical inertias were bounded (`--repair-inertia`).
+        plugins: its drive plugins (`converters.gazebo.plugins.DiffDrive`), if any.
     """
 
     name: str
     source: str
-    args: dict[str, str]
-    package_paths: dict[str, str]
+    request: SpawnRequest
     pose: Pose
-    on_ground: bool
     spawn_state: EntityState
     report: dict | None = None
     xml: str | None = field(default=None, repr=False)
-    joints: dict[str, float] = field(default_factory=dict)
     description: str | None = field(default=None, repr=False)
     sensors: tuple = field(default=(), repr=False)
-    plugins: tuple = field(default=(), repr=False)  # DiffDrive records (twin_cli.control)
-    env: dict[str, str] | None = None
-    repair_inertia: bool = False
+    plugins: tuple = field(default=(), repr=False)
 
 
 def element_names(model: mujoco.MjModel, adr: np.ndarray) -> list[str]:
@@ -251,3 +244,16 @@ def rest_state(model: mujoco.MjModel, index: EntityIndex, qpos: np.ndarray) -> E
 
 def _mocap_bodies(model: mujoco.MjModel) -> np.ndarray:
     return np.flatnonzero(model.body_mocapid >= 0)
+
+
+def typed_like(reference: EntityState, loaded: EntityState) -> EntityState:
+    """`loaded` with each array's dtype and shape taken from `reference` (a state read back
+    from JSON has lists where the world keeps typed arrays)."""
+    return EntityState(
+        **{
+            f.name: np.asarray(
+                getattr(loaded, f.name), dtype=getattr(reference, f.name).dtype
+            ).reshape(getattr(reference, f.name).shape)
+            for f in fields(EntityState)
+        }
+    )

@@ -11,9 +11,13 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING
 
 from twin_cli.world import realtime as rt
+from twin_cli.world.running import advance
+
+if TYPE_CHECKING:
+    from twin_cli.world.state import WorldState
 
 PAUSED_POLL_S = 0.05  # [s] how often a paused loop wakes to sample the meter
 YIELD_POLL_S = 0.00005  # [s] sleep while a request waits for the lock
@@ -21,16 +25,6 @@ YIELD_MAX_S = 0.01  # [s] longest the loop defers to waiting requests after a ba
 # [s] longest sleep between due steps: at a rate of 1e-4 Hz the next step is hours away, and a
 # rate change or `stop` must still be seen at once (the API fuzz found the server deaf to both).
 IDLE_POLL_S = 0.05
-
-
-class Steppable(Protocol):
-    """What the loop needs from a World."""
-
-    lock: WorldLock
-
-    def _advance(self, n: int) -> None: ...
-
-    def _loop_view(self) -> tuple[float, bool, float, int]: ...
 
 
 class WorldLock:
@@ -87,10 +81,10 @@ class LoopFigures:
 
 
 class SteppingLoop:
-    """Runs `world._advance` in a daemon thread at the world's update rate."""
+    """Runs `running.advance` on a world's state in a daemon thread at its update rate."""
 
-    def __init__(self, world: Steppable) -> None:
-        self._world = world
+    def __init__(self, state: WorldState) -> None:
+        self._state = state
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._origin = time.perf_counter()
@@ -139,7 +133,8 @@ class SteppingLoop:
         epoch, pacer, done, batch = -1, None, 0, 1
         while not self._stop.is_set():
             now = time.perf_counter()
-            rate, paused, sim, _ = self._world._loop_view()
+            state = self._state
+            rate, paused, sim = state.settings.rate, state.paused, float(state.data.time)
             self._meter = rt.observe(self._meter, now - self._origin, sim)
             if paused:
                 self._stop.wait(PAUSED_POLL_S)
@@ -163,14 +158,14 @@ class SteppingLoop:
 
     def _run_batch(self, n: int) -> int:
         """Steps n under the lock; returns the batch size for the next one."""
-        with self._world.lock:
+        with self._state.lock:
             start = time.perf_counter()
-            self._world._advance(n)
+            advance(self._state, n)
             took = time.perf_counter() - start
         return rt.batch_limit(n, took)
 
     def _step_aside(self) -> None:
-        lock = self._world.lock
+        lock = self._state.lock
         if not lock.waiting:
             return
         deadline = time.perf_counter() + YIELD_MAX_S

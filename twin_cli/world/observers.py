@@ -174,9 +174,10 @@ class WorldView:
 
 def world_view(world: Any) -> WorldView:
     """The world's model, data and entity index; call with `world.lock` held."""
+    names = world.entity_names()
     return WorldView(
         world.model,
         world.data,
-        dict(world._index),
-        {n: e.description for n, e in world._entities.items()},
+        {n: world.index_of(n) for n in names},
+        {n: world.entity(n).description for n in names},
     )

@@ -84,3 +84,17 @@ def rotate(q: Quat, v: tuple[float, float, float]) -> tuple[float, float, float]
     w, x, y, z = quat_multiply(quat_multiply(q, (0.0, *v)), (q[0], -q[1], -q[2], -q[3]))
     del w
     return (x, y, z)
+
+
+def check_finite(pose: Pose, subject: str) -> Pose:
+    """Returns `pose` when every value is finite.
+
+    Raises:
+        InvalidRequestError: a NaN or infinite value (it would poison the world's state).
+    """
+    from twin_cli.errors import InvalidRequestError
+
+    values = (pose.x, pose.y, pose.z, pose.roll, pose.pitch, pose.yaw)
+    if not all(math.isfinite(v) for v in values):
+        raise InvalidRequestError(subject, f"{values} is not finite", "give finite numbers")
+    return pose

@@ -1,10 +1,9 @@
-"""Save and load a world: settings, entities with their sources, and the full integration state.
+"""Save and load a world: its snapshot (settings, entities with their requests, full state) as JSON.
 
 The file is JSON (floats written with Python's shortest round-trip repr, so every double comes
 back bit for bit), written atomically (temporary file in the same folder, fsync, rename). Load
-spawns the same sources in the same order, so the compiled model has the same layout, then
-writes the saved `mj_getState(mjSTATE_INTEGRATION)` vector: a loaded world continues exactly as
-the saved one would have.
+spawns the same requests in the same order, so the compiled model has the same layout, then
+restores the saved snapshot: a loaded world continues exactly as the saved one would have.
 """
 
 from __future__ import annotations
@@ -12,46 +11,47 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from dataclasses import asdict, fields
+from dataclasses import asdict, fields, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import mujoco
 import numpy as np
 
-from twin_cli.errors import WorldFileError
+from twin_cli.errors import InvalidRequestError, WorldFileError
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.actuation import JointCommand, Push
+from twin_cli.world.engine import World
 from twin_cli.world.entities import Entity, EntityState
 from twin_cli.world.pose import Pose
-
-if TYPE_CHECKING:
-    from twin_cli.world.engine import World
+from twin_cli.world.snapshot import WorldSnapshot
+from twin_cli.world.values import WorldSettings
 
 FORMAT = "twin-world"
 VERSION = 1
-_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 
 
 def save(world: World, path: str | os.PathLike) -> None:
-    """Writes `world` to `path` atomically; the caller holds the world's lock.
+    """Writes `world`'s snapshot to `path` atomically.
 
     Raises:
         WorldFileError: an entity spawned from an MjSpec cannot be written as MJCF, or the
             folder is not writable.
     """
+    snap = world.snapshot()
     document = {
         "format": FORMAT,
         "version": VERSION,
-        "name": world.name,
-        "settings": asdict(world.settings),
-        "paused": world.paused,
-        "iterations": world._iterations,
-        "divergences": world.divergences,
-        "entities": [_entity_dict(e, path) for e in world._entities.values()],
-        "commands": [asdict(c) for c in world._commands.values()],
-        "pushes": [asdict(p) for p in world._pushes],
-        "layout": _layout(world.model),
-        "state": _state(world.model, world.data).tolist(),
+        "name": snap.name,
+        "settings": asdict(snap.settings),
+        "paused": snap.paused,
+        "iterations": snap.iterations,
+        "divergences": snap.divergences,
+        "entities": [_entity_dict(e, path) for e in snap.entities],
+        "commands": [asdict(c) for c in snap.commands],
+        "pushes": [asdict(p) for p in snap.pushes],
+        "layout": snap.layout,
+        "state": snap.state.tolist(),
     }
     _write_atomically(Path(path), json.dumps(document))
 
@@ -67,26 +67,11 @@ def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
     return {
         "name": entity.name,
         "source": entity.source,
-        "args": entity.args,
-        "package_paths": entity.package_paths,
         "pose": entity.pose.to_dict(),
-        "on_ground": entity.on_ground,
         "xml": entity.xml,
-        "joints": entity.joints,
-        "env": entity.env,
-        "repair_inertia": entity.repair_inertia,
+        **entity.request.options(),
         "spawn_state": state,
     }
-
-
-def _layout(model: mujoco.MjModel) -> dict[str, int]:
-    return {k: int(getattr(model, k)) for k in ("nq", "nv", "na", "nu", "nbody", "neq", "nmocap")}
-
-
-def _state(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    state = np.empty(mujoco.mj_stateSize(model, _STATE))
-    mujoco.mj_getState(model, data, state, _STATE)
-    return state
 
 
 def _write_atomically(path: Path, text: str) -> None:
@@ -104,7 +89,7 @@ def _write_atomically(path: Path, text: str) -> None:
         ) from exc
 
 
-def load(cls: type[World], path: str | os.PathLike) -> World:
+def load(path: str | os.PathLike) -> World:
     """A new, stopped world rebuilt from a file written by `save`.
 
     Raises:
@@ -112,20 +97,30 @@ def load(cls: type[World], path: str | os.PathLike) -> World:
             model no longer has the saved layout.
     """
     doc = _read(Path(path))
-    from twin_cli.world.values import WorldSettings
-
     settings = doc["settings"]
     settings["gravity"] = tuple(settings["gravity"])
-    world = cls(WorldSettings(**settings), name=doc["name"])
-    for item in doc["entities"]:
-        _respawn(world, item)
-    if _layout(world.model) != doc["layout"]:
+    world = World(WorldSettings(**settings), name=doc["name"])
+    entities = [_respawn(world, item) for item in doc["entities"]]
+    snapshot = WorldSnapshot(
+        doc["name"],
+        world.settings,
+        bool(doc["paused"]),
+        int(doc["iterations"]),
+        int(doc["divergences"]),
+        tuple(entities),
+        tuple(JointCommand(**c) for c in doc["commands"]),
+        tuple(Push(p["body"], tuple(p["wrench"]), int(p["end_step"])) for p in doc["pushes"]),
+        doc["layout"],
+        np.array(doc["state"], dtype=float),
+    )
+    try:
+        world.restore(snapshot)
+    except InvalidRequestError as exc:
         raise WorldFileError(
             path,
-            f"the sources now compile to {_layout(world.model)}, saved {doc['layout']}",
+            f"the sources now compile to {world.snapshot().layout}, saved {doc['layout']}",
             "restore the robot files as they were when saved, or spawn afresh",
-        )
-    _restore_runtime(world, doc)
+        ) from exc
     return world
 
 
@@ -145,61 +140,17 @@ def _read(path: Path) -> dict[str, Any]:
     return doc
 
 
-def _respawn(world: World, item: dict[str, Any]) -> None:
+def _respawn(world: World, item: dict[str, Any]) -> Entity:
+    """Spawns a saved entity again; returns its record with the saved spawn state.
+
+    Its saved pose is already on the ground, so it is spawned without on-ground placement;
+    its record keeps the request as it was given.
+    """
     source: Any = item["source"]
     if item["xml"] is not None:
         source = mujoco.MjSpec.from_string(item["xml"])
-    world.spawn(
-        source,
-        name=item["name"],
-        pose=Pose(**item["pose"]),
-        args=item["args"] or None,
-        package_paths=item["package_paths"] or None,
-        joints=item.get("joints") or None,  # absent in files saved before -J existed
-        env=item.get("env"),  # these two: absent in files saved before spawn sent them
-        repair_inertia=bool(item.get("repair_inertia", False)),
-    )
+    request = replace(SpawnRequest.from_body(item), source=source, xml=None, base_dir=None)
+    world.spawn(replace(request, on_ground=False), name=item["name"], pose=Pose(**item["pose"]))
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
-    entity = world._entities[item["name"]]
-    world._entities[item["name"]] = Entity(
-        entity.name,
-        item["source"],
-        entity.args,
-        entity.package_paths,
-        entity.pose,
-        item["on_ground"],
-        _typed_like(entity.spawn_state, spawn_state),
-        entity.report,
-        entity.xml,
-        entity.joints,
-        entity.description,
-        sensors=entity.sensors,
-        plugins=entity.plugins,
-        env=entity.env,
-        repair_inertia=entity.repair_inertia,
-    )
-
-
-def _typed_like(reference: EntityState, loaded: EntityState) -> EntityState:
-    """`loaded` with each array's dtype and shape taken from `reference`."""
-    return EntityState(
-        **{
-            f.name: np.asarray(
-                getattr(loaded, f.name), dtype=getattr(reference, f.name).dtype
-            ).reshape(getattr(reference, f.name).shape)
-            for f in fields(EntityState)
-        }
-    )
-
-
-def _restore_runtime(world: World, doc: dict[str, Any]) -> None:
-    with world.lock:
-        mujoco.mj_setState(world.model, world.data, np.array(doc["state"]), _STATE)
-        world._iterations = int(doc["iterations"])
-        world.divergences = int(doc["divergences"])
-        world._paused = bool(doc["paused"])
-        world._commands = {c["actuator"]: JointCommand(**c) for c in doc["commands"]}
-        world._reapply_commands(world.model, world.data)
-        world._pushes = [
-            Push(p["body"], tuple(p["wrench"]), int(p["end_step"])) for p in doc["pushes"]
-        ]
+    entity = world.entity(item["name"])
+    return replace(entity, source=item["source"], request=request, spawn_state=spawn_state)

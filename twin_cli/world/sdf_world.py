@@ -101,7 +101,9 @@ def load_world(
         return world_from_sdf(path, name=name, package_paths=package_paths)
     if is_mjcf_file(path):
         return world_from_mjcf(path, name=name)
-    return World.load(path)
+    from twin_cli.world import savefile
+
+    return savefile.load(path)
 
 
 def pose_of(T: np.ndarray) -> Pose:

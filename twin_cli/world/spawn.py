@@ -1,8 +1,8 @@
-"""Spawning: load a source into an MjSpec, attach it at a pose, seed it, check where it starts.
+"""Spawning: load a request's source into an MjSpec, attach it at a pose, seed it, remove it.
 
-The world calls these with its lock held, on a *copy* of its spec, so that a failure at any
-point leaves the world's spec, model and data untouched (peers.md §4.6: an orphan subtree left
-by a failed compile bricks the world).
+The world attaches to its live spec with its lock held and, on any failure, removes whatever of
+the entity was attached (`remove_entity`): an orphan subtree left by a failed compile would make
+every later compile of the world fail.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError, SpawnError
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat_multiply, rotate
@@ -27,21 +28,6 @@ PENETRATION_TOL = 1e-4  # [m] overlap below this is contact, not a bad start
 HOME_KEY = "home"
 ROOT_DEFAULT = "main"  # MjSpec's root default class, "<entity>/main" once attached
 _QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
-
-
-@dataclass(frozen=True)
-class DescriptionText:
-    """A description given as text (URDF, xacro output, SDF or MJCF), as SpawnEntity's `xml`.
-
-    Attributes:
-        text: the description; its root element says the format.
-        base_dir: where relative mesh paths start (the client's working directory).
-        label: how the source is shown (`<xml>`, `<stdin>`).
-    """
-
-    text: str
-    base_dir: str | None = None
-    label: str = "<xml>"
 
 
 @dataclass(frozen=True)
@@ -75,43 +61,42 @@ class LoadedSource:
     plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (URDF/SDF)
 
 
-def load_source(
-    source: str | os.PathLike | mujoco.MjSpec | DescriptionText,
-    args: dict[str, str] | None,
-    package_paths: dict[str, str] | None,
-    env: dict[str, str] | None = None,
-    repair_inertia: bool = False,
-) -> LoadedSource:
-    """Reads a URDF/xacro/SDF (through the converter), an MJCF file, a text or an MjSpec.
+def load_source(request: SpawnRequest) -> LoadedSource:
+    """Reads the request's URDF/xacro/SDF (through the converter), MJCF, text or MjSpec.
 
-    `env`: the caller's package search variables (twin_cli.package_env), over this process's.
-    `repair_inertia`: bound non-physical inertias instead of refusing them (`--repair-inertia`).
+    The request's `env` (the caller's package search variables) goes over this process's.
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
         converters.ConversionError: the converter refused the description.
     """
-    if env is not None:  # the caller's values over this process's (unset ones: this process's)
-        env = {**os.environ, **env}
-    if isinstance(source, mujoco.MjSpec):
-        spec = source.copy()
+    if request.xml is not None:
+        return _load_text(request)
+    if isinstance(request.source, mujoco.MjSpec):
+        spec = request.source.copy()
         return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
-    if isinstance(source, DescriptionText):
-        return _load_text(source, package_paths, env, repair_inertia)
-    path = Path(source).expanduser().resolve()
+    if request.source is None:
+        raise SpawnError("model", "<none>", "no source", "give a file or the description text")
+    path = Path(request.source).expanduser().resolve()
     if not path.is_file():
         raise SpawnError(path.stem, str(path), "no such file", "check the path")
     lower = path.name.lower()
     if lower.endswith(MJCF_SUFFIXES):
         return _load_mjcf(path)
     if lower.endswith(URDF_SUFFIXES + SDF_SUFFIXES) or _sniff(path) in ("urdf", "sdf"):
-        return _load_description(path, args, package_paths, env, repair_inertia)
+        return _load_description(path, request)
     if _sniff(path) == "mjcf":
         return _load_mjcf(path)
     kinds = ", ".join(URDF_SUFFIXES + SDF_SUFFIXES + MJCF_SUFFIXES)
     raise SpawnError(
         path.stem, str(path), "unknown file kind", f"give a URDF, xacro, SDF or MJCF file ({kinds})"
     )
+
+
+def resolving_env(request: SpawnRequest) -> dict[str, str] | None:
+    """The environment to resolve packages in: the caller's variables over this process's
+    (unset ones: this process's), or None for this process's own."""
+    return None if request.env is None else {**os.environ, **request.env}
 
 
 def _sniff(path: Path) -> str | None:
@@ -125,37 +110,31 @@ def _sniff(path: Path) -> str | None:
         return None
 
 
-def _load_text(
-    source: DescriptionText,
-    package_paths: dict[str, str] | None,
-    env: dict[str, str] | None,
-    repair_inertia: bool,
-) -> LoadedSource:
+def _load_text(request: SpawnRequest) -> LoadedSource:
     """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
     from converters.formats import format_of
     from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_text
 
-    if format_of(source.text) == "mjcf":
+    text, label = request.xml or "", request.label
+    if format_of(text) == "mjcf":
         try:
-            spec = mujoco.MjSpec.from_string(source.text)
+            spec = mujoco.MjSpec.from_string(text)
         except ValueError as exc:
-            raise SpawnError(
-                source.label, source.label, f"not valid MJCF ({exc})", "fix it"
-            ) from exc
-        return LoadedSource(spec, source.label, None, source.text, spec.modelname or "model")
+            raise SpawnError(label, label, f"not valid MJCF ({exc})", "fix it") from exc
+        return LoadedSource(spec, label, None, text, spec.modelname or "model")
     done = convert_text(
-        source.text,
-        source=source.label,
-        base_dir=source.base_dir,
-        package_paths=package_paths,
-        options=ConvertOptions(repair_inertia=repair_inertia),
-        env=env,
+        text,
+        source=label,
+        base_dir=request.base_dir,
+        package_paths=dict(request.package_paths),
+        options=ConvertOptions(repair_inertia=request.repair_inertia),
+        env=resolving_env(request),
     )
     name = done.report.robot or "model"
     return LoadedSource(
         done.spec,
-        source.label,
+        label,
         done.report.to_dict(),
         _xml_or_none(done.spec),
         name,
@@ -197,34 +176,25 @@ def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
     )
 
 
-def _load_description(
-    path: Path,
-    args: dict[str, str] | None,
-    package_paths: dict[str, str] | None,
-    env: dict[str, str] | None,
-    repair_inertia: bool,
-) -> LoadedSource:
+def _load_description(path: Path, request: SpawnRequest) -> LoadedSource:
     """A converted file, from the conversion cache when no file it read has changed."""
     from twin_cli.world.conversion_cache import CACHE, cache_key
 
-    key = cache_key(path, args, package_paths, env, repair_inertia)
-    return CACHE.load(
-        key, lambda: _convert_description(path, args, package_paths, env, repair_inertia)
-    )
+    key = cache_key(path, request, resolving_env(request))
+    return CACHE.load(key, lambda: _convert_description(path, request))
 
 
-def _convert_description(
-    path: Path,
-    args: dict[str, str] | None,
-    package_paths: dict[str, str] | None,
-    env: dict[str, str] | None,
-    repair_inertia: bool,
-) -> LoadedSource:
+def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
     from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
 
-    options = ConvertOptions(repair_inertia=repair_inertia)
-    done = convert_full(path, args=args, package_paths=package_paths, options=options, env=env)
+    done = convert_full(
+        path,
+        args=dict(request.args),
+        package_paths=dict(request.package_paths),
+        options=ConvertOptions(repair_inertia=request.repair_inertia),
+        env=resolving_env(request),
+    )
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
@@ -273,8 +243,8 @@ def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | No
 
     Names every unnamed body, joint, actuator and equality (state moves by name, and an unnamed
     free joint cannot be found again), adopts the world's global settings, and removes the
-    child's keyframes: attached keyframes get lost or collide ("repeated name 'home'",
-    peers.md §4.6), so the home pose is read here and seeded by the world instead.
+    child's keyframes: attached keyframes get lost or collide ("repeated name 'home'"), so the
+    home pose is read here and seeded by the world instead.
     """
     _name_unnamed(child)
     _min_friction_priorities(child)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.validate.checks.base import RobotUnderTest
 from twin_cli.validate.checks.model_joints import HINGE, SLIDE, joint_effort
 from twin_cli.validate.scenario import Action, Obstacle, Scenario
@@ -75,11 +76,13 @@ class ScenarioRun:
         self.world = World(settings, name=f"validate-{scenario.name}")
         pose = Pose(**scenario.robot.pose.model_dump())
         spawned = self.world.spawn(
-            robot.spec.copy(),
+            SpawnRequest(
+                robot.spec.copy(),
+                on_ground=scenario.robot.on_ground,
+                joints=dict(scenario.robot.joints),
+            ),
             name=robot.name,
             pose=pose,
-            on_ground=scenario.robot.on_ground,
-            joints=dict(scenario.robot.joints),
         )
         self.entity = spawned.name
         self._velocity_limits = {j.name: j.velocity for j in robot.declared_joints}

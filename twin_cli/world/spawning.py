@@ -1,0 +1,249 @@
+"""Spawning entities into a world: one request, one or many instances, one compile, all or none.
+
+A single spawn is a batch of one. Every name and pose is checked before anything is attached;
+on any later failure every attached instance is removed from the world spec, so the world is
+left exactly as it was. The source is read (and converted) before the lock is taken, so a slow
+conversion does not stall the stepping loop.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import mujoco
+import numpy as np
+
+from twin_cli.errors import EntityExistsError, InvalidRequestError, SpawnError
+from twin_cli.spawn_request import SpawnRequest, as_request
+from twin_cli.world import placement, posture, shared_meshes, spawn
+from twin_cli.world.entities import Entity, EntityState, index_entities, rest_state, write_state
+from twin_cli.world.pose import Pose, check_finite
+from twin_cli.world.recompile import Built, commit, ground, rebuild
+from twin_cli.world.respec import keep_spec
+from twin_cli.world.state import WorldState
+from twin_cli.world.values import SpawnResult
+
+MAX_BATCH = 1000  # instances per request: a guard against a runaway script, not a model limit
+
+
+@dataclass(frozen=True)
+class Placed:
+    """Where one instance started: its pose (after on-ground placement) and state at rest."""
+
+    pose: Pose
+    state: EntityState
+
+
+def batch_names(base: str, count: int) -> list[str]:
+    """Gazebo-style instance names `base_0`, `base_1`, … for `count` poses."""
+    return [f"{base}_{i}" for i in range(count)]
+
+
+def safe_base(default: str) -> str:
+    """A robot's own name made usable as an entity name."""
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in default) or "model"
+
+
+def check_batch(
+    names: Sequence[str], poses: Sequence[Pose], taken: Sequence[str], limit: int = MAX_BATCH
+) -> None:
+    """Refuses a batch before anything is attached (`limit`: most poses; a world file's models
+    have none).
+
+    Raises:
+        InvalidRequestError: no poses, counts differ, a name repeats, a pose is not finite.
+        EntityExistsError: a name is already an entity of the world.
+    """
+    if not poses or len(poses) > limit:
+        raise InvalidRequestError(
+            "batch spawn", f"{len(poses)} poses", f"give 1 to {MAX_BATCH} poses (--at X,Y)"
+        )
+    if len(names) != len(poses):
+        raise InvalidRequestError(
+            "batch spawn",
+            f"{len(names)} names for {len(poses)} poses",
+            "give one name per pose (--names a,b,c) or a base --name",
+        )
+    seen: set[str] = set()
+    for i, (name, pose) in enumerate(zip(names, poses, strict=True)):
+        spawn.check_entity_name(name)
+        if name in seen:
+            raise InvalidRequestError(f"entity name [{name}]", "given twice", "make names unique")
+        seen.add(name)
+        if name in taken:
+            raise EntityExistsError(name)
+        check_finite(pose, f"pose {i} of entity [{name}]")
+
+
+def make_entity(
+    name: str, loaded: spawn.LoadedSource, request: SpawnRequest, placed: Placed
+) -> Entity:
+    """The one place an entity's record is built: from its request and what was loaded."""
+    return Entity(
+        name,
+        loaded.source,
+        request,
+        placed.pose,
+        placed.state,
+        loaded.report,
+        loaded.xml,
+        loaded.description,
+        sensors=loaded.sensors,
+        plugins=loaded.plugins,
+    )
+
+
+def spawn_one(
+    state: WorldState,
+    request: SpawnRequest | object,
+    *,
+    name: str | None = None,
+    pose: Pose = Pose(),
+) -> SpawnResult:
+    """Adds one entity at `pose`; existing entities keep their exact state.
+
+    `request` is a `SpawnRequest` or a bare source (a path or an MjSpec). Without `name`,
+    the robot's own name is used, with `_1`, `_2`, … when taken. The entity starts at rest
+    in its own initial configuration (its `home` key if it has one) with the request's
+    `joints` written over it; mimic followers follow their leaders. That start is its spawn
+    state (what `reset` returns to). Returns once the entity is in the world.
+
+    Raises:
+        EntityExistsError: `name` is taken. SpawnError: unreadable source or compile error.
+        PartNotFoundError: a `joints` name is not a hinge/slide joint of the entity.
+        InvalidRequestError: a `joints` value is outside its joint's range (or sets a mimic
+            follower). On any error the world is unchanged.
+        converters.ConversionError: the converter refused the file.
+    """
+    request = as_request(request)
+    if name is not None:
+        spawn.check_entity_name(name)
+    loaded = spawn.load_source(request)
+    with state.lock:
+        name = name or free_name(state, safe_base(loaded.default_name))
+        return _spawn_loaded(state, [loaded], request, [name], [pose])[0]
+
+
+def spawn_batch(
+    state: WorldState,
+    request: SpawnRequest | object,
+    *,
+    poses: Sequence[Pose],
+    names: Sequence[str] | None = None,
+    base: str | None = None,
+) -> list[SpawnResult]:
+    """Adds one entity per pose, converting the source once and compiling the world once.
+
+    Instances are named `names`, else `base_0`, `base_1`, … (`base` defaults to the robot's
+    own name). Each starts as `spawn_one` would start it. Raises what `spawn_one` raises, plus
+    `check_batch`'s errors; on any error no instance is added and the world is unchanged.
+    """
+    request, poses = as_request(request), list(poses)
+    if names is None and base is not None:
+        names = batch_names(spawn.check_entity_name(base), len(poses))
+    if names is not None:
+        check_batch(list(names), poses, list(state.entities))
+    loaded = spawn.load_source(request)
+    names = list(names or batch_names(safe_base(loaded.default_name), len(poses)))
+    copies = [replace(loaded, spec=loaded.spec.copy()) for _ in poses]
+    return _spawn_loaded(state, copies, request, names, poses)
+
+
+def spawn_specs(
+    state: WorldState, items: Sequence[tuple[mujoco.MjSpec, str, Pose]]
+) -> list[SpawnResult]:
+    """Adds one entity per (MjSpec, name, pose) in one compile of the world: a world file's
+    models. One spawn each would compile the world once per model, a cost that grows with
+    the square of their number (800 boxes: 77 s). All or nothing, as `spawn_batch`."""
+    names = [spawn.check_entity_name(name) for _, name, _ in items]
+    poses = [pose for _, _, pose in items]
+    requests = [SpawnRequest(source=spec) for spec, _, _ in items]
+    loaded = [spawn.load_source(request) for request in requests]
+    return _spawn_loaded(state, loaded, requests, names, poses)
+
+
+def free_name(state: WorldState, base: str) -> str:
+    """`base`, or `base_1`, `base_2`, … when taken."""
+    candidate, k = base, 0
+    while candidate in state.entities:
+        k += 1
+        candidate = f"{base}_{k}"
+    return candidate
+
+
+def _spawn_loaded(
+    state: WorldState,
+    loaded: Sequence[spawn.LoadedSource],
+    requests: SpawnRequest | Sequence[SpawnRequest],
+    names: Sequence[str],
+    poses: Sequence[Pose],
+) -> list[SpawnResult]:
+    """Attaches each loaded source as its name at its pose, compiles once, seeds each."""
+    if isinstance(requests, SpawnRequest):
+        requests = [requests] * len(names)
+    with state.lock:
+        check_batch(names, poses, list(state.entities), limit=max(MAX_BATCH, len(poses)))
+        try:
+            homes = [
+                _attach(state, one, n, p) for one, n, p in zip(loaded, names, poses, strict=True)
+            ]
+            placed, (model, data, index) = _seed(
+                state, loaded[0].source, requests, names, poses, homes
+            )
+        except BaseException:
+            for n in names:
+                spawn.remove_entity(state.spec, n)
+            raise
+        results = []
+        for one, request, n, start in zip(loaded, requests, names, placed, strict=True):
+            state.entities[n] = make_entity(n, one, request, start)
+            starting = placement.start_warnings(model, data, index, n, start.pose.z)
+            warnings = [*one.notes, *starting]
+            results.append(SpawnResult(n, one.source, warnings, one.report, one.cached))
+        commit(state, state.spec, (model, data, index))
+        return results
+
+
+def _attach(
+    state: WorldState, loaded: spawn.LoadedSource, name: str, pose: Pose
+) -> np.ndarray | None:
+    """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
+    try:
+        home = spawn.prepare_child(loaded.spec, state.spec)
+        keep_spec(state, name, loaded.spec, loaded.mesh_keys)  # for renew_spec
+        shared_meshes.prepare(loaded.spec, state.spec, loaded.mesh_keys)
+        spawn.attach(state.spec, loaded.spec, name, pose)
+    except ValueError as exc:
+        raise SpawnError(
+            name, loaded.source, f"cannot be attached ({exc})", "fix the model"
+        ) from exc
+    return home
+
+
+def _seed(
+    state: WorldState,
+    source: str,
+    requests: Sequence[SpawnRequest],
+    names: Sequence[str],
+    poses: Sequence[Pose],
+    homes: Sequence[np.ndarray | None],
+) -> tuple[list[Placed], Built]:
+    """One compile of the world with every instance attached; each seeded at rest."""
+    kept = [n for n in state.entities if n in state.index]
+    model, data, index = rebuild(state, state.spec, names, source)
+    starts: list[tuple[Pose, np.ndarray]] = []
+    for request, n, pose, home in zip(requests, names, poses, homes, strict=True):
+        ix = index[n]
+        targets = posture.joint_targets(model, ix.joints, f"{n}/", dict(request.joints), n)
+        q = posture.apply_targets(spawn.initial_qpos(model, ix, home, pose), ix.qpos, targets)
+        if request.on_ground:  # a fixed base moves its frame: a recompile, layouts kept
+            pose, q, (model, data, _) = ground(state, (model, data, index), n, pose, q)
+            index = index_entities(model, kept + list(names))
+        starts.append((pose, q))
+    placed = []
+    for n, (pose, q) in zip(names, starts, strict=True):
+        at_rest = rest_state(model, index[n], q)
+        write_state(data, index[n], at_rest)
+        placed.append(Placed(pose, at_rest))
+    return placed, (model, data, index)
