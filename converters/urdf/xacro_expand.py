@@ -75,14 +75,15 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
         macro_names.append(name[6:] if name.startswith("xacro:") else name)
         original_grab(elt, macros)
 
-    saved = (subst._eval_find, subst._eval_dict["find"])
-    subst._eval_find = find
-    subst._eval_dict["find"] = find
+    # xacro has no hook for $(find): its substitution table is the one place to put ours.
+    saved = (subst._eval_find, subst._eval_dict["find"])  # noqa: SLF001
+    subst._eval_find = find  # noqa: SLF001
+    subst._eval_dict["find"] = find  # noqa: SLF001
     xacro.grab_macro = grab_macro
     try:
         yield macro_names
     finally:
-        subst._eval_find, subst._eval_dict["find"] = saved
+        subst._eval_find, subst._eval_dict["find"] = saved  # noqa: SLF001
         xacro.grab_macro = original_grab
 
 

@@ -1,4 +1,4 @@
-"""Sleeping of resting robots (issue 16): humanoids standing on their servos fall asleep, wake
+"""Sleeping of resting robots: humanoids standing on their servos fall asleep, wake
 when pushed or commanded, and rest where a world without sleeping puts them. Oracles: MuJoCo's
 own sleep state (`tree_asleep`, `ntree_awake`), and the same world stepped without sleeping."""
 

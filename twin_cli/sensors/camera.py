@@ -67,7 +67,8 @@ class CameraSensor:
 
     def _open(self, model: Any) -> Any:
         if self._renderer is not None:
-            self._renderer._gl_context.make_current()  # requests run on pool threads
+            # Requests run on pool threads; mujoco.Renderer keeps its GL context private.
+            self._renderer._gl_context.make_current()  # noqa: SLF001
             return self._renderer
         if _window_backend() and threading.current_thread() is not threading.main_thread():
             # GLFW may only start on the main thread: elsewhere it aborts the process.
@@ -126,8 +127,10 @@ def _render_depth(renderer: Any, near: float, far: float) -> np.ndarray:
     flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = True
     try:
         buffer = np.empty((renderer.height, renderer.width), np.float32)
-        mujoco.mjr_render(renderer._rect, renderer.scene, renderer._mjr_context)
-        mujoco.mjr_readPixels(None, buffer, renderer._rect, renderer._mjr_context)
+        # A float segmentation read needs mjr_* on the Renderer's own viewport and context.
+        rect, context = renderer._rect, renderer._mjr_context  # noqa: SLF001
+        mujoco.mjr_render(rect, renderer.scene, context)
+        mujoco.mjr_readPixels(None, buffer, rect, context)
     finally:
         np.copyto(flags, saved)
     reversed_z = np.flipud(buffer).astype(np.float64)  # GL rows are bottom first

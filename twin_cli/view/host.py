@@ -126,7 +126,7 @@ class WebHost:
             except BaseException as exc:
                 bound.put(exc)
                 raise
-            bound.put(viewer._http_port)
+            bound.put(viewer._http_port)  # noqa: SLF001 (the port it bound; no public name)
             viewer_protocol.run_viewer_loop(viewer)
 
         self._handle = launch_thread.launch_thread(run, sim_plugins=[self._bridge])

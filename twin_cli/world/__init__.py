@@ -1,10 +1,12 @@
 """The world engine: one MuJoCo world (spec, model, data), its entities and its real-time loop.
 
 No I/O but save and load. The server and validation drive it through `World`'s methods; viewers,
-recorders and sensors observe it the same way. Modules: `engine` (the World), `spawn`,
-`placement`, `posture` (adding entities), `entities`, `queries` (reading them), `running`,
-`loop`, `realtime` (stepping, pacing, the real-time factor), `physics`, `driving`, `actuation`
-(settings, pushes, joint commands), `divergence`, `scene`, `savefile`, `pose`, `values`.
+recorders and sensors observe it the same way. `engine` holds `World`, a facade over one
+`state.WorldState`; the functions that act on the state live in `spawning` (with `spawn`,
+`placement`, `posture`), `changes`, `recompile`, `running` (with `loop`, `realtime`,
+`observers`, `divergence`), `physics`, `driving` (with `actuation`, `joint_control`),
+`engine_threads`, `respec` and `snapshot` (with `savefile`); `entities` and `queries` read
+entities; `scene`, `pose` and `values` hold the world's building blocks.
 """
 
 from __future__ import annotations

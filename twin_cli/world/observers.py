@@ -4,7 +4,7 @@ An observer asks for a rate in *simulated* time; the stepping code splits each `
 call at the steps where an observer is due and calls it there, with the world's lock held, so a
 100 Hz recording of a 1 ms world gets a sample every 10 steps exactly, at any real-time factor,
 with no Python per physics step. Callbacks must only copy what they need (a few microseconds)
-and do their encoding and I/O elsewhere (design.md §7). The rules (`steps_until_due`,
+and do their encoding and I/O elsewhere, or they would slow the loop. The rules (`steps_until_due`,
 `is_due`, `next_due`) are pure functions, testable without threads; `Observers.run` inlines
 the first two on its hot path (tests drive `run` itself too).
 """

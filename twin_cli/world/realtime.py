@@ -5,7 +5,7 @@ wall-clock readings in and gets decisions out, so every rule is testable without
 
 The pacer is timed from a sync point, not from wake-up: step k is due at
 `anchor_wall + (k - anchor_step) / rate`, whatever happened before, so oversleeping one wake-up
-is paid back by the next batch instead of accumulating (style.md: a wake-up-timed pacer held only
+is paid back by the next batch instead of accumulating (a pacer timed from wake-up held only
 RTF 0.89 at 1 kHz). When the loop falls more than `max_backlog` steps behind (a slow model, a
 long spawn holding the lock), it drops the backlog and re-anchors instead of bursting to catch
 up forever; dropped steps are counted.

@@ -10,7 +10,7 @@ from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.errors import InvalidRequestError
 from twin_cli.world.scene import SceneSettings
 
-# Gravity presets [m/s²] (issue 4; `earth` is the --earth preset 9.81, not empty.world's 9.8).
+# Gravity presets [m/s²] (`earth` is the --earth preset 9.81, not empty.world's 9.8).
 GRAVITY_PRESETS = {
     "earth": (0.0, 0.0, -9.81),
     "moon": (0.0, 0.0, -1.62),
