@@ -15,54 +15,15 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
 from twin_cli.cli import pairs
 from twin_cli.cli.output import Output
+from twin_cli.cli.spawn_action import POSE_KEYS, Vec3
+from twin_cli.cli.spawn_action import spawn as spawn  # the table names it here
+from twin_cli.cli.spawn_action import spawn_many as spawn_many
+from twin_cli.cli.world_client import connect_world, not_running
 
-if TYPE_CHECKING:
-    from twin_cli.spawn_request import SpawnRequest
-
-POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
 GRAVITY_PRESETS = ("earth", "moon", "mars", "zero")
-Vec3 = tuple[float, float, float]
-
-
-def _connect(
-    world: str, *, start: bool = False, serve_args: tuple[str, ...] = (), announce: Any = None
-) -> Any:
-    """A client of the world's server; only `spawn` and `load` may start one in the background.
-
-    Raises:
-        NotRunningError: no server runs (the CLI boundary prints gz's line, exit code 1).
-    """
-    from twin_cli.server import client
-
-    return client.connect(world, start=start, serve_args=serve_args, announce=announce)
-
-
-def _not_running(exc: Exception | None = None) -> SystemExit:
-    """gz's readiness-probe wording on stderr (and what died, if so), exit code 1."""
-    sys.stderr.write(f"{exc or 'An instance of twin is not running.'}\n")
-    return SystemExit(1)
-
-
-def spawn_pose(
-    position: Vec3, rpy: Vec3, quat: tuple[float, float, float, float] | None
-) -> dict[str, Any]:
-    """The request pose: position and roll-pitch-yaw, or position and a quaternion (x, y, z, w).
-
-    Raises:
-        BadOption: both a rotation (-R/-P/-Y) and --quat, or a zero quaternion.
-    """
-    pose: dict[str, Any] = dict(zip(POSE_KEYS[:3], position, strict=True))
-    if quat is None:
-        return pose | dict(zip(POSE_KEYS[3:], rpy, strict=True))
-    if any(rpy):
-        raise pairs.BadOption("give -R/-P/-Y or --quat X Y Z W, not both")
-    if sum(v * v for v in quat) < 1e-12:
-        raise pairs.BadOption("--quat must not be zero; give a unit quaternion X Y Z W")
-    return pose | {"quat": list(quat)}
 
 
 def quat_of(pose: dict) -> tuple[float, float, float, float]:
@@ -87,162 +48,22 @@ def _pose_text(pose: dict) -> str:
 
 def stop(*, world: str) -> None:
     from twin_cli.errors import NotRunningError
-    from twin_cli.server import client
+    from twin_cli.server import connection
 
     try:
-        pid = client.stop(world)
+        pid = connection.stop(world)
     except NotRunningError as exc:
-        raise _not_running(exc) from None
+        raise not_running(exc) from None
     sys.stderr.write(f"twin: stopped world [{world}] (pid {pid})\n")
 
 
-def spawn_request(
-    file: Path | None,
-    xml: str | None,
-    arg: list[str] | None,
-    package: list[str] | None,
-    joint: list[str] | None,
-    on_ground: bool,
-    repair_inertia: bool,
-) -> SpawnRequest:
-    """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
-
-    Raises:
-        BadOption: neither or both of FILE and --xml, or an option that does not parse.
-    """
-    from twin_cli.spawn_request import SpawnRequest
-
-    if (file is None) == (xml is None):
-        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
-    if file is not None and str(file) == "-":
-        file, xml = None, sys.stdin.read()
-    inputs = pairs.source_inputs(arg, package)
-    return SpawnRequest(
-        source=None if file is None else str(file),
-        xml=xml,
-        base_dir=str(Path.cwd()) if xml is not None else None,
-        args=inputs.get("args") or {},
-        package_paths=inputs.get("package_paths") or {},
-        joints=pairs.joint_positions(joint) or {},
-        on_ground=on_ground,
-        repair_inertia=repair_inertia,
-    )
-
-
-def spawn(
-    *,
-    file: Path | None,
-    x: float,
-    y: float,
-    z: float,
-    roll: float,
-    pitch: float,
-    yaw: float,
-    name: str | None,
-    arg: list[str] | None,
-    package: list[str] | None,
-    on_ground: bool,
-    joint: list[str] | None,
-    world: str,
-    json: bool,
-    xml: str | None = None,
-    quat: tuple[float, float, float, float] | None = None,
-    at: list[str] | None = None,
-    names: str | None = None,
-    view: bool = False,
-    repair_inertia: bool = False,
-) -> None:
-    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
-
-    With `--at` (repeated), one entity per pose in one request (`spawn_many`); `view` also shows
-    the world in the web viewer (its URL on stderr).
-    """
-    if name is not None:
-        from twin_cli.names import name_message, name_problem
-
-        if name_problem(name) is not None:
-            from twin_cli.errors import InvalidRequestError
-
-            raise InvalidRequestError("--name", name_message(name), "nothing was spawned")
-    if at or names is not None:
-        spawn_many(
-            file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
-            name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
-            world=world, json=json, xml=xml, quat=quat, x=x, y=y, view=view,
-            repair_inertia=repair_inertia,
-        )  # fmt: skip
-        return
-    pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
-    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
-    with _connect(world, start=True) as c:
-        result = c.spawn(request, name=name, pose=pose)
-        if view:
-            url = c.request("POST", "/view", body={})["url"]
-            sys.stderr.write(f"twin: viewer on {url}\n")
-    out = Output(json)
-    if json:
-        out.data(result)
-        return
-    for warning in result.get("warnings") or []:
-        sys.stderr.write(f"twin: warning: {warning}\n")
-    out.line(result["name"])
-
-
-def spawn_many(
-    *,
-    file: Path | None,
-    at: list[str],
-    names: str | None,
-    z: float,
-    roll: float,
-    pitch: float,
-    yaw: float,
-    name: str | None,
-    arg: list[str] | None,
-    package: list[str] | None,
-    on_ground: bool,
-    joint: list[str] | None,
-    world: str,
-    json: bool,
-    xml: str | None,
-    quat: tuple[float, float, float, float] | None,
-    x: float = 0.0,
-    y: float = 0.0,
-    view: bool = False,
-    repair_inertia: bool = False,
-) -> None:
-    """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
-    from twin_cli.cli import batch_poses
-
-    if not at:
-        raise pairs.BadOption("--names needs one --at X,Y[,Z[,YAW]] per name")
-    if quat is not None or x or y:
-        raise pairs.BadOption("give positions with --at X,Y[,Z[,YAW]], not -x/-y/--quat")
-    poses = [batch_poses.parse_at(text, z, roll, pitch, yaw) for text in at]
-    listed = batch_poses.parse_names(names, len(poses))
-    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
-    with _connect(world, start=True) as c:
-        results = c.spawn_batch(request, poses=poses, names=listed, base=name)
-        if view:
-            url = c.request("POST", "/view", body={})["url"]
-            sys.stderr.write(f"twin: viewer on {url}\n")
-    out = Output(json)
-    if json:
-        out.data(results)
-        return
-    for result in results:
-        for warning in result.get("warnings") or []:
-            sys.stderr.write(f"twin: warning: {warning}\n")
-        out.line(result["name"])
-
-
 def delete(*, name: str, world: str) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         c.delete(name)
 
 
 def list_(*, world: str, json: bool) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         rows = c.entities()
     out = Output(json)
     if json:
@@ -259,7 +80,7 @@ def pose(
     *, name: str, set_: tuple[float, ...] | None, world: str, json: bool, quat: bool = False
 ) -> None:
     """Print (or set) an entity's pose; `quat` prints `x y z qx qy qz qw` (geometry_msgs order)."""
-    with _connect(world) as c:
+    with connect_world(world) as c:
         if set_ is None:
             result = c.pose(name)
         else:
@@ -277,7 +98,7 @@ def pose(
 
 
 def joints(*, name: str, world: str, json: bool) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         rows = c.joints(name)
         control = {j["name"]: j for j in c.joint_control(name)}
     for row in rows:  # each actuated joint's command: mode ("none": zero effort) and target
@@ -307,7 +128,7 @@ def push(
     world: str,
     json: bool = False,
 ) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         result = c.push(name, force, torque, link=link, duration=duration)
     if json:
         Output(json).data(result)
@@ -338,7 +159,7 @@ def gravity(
     json: bool,
 ) -> None:
     preset = gravity_choice(earth=earth, moon=moon, mars=mars, zero=zero, set_=set_)
-    with _connect(world) as c:
+    with connect_world(world) as c:
         if preset is not None:
             result = c.set_gravity(preset=preset)
         elif set_ is not None:
@@ -370,7 +191,7 @@ def physics(
     given = (("timestep", step), ("rate", rate), ("iterations", iterations))
     given += (("threads", threads), ("sleep", sleep), ("sleep_tolerance", sleep_tolerance))
     changes = {k: v for k, v in given if v is not None}
-    with _connect(world) as c:
+    with connect_world(world) as c:
         result = c.set_physics(**changes) if changes else c.physics()
     out = Output(json)
     if json:
@@ -380,19 +201,19 @@ def physics(
 
 
 def pause(*, world: str) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         c.pause()
 
 
 def resume(*, world: str) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         c.resume()
 
 
 def step(*, n: int, world: str, json: bool) -> None:
     from twin_cli.cli.stats_format import stats_line
 
-    with _connect(world) as c:
+    with connect_world(world) as c:
         result = c.step(n)
     out = Output(json)
     if json:
@@ -402,7 +223,7 @@ def step(*, n: int, world: str, json: bool) -> None:
 
 
 def reset(*, time_only: bool, world: str) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         c.reset(time_only=time_only)
 
 
@@ -411,9 +232,9 @@ def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None
     from twin_cli.errors import NotRunningError
 
     try:
-        c = _connect(world, start=False)
+        c = connect_world(world, start=False)
     except NotRunningError as exc:
-        raise _not_running(exc) from None
+        raise not_running(exc) from None
     render = fmt.stats_json if json else fmt.stats_csv_row if plot else fmt.stats_line
     try:
         with c:
@@ -423,13 +244,13 @@ def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None
                 time.sleep(max(0.0, tick - time.monotonic()))
                 print(render(c.stats()), flush=True)
     except NotRunningError as exc:
-        raise _not_running(exc) from None
+        raise not_running(exc) from None
     except (KeyboardInterrupt, BrokenPipeError):
         return
 
 
 def save(*, file: Path, world: str) -> None:
-    with _connect(world) as c:
+    with connect_world(world) as c:
         c.save(file)
 
 
@@ -453,7 +274,7 @@ def load(*, file: Path | None, world: str, last: bool = False) -> None:
         started.append(line)
         sys.stderr.write(f"{line}\n")
 
-    with _connect(world, start=True, serve_args=(path,), announce=announce) as c:
+    with connect_world(world, start=True, serve_args=(path,), announce=announce) as c:
         reply = None if any("started world" in line for line in started) else c.load(path)
     sys.stderr.write(f"twin: world [{world}] loaded from {path}\n")
     for consumer in ("recording", "foxglove"):  # a running recording follows, or says it stopped
@@ -463,12 +284,12 @@ def load(*, file: Path | None, world: str, last: bool = False) -> None:
 
 def _last_autosave(world: str) -> Path:
     """The world's newest autosave; a dead server is reported (and retired) first."""
-    from twin_cli.server import client, lifecycle
+    from twin_cli.server import lifecycle, runtime
 
-    paths = client.runtime.world_paths(world)
-    with client.runtime.start_lock(paths):
-        if not client.runtime.server_alive(paths):
-            client.runtime.clean_stale(paths)
+    paths = runtime.world_paths(world)
+    with runtime.start_lock(paths):
+        if not runtime.server_alive(paths):
+            runtime.clean_stale(paths)
             died = lifecycle.retire(paths)
             if died:
                 sys.stderr.write(f"twin: {died}\n")

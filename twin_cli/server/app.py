@@ -10,24 +10,12 @@ from __future__ import annotations
 import dataclasses
 import logging
 import os
-import secrets
 from typing import Any
 
 from fastapi import APIRouter, FastAPI, Request
-from fastapi.exceptions import RequestValidationError
-from fastapi.responses import JSONResponse
-from pydantic import BaseModel
-from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from converters.errors import ConversionError
-from twin_cli.errors import (
-    EntityExistsError,
-    EntityNotFoundError,
-    PartNotFoundError,
-    RequestError,
-    TwinError,
-)
 from twin_cli.server import consumer_routes, control_routes, sensor_routes, view_routes
+from twin_cli.server.error_replies import ERROR_RESPONSES, install_handlers
 from twin_cli.server.holder import WorldDep, WorldHolder
 from twin_cli.server.models import (
     CommandBody,
@@ -42,6 +30,7 @@ from twin_cli.server.models import (
     StepBody,
 )
 from twin_cli.server.operations import Operations
+from twin_cli.server.token_guard import TokenGuard
 
 log = logging.getLogger("twin.server")
 API_VERSION = "1"
@@ -248,142 +237,6 @@ def shutdown(request: Request) -> dict:
     return {"stopping": request.app.state.world_name}
 
 
-# Status of each error class; other TwinError and ConversionError subclasses are 400.
-ERROR_STATUS: dict[type[Exception], int] = {
-    EntityNotFoundError: 404,
-    PartNotFoundError: 404,
-    EntityExistsError: 409,
-}
-
-
-class ErrorBody(BaseModel):
-    """Every error reply: the error's class (the client raises it again) and one message."""
-
-    error: str
-    message: str
-
-
-# Documented on every operation, so the OpenAPI schema is the whole contract (422 included:
-# validation errors use this body too, not FastAPI's default).
-ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
-    status: {"model": ErrorBody, "description": text}
-    for status, text in (
-        (400, "bad request: the message names the value and the fix"),
-        (401, "TCP request without the bearer token"),
-        (404, "no such entity, joint, link or sensor"),
-        (409, "the name is taken"),
-        (422, "the body does not match the request schema"),
-        (500, "internal error; the world keeps running"),
-    )
-}
-
-
-def _error(status: int, name: str, message: str) -> JSONResponse:
-    return JSONResponse(status_code=status, content={"error": name, "message": message})
-
-
-def _known_error(request: Request, exc: Exception) -> JSONResponse:
-    """TwinError/ConversionError: the class name and its message (what, where, fix)."""
-    status = next((s for cls, s in ERROR_STATUS.items() if isinstance(exc, cls)), 400)
-    log.info(
-        "%s %s -> %d %s: %s", request.method, request.url.path, status, type(exc).__name__, exc
-    )
-    return _error(status, type(exc).__name__, str(exc))
-
-
-def _validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
-    """pydantic's findings as one line naming each bad field."""
-    problems = "; ".join(
-        f"{'.'.join(str(p) for p in err['loc'] if p != 'body') or 'body'}: "
-        f"{err['msg'].removeprefix('Value error, ')}"
-        for err in exc.errors()
-    )
-    message = str(
-        RequestError(
-            f"{request.method} {request.url.path}",
-            problems,
-            "see docs/api.md or /openapi.json for the request schema",
-        )
-    )
-    return _error(422, "RequestError", message)
-
-
-def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
-    """Starlette's own refusals (a body that is not JSON, an unknown path) in twin's error body."""
-    message = str(
-        RequestError(
-            f"{request.method} {request.url.path}",
-            str(exc.detail),
-            "see docs/api.md or /openapi.json for the request schema",
-        )
-    )
-    return _error(exc.status_code, "RequestError", message)
-
-
-def _os_error(request: Request, exc: OSError) -> JSONResponse:
-    """A file the request named cannot be read or written on the server's host."""
-    where = exc.filename or request.url.path
-    message = str(
-        RequestError(
-            str(where),
-            exc.strerror or str(exc),
-            "give a path that exists and is readable on the server's host",
-        )
-    )
-    return _error(400, "RequestError", message)
-
-
-def _value_error(request: Request, exc: ValueError) -> JSONResponse:
-    message = str(
-        RequestError(
-            f"{request.method} {request.url.path}",
-            str(exc),
-            "check the values against `twin physics`/docs/api.md",
-        )
-    )
-    return _error(400, "RequestError", message)
-
-
-def _unexpected(request: Request, exc: Exception) -> JSONResponse:
-    """Any other failure: logged with its traceback; the server and the world keep running."""
-    log.exception("%s %s failed", request.method, request.url.path)
-    message = str(
-        RequestError(
-            f"{request.method} {request.url.path}",
-            f"internal error {type(exc).__name__}: {exc}",
-            "see `twin logs`; the world is still running",
-        )
-    )
-    return _error(500, "RequestError", message)
-
-
-class TokenGuard:
-    """ASGI middleware: requests that arrive over TCP must carry `Authorization: Bearer TOKEN`.
-
-    Unix-socket requests pass (the 0700 directory and 0600 socket already restrict them to
-    the user). uvicorn reports a Unix socket's scope["server"] as (path, None).
-    """
-
-    def __init__(self, app: Any, token: str | None) -> None:
-        self.app = app
-        self.expected = f"Bearer {token}".encode() if token else None
-
-    async def __call__(self, scope: dict, receive: Any, send: Any) -> None:
-        server = scope.get("server") or (None, None)
-        if scope["type"] == "http" and server[1] is not None:
-            given = dict(scope.get("headers") or []).get(b"authorization", b"")
-            if self.expected is None or not secrets.compare_digest(given, self.expected):
-                reply = _error(
-                    401,
-                    "RequestError",
-                    "missing or wrong bearer token; send "
-                    "`Authorization: Bearer <contents of the world's .token file>`",
-                )
-                await reply(scope, receive, send)
-                return
-        await self.app(scope, receive, send)
-
-
 def create_app(
     world: Any, *, world_name: str = "default", token: str | None = None, request_exit: Any = None
 ) -> FastAPI:
@@ -412,12 +265,6 @@ def create_app(
         view_routes.router,
     ):
         app.include_router(routes, responses=ERROR_RESPONSES)
-    app.add_exception_handler(TwinError, _known_error)
-    app.add_exception_handler(ConversionError, _known_error)
-    app.add_exception_handler(RequestValidationError, _validation_error)
-    app.add_exception_handler(StarletteHTTPException, _http_error)
-    app.add_exception_handler(OSError, _os_error)
-    app.add_exception_handler(ValueError, _value_error)
-    app.add_exception_handler(Exception, _unexpected)
+    install_handlers(app)
     app.add_middleware(TokenGuard, token=token)
     return app

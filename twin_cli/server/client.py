@@ -8,9 +8,6 @@ own start-up.
 from __future__ import annotations
 
 import os
-import signal
-import sys
-import time
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -24,7 +21,6 @@ from twin_cli.spawn_request import SpawnRequest, as_request, body_key
 
 # Seconds: most requests are a lock and a copy; spawn, delete and load wait in `long_request`.
 DEFAULT_TIMEOUT_S = 10.0
-STOP_TIMEOUT_S = 15.0
 
 
 def _error_class(name: str) -> type[Exception] | None:
@@ -332,105 +328,3 @@ def _decoded(reply: Any) -> Any:
 def _seg(name: str) -> str:
     """An entity name as one URL path segment."""
     return path_segment(name)
-
-
-def connect(
-    world: str = runtime.DEFAULT_WORLD,
-    *,
-    start: bool = False,
-    announce: Any = None,
-    serve_args: tuple[str, ...] = (),
-) -> Client:
-    """A client of `world`'s server; with `start`, starts it in the background when none runs.
-
-    Only `twin spawn` (and `twin load`, which names the world to run) start a world: every other
-    command passes `start=False`, so a typo in --world or a dead server is reported, never
-    replaced by a fresh empty world. A server that is alive (it holds its pid lock) but not yet
-    answering is waited for.
-
-    Args:
-        world: world name.
-        start: start the server when none answers (False: raise NotRunningError).
-        announce: callable given one line to tell the user a server was started
-            (default: write it to stderr).
-        serve_args: extra `twin serve` arguments for a server started here (a world file).
-
-    Raises:
-        NotRunningError: none runs and `start` is False; its message says whether the world's
-            server died (pid, how, when, log) and which worlds do run.
-        ServerStartError: the background server did not come up.
-    """
-    from twin_cli.server import lifecycle
-
-    client = Client(world)
-    if client.alive():
-        return client
-    paths = client.paths
-    if not start:
-        if runtime.server_alive(paths):
-            runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
-            return client
-        client.close()
-        raise NotRunningError(world, lifecycle.not_running_detail(paths))
-    say = announce or _stderr
-    with runtime.start_lock(paths):
-        if not runtime.server_alive(paths):
-            runtime.clean_stale(paths)
-            died = lifecycle.retire(paths)
-            if died:
-                say(f"twin: {died}")
-            proc = runtime.launch_background(paths, list(serve_args))
-            runtime.wait_until(paths, client.alive, proc, runtime.START_TIMEOUT_S)
-            say(
-                f"twin: started world [{world}] in the background "
-                f"(pid {runtime.read_pid(paths)}); `twin stop` ends it"
-            )
-    runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
-    return client
-
-
-def _stderr(line: str) -> None:
-    sys.stderr.write(line + "\n")
-    sys.stderr.flush()
-
-
-def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) -> int | None:
-    """Ask `world`'s server to shut down and wait until its process is gone.
-
-    Escalates to SIGTERM, then SIGKILL, if it does not end within `timeout` seconds.
-
-    Returns:
-        The pid of the stopped server.
-
-    Raises:
-        NotRunningError: no server runs for this world.
-    """
-    paths = runtime.world_paths(world)
-    pid = runtime.read_pid(paths)
-    if not runtime.server_alive(paths):
-        from twin_cli.server import lifecycle
-
-        with runtime.start_lock(paths):
-            detail = lifecycle.not_running_detail(paths)
-            runtime.clean_stale(paths)
-            lifecycle.forget(paths)  # reported here: `twin stop` acknowledges a dead server
-        raise NotRunningError(world, detail)
-    with Client(world) as client:
-        try:
-            client.request("POST", "/shutdown")
-        except NotRunningError:
-            pass  # socket gone but process alive: fall through to signals
-    for sig in (None, signal.SIGTERM, signal.SIGKILL):
-        if sig is not None and pid:
-            try:
-                os.kill(pid, sig)
-            except ProcessLookupError:
-                break
-        deadline = time.monotonic() + timeout
-        while runtime.server_alive(paths) and time.monotonic() < deadline:
-            time.sleep(runtime.START_POLL_S)
-        if not runtime.server_alive(paths):
-            break
-    with runtime.start_lock(paths):
-        runtime.clean_stale(paths)
-    return pid

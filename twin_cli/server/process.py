@@ -17,6 +17,7 @@ from typing import Any
 
 from twin_cli.errors import RequestError
 from twin_cli.server import runtime
+from twin_cli.server.autosave import DEFAULT_INTERVAL_S
 
 log = logging.getLogger("twin.server")
 LOG_FORMAT = "%(asctime)s %(levelname)s %(name)s: %(message)s"
@@ -52,7 +53,7 @@ class ServeOptions:
     background: bool = False
     record: str | None = None
     foxglove: int | None = None
-    autosave: float = 10.0
+    autosave: float = DEFAULT_INTERVAL_S
     view: bool = False
     package_paths: dict[str, str] | None = None
 

@@ -55,7 +55,7 @@ def command(
 ) -> None:
     """Hold joint targets until changed (position, velocity or effort command interfaces)."""
     from twin_cli.errors import InvalidRequestError
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     if mode not in MODES:
         raise InvalidRequestError(f"--mode [{mode}]", "unknown", f"use one of {', '.join(MODES)}")
@@ -80,7 +80,7 @@ def trajectory(
     """Follow a joint trajectory with joint_trajectory_controller's interpolation."""
     from twin_cli.control.trajectory import read_trajectory
     from twin_cli.errors import InvalidRequestError
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     try:
         text = file.read_text(encoding="utf-8")

@@ -28,7 +28,7 @@ def drive(
 ) -> None:
     """Drive a diff-drive robot at a forward speed and yaw rate (geometry_msgs/Twist)."""
     from twin_cli.errors import InvalidRequestError
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
     from twin_cli.server.transport import path_segment
 
     for what, value in (("linear", linear), ("angular", angular), ("duration", duration)):
@@ -51,7 +51,7 @@ def odom(
     json: JsonOpt = False,
 ) -> None:
     """Print a diff-drive robot's odometry: pose and twist (nav_msgs/Odometry)."""
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
     from twin_cli.server.transport import path_segment
 
     with connect(world) as client:

@@ -33,7 +33,7 @@ def record(
 ) -> None:
     """Record /clock, /tf, /tf_static and each entity's joint_states, odom and
     robot_description into a rosbag2 MCAP file, until --duration or Ctrl-C."""
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     body = {"path": str(out.expanduser().resolve()), "rate": rate, "entities": entity or []}
     if duration is not None:
@@ -78,7 +78,7 @@ def foxglove(
     json: JsonOpt = False,
 ) -> None:
     """Stream the world's topics live to Foxglove (open ws://127.0.0.1:PORT in Foxglove)."""
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     with connect(world, start=False) as client:
         if stop:

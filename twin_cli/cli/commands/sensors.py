@@ -32,7 +32,7 @@ def sensors(
     json: JsonOpt = False,
 ) -> None:
     """Print the readings of an entity's sensors (IMU, lidar, contact, force/torque, camera)."""
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
     from twin_cli.server.transport import path_segment
 
     out = Output(json)

@@ -11,6 +11,7 @@ from typing import Annotated
 import typer
 
 from twin_cli.cli.options import PackageOpt, WorldOpt, usage_errors
+from twin_cli.server.autosave import DEFAULT_INTERVAL_S
 
 
 def serve(
@@ -42,7 +43,7 @@ def serve(
             envvar="TWIN_AUTOSAVE",
             help="Save the world every SECONDS for `twin load --last` (0: off).",
         ),
-    ] = 10.0,
+    ] = DEFAULT_INTERVAL_S,
     no_autosave: Annotated[
         bool, typer.Option("--no-autosave", help="Do not autosave (same as --autosave 0).")
     ] = False,

@@ -35,7 +35,7 @@ def view(
     The page can pause, run and reset the world and push bodies (Ctrl+drag). With --host other
     than 127.0.0.1 anyone who reaches the port can do the same: there is no password.
     """
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     with connect(world) as client:
         if stop:
@@ -67,7 +67,7 @@ def snapshot(
     json: JsonOpt = False,
 ) -> None:
     """Render the running world offscreen into a PNG (no browser or display needed)."""
-    from twin_cli.server.client import connect
+    from twin_cli.server.connection import connect
 
     body = {
         "path": str(out.expanduser().resolve()),

@@ -1,0 +1,174 @@
+"""`twin spawn`: a FILE, stdin or `--xml` text as one spawn request, at one pose or many.
+
+Called by the world commands' table (`world_table`) through `world_actions`; client-side only.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+from twin_cli.cli import pairs
+from twin_cli.cli.output import Output
+from twin_cli.cli.world_client import connect_world
+from twin_cli.spawn_request import SpawnRequest
+
+POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
+Vec3 = tuple[float, float, float]
+
+
+def spawn_pose(
+    position: Vec3, rpy: Vec3, quat: tuple[float, float, float, float] | None
+) -> dict[str, Any]:
+    """The request pose: position and roll-pitch-yaw, or position and a quaternion (x, y, z, w).
+
+    Raises:
+        BadOption: both a rotation (-R/-P/-Y) and --quat, or a zero quaternion.
+    """
+    pose: dict[str, Any] = dict(zip(POSE_KEYS[:3], position, strict=True))
+    if quat is None:
+        return pose | dict(zip(POSE_KEYS[3:], rpy, strict=True))
+    if any(rpy):
+        raise pairs.BadOption("give -R/-P/-Y or --quat X Y Z W, not both")
+    if sum(v * v for v in quat) < 1e-12:
+        raise pairs.BadOption("--quat must not be zero; give a unit quaternion X Y Z W")
+    return pose | {"quat": list(quat)}
+
+
+def spawn_request(
+    file: Path | None,
+    xml: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    joint: list[str] | None,
+    on_ground: bool,
+    repair_inertia: bool,
+) -> SpawnRequest:
+    """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
+
+    Raises:
+        BadOption: neither or both of FILE and --xml, or an option that does not parse.
+    """
+    if (file is None) == (xml is None):
+        raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
+    if file is not None and str(file) == "-":
+        file, xml = None, sys.stdin.read()
+    inputs = pairs.source_inputs(arg, package)
+    return SpawnRequest(
+        source=None if file is None else str(file),
+        xml=xml,
+        base_dir=str(Path.cwd()) if xml is not None else None,
+        args=inputs.get("args") or {},
+        package_paths=inputs.get("package_paths") or {},
+        joints=pairs.joint_positions(joint) or {},
+        on_ground=on_ground,
+        repair_inertia=repair_inertia,
+    )
+
+
+def spawn(
+    *,
+    file: Path | None,
+    x: float,
+    y: float,
+    z: float,
+    roll: float,
+    pitch: float,
+    yaw: float,
+    name: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    on_ground: bool,
+    joint: list[str] | None,
+    world: str,
+    json: bool,
+    xml: str | None = None,
+    quat: tuple[float, float, float, float] | None = None,
+    at: list[str] | None = None,
+    names: str | None = None,
+    view: bool = False,
+    repair_inertia: bool = False,
+) -> None:
+    """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
+
+    With `--at` (repeated), one entity per pose in one request (`spawn_many`); `view` also shows
+    the world in the web viewer (its URL on stderr).
+    """
+    if name is not None:
+        from twin_cli.names import name_message, name_problem
+
+        if name_problem(name) is not None:
+            from twin_cli.errors import InvalidRequestError
+
+            raise InvalidRequestError("--name", name_message(name), "nothing was spawned")
+    if at or names is not None:
+        spawn_many(
+            file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
+            name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
+            world=world, json=json, xml=xml, quat=quat, x=x, y=y, view=view,
+            repair_inertia=repair_inertia,
+        )  # fmt: skip
+        return
+    pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
+    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
+    with connect_world(world, start=True) as c:
+        result = c.spawn(request, name=name, pose=pose)
+        if view:
+            url = c.request("POST", "/view", body={})["url"]
+            sys.stderr.write(f"twin: viewer on {url}\n")
+    out = Output(json)
+    if json:
+        out.data(result)
+        return
+    for warning in result.get("warnings") or []:
+        sys.stderr.write(f"twin: warning: {warning}\n")
+    out.line(result["name"])
+
+
+def spawn_many(
+    *,
+    file: Path | None,
+    at: list[str],
+    names: str | None,
+    z: float,
+    roll: float,
+    pitch: float,
+    yaw: float,
+    name: str | None,
+    arg: list[str] | None,
+    package: list[str] | None,
+    on_ground: bool,
+    joint: list[str] | None,
+    world: str,
+    json: bool,
+    xml: str | None,
+    quat: tuple[float, float, float, float] | None,
+    x: float = 0.0,
+    y: float = 0.0,
+    view: bool = False,
+    repair_inertia: bool = False,
+) -> None:
+    """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
+    from twin_cli.cli import batch_poses
+
+    if not at:
+        raise pairs.BadOption("--names needs one --at X,Y[,Z[,YAW]] per name")
+    if quat is not None or x or y:
+        raise pairs.BadOption("give positions with --at X,Y[,Z[,YAW]], not -x/-y/--quat")
+    poses = [batch_poses.parse_at(text, z, roll, pitch, yaw) for text in at]
+    listed = batch_poses.parse_names(names, len(poses))
+    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
+    with connect_world(world, start=True) as c:
+        results = c.spawn_batch(request, poses=poses, names=listed, base=name)
+        if view:
+            url = c.request("POST", "/view", body={})["url"]
+            sys.stderr.write(f"twin: viewer on {url}\n")
+    out = Output(json)
+    if json:
+        out.data(results)
+        return
+    for result in results:
+        for warning in result.get("warnings") or []:
+            sys.stderr.write(f"twin: warning: {warning}\n")
+        out.line(result["name"])
