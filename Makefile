@@ -26,7 +26,7 @@ demo: $(STAMP)
 
 # The browser test runs alone after the rest: SwiftShader renders its page on the CPU, and with
 # both cores busy with other tests a frame could take longer than the test waits.
-BROWSER_TESTS = tests/twin_cli/test_view_browser.py
+BROWSER_TESTS = tests/twin_cli/view/test_view_browser.py
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup --timeout 300 -q --ignore=$(BROWSER_TESTS)

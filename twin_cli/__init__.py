@@ -16,7 +16,8 @@ from twin_cli.errors import TwinError
 from twin_cli.lazy import lazy_getattr
 
 if TYPE_CHECKING:
-    from twin_cli.server import Client, connect
+    from twin_cli.server.client import Client
+    from twin_cli.server.connection import connect
     from twin_cli.validate import Scenario, load_scenario, validate
     from twin_cli.world import (
         GRAVITY_PRESETS,
@@ -63,7 +64,7 @@ __getattr__ = lazy_getattr(
             "twin_cli.world",
         ),
         "Client": "twin_cli.server.client",
-        "connect": "twin_cli.server.client",
+        "connect": "twin_cli.server.connection",
         "Scenario": "twin_cli.validate.scenario",
         "load_scenario": "twin_cli.validate.scenario",
         "validate": "twin_cli.validate.runner",

@@ -10,7 +10,7 @@ positionals in any order), and calls the `world_actions` function the table name
 (returns None) whenever Typer would do anything else: `--help`, an unknown or clustered option, a
 missing or extra argument, a value that does not convert, so help and click's usage errors come
 from Typer itself. A value the action refuses (BadOption) reaches `app.main`'s error boundary.
-`tests/test_cli_fast.py` checks this grammar against the Typer app's parses.
+`tests/twin_cli/cli/test_cli_fast.py` checks this grammar against the Typer app's parses.
 """
 
 from __future__ import annotations

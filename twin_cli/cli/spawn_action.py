@@ -92,7 +92,7 @@ def spawn(
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
-    With `--at` (repeated), one entity per pose in one request (`spawn_many`); `view` also shows
+    With `--at` (repeated), one entity per pose in one request, all or none; `view` also shows
     the world in the web viewer (its URL on stderr).
     """
     if name is not None:
@@ -102,73 +102,52 @@ def spawn(
             from twin_cli.errors import InvalidRequestError
 
             raise InvalidRequestError("--name", name_message(name), "nothing was spawned")
-    if at or names is not None:
-        spawn_many(
-            file=file, at=at or [], names=names, z=z, roll=roll, pitch=pitch, yaw=yaw,
-            name=name, arg=arg, package=package, on_ground=on_ground, joint=joint,
-            world=world, json=json, xml=xml, quat=quat, x=x, y=y, view=view,
-            repair_inertia=repair_inertia,
-        )  # fmt: skip
-        return
-    pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
+    many = bool(at) or names is not None
+    if many:
+        poses, listed = batch_placements(at or [], names, (x, y), (z, roll, pitch, yaw), quat)
+    else:
+        pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
     request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
     with connect_world(world, start=True) as c:
-        result = c.spawn(request, name=name, pose=pose)
+        if many:
+            results = c.spawn_batch(request, poses=poses, names=listed, base=name)
+        else:
+            results = [c.spawn(request, name=name, pose=pose)]
         if view:
             url = c.request("POST", "/view", body={})["url"]
             sys.stderr.write(f"twin: viewer on {url}\n")
-    out = Output(json)
-    if json:
-        out.data(result)
-        return
-    for warning in result.get("warnings") or []:
-        sys.stderr.write(f"twin: warning: {warning}\n")
-    out.line(result["name"])
+    _report(results if many else results[0], json)
 
 
-def spawn_many(
-    *,
-    file: Path | None,
+def batch_placements(
     at: list[str],
     names: str | None,
-    z: float,
-    roll: float,
-    pitch: float,
-    yaw: float,
-    name: str | None,
-    arg: list[str] | None,
-    package: list[str] | None,
-    on_ground: bool,
-    joint: list[str] | None,
-    world: str,
-    json: bool,
-    xml: str | None,
+    xy: tuple[float, float],
+    z_rpy: tuple[float, float, float, float],
     quat: tuple[float, float, float, float] | None,
-    x: float = 0.0,
-    y: float = 0.0,
-    view: bool = False,
-    repair_inertia: bool = False,
-) -> None:
-    """`twin spawn FILE --at X,Y --at …`: every pose in one request; a bad one spawns none."""
+) -> tuple[list[dict[str, Any]], list[str] | None]:
+    """`--at X,Y[,Z[,YAW]]` poses (z, roll, pitch, yaw from -z -R -P -Y) and `--names`.
+
+    Raises:
+        BadOption: no --at for --names, or -x/-y/--quat given with --at.
+    """
     from twin_cli.cli import batch_poses
 
     if not at:
         raise pairs.BadOption("--names needs one --at X,Y[,Z[,YAW]] per name")
-    if quat is not None or x or y:
+    if quat is not None or any(xy):
         raise pairs.BadOption("give positions with --at X,Y[,Z[,YAW]], not -x/-y/--quat")
-    poses = [batch_poses.parse_at(text, z, roll, pitch, yaw) for text in at]
-    listed = batch_poses.parse_names(names, len(poses))
-    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
-    with connect_world(world, start=True) as c:
-        results = c.spawn_batch(request, poses=poses, names=listed, base=name)
-        if view:
-            url = c.request("POST", "/view", body={})["url"]
-            sys.stderr.write(f"twin: viewer on {url}\n")
+    poses = [batch_poses.parse_at(text, *z_rpy) for text in at]
+    return poses, batch_poses.parse_names(names, len(poses))
+
+
+def _report(results: dict | list[dict], json: bool) -> None:
+    """The spawned names (warnings on stderr), or the replies as JSON."""
     out = Output(json)
     if json:
         out.data(results)
         return
-    for result in results:
+    for result in results if isinstance(results, list) else [results]:
         for warning in result.get("warnings") or []:
             sys.stderr.write(f"twin: warning: {warning}\n")
         out.line(result["name"])

@@ -20,7 +20,6 @@ from twin_cli.cli import pairs
 from twin_cli.cli.output import Output
 from twin_cli.cli.spawn_action import POSE_KEYS, Vec3
 from twin_cli.cli.spawn_action import spawn as spawn  # the table names it here
-from twin_cli.cli.spawn_action import spawn_many as spawn_many
 from twin_cli.cli.world_client import connect_world, not_running
 
 GRAVITY_PRESETS = ("earth", "moon", "mars", "zero")

@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_sdf_world import LESSON_BOX, WORLD
+from sdf_models import LESSON_BOX, WORLD
 
 WORLD_NAME = "sdf_cli"
 

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from camera_models import BOX, CAM_Z, HFOV, SCENE, H, W, projection, red
 from models import write_urdf
-from test_camera_sensor import BOX, CAM_Z, HFOV, SCENE, H, W, _projection, _red
 from view_helpers import egl_missing
 
 SECONDS = 0.3  # [s] of sim time recorded at a 1 ms step
@@ -114,8 +114,8 @@ def test_recorded_images_are_sensor_msgs_image_at_the_camera_rate(egl_bag) -> No
 def test_the_recorded_picture_shows_the_box_where_the_pinhole_model_puts_it(egl_bag) -> None:
     _, last = egl_bag["/post/cam/image_raw"][-1]
     rgb = np.asarray(last.data, np.uint8).reshape(H, W, 3).astype(np.float64)
-    u, v, half = _projection()
-    rows, cols = np.nonzero(_red(rgb))
+    u, v, half = projection()
+    rows, cols = np.nonzero(red(rgb))
     assert len(cols), "the box is in view"
     assert cols.mean() == pytest.approx(u - 0.5, abs=1.5)
     assert rows.mean() == pytest.approx(v - 0.5, abs=1.5)

@@ -10,8 +10,6 @@ from pathlib import Path
 
 import matplotlib.image
 import pytest
-
-sys.path.insert(0, str(Path(__file__).resolve().parent / "twin_cli"))
 import validate_robots as robots  # noqa: E402
 
 import scenarios  # noqa: E402

@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 from record_helpers import read_bag, seconds
 
-HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+import scenarios
+
+HUMANOID = Path(scenarios.HUMANOID)
 # The Foxglove WebSocket protocol's spec names the first; foxglove-sdk servers answer the second.
 FOXGLOVE_SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 MESSAGE_DATA, TIME = 0x01, 0x02  # binary opcodes, server → client
@@ -379,8 +381,7 @@ def _image_session(port: int, client, topic: str) -> list:
 
 
 def test_foxglove_clients_receive_camera_images_as_sensor_msgs_image(tmp_path, serve_world):
-    from test_camera_sensor import CAM_Z, H, W, _red
-    from test_record_camera import POST
+    from camera_models import CAM_Z, POST, H, W, red
     from view_helpers import egl_missing, red_box
 
     if why := egl_missing():
@@ -402,6 +403,6 @@ def test_foxglove_clients_receive_camera_images_as_sensor_msgs_image(tmp_path, s
     assert schema == "sensor_msgs/msg/Image"
     assert (image.width, image.height, image.encoding, image.step) == (W, H, "rgb8", 3 * W)
     rgb = np.asarray(image.data, np.uint8).reshape(H, W, 3).astype(np.float64)
-    red = _red(rgb)
-    assert red.sum() > 20, "the red box is in the picture"
-    assert not red[:, W // 2 :].any(), "to the camera's left: nothing red in the right half"
+    red_pixels = red(rgb)
+    assert red_pixels.sum() > 20, "the red box is in the picture"
+    assert not red_pixels[:, W // 2 :].any(), "to the camera's left: nothing red in the right half"

@@ -19,9 +19,11 @@ import numpy as np
 import pytest
 from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing, pure_red, red_box
 
+import scenarios
+
 pytestmark = pytest.mark.skipif(bool(chromium_missing()), reason=chromium_missing() or "")
 
-HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+HUMANOID = Path(scenarios.HUMANOID)
 WORLD = "browser"
 VIEWPORT = {"width": 800, "height": 600}
 # Where MuJoCo Studio's Options panel draws its buttons in an 800×600 page (its default layout).

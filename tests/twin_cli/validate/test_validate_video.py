@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 from view_helpers import egl_missing
 
-HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+import scenarios
+
+HUMANOID = Path(scenarios.HUMANOID)
 FPS = 20  # frames per simulated second (twin_cli.view.video.FPS)
 # The two scenarios the test runs and their durations [s] (scenarios/*.toml).
 DURATIONS = {"free_fall": 0.5, "zero_gravity": 1.0}

@@ -10,58 +10,14 @@ a depth camera reads the distance from the camera to the box's near face along i
 from __future__ import annotations
 
 import json
-import math
 import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+from camera_models import BOX, CLIPS, POST, SCENE, H, W, projection, red
 from models import write_urdf
-
-W, H, HFOV = 64, 48, 1.0  # [px], [px], [rad]
-CAM_Z = 0.5  # [m] camera height
-BOX = (2.0, 0.3, CAM_Z, 0.1)  # centre x, y, z and half size [m]
-
-# Cameras like the two below with other <clip> planes [m] (the box's near face is 1.9 m ahead).
-CLIPS = {"depth_short": ("depth", 0.05, 1.5), "depth_long": ("depth", 0.05, 3.0),
-         "depth_near": ("depth", 2.5, 10.0), "cam_short": ("camera", 0.05, 1.5),
-         "cam_near": ("camera", 2.5, 10.0)}  # fmt: skip
-SENSOR = """<sensor type="{kind}" name="{name}"><pose>0 0 {z} 0 0 0</pose><camera>
-    <horizontal_fov>{hfov}</horizontal_fov><image><width>{w}</width><height>{h}</height></image>
-    <clip><near>{near}</near><far>{far}</far></clip></camera></sensor>"""
-CLIPPED = "\n".join(
-    SENSOR.format(kind=k, name=n, z=CAM_Z, hfov=HFOV, w=W, h=H, near=near, far=far)
-    for n, (k, near, far) in CLIPS.items()
-)
-
-POST = f"""<robot name="campost">
-  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
-    ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <gazebo><static>true</static></gazebo>
-  <gazebo reference="base">
-  <sensor type="camera" name="cam"><pose>0 0 {CAM_Z} 0 0 0</pose><update_rate>30</update_rate>
-    <camera><horizontal_fov>{HFOV}</horizontal_fov><image><width>{W}</width>
-    <height>{H}</height></image><clip><near>0.05</near><far>50</far></clip></camera></sensor>
-  <sensor type="depth" name="depth"><pose>0 0 {CAM_Z} 0 0 0</pose><update_rate>30</update_rate>
-    <camera><horizontal_fov>{HFOV}</horizontal_fov><image><width>{W}</width>
-    <height>{H}</height></image><clip><near>0.05</near><far>50</far></clip></camera></sensor>
-  {CLIPPED}
-  </gazebo>
-</robot>"""
-
-
-# The child's world: the camera post (URDF path `post`) and a red box at BOX (JSON `box`).
-SCENE = """
-x, y, z, h = json.loads(box)
-world = World(WorldSettings(ground=False))
-world.spawn(post, name="post")
-box = mujoco.MjSpec(); box.modelname = "box"
-box.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[h, h, h], pos=[x, y, z],
-                       rgba=[1, 0, 0, 1])
-world.spawn(box, name="box")
-"""
-
 
 CHILD = (
     """
@@ -104,19 +60,10 @@ def images(tmp_path_factory) -> dict:
     return out
 
 
-def _projection() -> tuple[float, float, float]:
-    """Pixel column and row of the box's near-face centre, and its half width [px]."""
-    f = (W / 2) / math.tan(HFOV / 2)
-    x, y, _, h = BOX
-    near = x - h
-    u = W / 2 - f * y / near  # image x grows to the camera's right (−y)
-    return u, H / 2, f * h / near
-
-
 def test_camera_sees_the_red_box_where_the_pinhole_projection_puts_it(images) -> None:
     rgb = np.array(images["rgb"], np.float64)
     assert images["encodings"] == ["rgb8", "32FC1"]
-    u, v, half = _projection()
+    u, v, half = projection()
     red = (rgb[..., 0] > 2 * rgb[..., 1] + 20) & (rgb[..., 0] > 2 * rgb[..., 2] + 20)
     rows, cols = np.nonzero(red)
     assert len(cols), "the box is in view"
@@ -130,21 +77,17 @@ def test_camera_sees_the_red_box_where_the_pinhole_projection_puts_it(images) ->
 
 def test_depth_camera_reads_the_distance_to_the_near_face(images) -> None:
     depth = np.array(images["depth"])
-    u, v, _ = _projection()
+    u, v, _ = projection()
     x, _, _, h = BOX
     centre = depth[int(v), int(u)]
     assert centre == pytest.approx(x - h, abs=0.01), "metres along the view axis to the face"
     assert depth[int(v), 2] > 10.0, "nothing to the right within range: far background"
 
 
-def _red(rgb: np.ndarray) -> np.ndarray:
-    return (rgb[..., 0] > 2 * rgb[..., 1] + 20) & (rgb[..., 0] > 2 * rgb[..., 2] + 20)
-
-
 def test_depth_beyond_the_far_clip_is_inf_and_within_it_the_box_reads_its_distance(
     images,
 ) -> None:
-    u, v, _ = _projection()
+    u, v, _ = projection()
     x, _, _, h = BOX
     # JSON carries ±inf as ±Infinity; json.loads reads them back as floats.
     short = np.array(images["clipped"]["depth_short"])
@@ -156,7 +99,7 @@ def test_depth_beyond_the_far_clip_is_inf_and_within_it_the_box_reads_its_distan
 
 
 def test_a_box_nearer_than_the_near_clip_reads_minus_inf(images) -> None:
-    u, v, _ = _projection()
+    u, v, _ = projection()
     near = np.array(images["clipped"]["depth_near"])
     assert np.isneginf(near[int(v), int(u)]), "box 1.9 m ahead, near plane 2.5 m: −inf"
     assert not np.isfinite(near).any(), "nothing between 2.5 m and 10 m in view"
@@ -164,7 +107,7 @@ def test_a_box_nearer_than_the_near_clip_reads_minus_inf(images) -> None:
 
 
 def test_colour_cameras_do_not_draw_what_lies_outside_their_clip_planes(images) -> None:
-    assert _red(np.array(images["rgb"], np.float64)).sum() > 20, "50 m far plane: the box shows"
+    assert red(np.array(images["rgb"], np.float64)).sum() > 20, "50 m far plane: the box shows"
     for name in ("cam_short", "cam_near"):
         rgb = np.array(images["clipped"][name], np.float64)
-        assert not _red(rgb).any(), f"{name}: the box at 1.9 m is outside {CLIPS[name][1:]} m"
+        assert not red(rgb).any(), f"{name}: the box at 1.9 m is outside {CLIPS[name][1:]} m"

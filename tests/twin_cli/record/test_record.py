@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 from record_helpers import compose_links, pose_error, read_bag, seconds
 
+import scenarios
 from twin_cli.errors import EntityNotFoundError, InvalidRequestError, RequestError
 from twin_cli.record import BagRecording, BagSink, Recording
 from twin_cli.world import Pose, World
 
-HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+HUMANOID = Path(scenarios.HUMANOID)
 RATE = 100.0  # [Hz]
 STEPS_PER_SAMPLE = 10  # 1 ms world step
 SAMPLES = 200  # 2 s

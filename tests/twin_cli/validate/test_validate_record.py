@@ -9,7 +9,9 @@ from pathlib import Path
 import numpy as np
 from record_helpers import read_bag, seconds
 
-HUMANOID = Path(__file__).parents[2] / "scenarios" / "robots" / "humanoid.urdf.xacro"
+import scenarios
+
+HUMANOID = Path(scenarios.HUMANOID)
 STEP = 0.001  # [s] the scenario world's timestep (twin's default)
 RATE = 100.0  # [Hz] twin_cli.validate.recording.RATE
 G = 9.81  # [m/s²] the scenario's "earth"
