@@ -1,4 +1,5 @@
-"""The import contracts hold on the tree, and break when a module imports against the flow."""
+"""The import contracts hold on the tree, and break when a module imports against the flow or
+two modules of a package import each other (a circle, at module level or inside a function)."""
 
 from __future__ import annotations
 
@@ -16,10 +17,13 @@ PACKAGES = ("twin_cli", "converters", "scenarios")
 pytestmark = pytest.mark.skipif(not LINT_IMPORTS.exists(), reason="import-linter not installed")
 
 
-def _lint_imports(cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(LINT_IMPORTS), "--no-cache"], cwd=cwd, capture_output=True, text=True, timeout=120
-    )
+CYCLES = "no-import-cycles"  # the id of the acyclic-siblings contract in pyproject.toml
+
+
+def _lint_imports(cwd: Path, contract: str | None = None) -> subprocess.CompletedProcess:
+    only = ["--contract", contract] if contract else []
+    command = [str(LINT_IMPORTS), "--no-cache", *only]
+    return subprocess.run(command, cwd=cwd, capture_output=True, text=True, timeout=120)
 
 
 def _copy_tree(tmp_path: Path) -> Path:
@@ -53,3 +57,22 @@ def test_an_import_against_the_flow_breaks_a_contract(
     proc = _lint_imports(tree)
     assert proc.returncode != 0, f"`{line}` in {module} kept every contract"
     assert broken in proc.stdout, proc.stdout[-2000:]
+
+
+@pytest.mark.parametrize(
+    ("package", "back_import"),
+    [
+        ("twin_cli/record", "from twin_cli.record import circle_a\n"),
+        ("converters/resources", "def load():\n    from converters.resources import circle_a\n"),
+    ],
+    ids=["module-level", "inside-a-function"],
+)
+def test_a_circle_breaks_the_check(tmp_path: Path, package: str, back_import: str) -> None:
+    tree = _copy_tree(tmp_path)
+    dotted = package.replace("/", ".")
+    (tree / package / "circle_a.py").write_text(f"from {dotted} import circle_b\n")
+    (tree / package / "circle_b.py").write_text(back_import)
+    proc = _lint_imports(tree, CYCLES)
+    assert proc.returncode != 0, f"circle_a <-> circle_b in {dotted} passed the check"
+    assert f"No cycles are allowed in {dotted}." in proc.stdout, proc.stdout[-3000:]
+    assert "circle_" in proc.stdout, proc.stdout[-3000:]
