@@ -4,11 +4,15 @@ Gazebo plugin stage, so it lives outside both packages and neither imports the o
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import mujoco
 
 CONTROL_TEXT = "control"
 
 
-def set_control_record(spec: object, joint: str, record: dict) -> None:
+def set_control_record(spec: mujoco.MjSpec, joint: str, record: dict) -> None:
     """Writes `joint`'s record into the spec's `control` text (created on first use)."""
     text = spec.text(CONTROL_TEXT)
     if text is None:

@@ -14,7 +14,8 @@ FORMATS = {"robot": "urdf", "sdf": "sdf", "mujoco": "mjcf"}
 
 def root_tag(text: str) -> str | None:
     """The root element's local name, or None when the text does not start with an element."""
-    rest = text[_PROLOGUE.match(text).end() :]
+    prologue = _PROLOGUE.match(text)  # always matches (all of it may be empty)
+    rest = text[prologue.end() :] if prologue else text
     found = _ROOT.match(rest)
     return found.group(2) if found else None
 

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.description import RobotDescription
+
+if TYPE_CHECKING:
+    import mujoco
 
 
 @dataclass(frozen=True)
@@ -40,7 +44,7 @@ class InertialStats:
         }
 
 
-def inertial_stats(spec: object, robot: RobotDescription) -> InertialStats:
+def inertial_stats(spec: mujoco.MjSpec, robot: RobotDescription) -> InertialStats:
     """Compile `spec`, pose it at qpos0 and sum every body's mass properties (parallel axis)."""
     import mujoco
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
@@ -20,13 +21,16 @@ from converters.resources.packages import PackageResolver
 from converters.urdf.reader import parse_urdf
 from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
+if TYPE_CHECKING:
+    import mujoco
+
 
 @dataclass(frozen=True)
 class Conversion:
     """Everything one conversion produced: the spec, the report, provenance, the description and
     the robot's sensors (typed `<sensor>` elements, each a site `sensor:<name>` in the spec)."""
 
-    spec: object
+    spec: mujoco.MjSpec
     report: Report
     provenance: Provenance
     description: RobotDescription

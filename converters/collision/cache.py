@@ -13,6 +13,7 @@ import hashlib
 import json
 import os
 import tempfile
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,7 +54,7 @@ def pack_parts(parts: list[tuple[np.ndarray, np.ndarray]]) -> dict[str, np.ndarr
     return arrays
 
 
-def unpack_parts(data: Any, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+def unpack_parts(data: Mapping[str, np.ndarray], count: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """The first `count` parts of an open .npz written from `pack_parts`."""
     return [(data[f"v{i}"], data[f"f{i}"]) for i in range(count)]
 
@@ -136,7 +137,7 @@ def store(key: str, parts: list[tuple[np.ndarray, np.ndarray]], meta: dict[str, 
     handle, tmp = tempfile.mkstemp(prefix=f".{key[:16]}.", suffix=".tmp", dir=directory)
     try:
         with os.fdopen(handle, "wb") as stream:
-            np.savez(stream, **arrays)
+            np.savez(stream, allow_pickle=False, **arrays)  # numbers and text: no pickles
             stream.flush()
             os.fsync(stream.fileno())
         final = directory / f"{key}{SUFFIX}"

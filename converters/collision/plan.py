@@ -56,7 +56,7 @@ class CoacdParams:
     max_ch_vertex: int
     seed: int = 0
 
-    def kwargs(self) -> dict[str, object]:
+    def kwargs(self) -> dict[str, float]:
         return asdict(self)
 
 

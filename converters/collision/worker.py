@@ -49,7 +49,7 @@ def run(job_path: str, result_path: str) -> None:
     arrays = {**pack_parts(parts), "count": np.array(len(parts))}
     tmp = f"{result_path}.part"
     with open(tmp, "wb") as stream:
-        np.savez(stream, **arrays)
+        np.savez(stream, allow_pickle=False, **arrays)  # numbers only: no pickles
     os.replace(tmp, result_path)
 
 

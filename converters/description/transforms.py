@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -39,3 +40,9 @@ def quat_matrix(xyzw: tuple[float, ...]) -> np.ndarray:
             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
         ]
     )
+
+
+def vec3(values: Iterable[float]) -> tuple[float, float, float]:
+    """Three numbers (a point, a direction or a colour) as floats."""
+    x, y, z = values
+    return float(x), float(y), float(z)

@@ -8,12 +8,15 @@ link-level tags (gravity, selfCollide, dampingFactor) act on the body that carri
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from converters.description.gazebo import GazeboExtensions, LinkExtension, Surface
 from converters.gazebo.contact import (
     CONTACT_MU_MAX,
     DEFAULT_MU,
+    ContactSoftness,
     contact_mu,
     contact_softness,
     friction_priority,
@@ -22,6 +25,9 @@ from converters.gazebo.joints import apply_joint_tags, report_blobs
 from converters.gazebo.materials import gazebo_rgba
 from converters.provenance import GeomOrigin, Provenance
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 DAMPING_FACTOR_PREFIX = "damping_factor:"
 """Custom numeric `damping_factor:<body>`: fraction of velocity lost per 0.001 s (world applies)."""
@@ -47,7 +53,9 @@ class BodyFlags:
     damping_factor: float | None
 
 
-def apply_gazebo(spec: Any, ext: GazeboExtensions, provenance: Provenance, report: Report) -> None:
+def apply_gazebo(
+    spec: mujoco.MjSpec, ext: GazeboExtensions, provenance: Provenance, report: Report
+) -> None:
     """Give a robot spec Gazebo's contact, collision, gravity and joint semantics.
 
     Args:
@@ -77,9 +85,9 @@ def apply_gazebo(spec: Any, ext: GazeboExtensions, provenance: Provenance, repor
 class _BodyMasses:
     """Body masses [kg]: the spec's explicit mass, else the compiled model's (compiled once)."""
 
-    def __init__(self, spec: Any) -> None:
+    def __init__(self, spec: mujoco.MjSpec) -> None:
         self.spec = spec
-        self.model: Any = None
+        self.model: mujoco.MjModel | None = None
 
     def of(self, body: str) -> float:
         mass = float(self.spec.body(body).mass)
@@ -94,7 +102,7 @@ class _BodyMasses:
 
 
 def _apply_surface(
-    spec: Any, origin: GeomOrigin, surface: Surface, masses: _BodyMasses, report: Report
+    spec: mujoco.MjSpec, origin: GeomOrigin, surface: Surface, masses: _BodyMasses, report: Report
 ) -> None:
     geom = spec.geom(origin.geom)
     if geom is None:
@@ -105,19 +113,19 @@ def _apply_surface(
     if surface.torsional is not None:
         friction[1] = surface.torsional
         geom.condim = max(int(geom.condim), 4)
-    geom.friction = friction
+    geom.friction = np.array(friction)
     geom.priority = friction_priority(mu)
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
     softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))
-    geom.solref = list(softness.solref)
-    geom.solimp = list(softness.solimp)
+    geom.solref = np.array(softness.solref)
+    geom.solimp = np.array(softness.solimp)
     if surface.kp is not None or surface.kd is not None:
         _report_softness(origin, surface, softness, masses.of(origin.body), report)
 
 
 def _report_softness(
-    origin: GeomOrigin, surface: Surface, softness: Any, mass: float, report: Report
+    origin: GeomOrigin, surface: Surface, softness: ContactSoftness, mass: float, report: Report
 ) -> None:
     subject = f"link '{origin.link}' geom '{origin.geom}'"
     figures = (
@@ -221,7 +229,7 @@ def _report_ignored_surface(subject: str, surface: Surface, report: Report) -> N
 
 
 def _apply_visuals(
-    spec: Any, ext: GazeboExtensions, provenance: Provenance, report: Report
+    spec: mujoco.MjSpec, ext: GazeboExtensions, provenance: Provenance, report: Report
 ) -> None:
     for link, link_ext in ext.links.items():
         if link in ext.unresolved:
@@ -241,12 +249,14 @@ def _apply_visuals(
         for origin in provenance.geoms_of_link(link, role="visual"):
             geom = spec.geom(origin.geom)
             if geom is not None:
-                geom.rgba = list(rgba)
+                geom.rgba = np.array(rgba)
                 geom.material = ""  # a Gazebo material replaces the URDF one, as in sdformat
         report.mapped(f"link '{link}'", f"visual colour rgba={rgba}", tag="material")
 
 
-def body_flags(spec: Any, ext: GazeboExtensions, provenance: Provenance) -> dict[str, BodyFlags]:
+def body_flags(
+    spec: mujoco.MjSpec, ext: GazeboExtensions, provenance: Provenance
+) -> dict[str, BodyFlags]:
     """Merge the link-level tags of every link onto the body that carries it.
 
     sdformat moves the extensions of a lumped link to its parent, so a link-level tag of any
@@ -274,7 +284,7 @@ def body_flags(spec: Any, ext: GazeboExtensions, provenance: Provenance) -> dict
     return flags
 
 
-def _apply_body_flags(spec: Any, flags: dict[str, BodyFlags], report: Report) -> None:
+def _apply_body_flags(spec: mujoco.MjSpec, flags: dict[str, BodyFlags], report: Report) -> None:
     for flag in flags.values():
         subject = f"body '{flag.body}' (links {', '.join(flag.links)})"
         if not flag.feels_gravity:
@@ -297,7 +307,10 @@ def _apply_body_flags(spec: Any, flags: dict[str, BodyFlags], report: Report) ->
 
 
 def add_self_collision_excludes(
-    spec: Any, provenance: Provenance, flags: dict[str, BodyFlags], model_self_collide: bool
+    spec: mujoco.MjSpec,
+    provenance: Provenance,
+    flags: dict[str, BodyFlags],
+    model_self_collide: bool,
 ) -> int:
     """Gazebo's self-collision rule as `<exclude>` pairs between the robot's bodies.
 
@@ -320,7 +333,11 @@ def add_self_collision_excludes(
 
 
 def _may_collide(
-    spec: Any, first: str, second: str, flags: dict[str, BodyFlags], model_self_collide: bool
+    spec: mujoco.MjSpec,
+    first: str,
+    second: str,
+    flags: dict[str, BodyFlags],
+    model_self_collide: bool,
 ) -> bool:
     if _parent_name(spec, first) == second or _parent_name(spec, second) == first:
         return False
@@ -328,6 +345,6 @@ def _may_collide(
     return any(wants)
 
 
-def _parent_name(spec: Any, body: str) -> str | None:
+def _parent_name(spec: mujoco.MjSpec, body: str) -> str | None:
     parent = spec.body(body).parent
     return None if parent is None else parent.name

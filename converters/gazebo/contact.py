@@ -22,7 +22,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import mujoco
 
 GROUND_MU = 100.0
 """μ of Gazebo's stock ground plane (`ground_plane` model, `surface/friction/ode/mu`)."""
@@ -166,7 +171,7 @@ def limit_solref(erp: float | None, timestep: float = GAZEBO_STEP) -> tuple[floa
     return (2.0 * timestep, 1.0 / (2.0 * math.sqrt(erp)))
 
 
-def add_gazebo_ground(spec: Any) -> None:
+def add_gazebo_ground(spec: mujoco.MjSpec) -> None:
     """Add Gazebo's stock ground plane: an infinite plane geom "ground", μ=100 (μ2=50).
 
     MuJoCo geoms are isotropic, so the plane carries μ=GROUND_MU; its priority comes from
@@ -183,6 +188,6 @@ def add_gazebo_ground(spec: Any) -> None:
         size=[0.0, 0.0, 1.0],
         rgba=[0.8, 0.8, 0.8, 1.0],
     )
-    geom.friction = [GROUND_MU, 0.005, 0.0001]
+    geom.friction = np.array([GROUND_MU, 0.005, 0.0001])
     geom.priority = friction_priority(GROUND_MU)
     geom.condim = 3

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from converters.description.gazebo import Blob, GazeboExtensions, JointExtension
 from converters.gazebo.contact import DEFAULT_LIMIT_ERP, LIMIT_SOLIMP, limit_solref
 from converters.provenance import Provenance
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 BLOB_REASONS = {
     "plugin": "Gazebo plugins are not run by twin",
@@ -23,7 +28,7 @@ BLOB_REASONS = {
 
 
 def apply_joint_tags(
-    spec: Any, ext: GazeboExtensions, provenance: Provenance, report: Report
+    spec: mujoco.MjSpec, ext: GazeboExtensions, provenance: Provenance, report: Report
 ) -> None:
     """Map springStiffness/springReference/stopErp/... of each tagged joint onto the spec.
 
@@ -49,7 +54,9 @@ def apply_joint_tags(
         _apply_joint(joint, joint_ext, subject, report)
 
 
-def _apply_default_limit_softness(spec: Any, provenance: Provenance, report: Report) -> None:
+def _apply_default_limit_softness(
+    spec: mujoco.MjSpec, provenance: Provenance, report: Report
+) -> None:
     """Gazebo's default joint limit (SDF `limit/erp` 0.2, cfm 0: hard) on every robot joint.
 
     `converters.gazebo.contact.limit_solref` gives MuJoCo the reference dynamics of ODE's limit row
@@ -62,8 +69,8 @@ def _apply_default_limit_softness(spec: Any, provenance: Provenance, report: Rep
     for mj_joint in provenance.joints:
         joint = spec.joint(mj_joint)
         if joint is not None:
-            joint.solref_limit = [timeconst, ratio]
-            joint.solimp_limit = list(LIMIT_SOLIMP)
+            joint.solref_limit = np.array([timeconst, ratio])
+            joint.solimp_limit = np.array(LIMIT_SOLIMP)
             count += 1
     if count:
         report.mapped(
@@ -80,18 +87,18 @@ def _has_dynamics(joint_ext: JointExtension) -> bool:
     return any(getattr(joint_ext, n) is not None for n in names)
 
 
-def _apply_joint(joint: Any, ext: JointExtension, subject: str, report: Report) -> None:
+def _apply_joint(joint: mujoco.MjsJoint, ext: JointExtension, subject: str, report: Report) -> None:
     if ext.spring_stiffness is not None:
         stiffness = list(joint.stiffness)
         stiffness[0] = ext.spring_stiffness
-        joint.stiffness = stiffness
+        joint.stiffness = np.array(stiffness)
         report.mapped(subject, f"joint stiffness {ext.spring_stiffness}", tag="springStiffness")
     if ext.spring_reference is not None:
         joint.springref = ext.spring_reference
         report.mapped(subject, f"springref {ext.spring_reference}", tag="springReference")
     if ext.stop_erp is not None or ext.stop_cfm is not None:
         timeconst, ratio = limit_solref(ext.stop_erp)
-        joint.solref_limit = [timeconst, ratio]
+        joint.solref_limit = np.array([timeconst, ratio])
         entry = report.approximated if ext.stop_cfm else report.mapped
         entry(
             subject,

@@ -15,12 +15,17 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from converters.control_text import set_control_record
 from converters.description.gazebo import Blob
 from converters.errors import GazeboTagError
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 DIFF_DRIVE_FILES = ("libgazebo_ros_diff_drive.so", "gazebo_ros_diff_drive")
 CONTROL_FILES = ("libgazebo_ros2_control.so", "libgazebo_ros_control.so", "gazebo_ros2_control")
@@ -139,7 +144,7 @@ def read_plugins(blobs: tuple[Blob, ...], source: str) -> tuple[DiffDrive, ...]:
     return tuple(read_diff_drive(b, source) for b in blobs if plugin_kind(b) == "diff_drive")
 
 
-def add_drive_motors(spec: Any, drives: tuple[DiffDrive, ...], report: Report) -> None:
+def add_drive_motors(spec: mujoco.MjSpec, drives: tuple[DiffDrive, ...], report: Report) -> None:
     """Gives each wheel joint of each drive a motor (±max wheel torque) unless it has one.
 
     Raises:
@@ -158,12 +163,12 @@ def add_drive_motors(spec: Any, drives: tuple[DiffDrive, ...], report: Report) -
             motor = spec.add_actuator(name=joint, target=joint)
             motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
             motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            motor.ctrlrange = [-drive.max_wheel_torque, drive.max_wheel_torque]
+            motor.ctrlrange = np.array([-drive.max_wheel_torque, drive.max_wheel_torque])
             _velocity_only(spec, joint, drive)
             driven.add(joint)
 
 
-def _velocity_only(spec: Any, joint: str, drive: DiffDrive) -> None:
+def _velocity_only(spec: mujoco.MjSpec, joint: str, drive: DiffDrive) -> None:
     """The plugin drives its wheels by velocity only (its joints' only command interface)."""
     record = {
         "modes": ["velocity"],

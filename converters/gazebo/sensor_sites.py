@@ -10,7 +10,7 @@ Gazebo's convention (look along +x, +z up) to MuJoCo's (look along −z, +y up).
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +22,7 @@ from converters.description.sensors import (
     CameraSpec,
     ForceTorqueSpec,
     ImuSpec,
+    Noise,
     RaySpec,
     SensorSpec,
 )
@@ -31,6 +32,9 @@ from converters.gazebo.sensors import KINDS, Placement, read_sensor
 from converters.provenance import Provenance
 from converters.report import Report
 
+if TYPE_CHECKING:
+    import mujoco
+
 SITE_GROUP = 5  # the group of the builder's frame sites (lumped links, SDF frames)
 # Gazebo camera axes (x forward, y left, z up) in MuJoCo camera axes (x right, y up, z back).
 R_SENSOR_CAMERA = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -38,7 +42,7 @@ NATIVE_KIND = {ImuSpec: "imu", ForceTorqueSpec: "force_torque"}  # keys of NATIV
 
 
 def add_sensors(
-    spec: Any, robot: RobotDescription, provenance: Provenance, report: Report
+    spec: mujoco.MjSpec, robot: RobotDescription, provenance: Provenance, report: Report
 ) -> tuple[SensorSpec, ...]:
     """Read every sensor of the robot, place a site for each and report what was mapped.
 
@@ -98,7 +102,7 @@ def _candidates(
                 reason = "fixed joint lumped into its parent; set preserveFixedJoint to measure it"
                 report.ignored(subject, reason, tag="sensor")
                 continue
-            placement = Placement(joint.child, body, name, parent, tuple(joint.anchor))
+            placement = Placement(joint.child, body, name, parent, joint.anchor)
             out.append((blob, placement, subject))
     return out
 
@@ -113,7 +117,7 @@ def _collision_geoms(link: str, body: str, provenance: Provenance) -> tuple[str,
 
 
 def _add_site(
-    spec: Any, sensor: SensorSpec, robot: RobotDescription, provenance: Provenance
+    spec: mujoco.MjSpec, sensor: SensorSpec, robot: RobotDescription, provenance: Provenance
 ) -> None:
     """The sensor's site (and camera) on its link's body, at link pose × sensor pose."""
     T_body_link = _T_body_link(spec, sensor.link, sensor.body)
@@ -133,7 +137,7 @@ def _add_site(
     _add_native(spec, sensor)
 
 
-def _add_native(spec: Any, sensor: SensorSpec) -> None:
+def _add_native(spec: mujoco.MjSpec, sensor: SensorSpec) -> None:
     """MuJoCo's own sensors on the site, computed in C at every step (`sensor:<name>:<part>`).
 
     A running world then reads an IMU or F/T sensor by copying `sensordata` (a few µs under
@@ -164,10 +168,10 @@ def _add_native(spec: Any, sensor: SensorSpec) -> None:
 
 def robot_anchor(robot: RobotDescription, joint: str) -> tuple[float, float, float]:
     """The joint's origin in its child link's frame [m]."""
-    return next(tuple(j.anchor) for j in robot.joints if j.name == joint)
+    return next(j.anchor for j in robot.joints if j.name == joint)
 
 
-def _T_body_link(spec: Any, link: str, body: str) -> np.ndarray:
+def _T_body_link(spec: mujoco.MjSpec, link: str, body: str) -> np.ndarray:
     """The link frame in its body: identity, or the lumped link's frame site (builder)."""
     if link == body:
         return np.eye(4)
@@ -227,7 +231,7 @@ def _details(sensor: SensorSpec) -> str:
     return f"contacts of {len(getattr(sensor, 'geoms', ()))} collision geoms"
 
 
-def _noise(noise: Any) -> str:
+def _noise(noise: Noise) -> str:
     if not noise.active:
         return "none"
     return f"{noise.type} mean {noise.mean:g} stddev {noise.stddev:g}"

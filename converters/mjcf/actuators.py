@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+import numpy as np
+
 from converters.description import Joint, RobotDescription
 from converters.errors import URDFStructureError
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 ACTUATABLE = ("revolute", "continuous", "prismatic")
 
@@ -35,7 +42,7 @@ def _effort(joint: Joint) -> float:
 
 
 def add_motors(
-    spec: object, joints: list[Joint], report: Report, tagged: frozenset[str] = frozenset()
+    spec: mujoco.MjSpec, joints: list[Joint], report: Report, tagged: frozenset[str] = frozenset()
 ) -> None:
     """One motor per joint, named after it, with ctrlrange = forcerange = ±effort [N or N·m].
 
@@ -68,12 +75,12 @@ def add_motors(
             )
             continue
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        actuator.ctrlrange = [-effort, effort]
+        actuator.ctrlrange = np.array([-effort, effort])
         actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        actuator.forcerange = [-effort, effort]
+        actuator.forcerange = np.array([-effort, effort])
 
 
-def add_mimics(spec: object, robot: RobotDescription, report: Report) -> None:
+def add_mimics(spec: mujoco.MjSpec, robot: RobotDescription, report: Report) -> None:
     """Each `<mimic>`: follower = offset + multiplier · leader, as a joint equality.
 
     MuJoCo's joint equality constrains `joint1 = polycoef[0] + polycoef[1]·joint2 + …`

@@ -6,6 +6,7 @@ Format-free: it reads only `converters.description`, so URDF and SDF robots buil
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
 from converters.provenance import GeomOrigin, Provenance
 from converters.report import Report
 from converters.resources.mesh_data import MeshData
+
+if TYPE_CHECKING:
+    import mujoco
 
 # Menagerie conventions and Gazebo's default world step (SDF physics max_step_size 0.001 s).
 TIMESTEP = 0.001
@@ -55,7 +59,7 @@ def pose(T: np.ndarray) -> tuple[list[float], list[float]]:
     return T[:3, 3].tolist(), quat.tolist()
 
 
-def new_spec(name: str) -> object:
+def new_spec(name: str) -> mujoco.MjSpec:
     """An empty spec with twin's compiler settings, option and default classes."""
     import mujoco
 
@@ -80,7 +84,7 @@ def build_spec(
     options: ConvertOptions,
     report: Report,
     provenance: Provenance,
-) -> object:
+) -> mujoco.MjSpec:
     """Build the robot's MjSpec (Gazebo tags are applied afterwards by the caller).
 
     Gazebo's model flags shape the bodies: `<static>` welds the base, preserveFixedJoint and
@@ -117,13 +121,13 @@ def build_spec(
 
 
 def _add_bodies(
-    spec: object,
+    spec: mujoco.MjSpec,
     plan: BodyPlan,
     inertias: dict[str, inr.Inertia],
     report: Report,
     provenance: Provenance,
-) -> tuple[dict[str, object], list[MjJointPlan]]:
-    bodies: dict[str, object] = {WORLDBODY: spec.worldbody}
+) -> tuple[dict[str, mujoco.MjsBody], list[MjJointPlan]]:
+    bodies: dict[str, mujoco.MjsBody] = {WORLDBODY: spec.worldbody}
     joints: list[MjJointPlan] = []
     for node in plan.bodies:
         pos, quat = pose(node.T_parent_body)
@@ -142,7 +146,7 @@ def _add_bodies(
     return bodies, joints
 
 
-def _set_inertial(body: object, value: inr.Inertia) -> None:
+def _set_inertial(body: mujoco.MjsBody, value: inr.Inertia) -> None:
     """Principal moments + axes quaternion: keeps the full tensor, off-diagonals included."""
     moments, quat = inr.principal(value)
     body.explicitinertial = True
@@ -152,7 +156,7 @@ def _set_inertial(body: object, value: inr.Inertia) -> None:
     body.inertia = moments.tolist()
 
 
-def _add_sites(bodies: dict[str, object], plan: BodyPlan, robot: RobotDescription) -> None:
+def _add_sites(bodies: dict[str, mujoco.MjsBody], plan: BodyPlan, robot: RobotDescription) -> None:
     """Lumped links and named frames (SDF `<frame>`) stay addressable as sites at their poses."""
     placed = [(link, plan.placements[link].T_body_link, link) for link in plan.lumped]
     for frame in robot.frames:
@@ -169,8 +173,8 @@ def _add_sites(bodies: dict[str, object], plan: BodyPlan, robot: RobotDescriptio
 
 
 def _add_geoms(
-    spec: object,
-    bodies: dict[str, object],
+    spec: mujoco.MjSpec,
+    bodies: dict[str, mujoco.MjsBody],
     geoms: list[GeomPlan],
     settings: CollisionSettings,
     report: Report,
@@ -201,12 +205,12 @@ def _add_geoms(
             mj = bodies[geom.body].add_geom(defaults[geom.role], name=name, pos=pos, quat=quat)
             if mesh is None:
                 mj.type = _primitive(geom.kind)
-                mj.size = list(geom.size) + [0.0] * (3 - len(geom.size))
+                mj.size = np.array(list(geom.size) + [0.0] * (3 - len(geom.size)))
             else:
                 mj.type = mujoco.mjtGeom.mjGEOM_MESH
                 mj.meshname = meshes.name_for(mesh, geom, flat=geom.degenerate is not None)
             if geom.colour is not None:
-                mj.rgba = list(geom.colour.rgba)
+                mj.rgba = np.array(geom.colour.rgba)
                 if geom.colour.texture and part == 0:
                     report.approximated(
                         f"link '{geom.link}' visual {geom.index}",
@@ -239,7 +243,11 @@ def _collision_parts(
     for key, parts in prepared.items():
         whole = by_key[key]
         out[key] = [
-            next(g.mesh for g in geoms if g.role == "collision" and _key(g) == key)
+            next(
+                g.mesh
+                for g in geoms
+                if g.role == "collision" and g.mesh is not None and _key(g) == key
+            )
             if p.vertices is whole.vertices
             else MeshData(np.asarray(p.vertices, float), np.asarray(p.faces, np.int32))
             for p in parts
@@ -250,7 +258,7 @@ def _collision_parts(
 class _MeshAssets:
     """Mesh assets carried inside the spec (vertex and face data, no files); one per mesh."""
 
-    def __init__(self, spec: object) -> None:
+    def __init__(self, spec: mujoco.MjSpec) -> None:
         self.spec = spec
         self.names: dict[int, str] = {}
         self.used: set[str] = set()
@@ -267,7 +275,9 @@ class _MeshAssets:
             n += 1
             name = f"{base}_{n}"
         asset = self.spec.add_mesh(
-            name=name, uservert=mesh.vertices.reshape(-1), userface=mesh.faces.reshape(-1)
+            name=name,
+            uservert=mesh.vertices.reshape(-1).tolist(),
+            userface=mesh.faces.reshape(-1).tolist(),
         )
         if flat:
             asset.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
@@ -301,7 +311,7 @@ def _summarise(
     )
 
 
-def _primitive(kind: str) -> object:
+def _primitive(kind: str) -> mujoco.mjtGeom:
     """The MuJoCo geom type of a primitive shape."""
     import mujoco
 

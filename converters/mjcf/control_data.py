@@ -12,9 +12,14 @@ so a delete's cost would otherwise grow with the robot's motor count.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from converters.control_text import set_control_record
 from converters.description import CONTROL_PLUGINS, MODES, Joint, JointControl, RobotDescription
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 
 def control_record(joint: Joint, control: JointControl | None, enabled: str | None) -> dict:
@@ -40,7 +45,11 @@ def control_record(joint: Joint, control: JointControl | None, enabled: str | No
 
 
 def add_control_data(
-    spec: object, joints: list[Joint], motors: set[str], robot: RobotDescription, report: Report
+    spec: mujoco.MjSpec,
+    joints: list[Joint],
+    motors: set[str],
+    robot: RobotDescription,
+    report: Report,
 ) -> None:
     """Each motor's record in the `control` text, and a report line saying which rule applies."""
     controls = {c.joint: c for c in robot.controls}

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from converters.description import Geometry, RobotDescription
+from converters.description import Geometry, RobotDescription, Visual
 from converters.mjcf.lumping import BodyPlan
 from converters.mjcf.materials import VisualColour, visual_colour
 from converters.report import Report
@@ -76,7 +76,7 @@ def plan_geoms(robot: RobotDescription, plan: BodyPlan, report: Report) -> list[
         for role, items in (("visual", link.visuals), ("collision", link.collisions)):
             for index, item in enumerate(items):
                 T = placement.T_body_link @ item.origin
-                colour = visual_colour(item.material) if role == "visual" else None
+                colour = visual_colour(item.material) if isinstance(item, Visual) else None
                 geom = _plan_one(item.geometry, link.name, cache)
                 if geom is None:
                     report.ignored(f"link '{link.name}' {role} {index}", "no geometry")

@@ -55,7 +55,7 @@ def combine(parts: list[Inertia]) -> Inertia:
     mass = sum(p.mass for p in parts)
     if mass <= 0:
         return Inertia(0.0, np.zeros(3), sum((p.tensor for p in parts), np.zeros((3, 3))))
-    com = sum(p.mass * p.com for p in parts) / mass
+    com = sum((p.mass * p.com for p in parts), np.zeros(3)) / mass
     tensor = np.zeros((3, 3))
     for p in parts:
         d = p.com - com

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.description import WORLD_LINK, Joint
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 # Name of the free joint of a floating base (prefixed by the entity name after attach).
 FREE_JOINT = "floating_base"
@@ -27,7 +31,7 @@ class MjJointPlan:
     home: tuple[float, ...]
 
 
-def add_joints(body: object, joint: Joint | None, report: Report) -> list[MjJointPlan]:
+def add_joints(body: mujoco.MjsBody, joint: Joint | None, report: Report) -> list[MjJointPlan]:
     """Add the MuJoCo joint(s) for `joint` to `body`; returns them in qpos order."""
     if joint is None:
         return []
@@ -52,16 +56,20 @@ def _axis(joint: Joint) -> np.ndarray:
     return axis / norm if norm > 0 else np.array([1.0, 0.0, 0.0])
 
 
-def _limited(body: object, joint: Joint, kind: int, report: Report) -> list[MjJointPlan]:
+def _limited(
+    body: mujoco.MjsBody, joint: Joint, kind: mujoco.mjtJoint, report: Report
+) -> list[MjJointPlan]:
     """revolute (hinge) or prismatic (slide) with range, damping and friction."""
     import mujoco
 
-    mj = body.add_joint(name=joint.name, type=kind, axis=_axis(joint), pos=list(joint.anchor))
+    mj = body.add_joint(
+        name=joint.name, type=kind, axis=_axis(joint).tolist(), pos=list(joint.anchor)
+    )
     _dynamics(mj, joint)
     lower, upper = _bounds(joint)
     if lower is not None and upper is not None and lower < upper:
         mj.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-        mj.range = [lower, upper]
+        mj.range = np.array([lower, upper])
         home = min(max(0.0, lower), upper)
         return [MjJointPlan(joint.name, joint.name, joint.kind, (lower, upper), (home,))]
     mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
@@ -79,36 +87,39 @@ def _bounds(joint: Joint) -> tuple[float | None, float | None]:
     return joint.limit.lower, joint.limit.upper
 
 
-def _dynamics(mj: object, joint: Joint) -> None:
+def _dynamics(mj: mujoco.MjsJoint, joint: Joint) -> None:
     if joint.dynamics is not None:
-        mj.damping = [joint.dynamics.damping, 0.0, 0.0]
+        mj.damping = np.array([joint.dynamics.damping, 0.0, 0.0])
         mj.frictionloss = joint.dynamics.friction
 
 
-def _revolute(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _revolute(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     return _limited(body, joint, mujoco.mjtJoint.mjJNT_HINGE, report)
 
 
-def _prismatic(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _prismatic(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     return _limited(body, joint, mujoco.mjtJoint.mjJNT_SLIDE, report)
 
 
-def _continuous(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _continuous(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     import mujoco
 
     mj = body.add_joint(
-        name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=_axis(joint), pos=list(joint.anchor)
+        name=joint.name,
+        type=mujoco.mjtJoint.mjJNT_HINGE,
+        axis=_axis(joint).tolist(),
+        pos=list(joint.anchor),
     )
     mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     _dynamics(mj, joint)
     return [MjJointPlan(joint.name, joint.name, "continuous", None, (0.0,))]
 
 
-def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _planar(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     """Motion in the plane normal to the axis: two slides in the plane and a hinge about it."""
     import mujoco
 
@@ -124,7 +135,7 @@ def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
         ("yaw", mujoco.mjtJoint.mjJNT_HINGE, normal),
     ):
         mj = body.add_joint(
-            name=f"{joint.name}_{suffix}", type=kind, axis=axis, pos=list(joint.anchor)
+            name=f"{joint.name}_{suffix}", type=kind, axis=axis.tolist(), pos=list(joint.anchor)
         )
         _dynamics(mj, joint)
         out.append(MjJointPlan(mj.name, joint.name, "planar", None, (0.0,)))
@@ -132,7 +143,7 @@ def _planar(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     return out
 
 
-def _floating(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _floating(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     """A floating joint: a free joint on a top-level body, else three slides and a ball (MuJoCo
     free joints must be top-level)."""
     import mujoco
@@ -154,7 +165,7 @@ def _floating(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
     return out
 
 
-def _spherical(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
+def _spherical(body: mujoco.MjsBody, joint: Joint, report: Report) -> list[MjJointPlan]:
     """Non-standard `spherical` (accepted by several parsers): a ball joint, unlimited."""
     import mujoco
 
@@ -164,7 +175,7 @@ def _spherical(body: object, joint: Joint, report: Report) -> list[MjJointPlan]:
 
 
 def add_free_joint(
-    body: object, pos: list[float], quat: list[float], name: str = FREE_JOINT
+    body: mujoco.MjsBody, pos: list[float], quat: list[float], name: str = FREE_JOINT
 ) -> MjJointPlan:
     """A named free joint; home = the body's pose (position [m], quaternion w-x-y-z)."""
     body.add_freejoint(name=name)

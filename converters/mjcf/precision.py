@@ -9,7 +9,10 @@ maps to something else is left exactly as MuJoCo wrote it.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import mujoco
 
 # Spec attribute names where the XML attribute name differs, by (element tag, attribute).
 ALIASES = {
@@ -43,7 +46,7 @@ ROUNDING = 5e-6
 TINY = 1e-10
 
 
-def restore_precision(xml: str, spec: Any) -> str:
+def restore_precision(xml: str, spec: mujoco.MjSpec) -> str:
     """`xml` (from `spec.to_xml()`) with every recognised number at full double precision."""
     from lxml import etree
 
@@ -58,7 +61,7 @@ def restore_precision(xml: str, spec: Any) -> str:
     return etree.tostring(root, encoding="unicode") + "\n"
 
 
-def _spec_object(spec: Any, element: Any) -> Any:
+def _spec_object(spec: mujoco.MjSpec, element: Any) -> object | None:
     if element.tag == "inertial":
         parent = element.getparent()
         return _find(spec, "body", parent.get("name")) if parent is not None else None
@@ -68,7 +71,7 @@ def _spec_object(spec: Any, element: Any) -> Any:
     return _find(spec, kind, element.get("name")) if kind else None
 
 
-def _find(spec: Any, kind: str, name: str | None) -> Any:
+def _find(spec: mujoco.MjSpec, kind: str, name: str | None) -> object | None:
     if not name:
         return None
     try:
@@ -77,9 +80,9 @@ def _find(spec: Any, kind: str, name: str | None) -> Any:
         return None
 
 
-def _rewrite(element: Any, target: Any) -> None:
+def _rewrite(element: Any, target: object) -> None:
     for attribute, text in element.attrib.items():
-        name = ALIASES.get((element.tag, attribute), attribute)
+        name = ALIASES.get((element.tag, attribute)) or attribute
         if name == "name" or not hasattr(target, name):
             continue
         written = _numbers(text)

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import mujoco
+import numpy as np
 
 # MuJoCo's solver and integrator names, as users type them (lower case).
 SOLVERS = {
@@ -62,7 +63,7 @@ class WorldOptions:
 def apply_world_options(spec: mujoco.MjSpec, options: WorldOptions = WorldOptions()) -> None:
     """Writes timestep, gravity, iterations, solver, integrator and tolerance into `spec.option`."""
     spec.option.timestep = options.timestep
-    spec.option.gravity = list(options.gravity)
+    spec.option.gravity = np.array(options.gravity)
     spec.option.iterations = options.iterations
     spec.option.solver = SOLVERS[options.solver]
     spec.option.integrator = INTEGRATORS[options.integrator]

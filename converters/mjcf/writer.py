@@ -7,10 +7,14 @@ import re
 import shutil
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
 
 ASSETS = "assets"
 SCENE = "scene.xml"
@@ -37,7 +41,7 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
     return _STL_HEADER + count + records.tobytes()
 
 
-def robot_xml(spec: object, assets_dir: Path) -> str:
+def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
     """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
     copy = spec.copy()
     copy.modelfiledir = str(assets_dir.parent)  # to_xml compiles: let it find the new files
@@ -79,7 +83,7 @@ def scene_xml(robot_file: str, model_name: str) -> str:
     return f'{head}  <include file="{robot_file}"/>\n{sep}{rest}'
 
 
-def write_model(spec: object, report: Report, out_dir: str | Path) -> Path:
+def write_model(spec: mujoco.MjSpec, report: Report, out_dir: str | Path) -> Path:
     """Write the converted robot as an MJCF directory, replacing `out_dir` atomically.
 
     Layout: `OUT/<robot>.xml`, `OUT/scene.xml` (ground + light + robot), `OUT/assets/*.stl`;

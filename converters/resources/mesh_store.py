@@ -56,7 +56,7 @@ def load(key: str) -> MeshData | None:
         path.unlink(missing_ok=True)
         return None
     rgba = tuple(meta["rgba"]) if meta["rgba"] is not None else None
-    return MeshData(vertices, faces, rgba, bool(meta["textured"]))  # type: ignore[arg-type]
+    return MeshData(vertices, faces, rgba, bool(meta["textured"]))
 
 
 def store(key: str, mesh: MeshData) -> None:

@@ -5,11 +5,16 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.errors import MeshError
 from converters.resources.mesh_data import MeshData
+
+if TYPE_CHECKING:
+    import trimesh
+    from PIL.Image import Image
 
 # Relative size below which a mesh counts as flat: smallest/largest principal extent.
 FLAT_RATIO = 1e-6
@@ -121,7 +126,7 @@ def read_with_trimesh(path: Path, link: str) -> MeshData:
 
     logging.getLogger("trimesh").setLevel(logging.ERROR)
     try:
-        loaded = trimesh.load(str(path), process=False, force="scene")
+        loaded = trimesh.load_scene(str(path), process=False)
     except Exception as exc:  # trimesh raises many types for corrupt files
         raise MeshError(str(path), link, f"cannot be read ({exc})") from exc
     parts_v: list[np.ndarray] = []
@@ -143,7 +148,7 @@ def read_with_trimesh(path: Path, link: str) -> MeshData:
     return MeshData(vertices * _unit_to_metres(loaded, path), faces, rgba, textured)
 
 
-def _main_colour(scene: object) -> tuple[tuple[float, float, float, float] | None, bool]:
+def _main_colour(scene: trimesh.Scene) -> tuple[tuple[float, float, float, float] | None, bool]:
     """The colour of the geometry with most faces that defines one, and whether any is textured.
 
     Gazebo draws a mesh in its own material colours when the URDF gives none; MuJoCo geoms
@@ -161,7 +166,7 @@ def _main_colour(scene: object) -> tuple[tuple[float, float, float, float] | Non
                 colour = _mean_colour(image)
             elif material is not None:
                 colour = material.main_color
-            elif getattr(visual, "defined", False):
+            elif visual is not None and getattr(visual, "defined", False):
                 colour = visual.main_color
             else:
                 continue
@@ -170,11 +175,11 @@ def _main_colour(scene: object) -> tuple[tuple[float, float, float, float] | Non
         rgba = tuple(float(c) / 255.0 for c in np.asarray(colour).reshape(-1)[:4])
         faces = len(getattr(geometry, "faces", ()))
         if len(rgba) == 4 and (best is None or faces > best[0]):
-            best = (faces, rgba)  # type: ignore[assignment]
+            best = (faces, rgba)
     return (best[1] if best else None), textured
 
 
-def _mean_colour(image: object) -> np.ndarray:
+def _mean_colour(image: Image) -> np.ndarray:
     """Average RGBA [0-255] of a texture image, from about 16×16 strided pixels.
 
     Strided sampling of the decoded pixels avoids converting and resizing whole textures
@@ -191,7 +196,7 @@ def _mean_colour(image: object) -> np.ndarray:
     return np.append(rgb, 255.0)
 
 
-def _unit_to_metres(scene: object, path: Path) -> float:
+def _unit_to_metres(scene: trimesh.Scene, path: Path) -> float:
     """COLLADA files declare their unit (`<unit meter="0.0254"/>`); Gazebo's loader applies it,
     so we do too (aliengo's calf.dae is in inches). Other formats carry no unit: metres."""
     from trimesh.units import unit_conversion

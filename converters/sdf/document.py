@@ -107,7 +107,7 @@ class _SdfValues(ValueContext):
         self.ctx = ctx
         self.element = element
 
-    def fail(self, tag: str, value: str, expected: str) -> SDFError:  # type: ignore[override]
+    def fail(self, tag: str, value: str, expected: str) -> SDFError:
         found = self.element.find(tag)
         at = found if found is not None else self.element
         return self.ctx.error(at, f"<{tag}> {value!r} is not {expected}", f"write {expected}")

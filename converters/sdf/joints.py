@@ -12,6 +12,7 @@ import numpy as np
 
 from converters.description import WORLD_LINK, Dynamics, Joint, JointExtension, Limit, Mimic
 from converters.description.gazebo import Blob
+from converters.description.transforms import vec3
 from converters.gazebo.tags import to_xml
 from converters.sdf.document import SdfContext, line_of
 from converters.sdf.poses import MODEL_FRAME, PoseGraph, scoped
@@ -60,7 +61,7 @@ def read_joint(
         child=child,
         origin=np.linalg.inv(X_M_P) @ X_M_C,
         axis=_axis(ctx, graph, axis_element, prefix, X_M_C, X_C_J),
-        anchor=tuple(float(v) for v in X_C_J[:3, 3]),  # type: ignore[arg-type]
+        anchor=vec3(X_C_J[:3, 3]),
         limit=_limit(ctx, axis_element, kind),
         dynamics=_dynamics(ctx, axis_element),
         mimic=_mimic(ctx, axis_element, prefix),
@@ -119,7 +120,7 @@ def _axis(
         R_C_axis = X_C_J[:3, :3]
     else:
         R_C_axis = X_M_C[:3, :3].T @ graph.pose(scoped(frame, prefix), axis)[:3, :3]
-    return tuple(float(v) for v in R_C_axis @ xyz)  # type: ignore[return-value]
+    return vec3(R_C_axis @ xyz)
 
 
 def _limit(ctx: SdfContext, axis: Any, kind: str) -> Limit | None:
@@ -175,4 +176,4 @@ def _extension(ctx: SdfContext, joint: Any, axis: Any, name: str) -> JointExtens
         Blob("sensor", s.get("name"), s.get("type"), to_xml(s), f"{ctx.source}:{line_of(s)}")
         for s in joint.findall("sensor")
     )
-    return JointExtension(joint=name, **springs, **softness, sensors=sensors)  # type: ignore[arg-type]
+    return JointExtension(joint=name, **springs, **softness, sensors=sensors)

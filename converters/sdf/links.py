@@ -140,7 +140,7 @@ def _mesh(ctx: SdfContext, shape: Any, subject: str) -> Geometry:
         ctx.report.ignored(subject, "<submesh> is not supported; the whole mesh is used")
     path = ctx.resolver.resolve(uri, base_dir=directory_of(ctx, shape), element=subject)
     scale = ctx.vector(shape, "scale", 3, (1.0, 1.0, 1.0))
-    return Geometry("mesh", (), Path(path), uri, scale)  # type: ignore[arg-type]
+    return Geometry("mesh", (), Path(path), uri, scale)
 
 
 _SHAPES = {
@@ -175,11 +175,12 @@ def _material(ctx: SdfContext, visual: Any) -> Material | None:
             if len(values) not in (3, 4):
                 raise ctx.error(element, f"{raw!r} is not a colour", "write r g b [a] in 0-1")
             numbers = [ctx.parse_number(element, v) for v in values] + [1.0]
-            rgba = tuple(numbers[:4])
+            r, g, b, a = numbers[:4]  # three or four values, then the default alpha
+            rgba = (r, g, b, a)
             break
     if rgba is None and name is not None:
         rgba = gazebo_rgba(name)
-    return Material(name, rgba, None)  # type: ignore[arg-type]
+    return Material(name, rgba, None)
 
 
 def _extension(ctx: SdfContext, link: Any, name: str) -> LinkExtension:

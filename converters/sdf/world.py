@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from converters.description import Light, PlacedModel, WorldDescription
+from converters.description.transforms import vec3
 from converters.sdf.document import SdfContext, read_pose
 from converters.sdf.include import expand_includes
 from converters.sdf.model import read_model
@@ -80,8 +81,8 @@ def _gravity(ctx: SdfContext, world: Any) -> tuple[float, float, float]:
     if world.find("gravity") is None:
         holder = next((p for p in world.findall("physics") if p.find("gravity") is not None), None)
         if holder is not None:
-            return ctx.vector(holder, "gravity", 3, DEFAULT_GRAVITY)  # type: ignore[return-value]
-    return ctx.vector(world, "gravity", 3, DEFAULT_GRAVITY)  # type: ignore[return-value]
+            return ctx.vector(holder, "gravity", 3, DEFAULT_GRAVITY)
+    return ctx.vector(world, "gravity", 3, DEFAULT_GRAVITY)
 
 
 def _physics(ctx: SdfContext, world: Any) -> dict[str, Any]:
@@ -121,12 +122,12 @@ def _light(ctx: SdfContext, light: Any) -> Light:
     pose, _ = read_pose(ctx, light)
     direction = np.asarray(ctx.vector(light, "direction", 3, (0.0, 0.0, -1.0)))
     diffuse = ctx.text(light, "diffuse") or "0.8 0.8 0.8 1"
-    colour = tuple(float(v) for v in diffuse.split()[:3])
+    colour = vec3(float(v) for v in diffuse.split()[:3])
     return Light(
         name=light.get("name", "light"),
         kind=light.get("type", "point"),
         pose=pose,
-        direction=tuple(float(v) for v in pose[:3, :3] @ direction),  # type: ignore[arg-type]
-        diffuse=colour,  # type: ignore[arg-type]
+        direction=vec3(pose[:3, :3] @ direction),
+        diffuse=colour,
         cast_shadows=ctx.flag(light, "cast_shadows", False),
     )

@@ -95,9 +95,19 @@ def _floats(element: ET.Element | None, attribute: str, default: tuple[float, ..
     return default if raw is None else tuple(float(v) for v in raw.split())
 
 
-def _number(element: ET.Element | None, attribute: str, default: float | None) -> float | None:
+def _number(element: ET.Element | None, attribute: str, default: float) -> float:
+    value = _optional_number(element, attribute)
+    return default if value is None else value
+
+
+def _optional_number(element: ET.Element | None, attribute: str) -> float | None:
     raw = element.get(attribute) if element is not None else None
-    return default if raw is None else float(raw)
+    return None if raw is None else float(raw)
+
+
+def _link_of(joint: ET.Element, role: str) -> str:
+    """The link a joint's `<parent>` or `<child>` names (`check_tree` made sure it exists)."""
+    return joint.findall(role)[0].attrib["link"]
 
 
 def _origin(owner: ET.Element) -> np.ndarray:
@@ -151,13 +161,15 @@ class _LinkReader:
 
     def geometry(self, owner: ET.Element, link: str, role: str, index: int) -> Geometry:
         """The one shape of a `<visual>`/`<collision>` (xml_checks guarantees there is one)."""
-        shape = owner.find("geometry")[0]
+        shape = owner.findall("geometry")[0][0]
         if shape.tag == "box":
             return Geometry("box", _floats(shape, "size", ()))
         if shape.tag in ("cylinder", "capsule"):
-            return Geometry(shape.tag, (float(shape.get("radius")), float(shape.get("length"))))
+            return Geometry(
+                shape.tag, (float(shape.attrib["radius"]), float(shape.attrib["length"]))
+            )
         if shape.tag == "sphere":
-            return Geometry("sphere", (float(shape.get("radius")),))
+            return Geometry("sphere", (float(shape.attrib["radius"]),))
         element = f"link '{link}' <{role}> {index} <mesh>"
         uri = shape.get("filename", "")
         path = self.resolver.resolve(uri, base_dir=self.base_dir, element=element)
@@ -202,13 +214,13 @@ def _joint(joint: ET.Element) -> Joint:
     return Joint(
         name=joint.get("name", ""),
         kind=joint.get("type", ""),
-        parent=joint.find("parent").get("link"),
-        child=joint.find("child").get("link"),
+        parent=_link_of(joint, "parent"),
+        child=_link_of(joint, "child"),
         origin=_origin(joint),
         axis=_floats(joint.find("axis"), "xyz", DEFAULT_AXIS),
         limit=None
         if limit is None
-        else Limit(*(_number(limit, k, None) for k in ("lower", "upper", "effort", "velocity"))),
+        else Limit(*(_optional_number(limit, k) for k in ("lower", "upper", "effort", "velocity"))),
         dynamics=None
         if dynamics is None
         else Dynamics(_number(dynamics, "damping", 0.0), _number(dynamics, "friction", 0.0)),

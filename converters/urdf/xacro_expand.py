@@ -10,6 +10,7 @@ import xml.dom.minidom
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 from converters.errors import ConversionError, XacroError
 from converters.resources.packages import PackageResolver
@@ -140,7 +141,8 @@ def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver)
     FOUND.set({})
     with _LOCK, _patched_find(resolver) as macro_names, contextlib.redirect_stderr(stderr):
         try:
-            doc = xacro.process_file(str(path), mappings=dict(args))
+            # xacro has no annotations; process_file returns the expanded DOM document.
+            doc = cast(xml.dom.minidom.Document, xacro.process_file(str(path), mappings=dict(args)))
         except Exception as exc:  # xacro raises many types (XacroException, NameError, …)
             ours = _conversion_cause(exc)
             if ours is not None:
@@ -156,7 +158,10 @@ def expand_xacro(path: Path, args: Mapping[str, str], resolver: PackageResolver)
 def _unexpanded_calls(doc: xml.dom.minidom.Document, macro_names: set[str]) -> tuple[str, ...]:
     """Tags left in the output whose name is a macro's: calls written without `xacro:`."""
     found: list[str] = []
-    for node in doc.documentElement.getElementsByTagName("*"):
+    root = doc.documentElement
+    if root is None:
+        return ()
+    for node in root.getElementsByTagName("*"):
         tag = node.tagName.split(":")[-1]
         if tag in macro_names:
             attrs = " ".join(f'{k}="{v}"' for k, v in node.attributes.items())

@@ -95,30 +95,17 @@ def check_tree(root: ET.Element, source: str) -> str:
     _unique_names(root, "joint", source)
     if not links:
         raise URDFStructureError(source, "<robot>", "has no <link>", "add at least one link")
-    known = ", ".join(links)
     parent_of: dict[str, str] = {}
     for joint in root.findall("joint"):
-        name = joint.get("name")
-        for role in ("parent", "child"):
-            element = joint.find(role)
-            link = element.get("link") if element is not None else None
-            if link not in links:
-                raise URDFStructureError(
-                    source,
-                    f"joint '{name}'",
-                    f"{role} link {link!r} does not exist",
-                    f"use one of the links: {known}",
-                )
-        child = joint.find("child").get("link")
+        parent, child = _joint_links(joint, links, source)
         if child in parent_of:
             raise URDFStructureError(
                 source,
                 f"link '{child}'",
-                f"is the child of two joints (parents '{parent_of[child]}' "
-                f"and '{joint.find('parent').get('link')}')",
+                f"is the child of two joints (parents '{parent_of[child]}' and '{parent}')",
                 "a URDF must be a tree: remove one joint",
             )
-        parent_of[child] = joint.find("parent").get("link")
+        parent_of[child] = parent
     _check_acyclic(parent_of, source)
     roots = [link for link in links if link not in parent_of]
     if len(roots) != 1:
@@ -129,6 +116,27 @@ def check_tree(root: ET.Element, source: str) -> str:
             "connect them with joints so exactly one root remains",
         )
     return roots[0]
+
+
+def _joint_links(joint: ET.Element, links: list[str], source: str) -> tuple[str, str]:
+    """The joint's parent and child links.
+
+    Raises:
+        URDFStructureError: either is missing or names no link of the robot.
+    """
+    found: list[str] = []
+    for role in ("parent", "child"):
+        element = joint.find(role)
+        link = element.get("link") if element is not None else None
+        if link not in links:
+            raise URDFStructureError(
+                source,
+                f"joint '{joint.get('name')}'",
+                f"{role} link {link!r} does not exist",
+                f"use one of the links: {', '.join(links)}",
+            )
+        found.append(link)
+    return found[0], found[1]
 
 
 def _check_acyclic(parent_of: dict[str, str], source: str) -> None:

@@ -12,12 +12,17 @@ once the command's duration ran out, and integrates encoder odometry when the pl
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
 
 from twin_cli.control.kinematics import Pose2D, body_twist, integrate_encoders, ramp, rim_speeds
+
+if TYPE_CHECKING:
+    from converters.gazebo.plugins import DiffDrive
+    from twin_cli.world.engine import World
+    from twin_cli.world.entities import Entity
 
 FALLBACK_RATE = 100.0  # [Hz] for update_rate 0 ("every step" in Gazebo): no per-step Python
 MIN_RATE = 250.0
@@ -37,7 +42,7 @@ class DiffDriveController:
         entity: entity name; plugin: its `converters.gazebo.plugins.DiffDrive` record.
     """
 
-    def __init__(self, world: Any, entity: str, plugin: Any) -> None:
+    def __init__(self, world: World, entity: str, plugin: DiffDrive) -> None:
         self.world, self.entity, self.plugin = world, entity, plugin
         self.radius = plugin.wheel_diameter / 2.0
         self.plugin_rate = plugin.update_rate if plugin.update_rate > 0 else FALLBACK_RATE
@@ -46,7 +51,7 @@ class DiffDriveController:
         self.until = math.inf  # [s] sim time the command stops at
         self.rims = (0.0, 0.0)  # rim speeds [m/s] written at the last update
         self.updates = 0
-        self.entity_record: Any = None  # the Entity this controller was made for
+        self.entity_record: Entity | None = None  # the entity this controller was made for
         self._written: dict = {}  # the world's commands after our last write (reset clears them)
         self._start()
         self.handle = world.add_observer(self._update, self.rate)

@@ -11,10 +11,13 @@ from __future__ import annotations
 import math
 import threading
 import weakref
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.control.diff_drive import DiffDriveController
 from twin_cli.errors import InvalidRequestError
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 _CONTROLLERS: weakref.WeakKeyDictionary[Any, dict[str, DiffDriveController]] = (
     weakref.WeakKeyDictionary()
@@ -23,7 +26,7 @@ _GUARD = threading.Lock()
 
 
 def drive(
-    world: Any, entity: str, linear: float, angular: float, duration: float | None = None
+    world: World, entity: str, linear: float, angular: float, duration: float | None = None
 ) -> dict[str, Any]:
     """Commands entity's base at (v [m/s], ω [rad/s]), for `duration` [s] of sim time or until
     replaced (the lesson's /cmd_vel); returns the command as applied.
@@ -50,12 +53,12 @@ def drive(
     }
 
 
-def odometry(world: Any, entity: str) -> dict[str, Any]:
+def odometry(world: World, entity: str) -> dict[str, Any]:
     """The entity's odometry (pose and twist) as its diff drive reports it."""
     return controller_of(world, entity).odometry()
 
 
-def controller_of(world: Any, entity: str) -> DiffDriveController:
+def controller_of(world: World, entity: str) -> DiffDriveController:
     """The entity's diff-drive controller, created on first use.
 
     Raises:

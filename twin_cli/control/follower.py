@@ -15,10 +15,16 @@ import math
 import threading
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 from twin_cli.control.trajectory import Trajectory, TrajectoryPoint, sample, segment
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
+
+if TYPE_CHECKING:
+    import mujoco
+    import numpy as np
+
+    from twin_cli.world.engine import World
 
 UPDATE_RATE = 100.0  # [Hz] controller_manager's usual update_rate
 BLOCK = 100  # updates whose references are sampled at once (1 s at 100 Hz)
@@ -51,7 +57,7 @@ class TrackingReport:
 class TrajectoryFollower:
     """Follows one trajectory on one entity of a World (see module docstring)."""
 
-    def __init__(self, world: Any, entity: str, trajectory: Trajectory, rate: float) -> None:
+    def __init__(self, world: World, entity: str, trajectory: Trajectory, rate: float) -> None:
         self.world, self.entity, self.trajectory = world, entity, trajectory
         self.report = TrackingReport(entity, trajectory.joint_names, trajectory.duration)
         with world.lock:
@@ -70,10 +76,10 @@ class TrajectoryFollower:
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
             self._block = _References(trajectory, self.start, rate)
-            self._max: Any = None  # numpy: the largest error so far, per joint
+            self._max: np.ndarray | None = None  # the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)
 
-    def _addresses(self, model: Any) -> list[int]:
+    def _addresses(self, model: mujoco.MjModel) -> list[int]:
         """The followed joints' qpos addresses in `model`."""
         return [int(model.joint(f"{self.entity}/{j}").qposadr[0]) for j in self.start_names]
 
@@ -110,7 +116,7 @@ class TrajectoryFollower:
         if done:
             self.stop()
 
-    def _write(self, positions: Any, speeds: Any) -> None:
+    def _write(self, positions: np.ndarray, speeds: np.ndarray) -> None:
         """Moves each position servo's target and damping reference: ctrl and the bias constant.
 
         Only those two numbers change (see actuation.apply_command), written as arrays; actuator
@@ -148,7 +154,7 @@ class TrajectoryFollower:
             self._record_last()
 
 
-def _check_points(world: Any, entity: str, trajectory: Trajectory) -> None:
+def _check_points(world: World, entity: str, trajectory: Trajectory) -> None:
     """Refuses positions outside a joint's range or velocities past its limit (world unchanged)."""
     from twin_cli.world.joint_control import allowed_range, limits_of
 
@@ -177,7 +183,7 @@ def _check_points(world: Any, entity: str, trajectory: Trajectory) -> None:
                 )
 
 
-def _names(model: Any) -> set[str]:
+def _names(model: mujoco.MjModel) -> set[str]:
     return {model.joint(j).name for j in range(model.njnt)}
 
 
@@ -186,7 +192,7 @@ _LOCK = threading.Lock()
 
 
 def follow_trajectory(
-    world: Any, entity: str, trajectory: Trajectory, rate: float = UPDATE_RATE
+    world: World, entity: str, trajectory: Trajectory, rate: float = UPDATE_RATE
 ) -> TrajectoryFollower:
     """Starts following `trajectory` on `entity` (replacing its running one); returns at once.
 
@@ -206,7 +212,7 @@ def follow_trajectory(
         return follower
 
 
-def tracking_report(world: Any, entity: str) -> dict | None:
+def tracking_report(world: World, entity: str) -> dict | None:
     """The entity's last trajectory report, or None when it never followed one."""
     with _LOCK:
         follower = _FOLLOWERS.get(world, {}).get(entity)

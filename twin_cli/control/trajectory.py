@@ -81,7 +81,8 @@ def _vector(values: object, n: int, field: str, where: str) -> tuple[float, ...]
     if values is None or values == []:
         return None
     try:
-        out = tuple(float(v) for v in values)  # type: ignore[union-attr]
+        # any JSON value: one that is not a list of numbers raises here and is reported below
+        out = tuple(float(v) for v in values)  # pyright: ignore[reportGeneralTypeIssues]
     except (TypeError, ValueError) as exc:
         raise _bad(where, f"{field} {values!r} are not numbers", "give numbers") from exc
     if len(out) != n or not all(math.isfinite(v) for v in out):
@@ -197,7 +198,9 @@ def segment(a: TrajectoryPoint, b: TrajectoryPoint, j: int, s: float, T: float) 
     return position, velocity
 
 
-def _quintic(p0, v0, a0, p1, v1, a1, T) -> list[float]:  # noqa: ANN001
+def _quintic(
+    p0: float, v0: float, a0: float, p1: float, v1: float, a1: float, T: float
+) -> list[float]:
     """Coefficients c0..c5 of the quintic matching position, velocity, acceleration at 0 and T."""
     h = p1 - p0
     c3 = (20 * h - (8 * v1 + 12 * v0) * T - (3 * a0 - a1) * T**2) / (2 * T**3)

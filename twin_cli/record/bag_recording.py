@@ -18,7 +18,7 @@ import sys
 import threading
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.record import ring
@@ -30,6 +30,11 @@ from twin_cli.record.sensor_feed import KEPT, SensorFeed
 from twin_cli.record.sensor_pump import SensorPump
 from twin_cli.world.observers import world_view
 
+if TYPE_CHECKING:
+    import mujoco
+
+    from twin_cli.world.engine import World
+
 RING_BYTES = 32 << 20  # [B] ~40 s of a humanoid at 1,000 samples per wall second
 START_TIMEOUT_S = 60.0  # [s] for the encoder's answer when stopping (imports on a loaded host)
 
@@ -39,7 +44,7 @@ class BagRecording(Follows):
 
     def __init__(
         self,
-        world: Any,
+        world: World,
         path: str | Path,
         *,
         rate: float = 100.0,
@@ -70,7 +75,7 @@ class BagRecording(Follows):
         self._ring_fd = fd
         self._process: subprocess.Popen | None = None
         self._writer = ring.RingWriter(data, self._header, self._alive)
-        self._model: Any = None
+        self._model: mujoco.MjModel | None = None
         self._feed = SensorFeed(world, entities)
         self._pump = SensorPump(self._send_readings, "record-sensors")
         self._send_lock = threading.Lock()  # the stepping and sensor threads share the pipe

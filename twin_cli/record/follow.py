@@ -8,10 +8,13 @@ loaded world's clock, which may be earlier than the last sample's.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from twin_cli.record.sampler import Sampler
 from twin_cli.record.sensor_feed import SensorFeed
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 
 class Follows:
@@ -20,7 +23,7 @@ class Follows:
 
     _sensor_handles: tuple[int, ...] | list[int] = ()  # sensor observers of `_sensor_world`
 
-    def retarget(self, world: Any) -> None:
+    def retarget(self, world: World) -> None:
         """Samples `world` instead of the current one, starting with a sample now.
 
         Raises:
@@ -53,7 +56,7 @@ class Follows:
         if self._world.model is not getattr(self, "_sensor_model", None):
             self._follow_sensors(self._world)
 
-    def _follow_sensors(self, world: Any) -> None:
+    def _follow_sensors(self, world: World) -> None:
         """Observes `world` at each of its sensors' rates (no sensors: not at all)."""
         self._stop_sensors()
         with world.lock:

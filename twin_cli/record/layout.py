@@ -13,7 +13,6 @@ reset).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import mujoco
 import numpy as np
@@ -60,14 +59,14 @@ class EntityLayout:
 class Layout:
     """The layouts of the observed entities in `model`, and every body's frame id."""
 
-    model: Any
+    model: mujoco.MjModel
     entities: tuple[EntityLayout, ...]
     body_frames: tuple[str, ...]
     site_frames: tuple[str, ...]
 
 
 def make_layout(
-    model: Any, index: dict[str, EntityIndex], descriptions: dict[str, str | None]
+    model: mujoco.MjModel, index: dict[str, EntityIndex], descriptions: dict[str, str | None]
 ) -> Layout:
     """The layout of entities `index` (name → EntityIndex) in `model`."""
     bodies = element_names(model, model.name_bodyadr)
@@ -80,7 +79,7 @@ def make_layout(
 
 
 def entity_layout(
-    model: Any, name: str, ix: EntityIndex, frames: list[str], description: str | None
+    model: mujoco.MjModel, name: str, ix: EntityIndex, frames: list[str], description: str | None
 ) -> EntityLayout:
     """One entity's layout (see EntityLayout)."""
     parents = model.body_parentid[ix.bodies]
@@ -109,6 +108,6 @@ def entity_layout(
     )
 
 
-def is_ball(model: Any, joint: int) -> bool:
+def is_ball(model: mujoco.MjModel, joint: int) -> bool:
     """Whether joint `joint` is a ball joint (its JointState is an angle and a speed)."""
     return model.jnt_type[joint] == _BALL

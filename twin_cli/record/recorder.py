@@ -13,7 +13,7 @@ import queue
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.record import messages as ros
@@ -25,6 +25,9 @@ from twin_cli.record.sensor_feed import KEPT, SensorFeed
 from twin_cli.record.sensor_messages import sensor_message
 from twin_cli.record.sensor_pump import SensorPump
 from twin_cli.record.topics import Message, Topic, latched_messages, topics
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 log = logging.getLogger("twin.record")
 HEARTBEAT_S = 0.5  # [s] wall: how often a live view republishes a world that is not stepping
@@ -80,7 +83,7 @@ class Recording(Follows):
 
     def __init__(
         self,
-        world: Any,
+        world: World,
         sinks: Sequence[Sink],
         *,
         rate: float = 100.0,

@@ -26,7 +26,7 @@ import mmap
 import os
 import tempfile
 import time
-from typing import Any
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -44,12 +44,12 @@ STATE = int(
 )
 
 
-def record_length(model: Any) -> int:
+def record_length(model: mujoco.MjModel) -> int:
     """Doubles in one record of `model`: its `STATE` and then `qfrc_actuator`."""
     return int(mujoco.mj_stateSize(model, STATE)) + int(model.nv)
 
 
-def allocate(doubles: int) -> tuple[int, Any]:
+def allocate(doubles: int) -> tuple[int, mmap.mmap]:
     """A ring of `doubles` float64 in an unnamed shared file: its descriptor (for the reader
     process) and the writable mapping. Nothing is left behind when both sides close it."""
     folder = "/dev/shm" if os.path.isdir("/dev/shm") else None
@@ -62,12 +62,12 @@ def allocate(doubles: int) -> tuple[int, Any]:
     return fd, mmap.mmap(fd, size, flags=flags)
 
 
-def attach(fd: int) -> Any:
+def attach(fd: int) -> mmap.mmap:
     """The mapping of a ring whose descriptor the writer handed down."""
     return mmap.mmap(fd, os.fstat(fd).st_size)
 
 
-def views(memory: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def views(memory: mmap.mmap) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """numpy views (no copies) of a ring's data, header (int64) and span (float64)."""
     header = np.frombuffer(memory, dtype=np.int64, count=HEADER)
     span = np.frombuffer(memory, dtype=np.float64, count=SPAN, offset=8 * HEADER)
@@ -79,27 +79,27 @@ class RingWriter:
     """The stepping thread's side: copies one state into the next record (two C calls; the read
     position is re-read only when room runs short)."""
 
-    def __init__(self, data: np.ndarray, header: np.ndarray, alive: Any) -> None:
+    def __init__(self, data: np.ndarray, header: np.ndarray, alive: Callable[[], bool]) -> None:
         """Args: data, header: ring views; alive: () -> bool, whether the reader still runs."""
         self._data, self._header, self._alive = data, header, alive
         self._capacity = data.size
         self._write = int(header[WRITE])  # only this side writes it: a Python mirror
         self._limit = int(header[READ]) + data.size  # write may grow to here without a look
-        self._model: Any = None
-        self._d: Any = None  # the MjData whose qfrc_actuator view is cached
-        self._forces: Any = None
+        self._model: mujoco.MjModel | None = None
+        self._d: mujoco.MjData | None = None  # the MjData whose qfrc_actuator view is cached
+        self._forces: np.ndarray | None = None
         self._state = self._length = 0
         self.blocked_s = 0.0  # [s] waited for room (the reader fell behind)
         self.waits = 0
 
-    def start_layout(self, model: Any) -> int:
+    def start_layout(self, model: mujoco.MjModel) -> int:
         """Records from now on are of `model`; the position they start at, for the reader."""
         self._model, self._d = model, None
         self._state = int(mujoco.mj_stateSize(model, STATE))
         self._length = record_length(model)
         return self._write
 
-    def put(self, d: Any) -> bool:
+    def put(self, d: mujoco.MjData) -> bool:
         """Writes MjData `d`'s state (of the model of the last `start_layout`) as a record;
         False if the reader is gone."""
         if d is not self._d:
@@ -159,7 +159,7 @@ class RingReader:
         self._data, self._header = data, header
         self._layouts: collections.deque[tuple[int, int, int]] = collections.deque()
 
-    def add_layout(self, start: int, epoch: int, model: Any) -> None:
+    def add_layout(self, start: int, epoch: int, model: mujoco.MjModel) -> None:
         """Records from position `start` on are of `model`, tagged `epoch`."""
         self._layouts.append((start, epoch, record_length(model)))
 

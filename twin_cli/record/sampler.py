@@ -10,14 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 from twin_cli.errors import EntityNotFoundError
 from twin_cli.record.layout import Layout, make_layout
-from twin_cli.world.observers import world_view
+from twin_cli.world.observers import WorldView, world_view
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 
 @dataclass(frozen=True)
@@ -43,7 +46,7 @@ class Sampler:
 
     def __init__(
         self,
-        world: Any,
+        world: World,
         entities: Sequence[str] = (),
         descriptions: dict[str, str] | None = None,
     ) -> None:
@@ -59,7 +62,7 @@ class Sampler:
         self._world = world
         self._names = tuple(entities)
         self._descriptions = dict(descriptions or {})
-        self._model: Any = None
+        self._model: mujoco.MjModel | None = None
         self._layout: Layout | None = None
         with world.lock:
             known = list(world_view(world).index)
@@ -84,7 +87,7 @@ class Sampler:
             d.mocap_quat.copy(),
         )
 
-    def selection(self, view: Any) -> tuple[dict, dict]:
+    def selection(self, view: WorldView) -> tuple[dict, dict]:
         """The observed entities' index (name → EntityIndex) and URDF texts in `view`."""
         names = self._names or tuple(view.index)
         index = {n: view.index[n] for n in names if n in view.index}
@@ -140,8 +143,8 @@ class Kinematics:
     """Body poses of samples, on scratch data of the samples' model (consumer side)."""
 
     def __init__(self) -> None:
-        self._model: Any = None
-        self._data: Any = None
+        self._model: mujoco.MjModel | None = None
+        self._data: mujoco.MjData | None = None
 
     def poses(self, samples: Samples) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World positions [m] (n×nbody×3), quaternions w,x,y,z (n×nbody×4) and rotation

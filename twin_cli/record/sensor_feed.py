@@ -17,12 +17,17 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.record.sensor_messages import sensor_topic
 from twin_cli.record.topics import Topic
 from twin_cli.sensors import HISTORY_SAMPLES, Reading, SensorSuite
 from twin_cli.world.observers import world_view
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from twin_cli.world.engine import World
 
 log = logging.getLogger("twin.record")
 MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
@@ -35,9 +40,9 @@ Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pendin
 class SensorFeed:
     """New sensor readings of some (or all) entities of a world, as (topic, reading) pairs."""
 
-    def __init__(self, world: Any, entities: Sequence[str] = ()) -> None:
+    def __init__(self, world: World, entities: Sequence[str] = ()) -> None:
         self._world, self._names = world, tuple(entities)
-        self._model: Any = None
+        self._model: mujoco.MjModel | None = None
         self._suites: dict[str, SensorSuite] = {}
         self._wanted: dict[str, list[str]] = {}  # entity → its sensors still recorded
         self._rates: list[float] = []  # [Hz] of the observers, fastest first

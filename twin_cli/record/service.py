@@ -9,12 +9,15 @@ from __future__ import annotations
 import threading
 from collections.abc import Sequence
 from dataclasses import asdict
-from typing import Any
+from typing import TYPE_CHECKING
 
 from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.record.bag_recording import BagRecording
 from twin_cli.record.foxglove import LiveStream
 from twin_cli.record.recorder import Recording
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 
 class Consumers:
@@ -28,7 +31,7 @@ class Consumers:
 
     def record(
         self,
-        world: Any,
+        world: World,
         path: str,
         *,
         rate: float = 100.0,
@@ -72,7 +75,9 @@ class Consumers:
             self.recording = None
             return status
 
-    def stream(self, world: Any, *, port: int, host: str = "127.0.0.1", rate: float = 30.0) -> dict:
+    def stream(
+        self, world: World, *, port: int, host: str = "127.0.0.1", rate: float = 30.0
+    ) -> dict:
         """Starts the Foxglove server on `host:port` (latest sample only: never slows the loop)."""
         with self._lock:
             if self.live is not None:
@@ -99,7 +104,7 @@ class Consumers:
             self.live = None
             return {"stopped": live.port}
 
-    def follow(self, world: Any) -> dict:
+    def follow(self, world: World) -> dict:
         """Moves the recording and the live stream to `world` (the server loaded a new one).
 
         Returns what happened to each, for the `/load` reply: "moved", or "stopped: <why>"

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import os
 import threading
-from typing import Any
 
 import mujoco
 import numpy as np
@@ -40,15 +39,15 @@ class CameraSensor:
         self.spec = spec
         self.entity = entity
         self.camera = -1
-        self._renderer: Any = None
+        self._renderer: mujoco.Renderer | None = None
         self._lock = threading.Lock()  # one GL context: one render at a time
 
-    def bind(self, model: Any) -> None:
+    def bind(self, model: mujoco.MjModel) -> None:
         name = f"{self.entity}/{self.spec.site}"
         self.camera = element_id(model, mujoco.mjtObj.mjOBJ_CAMERA, "camera", name, self.entity)
         self._close()
 
-    def read(self, model: Any, data: Any, time: float) -> ImageReading:
+    def read(self, model: mujoco.MjModel, data: mujoco.MjData, time: float) -> ImageReading:
         """Raises: InvalidRequestError: no offscreen GL here, or the image is too large."""
         with self._lock:
             renderer = self._open(model)
@@ -65,7 +64,7 @@ class CameraSensor:
             self.spec.width, self.spec.height, encoding, raw,
         )  # fmt: skip
 
-    def _open(self, model: Any) -> Any:
+    def _open(self, model: mujoco.MjModel) -> mujoco.Renderer:
         if self._renderer is not None:
             # Requests run on pool threads; mujoco.Renderer keeps its GL context private.
             self._renderer._gl_context.make_current()  # noqa: SLF001
@@ -99,7 +98,7 @@ def _window_backend() -> bool:
     return os.environ.get("MUJOCO_GL", "glfw").lower() in ("", "glfw")
 
 
-def _clip(scene: Any, near: float, far: float) -> None:
+def _clip(scene: mujoco.MjvScene, near: float, far: float) -> None:
     """Sets the frustum planes [m] of the scene's cameras (both eyes) after `update_scene`.
 
     MuJoCo sizes the frustum at its near plane, so its extents scale with it (same view angle).
@@ -113,7 +112,7 @@ def _clip(scene: Any, near: float, far: float) -> None:
         camera.frustum_near, camera.frustum_far = near, far
 
 
-def _render_depth(renderer: Any, near: float, far: float) -> np.ndarray:
+def _render_depth(renderer: mujoco.Renderer, near: float, far: float) -> np.ndarray:
     """Depth [m] along the view axis, top row first: −inf nearer than `near`, +inf from `far`.
 
     Uses the renderer's own GL context and buffers (`mujoco.Renderer` has no public call that

@@ -9,8 +9,6 @@ points from geom1 to geom2 and pushes geom2 along it, so the force on the sensor
 
 from __future__ import annotations
 
-from typing import Any
-
 import mujoco
 import numpy as np
 
@@ -27,14 +25,14 @@ class ContactSensor:
         self.entity = entity
         self.geoms: frozenset[int] = frozenset()
 
-    def bind(self, model: Any) -> None:
+    def bind(self, model: mujoco.MjModel) -> None:
         kind = mujoco.mjtObj.mjOBJ_GEOM
         self.geoms = frozenset(
             element_id(model, kind, "geom", f"{self.entity}/{g}", self.entity)
             for g in self.spec.geoms
         )
 
-    def read(self, model: Any, data: Any, time: float) -> ContactReading:
+    def read(self, model: mujoco.MjModel, data: mujoco.MjData, time: float) -> ContactReading:
         states = [
             self._state(model, data, i)
             for i in range(data.ncon)
@@ -50,7 +48,7 @@ class ContactSensor:
             (float(total[0]), float(total[1]), float(total[2])),
         )
 
-    def _state(self, model: Any, data: Any, i: int) -> ContactState:
+    def _state(self, model: mujoco.MjModel, data: mujoco.MjData, i: int) -> ContactState:
         contact = data.contact[i]
         mine_is_geom2 = int(contact.geom2) in self.geoms
         sign = 1.0 if mine_is_geom2 else -1.0
@@ -72,7 +70,7 @@ class ContactSensor:
         )
 
 
-def _name(model: Any, geom: int) -> str:
+def _name(model: mujoco.MjModel, geom: int) -> str:
     return model.geom(int(geom)).name or f"geom {int(geom)}"
 
 

@@ -17,7 +17,7 @@ Gazebo's F/T sensor adds it to the wrench it publishes.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +25,9 @@ from converters.description.sensors import NATIVE_PARTS, ForceTorqueSpec
 from twin_cli.sensors.frames import body_id, native_slice, site_id
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import WrenchReading
+
+if TYPE_CHECKING:
+    import mujoco
 
 
 class ForceTorqueSensor:
@@ -38,14 +41,14 @@ class ForceTorqueSensor:
         self.sign = -1.0 if spec.measure_direction == "child_to_parent" else 1.0
         self.noise = NoiseSampler(spec.force_noise + spec.torque_noise, rng)
 
-    def bind(self, model: Any) -> None:
+    def bind(self, model: mujoco.MjModel) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         self.child = body_id(model, self.entity, self.spec.child_body)
         self.parent = body_id(model, self.entity, self.spec.parent_body)
         parts = NATIVE_PARTS["force_torque"]
         self.native = native_slice(model, self.entity, self.spec.site, parts)
 
-    def capture(self, data: Any) -> np.ndarray | None:
+    def capture(self, data: mujoco.MjData) -> np.ndarray | None:
         """(force, torque) of the last step in the asked frame and direction, from MuJoCo's
         sensors; None when MuJoCo has not computed them (all zero: not stepped since built)."""
         if self.native is None:
@@ -56,13 +59,13 @@ class ForceTorqueSensor:
         R = self._frame(data).T @ data.site_xmat[self.site].reshape(3, 3)  # site → asked frame
         return self.sign * np.concatenate([R @ site_wrench[:3], R @ site_wrench[3:]])
 
-    def compute(self, model: Any, data: Any) -> np.ndarray:
+    def compute(self, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         """What `capture` returns, computed from evaluated `data`."""
         force, torque = self.wrench_world(model, data)
         R = self._frame(data)
         return np.concatenate([R.T @ force, R.T @ torque])
 
-    def read(self, model: Any, data: Any, time: float) -> WrenchReading:
+    def read(self, model: mujoco.MjModel, data: mujoco.MjData, time: float) -> WrenchReading:
         values = self.capture(data)
         return self.reading(values if values is not None else self.compute(model, data), time)
 
@@ -86,7 +89,9 @@ class ForceTorqueSensor:
             self.spec.measure_direction,
         )
 
-    def wrench_world(self, model: Any, data: Any) -> tuple[np.ndarray, np.ndarray]:
+    def wrench_world(
+        self, model: mujoco.MjModel, data: mujoco.MjData
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(force [N], torque [N m] about the sensor origin), world axes, measured direction."""
         spatial = data.cfrc_int[self.child]
         torque_c, force = spatial[:3], spatial[3:]
@@ -95,7 +100,7 @@ class ForceTorqueSensor:
         torque = torque_c + np.cross(centre - point, force)
         return self.sign * force, self.sign * torque
 
-    def _frame(self, data: Any) -> np.ndarray:
+    def _frame(self, data: mujoco.MjData) -> np.ndarray:
         if self.spec.frame == "sensor":
             return data.site_xmat[self.site].reshape(3, 3)
         body = self.parent if self.spec.frame == "parent" else self.child

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import mujoco
 
 from twin_cli.errors import PartNotFoundError
 
 
-def element_id(model: Any, kind: Any, label: str, name: str, entity: str) -> int:
+def element_id(
+    model: mujoco.MjModel, kind: mujoco.mjtObj, label: str, name: str, entity: str
+) -> int:
     """The id of element `name` of `kind` (mjtObj) in `model`.
 
     Raises:
@@ -21,24 +21,26 @@ def element_id(model: Any, kind: Any, label: str, name: str, entity: str) -> int
     return int(found)
 
 
-def site_id(model: Any, entity: str, site: str) -> int:
+def site_id(model: mujoco.MjModel, entity: str, site: str) -> int:
     return element_id(model, mujoco.mjtObj.mjOBJ_SITE, "site", f"{entity}/{site}", entity)
 
 
-def body_id(model: Any, entity: str, body: str) -> int:
+def body_id(model: mujoco.MjModel, entity: str, body: str) -> int:
     """Body `body` of the entity (the world body for "world")."""
     if body == "world":
         return 0
     return element_id(model, mujoco.mjtObj.mjOBJ_BODY, "body", f"{entity}/{body}", entity)
 
 
-def entity_bodies(model: Any, entity: str) -> frozenset[int]:
+def entity_bodies(model: mujoco.MjModel, entity: str) -> frozenset[int]:
     """Ids of every body whose name starts with `<entity>/`."""
     prefix = f"{entity}/"
     return frozenset(b for b in range(model.nbody) if model.body(b).name.startswith(prefix))
 
 
-def native_ids(model: Any, entity: str, site: str, parts: tuple[tuple[str, str], ...]) -> list[int]:
+def native_ids(
+    model: mujoco.MjModel, entity: str, site: str, parts: tuple[tuple[str, str], ...]
+) -> list[int]:
     """The ids of the MuJoCo sensors `<entity>/<site>:<part>`, in `parts` order ([]: one lacks)."""
     kind = mujoco.mjtObj.mjOBJ_SENSOR
     ids = [mujoco.mj_name2id(model, kind, f"{entity}/{site}:{part}") for part, _ in parts]
@@ -46,7 +48,7 @@ def native_ids(model: Any, entity: str, site: str, parts: tuple[tuple[str, str],
 
 
 def native_slice(
-    model: Any, entity: str, site: str, parts: tuple[tuple[str, str], ...]
+    model: mujoco.MjModel, entity: str, site: str, parts: tuple[tuple[str, str], ...]
 ) -> slice | None:
     """Where the MuJoCo sensors `<entity>/<site>:<part>` of one twin sensor sit in sensordata.
 

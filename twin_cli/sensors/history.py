@@ -10,12 +10,15 @@ business (`twin_cli.world.sensor_rings`, which also keeps the rings in step with
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.description.sensors import HISTORY_SAMPLES
 from twin_cli.world.sensor_rings import CURSOR, ring_parts
+
+if TYPE_CHECKING:
+    import mujoco
 
 __all__ = ["HISTORY_SAMPLES", "SensorHistory"]
 
@@ -23,18 +26,18 @@ __all__ = ["HISTORY_SAMPLES", "SensorHistory"]
 class SensorHistory:
     """The rings of some MuJoCo sensors that make up one twin sensor (same `nsample`)."""
 
-    def __init__(self, model: Any, sensors: list[int]) -> None:
+    def __init__(self, model: mujoco.MjModel, sensors: list[int]) -> None:
         self.n = int(model.sensor_history[sensors[0]][0])
         self.parts = [(int(model.sensor_historyadr[s]), int(model.sensor_dim[s])) for s in sensors]
         self.width = sum(dim for _, dim in self.parts)
 
     @classmethod
-    def of(cls, model: Any, sensors: list[int]) -> SensorHistory | None:
+    def of(cls, model: mujoco.MjModel, sensors: list[int]) -> SensorHistory | None:
         """The history of `sensors`, or None when one keeps none (a model built before)."""
         counts = {int(model.sensor_history[s][0]) for s in sensors}
         return cls(model, sensors) if sensors and len(counts) == 1 and min(counts) > 0 else None
 
-    def since(self, data: Any, time: float) -> tuple[np.ndarray, np.ndarray]:
+    def since(self, data: mujoco.MjData, time: float) -> tuple[np.ndarray, np.ndarray]:
         """Sample times [s] after `time` and not after now (samples from before a reset of the
         clock are not), oldest first, and their values (k × width).
 
@@ -54,7 +57,7 @@ class SensorHistory:
             column += dim
         return times[slots], rows
 
-    def latest(self, data: Any) -> tuple[float, np.ndarray]:
+    def latest(self, data: mujoco.MjData) -> tuple[float, np.ndarray]:
         """The newest sample's time [s] and values (width); it may date from before a reset of
         the clock (a time after now)."""
         ring, out, column = data.history, np.empty(self.width), 0

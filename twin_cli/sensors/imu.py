@@ -17,8 +17,6 @@ functions MuJoCo uses.
 
 from __future__ import annotations
 
-from typing import Any
-
 import mujoco
 import numpy as np
 
@@ -41,11 +39,11 @@ class ImuSensor:
         self.accel_noise = NoiseSampler(spec.linear_acceleration_noise, rng)
         self.site = -1
         self.native: slice | None = None
-        self._data: Any = None
+        self._data: mujoco.MjData | None = None
         self._view = np.zeros(0)
         self.history: SensorHistory | None = None
 
-    def bind(self, model: Any) -> None:
+    def bind(self, model: mujoco.MjModel) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         parts = NATIVE_PARTS["imu"]
         self.native = native_slice(model, self.entity, self.spec.site, parts)
@@ -53,7 +51,7 @@ class ImuSensor:
         self.history = SensorHistory.of(model, ids) if self.native is not None else None
         self._data = None
 
-    def latest(self, data: Any) -> tuple[float, np.ndarray] | None:
+    def latest(self, data: mujoco.MjData) -> tuple[float, np.ndarray] | None:
         """The newest sample MuJoCo kept (its time [s] and `capture`'s values), None when
         there is no history or no sample yet; a copy."""
         if self.history is None:
@@ -62,14 +60,14 @@ class ImuSensor:
         fresh = values[:4] @ values[:4] > 0.0 and time <= data.time + 1e-12  # not pre-reset
         return (time, values) if fresh else None
 
-    def samples_since(self, data: Any, time: float) -> tuple[np.ndarray, np.ndarray]:
+    def samples_since(self, data: mujoco.MjData, time: float) -> tuple[np.ndarray, np.ndarray]:
         """Every kept sample after sim `time` [s]: times, oldest first, and values (k×10)."""
         assert self.history is not None
         times, rows = self.history.since(data, time)
         computed = np.einsum("ij,ij->i", rows[:, :4], rows[:, :4]) > 0.0
         return times[computed], rows[computed]
 
-    def capture(self, data: Any) -> np.ndarray | None:
+    def capture(self, data: mujoco.MjData) -> np.ndarray | None:
         """The last step's (quat w x y z, gyro, specific force) in `sensordata`: a copy; None
         when MuJoCo has not computed them (no native sensors, or not stepped since built)."""
         if self.native is None:
@@ -79,12 +77,12 @@ class ImuSensor:
         values = self._view.copy()
         return values if values[:4] @ values[:4] > 0.0 else None
 
-    def read(self, model: Any, data: Any, time: float) -> ImuReading:
+    def read(self, model: mujoco.MjModel, data: mujoco.MjData, time: float) -> ImuReading:
         """The reading of `data` (after forward dynamics and `mj_rnePostConstraint`)."""
         values = self.capture(data)
         return self.reading(values if values is not None else self.compute(model, data), time)
 
-    def compute(self, model: Any, data: Any) -> np.ndarray:
+    def compute(self, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         """What the native sensors hold, computed from evaluated `data` (same 10 numbers)."""
         out = np.zeros(10)
         velocity, acceleration = np.zeros(6), np.zeros(6)

@@ -14,7 +14,6 @@ up from its x-y plane, `samples × resolution` rays evenly from min to max angle
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import mujoco
 import numpy as np
@@ -65,7 +64,7 @@ class RaySensor:
         self.angle_min, self.angle_max = float(horizontal[0]), float(horizontal[-1])
         self.increment = float(horizontal[1] - horizontal[0]) if len(horizontal) > 1 else 0.0
 
-    def bind(self, model: Any) -> None:
+    def bind(self, model: mujoco.MjModel) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
         self.body = body_id(model, self.entity, self.spec.body)
         self.own = entity_bodies(model, self.entity)
@@ -73,7 +72,7 @@ class RaySensor:
         own = np.isin(model.geom_bodyid, list(self.own))
         self.skip = own | self.passive
 
-    def read(self, model: Any, data: Any, time: float) -> ScanReading:
+    def read(self, model: mujoco.MjModel, data: mujoco.MjData, time: float) -> ScanReading:
         ranges = self.ranges(model, data)
         hit = np.isfinite(ranges)
         noisy = np.clip(self.noise.apply(ranges[hit]), self.spec.range_min, self.spec.range_max)
@@ -94,7 +93,7 @@ class RaySensor:
             self.spec.vertical_rays,
         )
 
-    def ranges(self, model: Any, data: Any) -> np.ndarray:
+    def ranges(self, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
         """Noise-free ranges [m] of every ray, +inf where nothing is within range_max."""
         origin = data.site_xpos[self.site].copy()
         dirs = self.local_dirs @ data.site_xmat[self.site].reshape(3, 3).T
@@ -110,12 +109,18 @@ class RaySensor:
             dist[i], geoms[i] = self._recast(model, data, origin, dirs[i], dist[i], geoms[i])
         return np.where((geoms >= 0) & (dist <= cutoff), dist, math.inf)
 
-    def _skipped(self, model: Any, geoms: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    def _skipped(self, model: mujoco.MjModel, geoms: np.ndarray, dist: np.ndarray) -> np.ndarray:
         hit = geoms >= 0
         return hit & (self.skip[np.where(hit, geoms, 0)] | (dist < self.spec.range_min))
 
     def _recast(
-        self, model: Any, data: Any, origin: np.ndarray, direction: np.ndarray, t: float, geom: int
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        origin: np.ndarray,
+        direction: np.ndarray,
+        t: float,
+        geom: int,
     ) -> tuple[float, int]:
         """Continue one ray past hits it must not see; (distance, geom) or (−1, −1)."""
         found = np.array([-1], np.int32)

@@ -10,10 +10,14 @@ interaction forces), where the live data after `mj_step` would be one step stale
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
+    from twin_cli.world.entities import Entity
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
 
@@ -28,12 +32,12 @@ class Snapshot:
     """
 
     time: float
-    model: Any
+    model: mujoco.MjModel
     state: np.ndarray
-    entity: Any
+    entity: Entity
 
 
-def take(world: Any, name: str) -> Snapshot:
+def take(world: World, name: str) -> Snapshot:
     """Copy the world's state and entity `name`'s record, holding the lock once.
 
     Raises:
@@ -51,10 +55,10 @@ class Evaluator:
     """Scratch data for one model at a time: the snapshot's positions, velocities and forces."""
 
     def __init__(self) -> None:
-        self.model: Any = None
-        self.data: Any = None
+        self.model: mujoco.MjModel | None = None
+        self.data: mujoco.MjData | None = None
 
-    def evaluate(self, snapshot: Snapshot, *, dynamics: bool = True) -> Any:
+    def evaluate(self, snapshot: Snapshot, *, dynamics: bool = True) -> mujoco.MjData:
         """MjData at the snapshot's instant: poses only (`dynamics=False`: all rays and cameras
         need), else forward dynamics with cacc, cfrc_int and cfrc_ext."""
         if snapshot.model is not self.model:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -36,6 +36,10 @@ from twin_cli.sensors.noise import sensor_rng
 from twin_cli.sensors.ray import RaySensor
 from twin_cli.sensors.readings import Reading
 from twin_cli.sensors.snapshot import STATE, Evaluator, Snapshot, take
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
+    from twin_cli.world.entities import Entity
 
 SENSOR_TYPES: dict[type, Any] = {
     ImuSpec: ImuSensor,
@@ -76,7 +80,7 @@ def period_slot(time: float, rate: float, timestep: float) -> int:
 class SensorSuite:
     """The sensors of entity `entity` in `world`, with reproducible noise (`seed`)."""
 
-    def __init__(self, world: Any, entity: str, *, seed: int = 0) -> None:
+    def __init__(self, world: World, entity: str, *, seed: int = 0) -> None:
         """Raises: EntityNotFoundError: the world has no entity `entity`."""
         self.world = world
         self.entity = entity
@@ -84,9 +88,9 @@ class SensorSuite:
         self._evaluator = Evaluator()
         self._build(take(world, entity).entity)
 
-    def _build(self, record: Any) -> None:
+    def _build(self, record: Entity) -> None:
         self._record = record
-        self._model: Any = None
+        self._model: mujoco.MjModel | None = None
         self.specs: dict[str, SensorSpec] = {s.name: s for s in record.sensors}
         self._sensors = {
             name: SENSOR_TYPES[type(spec)](spec, self.entity, sensor_rng(self.seed, name))
@@ -197,7 +201,7 @@ class SensorSuite:
             out += batch
         return out
 
-    def _entity(self) -> Any:
+    def _entity(self) -> Entity:
         """The entity's record (the world's; read-only).
 
         Raises:
@@ -205,7 +209,7 @@ class SensorSuite:
         """
         return self.world.entity(self.entity)
 
-    def _bind(self, model: Any) -> None:
+    def _bind(self, model: mujoco.MjModel) -> None:
         for sensor in self._sensors.values():
             sensor.bind(model)
         self._model = model
@@ -227,7 +231,7 @@ class SensorSuite:
         values = None if capture is None else capture(self.world.data)
         return None if values is None else (time, values)
 
-    def _snapshot(self, time: float, model: Any, record: Any) -> Snapshot:
+    def _snapshot(self, time: float, model: mujoco.MjModel, record: Entity) -> Snapshot:
         state = np.empty(mujoco.mj_stateSize(model, STATE))
         mujoco.mj_getState(model, self.world.data, state, STATE)
         return Snapshot(time, model, state, record)

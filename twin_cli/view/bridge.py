@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import copy
 import logging
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -22,6 +22,9 @@ from mujoco.studio import messages, plugin, sim
 
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world.entities import element_names
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 log = logging.getLogger("twin.view")
 
@@ -39,7 +42,7 @@ class WorldBridge(plugin.SimPlugin):
     (re-entrant) lock held, so each World call below takes the lock it already holds.
     """
 
-    def __init__(self, world: Any) -> None:
+    def __init__(self, world: World) -> None:
         self.world = world
         self._paused_shown: bool | None = None
         self._perturbed = False

@@ -13,9 +13,17 @@ import io
 import os
 import sys
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.errors import OffscreenUnavailableError
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    import mujoco
+    import numpy as np
+
+    from twin_cli.world.engine import World
 
 AZIMUTH_DEG = 135.0  # gzclient's default view: from the +x/+y quadrant, looking down
 ELEVATION_DEG = -25.0
@@ -50,7 +58,14 @@ class CameraView:
         return asdict(self)
 
 
-def aim(model: Any, data: Any, lookat: Any, extent: float, width: int, height: int) -> CameraView:
+def aim(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    lookat: Iterable[float],
+    extent: float,
+    width: int,
+    height: int,
+) -> CameraView:
     """The camera that frames a thing of size `extent` [m] centred at `lookat`."""
     distance = max(MIN_DISTANCE_M, DISTANCE_FACTOR * extent)
     return CameraView(
@@ -64,7 +79,7 @@ def aim(model: Any, data: Any, lookat: Any, extent: float, width: int, height: i
     )
 
 
-def renderer(model: Any, width: int, height: int) -> Any:
+def renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
     """A `mujoco.Renderer`, or OffscreenUnavailableError naming what to install."""
     import mujoco
 
@@ -83,7 +98,12 @@ def renderer(model: Any, width: int, height: int) -> Any:
         raise OffscreenUnavailableError(f"MUJOCO_GL={backend}: {exc}") from exc
 
 
-def render(model: Any, data: Any, view: CameraView, scene_renderer: Any = None) -> Any:
+def render(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    view: CameraView,
+    scene_renderer: mujoco.Renderer | None = None,
+) -> np.ndarray:
     """The picture as an (height, width, 3) uint8 array."""
     import mujoco
 
@@ -104,7 +124,7 @@ def render(model: Any, data: Any, view: CameraView, scene_renderer: Any = None) 
             r.close()
 
 
-def png_bytes(pixels: Any) -> bytes:
+def png_bytes(pixels: np.ndarray) -> bytes:
     """PNG encoding of an RGB array (matplotlib's writer: already a dependency)."""
     from matplotlib import image
 
@@ -113,7 +133,9 @@ def png_bytes(pixels: Any) -> bytes:
     return buffer.getvalue()
 
 
-def entity_view(model: Any, data: Any, bodies: Any, width: int, height: int) -> CameraView:
+def entity_view(
+    model: mujoco.MjModel, data: mujoco.MjData, bodies: np.ndarray | None, width: int, height: int
+) -> CameraView:
     """The camera on an entity's `bodies` (its root body's centre of mass, its bodies' spread),
     or on the whole scene when `bodies` is None."""
     import numpy as np
@@ -125,7 +147,9 @@ def entity_view(model: Any, data: Any, bodies: Any, width: int, height: int) -> 
     return aim(model, data, centre, max(spread, 0.3), width, height)
 
 
-def snapshot_png(world: Any, *, entity: str | None, width: int, height: int) -> tuple[bytes, dict]:
+def snapshot_png(
+    world: World, *, entity: str | None, width: int, height: int
+) -> tuple[bytes, dict]:
     """Renders `world` now; returns the PNG and the camera (`CameraView.to_dict`).
 
     The state is copied under the world's lock and rendered outside it (the loop keeps

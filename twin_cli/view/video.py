@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import os
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING
 
 from twin_cli.view import offscreen
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 FPS = 20  # [frames per simulated second]; played at the same rate: real speed
 WIDTH, HEIGHT = 320, 240  # [px]; H.264 with yuv420p needs even sizes
@@ -26,7 +29,7 @@ class WorldVideo:
     was written.
     """
 
-    def __init__(self, world: Any, entity: str, path: str, *, fps: int = FPS) -> None:
+    def __init__(self, world: World, entity: str, path: str, *, fps: int = FPS) -> None:
         import av
 
         self.world, self.entity, self.path, self.fps = world, entity, path, fps

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +22,9 @@ from twin_cli.world.recompile import commit, rebuild
 from twin_cli.world.respec import count_delete
 from twin_cli.world.scene import replace_lights
 from twin_cli.world.state import WorldState
+
+if TYPE_CHECKING:
+    from converters.description import Light
 
 
 def delete(state: WorldState, name: str) -> None:
@@ -46,7 +49,7 @@ def delete(state: WorldState, name: str) -> None:
         count_delete(state)  # every RENEW_EVERY deletes: a fresh spec (bounded memory)
 
 
-def set_lights(state: WorldState, lights: Sequence[Any]) -> None:
+def set_lights(state: WorldState, lights: Sequence[Light]) -> None:
     """Replace the world's lights (an SDF world's `<light>`s, its included `sun` among them)."""
     with state.lock:
         trial = state.spec.copy()

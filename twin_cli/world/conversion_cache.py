@@ -23,10 +23,15 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from twin_cli.package_env import PACKAGE_ENVS
 from twin_cli.spawn_request import SpawnRequest
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from twin_cli.world.spawn import LoadedSource
 
 MAX_ENTRIES = 32  # conversions kept (a booster_t1 spec holds ~8 MB of mesh arrays)
 _WRITE_MODES = ("w", "a", "x", "+")
@@ -89,7 +94,7 @@ def file_digest(path: str) -> str | None:
     stamp = (path, st.st_size, st.st_mtime_ns, st.st_ino)
     if stamp not in _digests:
         digest = hashlib.blake2b(digest_size=20)
-        with open(path, "rb") as handle:  # noqa: PTH123 (not recorded: no recording here)
+        with open(path, "rb") as handle:  # not recorded: no recording runs on this thread here
             for block in iter(lambda: handle.read(1 << 20), b""):
                 digest.update(block)
         _digests[stamp] = digest.hexdigest()
@@ -111,11 +116,11 @@ def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> 
 
 @dataclass(frozen=True)
 class _Entry:
-    loaded: Any  # spawn.LoadedSource with the pristine spec
+    loaded: LoadedSource  # with the pristine spec
     files: tuple[tuple[str, str | None], ...]  # (path, digest) of every file read
 
 
-def mesh_keys(spec: Any, conversion: tuple) -> dict[str, str]:
+def mesh_keys(spec: mujoco.MjSpec, conversion: tuple) -> dict[str, str]:
     """Mesh name → a digest of the conversion (key and files read) and the name: two meshes
     with the same key come from the same files through the same conversion, so they are equal."""
     base = hashlib.blake2b(repr(conversion).encode(), digest_size=16).hexdigest()
@@ -136,10 +141,10 @@ class ConversionCache:
         self.hits = 0
         self.misses = 0
 
-    def load(self, key: tuple, convert: Callable[[], Any]) -> Any:
+    def load(self, key: tuple, convert: Callable[[], LoadedSource]) -> LoadedSource:
         """The cached result for `key` (a copy, with `cached=True`), else `convert()`'s, stored.
 
-        `convert` returns a `spawn.LoadedSource`; errors it raises are not cached.
+        Errors `convert` raises are not cached.
         """
         with self._lock:
             entry = self._entries.get(key)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from twin_cli.world.entities import EntityIndex
 
@@ -82,6 +83,6 @@ def find_divergent(
     return found
 
 
-def _owners(indices: dict[str, EntityIndex], field: str, addresses: object) -> list[str]:
+def _owners(indices: dict[str, EntityIndex], field: str, addresses: ArrayLike) -> list[str]:
     owners = [n for n, ix in indices.items() if np.isin(getattr(ix, field), addresses).any()]
     return owners or ["<world>"]

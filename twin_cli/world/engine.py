@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 
@@ -45,6 +45,9 @@ from twin_cli.world.values import (
     check_settings,
     scene_settings,
 )
+
+if TYPE_CHECKING:
+    from converters.description import Light
 
 __all__ = ["World"]
 
@@ -133,7 +136,7 @@ class World:
         """Removes entity `name`; the others keep their exact state."""
         changes.delete(self._state, name)
 
-    def set_lights(self, lights: Sequence[Any]) -> None:
+    def set_lights(self, lights: Sequence[Light]) -> None:
         """Replace the world's lights (an SDF world's `<light>`s)."""
         changes.set_lights(self._state, lights)
 

@@ -130,21 +130,16 @@ def index_entities(model: mujoco.MjModel, names: list[str]) -> dict[str, EntityI
     geom_owner = body_owner[model.geom_bodyid]
     return {
         name: replace(
-            _index_one(model, *parts[name], np.flatnonzero(geom_owner == k).astype(_INT)),
+            _index_one(model, parts[name], np.flatnonzero(geom_owner == k).astype(_INT)),
             model_site=mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/{MODEL_SITE}"),
         )
         for k, name in enumerate(names)
     }
 
 
-def _index_one(
-    model: mujoco.MjModel,
-    bodies: np.ndarray,
-    joints: np.ndarray,
-    actuators: np.ndarray,
-    equalities: np.ndarray,
-    geoms: np.ndarray,
-) -> EntityIndex:
+def _index_one(model: mujoco.MjModel, parts: list[np.ndarray], geoms: np.ndarray) -> EntityIndex:
+    """One entity's index from its bodies, joints, actuators and equalities (`parts`)."""
+    bodies, joints, actuators, equalities = parts
     roots = bodies[model.body_parentid[bodies] == 0]
     root = int(roots[0]) if len(roots) else -1
     types = model.jnt_type[joints]

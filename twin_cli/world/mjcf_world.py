@@ -10,13 +10,16 @@ gets no Gazebo ground of its own, and the whole scene becomes one entity named a
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from pathlib import Path
+from typing import SupportsInt
 
 import mujoco
 
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.errors import SpawnError
 from twin_cli.world.engine import World
+from twin_cli.world.pose import vec3
 from twin_cli.world.values import WorldSettings
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
@@ -47,7 +50,7 @@ def world_from_mjcf(path: str | os.PathLike, *, name: str = "default") -> World:
     settings = WorldSettings(
         timestep=float(option.timestep),
         rate=1.0 / float(option.timestep),
-        gravity=tuple(float(g) for g in option.gravity),
+        gravity=vec3(option.gravity),
         iterations=int(option.iterations),
         ground=False,
         solver=_named(SOLVERS, option.solver),
@@ -58,7 +61,7 @@ def world_from_mjcf(path: str | os.PathLike, *, name: str = "default") -> World:
     return world
 
 
-def _named(names: dict[str, object], value: object) -> str:
+def _named(names: Mapping[str, SupportsInt], value: SupportsInt) -> str:
     """twin's name of a MuJoCo enum value (the scene's solver or integrator)."""
     return next(n for n, v in names.items() if int(v) == int(value))
 

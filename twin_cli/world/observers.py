@@ -15,7 +15,13 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from twin_cli.world.engine import World
+    from twin_cli.world.entities import EntityIndex
 
 DUE_TOLERANCE = 1e-6  # fraction of a step: sim time accumulates rounding (0.01 != 10 * 0.001)
 
@@ -78,7 +84,9 @@ class Observers:
         if self._entries.pop(handle, None) is not None:
             self._summarize()
 
-    def run(self, n: int, step: Callable[[int], None], data: Any, timestep: float) -> None:
+    def run(
+        self, n: int, step: Callable[[int], None], data: mujoco.MjData, timestep: float
+    ) -> None:
         """Steps `n` times through `step(k)`, calling each observer when it is due.
 
         A clock that went back (reset) re-anchors the observers at the new time. This runs
@@ -104,7 +112,9 @@ class Observers:
                         step(n)
                     return
 
-    def _stride(self, n: int, step: Callable[[int], None], data: Any, timestep: float) -> int:
+    def _stride(
+        self, n: int, step: Callable[[int], None], data: mujoco.MjData, timestep: float
+    ) -> int:
         """Right after a call: while a lone observer, called just now, has a period of a whole
         number K of steps, steps K and calls it, with no sim-time arithmetic in between (it
         cost a 100 Hz recording of an unthrottled humanoid about 1 % of the loop). A callback
@@ -166,13 +176,13 @@ class WorldView:
         descriptions: entity name → its URDF text after xacro (None: not a URDF source).
     """
 
-    model: Any
-    data: Any
-    index: dict
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    index: dict[str, EntityIndex]
     descriptions: dict[str, str | None]
 
 
-def world_view(world: Any) -> WorldView:
+def world_view(world: World) -> WorldView:
     """The world's model, data and entity index; call with `world.lock` held."""
     names = world.entity_names()
     return WorldView(

@@ -10,11 +10,14 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.world import actuation as control
 from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.engine_threads import set_engine, sleeping, threads_of
 from twin_cli.world.entities import element_names
+from twin_cli.world.pose import vec3
 from twin_cli.world.scene import ODE_ONLY_FIELDS
 from twin_cli.world.sensor_rings import align_sensor_ticks
 from twin_cli.world.sleeping import wake_trees
@@ -28,7 +31,7 @@ if TYPE_CHECKING:
 def gravity(state: WorldState) -> tuple[float, float, float]:
     """The gravity vector [m/s²]."""
     with state.lock:
-        return tuple(float(v) for v in state.model.opt.gravity)  # type: ignore[return-value]
+        return vec3(state.model.opt.gravity)
 
 
 def set_gravity(state: WorldState, vector: tuple[float, float, float]) -> None:
@@ -36,8 +39,8 @@ def set_gravity(state: WorldState, vector: tuple[float, float, float]) -> None:
     g = finite_vector("gravity", vector, 3)
     with state.lock:
         state.model.opt.gravity[:] = g
-        state.spec.option.gravity = g
-        state.settings = replace(state.settings, gravity=tuple(g))
+        state.spec.option.gravity = np.array(g)
+        state.settings = replace(state.settings, gravity=vec3(g))
         wake_trees(state.data, range(state.model.ntree))  # sleeping robots feel it too
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 Quat = tuple[float, float, float, float]
@@ -28,9 +29,9 @@ class Pose:
     yaw: float = 0.0
 
     @classmethod
-    def from_quat(cls, x: float, y: float, z: float, quat_wxyz: object) -> Pose:
+    def from_quat(cls, x: float, y: float, z: float, quat_wxyz: Iterable[float]) -> Pose:
         """Builds a pose from a position [m] and a unit quaternion (w, x, y, z)."""
-        w, qx, qy, qz = (float(v) for v in quat_wxyz)  # type: ignore[attr-defined]
+        w, qx, qy, qz = (float(v) for v in quat_wxyz)
         norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz) or 1.0
         w, qx, qy, qz = w / norm, qx / norm, qy / norm, qz / norm
         roll = math.atan2(2.0 * (w * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
@@ -38,6 +39,12 @@ class Pose:
         pitch = math.asin(sin_pitch)
         yaw = math.atan2(2.0 * (w * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
         return cls(float(x), float(y), float(z), roll, pitch, yaw)
+
+    @classmethod
+    def at(cls, position: Iterable[float], quat_wxyz: Iterable[float]) -> Pose:
+        """Builds a pose from a position (x, y, z) [m] and a unit quaternion (w, x, y, z)."""
+        x, y, z = position
+        return cls.from_quat(x, y, z, quat_wxyz)
 
     def quat(self) -> Quat:
         """The orientation as a unit quaternion (w, x, y, z) = q_yaw * q_pitch * q_roll."""
@@ -65,6 +72,18 @@ class Pose:
             "pitch": self.pitch,
             "yaw": self.yaw,
         }
+
+
+def vec3(values: Iterable[float]) -> tuple[float, float, float]:
+    """Three numbers (a position or a vector, e.g. a row of a MuJoCo array) as floats."""
+    x, y, z = values
+    return float(x), float(y), float(z)
+
+
+def quat4(values: Iterable[float]) -> Quat:
+    """Four numbers (a quaternion w, x, y, z, e.g. a row of a MuJoCo array) as floats."""
+    w, x, y, z = values
+    return float(w), float(x), float(y), float(z)
 
 
 def quat_multiply(a: Quat, b: Quat) -> Quat:

@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.world.entities import EntityIndex, element_names
-from twin_cli.world.pose import Pose, quat_multiply, rotate
+from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate, vec3
 
 _FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
 
@@ -85,7 +85,7 @@ def link_poses(
     mujoco.mj_kinematics(model, scratch)
     names = element_names(model, model.name_bodyadr[index.bodies])
     return {
-        name.removeprefix(prefix): Pose.from_quat(*scratch.xpos[b], scratch.xquat[b])
+        name.removeprefix(prefix): Pose.at(scratch.xpos[b], scratch.xquat[b])
         for b, name in zip(index.bodies, names, strict=True)
     }
 
@@ -102,18 +102,18 @@ def joint_names(model: mujoco.MjModel, index: EntityIndex, prefix: str) -> list[
 
 def model_from_root(model: mujoco.MjModel, index: EntityIndex, root: Pose) -> Pose:
     """The model frame's pose given the root body's: root ∘ (the site's pose in the root)."""
-    site_pos = tuple(float(v) for v in model.site_pos[index.model_site])
-    site_quat = tuple(float(v) for v in model.site_quat[index.model_site])
+    site_pos = vec3(model.site_pos[index.model_site])
+    site_quat = quat4(model.site_quat[index.model_site])
     q_root = root.quat()
-    offset = rotate(q_root, site_pos)  # type: ignore[arg-type]
+    offset = rotate(q_root, site_pos)
     position = [p + o for p, o in zip(root.position(), offset, strict=True)]
-    return Pose.from_quat(*position, quat_multiply(q_root, site_quat))  # type: ignore[arg-type]
+    return Pose.at(position, quat_multiply(q_root, site_quat))
 
 
 def root_from_model(model: mujoco.MjModel, index: EntityIndex, pose: Pose) -> Pose:
     """The root body's pose that puts the model frame at `pose` (inverse of model_from_root)."""
     w, x, y, z = (float(v) for v in model.site_quat[index.model_site])
     q_root = quat_multiply(pose.quat(), (w, -x, -y, -z))
-    offset = rotate(q_root, tuple(float(v) for v in model.site_pos[index.model_site]))
+    offset = rotate(q_root, vec3(model.site_pos[index.model_site]))
     position = [p - o for p, o in zip(pose.position(), offset, strict=True)]
-    return Pose.from_quat(*position, q_root)  # type: ignore[arg-type]
+    return Pose.at(position, q_root)

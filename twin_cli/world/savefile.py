@@ -146,7 +146,7 @@ def _respawn(world: World, item: dict[str, Any]) -> Entity:
     Its saved pose is already on the ground, so it is spawned without on-ground placement;
     its record keeps the request as it was given.
     """
-    source: Any = item["source"]
+    source: str | mujoco.MjSpec = item["source"]
     if item["xml"] is not None:
         source = mujoco.MjSpec.from_string(item["xml"])
     request = replace(SpawnRequest.from_body(item), source=source, xml=None, base_dir=None)

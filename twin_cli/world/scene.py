@@ -4,11 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import mujoco
 
 from converters.mjcf.world_options import INTEGRATOR, SOLVER, WorldOptions, apply_world_options
+from twin_cli.world.pose import vec3
+
+if TYPE_CHECKING:
+    from converters.description import Light
 
 # The SDF/ODE physics fields MuJoCo has no counterpart for (sdf/1.11/physics.sdf, ode section).
 ODE_ONLY_FIELDS = (
@@ -62,7 +66,7 @@ def build_world_spec(settings: SceneSettings) -> mujoco.MjSpec:
     return spec
 
 
-def replace_lights(spec: mujoco.MjSpec, lights: Sequence[Any]) -> None:
+def replace_lights(spec: mujoco.MjSpec, lights: Sequence[Light]) -> None:
     """Replace the world's own lights by `lights` (SDF `<light>`: kind, pose, direction, diffuse).
 
     SDF kinds map to MuJoCo's: directional, spot, point.
@@ -90,7 +94,7 @@ def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:
     `spec.option`, and disables MuJoCo's auto-reset."""
     options = WorldOptions(
         settings.timestep,
-        tuple(settings.gravity),
+        vec3(settings.gravity),
         settings.iterations,
         settings.solver,
         settings.integrator,

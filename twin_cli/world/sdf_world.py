@@ -9,13 +9,16 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin_cli.world.engine import World
 from twin_cli.world.pose import Pose
 from twin_cli.world.values import WorldSettings
+
+if TYPE_CHECKING:
+    from converters.report import Report
 
 # Suffixes of Gazebo world files (`twin serve`, `twin load`).
 WORLD_SUFFIXES = (".sdf", ".world")
@@ -77,7 +80,7 @@ def world_from_sdf(
     return world
 
 
-def _notes(report: Any, prefix: str) -> list[str]:
+def _notes(report: Report, prefix: str) -> list[str]:
     """What a conversion left out or could only warn about, one line each (`twin serve` says
     them: a world's populations, actors and unsupported shapes would otherwise vanish)."""
     from converters.report import Outcome
@@ -112,4 +115,4 @@ def pose_of(T: np.ndarray) -> Pose:
 
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).reshape(-1))
-    return Pose.from_quat(*T[:3, 3], quat)
+    return Pose.at(T[:3, 3], quat)

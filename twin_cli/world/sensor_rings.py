@@ -12,20 +12,26 @@ its grid point (`align_sensor_ticks`); `twin_cli.sensors.history` reads the samp
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import mujoco
+    import numpy as np
 
 TICK, CURSOR, TIMES = 0, 1, 2  # offsets in a sensor's ring; values follow the n times
 TICK_LEAD = 1e-3  # of a step: an interval sensor's tick lead when its period is not whole steps
 
 
-def ring_parts(history: Any, address: int, n: int, dim: int) -> tuple[Any, Any]:
+def ring_parts(
+    history: np.ndarray, address: int, n: int, dim: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Views of one sensor's ring at `address` in `history`: its n times and n×dim values."""
     times = history[address + TIMES : address + TIMES + n]
     values = history[address + TIMES + n : address + TIMES + n + n * dim].reshape(n, dim)
     return times, values
 
 
-def shift_sensor_history(model: Any, data: Any, shift: float) -> None:
+def shift_sensor_history(model: mujoco.MjModel, data: mujoco.MjData, shift: float) -> None:
     """Moves the samples MuJoCo keeps for sensors with a history (an IMU's) by `shift` [s] with
     the clock, so that a time-only reset does not leave their last tick in the future: MuJoCo
     would compute them again only once sim time passed it."""
@@ -38,7 +44,7 @@ def shift_sensor_history(model: Any, data: Any, shift: float) -> None:
             ring[address + TIMES : address + TIMES + n] += shift
 
 
-def align_sensor_ticks(model: Any, data: Any) -> None:
+def align_sensor_ticks(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     """Puts each interval sensor's last tick (ring slot 0) just before its grid point.
 
     MuJoCo computes such a sensor at the first step where last tick + period <= time, then adds

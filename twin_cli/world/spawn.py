@@ -18,7 +18,7 @@ from twin_cli.errors import InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import shared_meshes
 from twin_cli.world.entities import EntityIndex
-from twin_cli.world.pose import Pose, quat_multiply, rotate
+from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
@@ -302,7 +302,7 @@ def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) ->
     """Attaches `child` to `world` in a frame "<name>/" at `pose`, prefixing names "<name>/"."""
     shares = shared_meshes.uses_shared(child)
     frame = world.worldbody.add_frame(name=f"{name}/", pos=list(pose.position()))
-    frame.quat = list(pose.quat())
+    frame.quat = np.array(pose.quat())
     world.attach(child, frame=frame, prefix=f"{name}/")
     if shares:  # a robot's meshes compile once per world, not once per instance
         shared_meshes.adopt(world, name)
@@ -311,8 +311,8 @@ def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) ->
 def move_frame(world: mujoco.MjSpec, name: str, pose: Pose) -> None:
     """Moves the attach frame of entity `name` (fixed-base entities) to `pose`."""
     frame = world.frame(f"{name}/")
-    frame.pos = list(pose.position())
-    frame.quat = list(pose.quat())
+    frame.pos = np.array(pose.position())
+    frame.quat = np.array(pose.quat())
 
 
 _PREFIXED_LISTS = (
@@ -381,7 +381,5 @@ def initial_qpos(
     for at in free_offsets(model, index):
         key_pos = (float(home[at]), float(home[at + 1]), float(home[at + 2]))
         q[at : at + 3] = np.add(pose.position(), rotate(frame_quat, key_pos))
-        q[at + 3 : at + 7] = quat_multiply(
-            frame_quat, tuple(float(v) for v in home[at + 3 : at + 7])
-        )
+        q[at + 3 : at + 7] = quat_multiply(frame_quat, quat4(home[at + 3 : at + 7]))
     return q

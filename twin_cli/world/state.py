@@ -10,14 +10,16 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 from twin_cli.errors import EntityNotFoundError
+from twin_cli.world.observers import Observers
 
 if TYPE_CHECKING:
+    from converters.description import Light
     from twin_cli.world.actuation import Damping, JointCommand, Push
     from twin_cli.world.divergence import Divergence
     from twin_cli.world.entities import Entity, EntityIndex
@@ -72,10 +74,10 @@ class WorldState:
     divergence_log: list[Divergence] = field(default_factory=list)
     mujoco_warnings: deque[str] = field(default_factory=lambda: deque(maxlen=WARNINGS_KEPT))
     scratch_state: np.ndarray = field(default_factory=lambda: np.empty(0))
-    observers: Any = None
+    observers: Observers = field(default_factory=Observers)
     threads: int | None = None
     pool_threads: int = 0
-    lights: list[Any] | None = None
+    lights: list[Light] | None = None
     kept_specs: dict[str, tuple[mujoco.MjSpec, dict[str, str] | None]] = field(default_factory=dict)
     deletes_since_renewal: int = 0
     spec_renewals: int = 0
@@ -83,10 +85,6 @@ class WorldState:
     file_notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        from twin_cli.world.observers import Observers
-
-        if self.observers is None:
-            self.observers = Observers()
         self.scratch_state = np.empty(mujoco.mj_stateSize(self.model, STATE))
 
     def require(self, name: str) -> EntityIndex:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from converters.mjcf import world_options as options
@@ -83,9 +84,9 @@ def scene_settings(settings: WorldSettings) -> SceneSettings:
     )
 
 
-def finite_vector(what: str, values: object, size: int) -> list[float]:
+def finite_vector(what: str, values: Iterable[float], size: int) -> list[float]:
     try:
-        vector = [float(v) for v in values]  # type: ignore[attr-defined]
+        vector = [float(v) for v in values]
     except (TypeError, ValueError) as exc:
         raise InvalidRequestError(
             what, f"{values!r} is not a list of numbers", f"give {size} numbers"
