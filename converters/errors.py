@@ -162,3 +162,16 @@ class SDFError(ConversionError):
         self.path = path
         self.line = line
         self.element = element
+
+
+class DanglingReferenceError(ConversionError):
+    """Gazebo or control tags name a link or joint the robot does not have."""
+
+    def __init__(self, source: str, problems: list[str], names: list[str]) -> None:
+        shown = ", ".join(names[:30]) + (f" (+{len(names) - 30} more)" if len(names) > 30 else "")
+        super().__init__(
+            f"{source}: {'; '.join(problems)}; name one of its links or joints ({shown}), or "
+            "convert with --drop-dangling to leave these out, as Gazebo does"
+        )
+        self.source = source
+        self.problems = problems

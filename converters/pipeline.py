@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
-from converters.errors import InputFileError
+from converters.errors import DanglingReferenceError, InputFileError
 from converters.formats import format_of
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
@@ -164,6 +164,7 @@ def build_description(
     options = options or ConvertOptions()
     report = report or Report(source=robot.source)
     report.robot = robot.name
+    check_references(robot, options, report)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
     apply_gazebo(spec, robot.gazebo, provenance, report)
@@ -171,6 +172,23 @@ def build_description(
     plugins = read_plugins(robot.gazebo.plugins, robot.source)
     add_drive_motors(spec, plugins, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)
+
+
+def check_references(robot: RobotDescription, options: ConvertOptions, report: Report) -> None:
+    """Refuse tags that name a missing link or joint, or with `drop_dangling` report each as
+    left out.
+
+    Raises:
+        DanglingReferenceError: one or more, each with what it carries, and the valid names.
+    """
+    from converters.description.references import dangling_references, part_names
+
+    missing = dangling_references(robot)
+    if missing and not options.drop_dangling:
+        problems = [d.describe() for d in missing]
+        raise DanglingReferenceError(robot.source, problems, part_names(robot))
+    for d in missing:
+        report.warn(d.element, f"{d.describe()}; left out (--drop-dangling)")
 
 
 def convert(

@@ -11,6 +11,7 @@ from corpus_registry import (
     CORPUS,
     CORPUS_MISSING,
     CORPUS_ROOT,
+    DANGLING,
     NON_PHYSICAL_INERTIA,
     PACKAGES_ROOT,
     REPO_ROOT,
@@ -69,6 +70,7 @@ def converted_corpus(corpus_root: Path) -> Callable[[str], Any]:
             robot = CORPUS[robot_id]
             options = ConvertOptions(
                 repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
+                drop_dangling=robot_id in DANGLING,
                 collision=CollisionSettings(mode="hull"),
             )
             cache[robot_id] = convert_full(

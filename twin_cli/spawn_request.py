@@ -36,6 +36,8 @@ class SpawnRequest:
             `spawn_model -J`).
         on_ground: lower the entity until its lowest collision point rests on z = 0.
         repair_inertia: bound non-physical inertias instead of refusing the file.
+        drop_dangling: leave out Gazebo and control tags that name a missing link or joint
+            (Gazebo's behaviour) instead of refusing the file.
     """
 
     source: Any = None
@@ -47,6 +49,7 @@ class SpawnRequest:
     joints: Mapping[str, float] = field(default_factory=dict)
     on_ground: bool = False
     repair_inertia: bool = False
+    drop_dangling: bool = False
 
     @property
     def label(self) -> str:
@@ -78,6 +81,7 @@ class SpawnRequest:
             "joints": dict(self.joints),
             "on_ground": self.on_ground,
             "repair_inertia": self.repair_inertia,
+            "drop_dangling": self.drop_dangling,
         }
 
     def to_body(self) -> dict[str, Any]:
@@ -105,6 +109,7 @@ class SpawnRequest:
             joints={k: float(v) for k, v in (body.get("joints") or {}).items()},
             on_ground=bool(body.get("on_ground", False)),
             repair_inertia=bool(body.get("repair_inertia", False)),
+            drop_dangling=bool(body.get("drop_dangling", False)),
         )
 
 

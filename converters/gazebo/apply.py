@@ -64,11 +64,6 @@ def apply_gazebo(
         provenance: which link/body each geom came from, which body carries each link.
         report: receives one entry per tag (mapped, approximated, ignored) and each warning.
     """
-    for reference in ext.unresolved:
-        report.warn(
-            f"<gazebo reference='{reference}'>",
-            f"no link or joint named '{reference}' in {ext.source}; its tags are not applied",
-        )
     masses = _BodyMasses(spec)
     for geom in provenance.geoms:
         if geom.role == "collision":

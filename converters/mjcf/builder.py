@@ -40,14 +40,16 @@ MODEL_SITE = "__model__"
 
 @dataclass(frozen=True)
 class ConvertOptions:
-    """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan, and
+    """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan,
     `as_written`: apply what a URDF says where Gazebo's own parser drops it (inline `<surface>`,
-    link surface values on named collisions) instead of simulating what Gazebo simulates."""
+    link surface values on named collisions) instead of simulating what Gazebo simulates, and
+    `drop_dangling`: leave out tags that name a missing link or joint instead of refusing them."""
 
     keep_fixed: bool = False
     repair_inertia: bool = False
     collision: CollisionSettings = field(default_factory=CollisionSettings)
     as_written: bool = False
+    drop_dangling: bool = False
 
 
 def pose(T: np.ndarray) -> tuple[list[float], list[float]]:

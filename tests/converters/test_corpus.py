@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from corpus_registry import CORPUS, NON_PHYSICAL_INERTIA, PACKAGES_ROOT, corpus_ids, package_paths
+from corpus_registry import (
+    CORPUS,
+    DANGLING,
+    NON_PHYSICAL_INERTIA,
+    PACKAGES_ROOT,
+    corpus_ids,
+    package_paths,
+)
 
 # Control drawn in ctrlrange, except where the URDF's effort is non-physical. solo12 gives
 # 1000 N·m to 38 g legs (no-load ≈1.8e6 rad/s²); the free-floating base then spins at > 1000 rad/s
@@ -48,7 +55,9 @@ def test_corpus_robot_converts_through_ros_package_path(
     robot = CORPUS[robot_id]
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(PACKAGES_ROOT))
     options = ConvertOptions(
-        repair_inertia=robot_id in NON_PHYSICAL_INERTIA, collision=CollisionSettings(mode="mesh")
+        repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
+        drop_dangling=robot_id in DANGLING,
+        collision=CollisionSettings(mode="mesh"),
     )
     done = convert_full(PACKAGES_ROOT / robot["entry"], args=robot["xacro_args"], options=options)
     model = done.spec.compile()
@@ -82,6 +91,38 @@ def test_non_physical_inertia_fails_with_link_named_and_converts_with_repair(
     )
     repaired = converted_corpus(robot_id).report.of(Outcome.REPAIRED)
     assert any(caught.value.link in e.subject for e in repaired), f"{robot_id}: repair not reported"
+
+
+@pytest.mark.parametrize("robot_id", corpus_ids(DANGLING))
+def test_a_reference_to_a_missing_link_is_refused_then_left_out_with_drop_dangling(
+    robot_id: str, converted_corpus
+) -> None:
+    from converters.errors import DanglingReferenceError
+    from converters.pipeline import convert_full
+    from converters.report import Outcome
+
+    robot = CORPUS[robot_id]
+    missing = robot["gazebo_references_to_missing_links"]
+    with pytest.raises(DanglingReferenceError) as caught:
+        convert_full(
+            PACKAGES_ROOT / robot["entry"],
+            args=robot["xacro_args"],
+            package_paths=package_paths(robot),
+            options=_repair(robot_id),
+        )
+    message = str(caught.value)
+    for link in missing:
+        assert f"<gazebo reference='{link}'>" in message, message
+    assert "--drop-dangling" in message and converted_corpus(robot_id).description.links[0].name
+    warned = [e.subject for e in converted_corpus(robot_id).report.of(Outcome.WARNING)]
+    for link in missing:
+        assert f"<gazebo reference='{link}'>" in warned, f"{robot_id}: {warned}"
+
+
+def _repair(robot_id: str):  # noqa: ANN202
+    from converters.mjcf.builder import ConvertOptions
+
+    return ConvertOptions(repair_inertia=robot_id in NON_PHYSICAL_INERTIA)
 
 
 @pytest.mark.parametrize("robot_id", corpus_ids(sorted(set(CORPUS) - set(NON_PHYSICAL_INERTIA))))

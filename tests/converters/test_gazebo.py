@@ -19,6 +19,7 @@ from converters.gazebo.contact import (
     friction_priority,
     max_contact_stiffness,
 )
+from converters.mjcf.builder import ConvertOptions
 from converters.pipeline import convert_full
 from converters.report import Outcome
 
@@ -374,11 +375,46 @@ def test_bad_value_names_file_reference_tag_and_value(tmp_path, tags, tag, value
     assert "reference='arm'" in message or "reference='hinge'" in message, message
 
 
-def test_reference_to_missing_link_is_a_warning(tmp_path):
-    done, _ = _convert(tmp_path, _ref("camera_link", "<material>Gazebo/Red</material>"))
-    warnings = [e for e in done.report.of(Outcome.WARNING) if "camera_link" in e.subject]
-    assert warnings, "a <gazebo reference> to a missing link must be reported"
-    assert not [e for e in done.report.of(Outcome.MAPPED) if "camera_link" in e.subject]
+LIDAR = (
+    '<sensor type="ray" name="front_lidar"><ray><scan><horizontal><samples>8</samples>'
+    "<min_angle>-0.5</min_angle><max_angle>0.5</max_angle></horizontal></scan>"
+    "<range><min>0.1</min><max>5</max></range></ray></sensor>"
+)
+TRANSMISSION = """<transmission name="t"><type>transmission_interface/SimpleTransmission</type>
+  <joint name="elbow"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>
+  </joint><actuator name="m"/></transmission>"""
+
+
+@pytest.mark.parametrize(
+    ("tags", "named"),
+    [
+        (_ref("camera_link", "<material>Gazebo/Red</material>"), ["camera_link", "material"]),
+        (_ref("lidar_linkk", LIDAR), ["lidar_linkk", "sensor 'front_lidar'"]),
+        (TRANSMISSION, ["<transmission name='t'> joint", "'elbow'"]),
+    ],
+    ids=["tags", "sensor", "transmission"],
+)
+def test_a_reference_to_a_missing_part_is_refused_naming_it_and_the_valid_names(
+    tmp_path, tags: str, named: list[str]
+):
+    from converters.errors import DanglingReferenceError
+
+    with pytest.raises(DanglingReferenceError) as caught:
+        _convert(tmp_path, tags)
+    message = str(caught.value)
+    for part in [*named, "does not exist", "base, arm", "--drop-dangling", "tagbot.urdf"]:
+        assert part in message, f"{part!r} missing from {message!r}"
+
+
+def test_drop_dangling_leaves_the_reference_out_and_reports_it(tmp_path):
+    path = tmp_path / "tagbot.urdf"
+    path.write_text(tagbot(_ref("lidar_linkk", LIDAR) + _ref("arm", "<mu1>0.25</mu1>")))
+    done = convert_full(path, options=ConvertOptions(drop_dangling=True))
+    warnings = [e for e in done.report.of(Outcome.WARNING) if "lidar_linkk" in e.subject]
+    assert warnings and "sensor 'front_lidar'" in warnings[0].detail, warnings
+    assert not done.sensors, "the lidar on a missing link is left out"
+    model = done.spec.compile()
+    assert model.geom_friction[_geom(done, model, "arm").id][0] == pytest.approx(0.25), "mu1"
 
 
 @needs_corpus

@@ -44,6 +44,7 @@ def spawn_request(
     joint: list[str] | None,
     on_ground: bool,
     repair_inertia: bool,
+    drop_dangling: bool = False,
 ) -> SpawnRequest:
     """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
 
@@ -64,6 +65,7 @@ def spawn_request(
         joints=pairs.joint_positions(joint) or {},
         on_ground=on_ground,
         repair_inertia=repair_inertia,
+        drop_dangling=drop_dangling,
     )
 
 
@@ -89,6 +91,7 @@ def spawn(
     names: str | None = None,
     view: bool = False,
     repair_inertia: bool = False,
+    drop_dangling: bool = False,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
@@ -107,7 +110,9 @@ def spawn(
         poses, listed = batch_placements(at or [], names, (x, y), (z, roll, pitch, yaw), quat)
     else:
         pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
-    request = spawn_request(file, xml, arg, package, joint, on_ground, repair_inertia)
+    request = spawn_request(
+        file, xml, arg, package, joint, on_ground, repair_inertia, drop_dangling
+    )
     with connect_world(world, start=True) as c:
         if many:
             results = c.spawn_batch(request, poses=poses, names=listed, base=name)

@@ -127,6 +127,12 @@ SPAWN = Command(
             dest="repair_inertia",
             help="Bound non-physical inertias instead of failing.",
         ),
+        flag(
+            "--drop-dangling",
+            dest="drop_dangling",
+            help="Leave out tags naming a missing link or joint (as Gazebo does) instead of "
+            "failing.",
+        ),
     ),
 )
 

@@ -91,6 +91,10 @@ class SpawnBody(Body):
     repair_inertia: bool = Field(
         default=False, description="bound non-physical inertias instead of refusing the file"
     )
+    drop_dangling: bool = Field(
+        default=False,
+        description="leave out tags that name a missing link or joint instead of refusing them",
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> SpawnBody:

@@ -126,4 +126,38 @@ def start_warnings(
         return "the ground" if geom_name == "ground" else f"geom [{geom_name}]"
 
     geoms = collision_geoms(model, index[name].geoms)
-    return overlap_warnings(name, z, overlaps(scratch, geoms, party_of))
+    found = overlap_warnings(name, z, overlaps(scratch, geoms, party_of))
+    return found + self_overlap_warnings(model, scratch, name, geoms)
+
+
+def self_overlaps(
+    model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray
+) -> dict[tuple[str, str], float]:
+    """The deepest overlap [m] between two of an entity's own links, per pair of body names.
+
+    Only pairs that collide show up: MuJoCo leaves out parent and child, and the converter
+    excludes every pair Gazebo does not collide (self_collide off), so a pair here is one the
+    robot's own description asks to collide.
+    """
+    mine = np.isin(data.contact.geom, geoms)
+    deepest: dict[tuple[str, str], float] = {}
+    for (g1, g2), (in1, in2), dist in zip(data.contact.geom, mine, data.contact.dist, strict=True):
+        if not (in1 and in2) or -dist <= PENETRATION_TOL:
+            continue
+        pair = sorted(model.body(int(model.geom_bodyid[g])).name for g in (g1, g2))
+        key = (pair[0], pair[1])
+        deepest[key] = max(deepest.get(key, 0.0), -float(dist))
+    return deepest
+
+
+def self_overlap_warnings(
+    model: mujoco.MjModel, data: mujoco.MjData, name: str, geoms: np.ndarray
+) -> list[str]:
+    """One warning per pair of the entity's links that start inside each other."""
+    prefix = f"{name}/"
+    return [
+        f"entity [{name}]: links '{a.removeprefix(prefix)}' and '{b.removeprefix(prefix)}' start "
+        f"{depth:.4f} m inside each other with self-collision on; choose a start posture that "
+        "separates them (-J JOINT=POS) or turn self_collide off for one of them"
+        for (a, b), depth in sorted(self_overlaps(model, data, geoms).items(), key=lambda i: -i[1])
+    ]

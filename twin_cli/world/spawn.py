@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -20,6 +21,9 @@ from twin_cli.world import shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
+
+if TYPE_CHECKING:
+    from converters.mjcf.builder import ConvertOptions
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 URDF_SUFFIXES = (".urdf", ".xacro")
@@ -93,6 +97,15 @@ def load_source(request: SpawnRequest) -> LoadedSource:
     )
 
 
+def convert_options(request: SpawnRequest) -> ConvertOptions:
+    """The converter's options that the request sets."""
+    from converters.mjcf.builder import ConvertOptions
+
+    return ConvertOptions(
+        repair_inertia=request.repair_inertia, drop_dangling=request.drop_dangling
+    )
+
+
 def resolving_env(request: SpawnRequest) -> dict[str, str] | None:
     """The environment to resolve packages in: the caller's variables over this process's
     (unset ones: this process's), or None for this process's own."""
@@ -113,7 +126,6 @@ def _sniff(path: Path) -> str | None:
 def _load_text(request: SpawnRequest) -> LoadedSource:
     """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
     from converters.formats import format_of
-    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_text
 
     text, label = request.xml or "", request.label
@@ -128,7 +140,7 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
         source=label,
         base_dir=request.base_dir,
         package_paths=dict(request.package_paths),
-        options=ConvertOptions(repair_inertia=request.repair_inertia),
+        options=convert_options(request),
         env=resolving_env(request),
     )
     name = done.report.robot or "model"
@@ -185,14 +197,13 @@ def _load_description(path: Path, request: SpawnRequest) -> LoadedSource:
 
 
 def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
-    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
 
     done = convert_full(
         path,
         args=dict(request.args),
         package_paths=dict(request.package_paths),
-        options=ConvertOptions(repair_inertia=request.repair_inertia),
+        options=convert_options(request),
         env=resolving_env(request),
     )
     spec, report = done.spec, done.report

@@ -76,6 +76,13 @@ def check_batch(
         check_finite(pose, f"pose {i} of entity [{name}]")
 
 
+def conversion_warnings(report: dict | None) -> list[str]:
+    """The converter's warnings (what it left out or could not honour), for the terminal: the
+    JSON report alone is not where a user looks."""
+    entries = (report or {}).get("entries", [])
+    return [f"{e['subject']}: {e['detail']}" for e in entries if e.get("outcome") == "warning"]
+
+
 def make_entity(
     name: str, loaded: spawn.LoadedSource, request: SpawnRequest, placed: Placed
 ) -> Entity:
@@ -199,7 +206,7 @@ def _spawn_loaded(
         for one, request, n, start in zip(loaded, requests, names, placed, strict=True):
             state.entities[n] = make_entity(n, one, request, start)
             starting = placement.start_warnings(model, data, index, n, start.pose.z)
-            warnings = [*one.notes, *starting]
+            warnings = [*one.notes, *conversion_warnings(one.report), *starting]
             results.append(SpawnResult(n, one.source, warnings, one.report, one.cached))
         commit(state, state.spec, (model, data, index))
         return results

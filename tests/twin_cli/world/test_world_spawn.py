@@ -369,3 +369,43 @@ def test_a_failed_fixed_base_move_leaves_the_entity_as_it_was(tmp_path):
     world._state.spec.delete(bad)
     world.set_pose("p", Pose(x=2.0))
     assert world.get_pose("p").x == pytest.approx(2.0) and world.entity("p").pose.x == 2.0
+
+
+def _folded_arm() -> str:
+    """base → (j1 about z) → upper, 0.3 m out → (j2 about z) → fore, folded back over the base:
+    at zero posture fore's box sits 0.05 m deep in base's; j2 = 3 rad swings it clear."""
+
+    def link(name: str, x: float) -> str:
+        inertia = '<inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/>'
+        box = f'<origin xyz="{x} 0 0"/><geometry><box size="0.2 0.2 0.2"/></geometry>'
+        return (
+            f'<link name="{name}"><inertial><mass value="0.5"/>{inertia}</inertial>'
+            f"<collision>{box}</collision></link>"
+            f'<gazebo reference="{name}"><selfCollide>true</selfCollide></gazebo>'
+        )
+
+    def joint(name: str, parent: str, child: str, x: float) -> str:
+        return (
+            f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{x} 0 0"/><axis xyz="0 0 1"/>'
+            '<limit lower="-3.1" upper="3.1" effort="10" velocity="1"/></joint>'
+        )
+
+    parts = link("base", 0.0) + link("upper", 0.15) + link("fore", -0.15)
+    joints = joint("j1", "base", "upper", 0.0) + joint("j2", "upper", "fore", 0.3)
+    return f'<robot name="folded">{parts}{joints}</robot>'
+
+
+def test_spawn_warns_of_links_that_start_inside_each_other_and_the_posture_that_clears_it(
+    tmp_path,
+):
+    urdf = write_urdf(tmp_path, _folded_arm())
+    world = World(WorldSettings(ground=False))
+    folded = world.spawn(urdf, name="a", pose=Pose(z=1.0))
+    said = [w for w in folded.warnings if "inside each other" in w]
+    assert len(said) == 1 and "'base' and 'fore'" in said[0], folded.warnings
+    depth = float(said[0].split(" start ")[1].split(" m ")[0])
+    assert depth == pytest.approx(0.05, abs=1e-3), f"overlap depth [m] in {said[0]}"
+    assert "-J" in said[0] and "self_collide" in said[0], said[0]
+    clear = world.spawn(SpawnRequest(urdf, joints={"j2": 3.0}), name="b", pose=Pose(x=3, z=1.0))
+    assert not [w for w in clear.warnings if "inside each other" in w], clear.warnings

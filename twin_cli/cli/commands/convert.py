@@ -27,6 +27,13 @@ RepairOpt = Annotated[
     bool,
     typer.Option("--repair-inertia", help="Bound non-physical inertias instead of failing."),
 ]
+DanglingOpt = Annotated[
+    bool,
+    typer.Option(
+        "--drop-dangling",
+        help="Leave out tags naming a missing link or joint (as Gazebo does) instead of failing.",
+    ),
+]
 
 
 def _options(
@@ -34,12 +41,17 @@ def _options(
     repair: bool,
     collision: dict[str, Any] | None = None,
     as_written: bool = False,
+    drop_dangling: bool = False,
 ) -> Any:
     from converters.collision.plan import CollisionSettings
     from converters.mjcf.builder import ConvertOptions
 
     return ConvertOptions(
-        keep_fixed, repair, CollisionSettings(**(collision or {})), as_written=as_written
+        keep_fixed,
+        repair,
+        CollisionSettings(**(collision or {})),
+        as_written=as_written,
+        drop_dangling=drop_dangling,
     )
 
 
@@ -82,6 +94,7 @@ def convert_command(
     package: PackageOpt = None,
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
+    drop_dangling: DanglingOpt = False,
     print_xml: Annotated[bool, typer.Option("--print", help="Write the MJCF to stdout.")] = False,
     json_mode: JsonOpt = False,
     collision: Annotated[
@@ -139,7 +152,7 @@ def convert_command(
     done = convert_full(
         robot,
         **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, settings, as_written),
+        options=_options(keep_fixed, repair_inertia, settings, as_written, drop_dangling),
     )
     if print_xml:
         typer.echo(done.spec.to_xml(), nl=False)
@@ -171,6 +184,7 @@ def inspect_command(
     package: PackageOpt = None,
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
+    drop_dangling: DanglingOpt = False,
     json_mode: JsonOpt = False,
     as_written: AsWrittenOpt = False,
 ) -> None:
@@ -182,7 +196,7 @@ def inspect_command(
     done = convert_full(
         robot,
         **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}, as_written),
+        options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}, as_written, drop_dangling),
     )
     stats = inertial_stats(done.spec, done.description)
     out = Output(json_mode)

@@ -1,0 +1,65 @@
+"""References that name no part of the robot: a `<gazebo reference>` (with its sensors and
+plugins) on a missing link, or a `<ros2_control>`/`<transmission>` joint that does not exist.
+
+Gazebo's own parser drops such a block with a warning and loads the robot without it: a camera
+on a link that was commented out is simply not there, and nothing says so where the user looks.
+twin refuses the description instead, naming the reference, what it carries and the valid
+names, unless the user asks to leave them out (`--drop-dangling`, Gazebo's behaviour), when each
+is reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from converters.description.robot import RobotDescription
+
+
+@dataclass(frozen=True)
+class Dangling:
+    """One reference to a part that does not exist.
+
+    Attributes:
+        element: where it is written, e.g. `<gazebo reference='camera_link'>`.
+        target: the link or joint it names.
+        kind: "link or joint" or "joint" (what the name should be).
+        carries: what is lost with it, e.g. ("sensor 'cam'", "tags mu1, material").
+    """
+
+    element: str
+    target: str
+    kind: str
+    carries: tuple[str, ...] = ()
+
+    def describe(self) -> str:
+        lost = f" ({', '.join(self.carries)})" if self.carries else ""
+        return f"{self.element}{lost} names {self.kind} '{self.target}', which does not exist"
+
+
+def dangling_references(robot: RobotDescription) -> list[Dangling]:
+    """Every reference of the robot's Gazebo and control tags that names no link or joint."""
+    found = [_gazebo_reference(robot, name) for name in robot.gazebo.unresolved]
+    joints = {joint.name for joint in robot.joints}
+    for control in robot.controls:
+        if control.joint not in joints:
+            element = f"{control.where} joint"
+            found.append(Dangling(element, control.joint, "joint", ("command interfaces",)))
+    return found
+
+
+def _gazebo_reference(robot: RobotDescription, name: str) -> Dangling:
+    ext = robot.gazebo.links.get(name)
+    carries: list[str] = []
+    if ext is not None:
+        carries += [f"sensor '{blob.name}'" for blob in ext.sensors]
+        carries += [f"<{blob.tag}> '{blob.name or blob.kind}'" for blob in ext.blobs]
+        kept_whole = {blob.tag for blob in (*ext.sensors, *ext.blobs)}
+        tags = sorted({source.tag for source in ext.sources} - kept_whole)
+        if tags:
+            carries.append("tags " + ", ".join(tags))
+    return Dangling(f"<gazebo reference='{name}'>", name, "link or joint", tuple(carries))
+
+
+def part_names(robot: RobotDescription) -> list[str]:
+    """The robot's links and joints, for the message that lists the valid names."""
+    return [link.name for link in robot.links] + [joint.name for joint in robot.joints]
