@@ -125,6 +125,21 @@ class WorldFileError(TwinError):
         self.path = path
 
 
+class NoReplyError(TwinError):
+    """A request got no reply in time: the server may still be doing it."""
+
+    # sysexits' EX_TEMPFAIL, as OutcomeUnknownError: not bad input, not a bug.
+    exit_code = 75
+
+    def __init__(self, world: str, what: str, waited: float) -> None:
+        super().__init__(
+            f"{what} on world [{world}]: no reply within {waited:g} s, so the outcome is unknown "
+            f"(the server may be busy); check with `twin stats --world {world}` and "
+            "`twin logs`, then try again"
+        )
+        self.world = world
+
+
 class OutcomeUnknownError(TwinError):
     """A spawn or delete got no reply within the client's patience: it may still happen."""
 

@@ -93,8 +93,23 @@ def main() -> None:
     try:
         if not fast.run(sys.argv[1:]):
             _run_app(sys.argv[1:])
+        sys.stdout.flush()  # a reader that went away (`| head -1`) shows up here, if not before
+    except BrokenPipeError:
+        _reader_gone()
     except Exception as exc:
         _fail(exc, debug)
+
+
+def _reader_gone() -> NoReturn:
+    """The command's reader closed the pipe (`twin list | head -1`): what it wanted it has.
+
+    Standard output goes to /dev/null so that the interpreter's last flush cannot fail again.
+    """
+    import os
+
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    sys.exit(0)
 
 
 def _run_app(argv: list[str]) -> None:

@@ -15,6 +15,7 @@ from typing import Any
 from fastapi import APIRouter, FastAPI, Request
 
 from twin_cli.server import consumer_routes, control_routes, sensor_routes, view_routes
+from twin_cli.server.body_limit import BodyLimit
 from twin_cli.server.error_replies import ERROR_RESPONSES, install_handlers
 from twin_cli.server.holder import WorldDep, WorldHolder
 from twin_cli.server.models import (
@@ -267,4 +268,5 @@ def create_app(
         app.include_router(routes, responses=ERROR_RESPONSES)
     install_handlers(app)
     app.add_middleware(TokenGuard, token=token)
+    app.add_middleware(BodyLimit)  # outermost: a huge body is refused before anything reads it
     return app

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from twin_cli import errors as twin_errors
-from twin_cli.errors import NotRunningError, RequestError
+from twin_cli.errors import NoReplyError, NotRunningError, RequestError
 from twin_cli.package_env import package_env
 from twin_cli.server import runtime
 from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
@@ -99,16 +99,13 @@ class Client:
 
         Raises:
             NotRunningError: no server listens for this world.
+            NoReplyError: no reply within `timeout` seconds; the outcome is unknown (exit 75).
             TwinError | ConversionError: the server's error, as the same class.
         """
         try:
             reply = self._http.request(method, path, json=body, timeout=timeout)
         except TimeoutError as exc:
-            raise RequestError(
-                f"{method} {path}",
-                f"no answer from world [{self.world}] in {timeout:.0f} s",
-                "the server may be busy; see `twin logs`",
-            ) from exc
+            raise NoReplyError(self.world, f"{method} {path}", timeout) from exc
         except NOT_ANSWERING as exc:
             raise NotRunningError(self.world) from exc
         return _decoded(reply)

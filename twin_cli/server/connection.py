@@ -106,6 +106,8 @@ def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) ->
             client.request("POST", "/shutdown")
         except NotRunningError:
             pass  # socket gone but process alive: fall through to signals
+    # The server lets go of its pid lock as it shuts down, while a request thread (a render, a
+    # conversion) may still be finishing: wait for the process itself to be gone as well.
     for sig in (None, signal.SIGTERM, signal.SIGKILL):
         if sig is not None and pid:
             try:
@@ -113,10 +115,34 @@ def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) ->
             except ProcessLookupError:
                 break
         deadline = time.monotonic() + timeout
-        while runtime.server_alive(paths) and time.monotonic() < deadline:
+        while _running(paths, pid) and time.monotonic() < deadline:
             time.sleep(runtime.START_POLL_S)
-        if not runtime.server_alive(paths):
+        if not _running(paths, pid):
             break
     with runtime.start_lock(paths):
         runtime.clean_stale(paths)
     return pid
+
+
+def _running(paths: runtime.WorldPaths, pid: int | None) -> bool:
+    """The server holds its pid lock, or its process still exists (finishing its threads)."""
+    if runtime.server_alive(paths):
+        return True
+    if not pid:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return not _zombie(pid)
+
+
+def _zombie(pid: int) -> bool:
+    """An ended process its parent (the supervisor) has not reaped yet counts as gone."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as handle:
+            return handle.read().rsplit(")", 1)[1].split()[0] == "Z"
+    except (OSError, IndexError):
+        return False

@@ -51,6 +51,7 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
         (401, "TCP request without the bearer token"),
         (404, "no such entity, joint, link or sensor"),
         (409, "the name is taken"),
+        (413, "the request body is over the server's limit"),
         (422, "the body does not match the request schema"),
         (500, "internal error; the world keeps running"),
     )

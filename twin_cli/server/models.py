@@ -11,6 +11,7 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from twin_cli.names import name_message, name_problem
+from twin_cli.server.body_limit import MAX_BODY_BYTES
 from twin_cli.spawn_request import SpawnRequest
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -69,7 +70,7 @@ class SpawnBody(Body):
     source: Annotated[str, Field(min_length=1)] | None = Field(
         default=None, description="absolute path on the server host"
     )
-    xml: Annotated[str, Field(min_length=1, max_length=50_000_000)] | None = Field(
+    xml: Annotated[str, Field(min_length=1, max_length=MAX_BODY_BYTES)] | None = Field(
         default=None, description="the description as text, instead of `source`"
     )
     base_dir: str | None = Field(

@@ -63,6 +63,23 @@ def test_unknown_entity_is_404_naming_it(server):
         client.delete("ghost")
 
 
+def test_a_body_over_the_limit_is_refused_at_once_with_413(server):
+    from twin_cli.errors import RequestError
+    from twin_cli.server.body_limit import MAX_BODY_BYTES
+
+    client, _ = server
+    before, entities = _sim_time(client), client.entities()
+    huge = {"xml": "<robot>" + " " * (MAX_BODY_BYTES + 1024) + "</robot>"}
+    start = time.monotonic()
+    with pytest.raises(RequestError, match="over the server's limit") as caught:
+        client.request("POST", "/entities", body=huge, timeout=30.0)
+    took = time.monotonic() - start
+    assert "POST /entities" in str(caught.value), str(caught.value)
+    assert took < 5.0, f"a refused {MAX_BODY_BYTES} byte body took {took:.1f} s to answer"
+    _assert_still_stepping(client, before)
+    assert [e["name"] for e in client.entities()] == [e["name"] for e in entities], "no spawn"
+
+
 def test_malformed_pose_is_422_naming_the_field(server):
     client, _ = server
     before = _sim_time(client)

@@ -215,3 +215,20 @@ def test_a_different_spawn_after_an_unknown_outcome_happens_and_a_repeat_is_repl
     assert len(json.loads(twin("list", "--json").stdout)) == 4
     twin("stop")
     assert not list(twin.dir.glob("*.pending-*")), "idempotency keys left after the world ended"
+
+
+def test_a_snapshot_that_outlives_the_clients_patience_is_unknown_not_bad_input(twin, tmp_path):
+    twin("spawn", twin.box, "--name", "box", "-z", "1")
+    twin("pause")
+    busy = _busy_world(twin, 5.0)
+    time.sleep(0.5)  # the step request holds the world's lock now
+    shot = subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", "snapshot", str(tmp_path / "s.png")],
+        env={**twin.env, "TWIN_TIMEOUT": "1"},
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert shot.returncode == 75, f"exit {shot.returncode}: {shot.stderr}"
+    assert "outcome is unknown" in shot.stderr and "Traceback" not in shot.stderr, shot.stderr
+    assert busy.wait(timeout=120) == 0, busy.stderr.read()

@@ -75,8 +75,10 @@ def snapshot(
         "width": width,
         "height": height,
     }
-    with connect(world) as client:
-        reply = client.request("POST", "/snapshot", body=body)
+    with connect(world) as client:  # a first render starts GL: wait while the server lives
+        reply = client.long_request(
+            "POST", "/snapshot", body=body, what=f"snapshot {body['path']}", repeat="twin snapshot"
+        )
     sink = Output(json)
     if json:
         sink.data(reply)
