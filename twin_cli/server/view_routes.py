@@ -50,11 +50,20 @@ def stop_view(request: Request) -> dict:
     return views(request).stop()
 
 
+PICTURE_MODE = 0o644  # a picture holds no world state, unlike a save (0600)
+
+
 @router.post("/snapshot")
 def snapshot(body: SnapshotBody, world: WorldDep) -> dict:
     """Render the world offscreen into a PNG at `path` (atomically); reply with the camera."""
-    from twin_cli.view.offscreen import snapshot_png, write_atomically
+    from twin_cli.errors import RequestError
+    from twin_cli.output_files import OutputFileError, checked_target, write_atomically
+    from twin_cli.view.offscreen import snapshot_png
 
-    png, camera = snapshot_png(world, entity=body.entity, width=body.width, height=body.height)
-    write_atomically(body.path, png)
+    try:
+        checked_target(body.path)  # before rendering: a bad target costs no frame
+        png, camera = snapshot_png(world, entity=body.entity, width=body.width, height=body.height)
+        write_atomically(body.path, png, mode=PICTURE_MODE)
+    except OutputFileError as exc:
+        raise RequestError(f"snapshot {exc.filename}", exc.problem, exc.fix) from exc
     return {"path": body.path, "bytes": len(png), "camera": camera}

@@ -166,19 +166,3 @@ def snapshot_png(
     mujoco.mj_forward(model, data)
     view = entity_view(model, data, bodies, width, height)
     return png_bytes(render(model, data, view)), view.to_dict()
-
-
-def write_atomically(path: str, payload: bytes) -> None:
-    """Writes `payload` to a temporary file beside `path`, then renames it over `path`."""
-    import tempfile
-
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, temp = tempfile.mkstemp(dir=directory, prefix=".twin-", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(payload)
-        os.replace(temp, path)
-    except BaseException:
-        if os.path.exists(temp):
-            os.unlink(temp)
-        raise

@@ -243,12 +243,21 @@ def _mocap_bodies(model: mujoco.MjModel) -> np.ndarray:
 
 def typed_like(reference: EntityState, loaded: EntityState) -> EntityState:
     """`loaded` with each array's dtype and shape taken from `reference` (a state read back
-    from JSON has lists where the world keeps typed arrays)."""
-    return EntityState(
-        **{
-            f.name: np.asarray(
-                getattr(loaded, f.name), dtype=getattr(reference, f.name).dtype
-            ).reshape(getattr(reference, f.name).shape)
-            for f in fields(EntityState)
-        }
-    )
+    from JSON has lists where the world keeps typed arrays).
+
+    Raises:
+        InvalidRequestError: an array whose size is not the reference's.
+    """
+    from twin_cli.errors import InvalidRequestError
+
+    typed = {}
+    for f in fields(EntityState):
+        ref, got = getattr(reference, f.name), np.asarray(getattr(loaded, f.name))
+        if got.size != ref.size:
+            raise InvalidRequestError(
+                f"spawn state '{f.name}'",
+                f"{got.size} values, the entity has {ref.size}",
+                "give the state of the same robot",
+            )
+        typed[f.name] = got.astype(ref.dtype).reshape(ref.shape)
+    return EntityState(**typed)

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import asdict, fields, replace
 from pathlib import Path
 from typing import Any
@@ -18,17 +17,21 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from twin_cli.errors import InvalidRequestError, WorldFileError
+from converters.errors import ConversionError
+from twin_cli.errors import InvalidRequestError, TwinError, WorldFileError
+from twin_cli.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.engine import World
 from twin_cli.world.entities import Entity, EntityState
 from twin_cli.world.pose import Pose
+from twin_cli.world.save_schema import SaveDocument, checked_document
 from twin_cli.world.snapshot import WorldSnapshot
 from twin_cli.world.values import WorldSettings
 
 FORMAT = "twin-world"
 VERSION = 1
+SAVED_BY_TWIN = "give a file written by `twin save`"
 
 
 def save(world: World, path: str | os.PathLike) -> None:
@@ -75,14 +78,11 @@ def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
 
 
 def _write_atomically(path: Path, text: str) -> None:
+    """Atomically, to a regular file only, 0600 (`twin_cli.output_files`)."""
     try:
-        with tempfile.NamedTemporaryFile(
-            "w", dir=path.parent, prefix=f".{path.name}.", delete=False, encoding="utf-8"
-        ) as tmp:
-            tmp.write(text)
-            tmp.flush()
-            os.fsync(tmp.fileno())
-        os.replace(tmp.name, path)
+        write_atomically(path, text.encode("utf-8"))
+    except OutputFileError as exc:
+        raise WorldFileError(exc.filename, exc.problem, exc.fix) from exc
     except OSError as exc:
         raise WorldFileError(
             path, f"cannot write ({exc.strerror})", "choose a writable folder"
@@ -97,50 +97,72 @@ def load(path: str | os.PathLike) -> World:
             model no longer has the saved layout.
     """
     doc = _read(Path(path))
-    settings = doc["settings"]
-    settings["gravity"] = tuple(settings["gravity"])
-    world = World(WorldSettings(**settings), name=doc["name"])
-    entities = [_respawn(world, item) for item in doc["entities"]]
+    world = _new_world(path, doc)
+    entities = [_respawn(path, world, item.model_dump()) for item in doc.entities]
     snapshot = WorldSnapshot(
-        doc["name"],
+        doc.name,
         world.settings,
-        bool(doc["paused"]),
-        int(doc["iterations"]),
-        int(doc["divergences"]),
+        doc.paused,
+        doc.iterations,
+        doc.divergences,
         tuple(entities),
-        tuple(JointCommand(**c) for c in doc["commands"]),
-        tuple(Push(p["body"], tuple(p["wrench"]), int(p["end_step"])) for p in doc["pushes"]),
-        doc["layout"],
-        np.array(doc["state"], dtype=float),
+        tuple(JointCommand(**c.model_dump()) for c in doc.commands),
+        tuple(Push(p.body, tuple(p.wrench), p.end_step) for p in doc.pushes),
+        dict(doc.layout),
+        np.array(doc.state, dtype=float),
     )
     try:
         world.restore(snapshot)
     except InvalidRequestError as exc:
         raise WorldFileError(
-            path,
-            f"the sources now compile to {world.snapshot().layout}, saved {doc['layout']}",
-            "restore the robot files as they were when saved, or spawn afresh",
+            path, str(exc), "restore the robot files as they were when saved, or spawn afresh"
         ) from exc
     return world
 
 
-def _read(path: Path) -> dict[str, Any]:
+def _new_world(path: str | os.PathLike, doc: SaveDocument) -> World:
+    """An empty world with the saved settings (checked like any settings)."""
+    values = doc.settings.model_dump()
+    values["gravity"] = tuple(values["gravity"])
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        return World(WorldSettings(**values), name=doc.name)
+    except TwinError as exc:
+        raise WorldFileError(
+            path, f"settings: {exc}", "give a file written by `twin save`"
+        ) from exc
+
+
+def _read(path: Path) -> SaveDocument:
+    """The file's document, checked field by field (`save_schema`).
+
+    Raises:
+        WorldFileError: unreadable, not JSON, too deeply nested, or a field that is wrong.
+    """
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
         raise WorldFileError(path, f"cannot read ({exc.strerror})", "check the path") from exc
     except json.JSONDecodeError as exc:
         raise WorldFileError(
             path, f"not JSON ({exc.msg}, line {exc.lineno})", "give a file written by `twin save`"
         ) from exc
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT or doc.get("version") != VERSION:
+    except (RecursionError, UnicodeDecodeError) as exc:
+        raise WorldFileError(
+            path,
+            f"not a twin world file ({type(exc).__name__})",
+            "give a file written by `twin save`",
+        ) from exc
+    if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("version") != VERSION:
         raise WorldFileError(
             path, "not a twin world file (version 1)", "give a file written by `twin save`"
         )
+    doc, problem = checked_document(data)
+    if doc is None:
+        raise WorldFileError(path, problem, SAVED_BY_TWIN)
     return doc
 
 
-def _respawn(world: World, item: dict[str, Any]) -> Entity:
+def _respawn(path: str | os.PathLike, world: World, item: dict[str, Any]) -> Entity:
     """Spawns a saved entity again; returns its record with the saved spawn state.
 
     Its saved pose is already on the ground, so it is spawned without on-ground placement;
@@ -148,9 +170,17 @@ def _respawn(world: World, item: dict[str, Any]) -> Entity:
     """
     source: str | mujoco.MjSpec = item["source"]
     if item["xml"] is not None:
-        source = mujoco.MjSpec.from_string(item["xml"])
+        try:
+            source = mujoco.MjSpec.from_string(item["xml"])
+        except ValueError as exc:
+            problem = f"entity [{item['name']}]: its xml (MJCF) is not valid ({exc})"
+            raise WorldFileError(path, problem, SAVED_BY_TWIN) from exc
     request = replace(SpawnRequest.from_body(item), source=source, xml=None, base_dir=None)
-    world.spawn(replace(request, on_ground=False), name=item["name"], pose=Pose(**item["pose"]))
+    try:
+        world.spawn(replace(request, on_ground=False), name=item["name"], pose=Pose(**item["pose"]))
+    except (TwinError, ConversionError) as exc:
+        problem = f"entity [{item['name']}] cannot be spawned from its source again ({exc})"
+        raise WorldFileError(path, problem, "restore its source file, or spawn afresh") from exc
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world.entity(item["name"])
     return replace(entity, source=item["source"], request=request, spawn_state=spawn_state)

@@ -88,11 +88,17 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
     """
     with state.lock:
         names = [e.name for e in snapshot.entities]
-        if names != list(state.entities) or snapshot.layout != layout_of(state.model):
+        size = mujoco.mj_stateSize(state.model, STATE)
+        if (
+            names != list(state.entities)
+            or snapshot.layout != layout_of(state.model)
+            or np.size(snapshot.state) != size
+        ):
             raise InvalidRequestError(
                 "world snapshot",
-                f"entities {names} in layout {snapshot.layout}, this world has "
-                f"{list(state.entities)} in {layout_of(state.model)}",
+                f"entities {names} in layout {snapshot.layout} with {np.size(snapshot.state)} "
+                f"state values, this world has {list(state.entities)} in "
+                f"{layout_of(state.model)} with {size}",
                 "restore into a world that spawned the same sources in the same order",
             )
         for entity in snapshot.entities:

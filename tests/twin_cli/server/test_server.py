@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import socket
 import stat
@@ -219,3 +220,22 @@ def test_set_pose_then_push_moves_by_half_a_t_squared(server, files):
         client.delete("puck")
         client.set_gravity(preset="earth")
         client.resume()
+
+
+def test_a_rejected_load_leaves_the_world_byte_identical(server, tmp_path):
+    from twin_cli.errors import WorldFileError
+
+    client, _ = server
+    client.pause()
+    try:
+        client.save(tmp_path / "before.json")
+        bad = json.loads((tmp_path / "before.json").read_text())
+        bad["state"] = bad["state"][:3]  # a truncated state vector
+        (tmp_path / "bad.json").write_text(json.dumps(bad))
+        with pytest.raises(WorldFileError, match="bad.json"):
+            client.load(tmp_path / "bad.json")
+        client.save(tmp_path / "after.json")
+    finally:
+        client.resume()
+    before, after = ((tmp_path / n).read_bytes() for n in ("before.json", "after.json"))
+    assert before == after, "the world changed after a refused load"
