@@ -124,11 +124,15 @@ class BadNumberError(ConversionError):
 class InertiaError(ConversionError):
     """A moving link has no, or a non-physical, mass/inertia."""
 
-    def __init__(self, path: str, link: str, problem: str, values: str) -> None:
-        super().__init__(
-            f"{path}: link '{link}': {problem} ({values}); give it a physical <inertial> "
-            "(mass > 0, positive-definite tensor, ixx+iyy >= izz etc.) or pass --repair-inertia"
-        )
+    REPAIRABLE = (
+        "give it a physical <inertial> (mass > 0, positive-definite tensor, ixx+iyy >= izz etc.) "
+        "or pass --repair-inertia"
+    )
+
+    def __init__(
+        self, path: str, link: str, problem: str, values: str, fix: str = REPAIRABLE
+    ) -> None:
+        super().__init__(f"{path}: link '{link}': {problem} ({values}); {fix}")
         self.path = path
         self.link = link
 

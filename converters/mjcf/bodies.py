@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from converters.description import RobotDescription
+from converters.description.robot import Inertial
 from converters.errors import InertiaError
 from converters.mjcf import inertia as inr
 from converters.mjcf.geometry import GeomPlan
@@ -27,6 +28,10 @@ def link_inertias(robot: RobotDescription, repair: bool, report: Report) -> dict
         if value.mass == 0 and not np.any(value.tensor):
             out[link.name] = value
             continue
+        wild = inr.out_of_range(value)
+        if wild is not None:
+            fix = "give its <inertial> the mass [kg] and inertia [kg m²] of a real part"
+            raise InertiaError(robot.source, link.name, wild, _declared(link.inertial), fix)
         trouble = inr.problem(value)
         if trouble is not None and value.mass > 0 and repair:
             fixed = inr.repair_tensor(value)
@@ -39,6 +44,13 @@ def link_inertias(robot: RobotDescription, repair: bool, report: Report) -> dict
             raise InertiaError(robot.source, link.name, trouble, inr.describe(value))
         out[link.name] = value
     return out
+
+
+def _declared(inertial: Inertial | None) -> str:
+    """The values as the file gives them (the turned ones may have overflowed)."""
+    if inertial is None:
+        return "no <inertial>"
+    return inr.describe(inr.Inertia(inertial.mass, np.zeros(3), inertial.inertia))
 
 
 def body_inertias(

@@ -11,6 +11,9 @@ from converters.description import Inertial
 # Tolerance of the checks, relative to the largest principal moment: MuJoCo itself rejects a
 # triangle-inequality violation only beyond its mjMINVAL (1e-15), so this is stricter than needed.
 REL_TOL = 1e-9
+# [kg], [kg m²], [m]: no robot part comes near it (a 1000 t ship hull is ~1e9 kg m²); past it a
+# value is a typo or an attack, and its squares overflow a double when the frame turns.
+MAX_MAGNITUDE = 1e15
 # Smallest principal moment a repaired tensor keeps, relative to its largest (and absolute [kg·m²]).
 REPAIR_MIN_REL = 1e-3
 REPAIR_MIN_ABS = 1e-9
@@ -46,8 +49,22 @@ def from_inertial(inertial: Inertial | None) -> Inertia | None:
     if inertial is None:
         return None
     tensor = inertial.inertia
-    local = Inertia(inertial.mass, np.zeros(3), (tensor + tensor.T) / 2)
-    return local.transformed(inertial.origin)
+    local = Inertia(inertial.mass, np.zeros(3), tensor / 2 + tensor.T / 2)  # no overflow
+    with np.errstate(over="ignore", invalid="ignore"):  # `out_of_range` names such values
+        return local.transformed(inertial.origin)
+
+
+def out_of_range(inertia: Inertia) -> str | None:
+    """Why an inertia's numbers cannot be a body's (None if they can): NaN, infinite or huge.
+
+    No repair applies: the values are not a physical body's to bound.
+    """
+    values = np.concatenate([[inertia.mass], inertia.com, np.ravel(inertia.tensor)])
+    if not np.all(np.isfinite(values)):
+        return "its <inertial> holds a value that is not a finite number"
+    if np.max(np.abs(values)) > MAX_MAGNITUDE:
+        return f"its <inertial> holds a value beyond {MAX_MAGNITUDE:g} (kg, kg m², m)"
+    return None
 
 
 def combine(parts: list[Inertia]) -> Inertia:

@@ -87,6 +87,16 @@ BAD_INPUTS = {
         '"package://no_such_pkg/m.stl"/></geometry></visual></link></robot>',
         ["no_such_pkg", "package://no_such_pkg/m.stl", "link 'a'", "tried"],
     ),
+    "huge_inertia": (
+        '<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="1e308" '
+        'iyy="1e308" izz="1e308" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>',
+        ["link 'a'", "ixx=1e+308", "beyond", "mass [kg] and inertia [kg m²]"],
+    ),
+    "nan_inertia": (
+        '<robot name="r"><link name="a"><inertial><origin rpy="0.3 0 0"/><mass value="1"/>'
+        '<inertia ixx="nan" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>',
+        ["link 'a'", "'nan'"],
+    ),
     "massless_moving_link": (
         '<robot name="r">'
         + GOOD_LINK.format(n="a")
