@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
-from converters.errors import DanglingReferenceError, InputFileError
+from converters.errors import DanglingReferenceError, InputFileError, URDFStructureError
 from converters.formats import format_of
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
@@ -165,6 +165,7 @@ def build_description(
     report = report or Report(source=robot.source)
     report.robot = robot.name
     check_references(robot, options, report)
+    check_joints(robot)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
     apply_gazebo(spec, robot.gazebo, provenance, report)
@@ -172,6 +173,18 @@ def build_description(
     plugins = read_plugins(robot.gazebo.plugins, robot.source)
     add_drive_motors(spec, plugins, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)
+
+
+def check_joints(robot: RobotDescription) -> None:
+    """Refuse joints no simulator can honour (no axis, mimic circles).
+
+    Raises:
+        URDFStructureError: the first such joint, named, with the fix.
+    """
+    from converters.description.joint_checks import joint_problems
+
+    for found in joint_problems(robot)[:1]:
+        raise URDFStructureError(robot.source, found.subject, found.problem, found.fix)
 
 
 def check_references(robot: RobotDescription, options: ConvertOptions, report: Report) -> None:

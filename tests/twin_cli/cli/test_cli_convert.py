@@ -97,6 +97,26 @@ BAD_INPUTS = {
         '<inertia ixx="nan" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>',
         ["link 'a'", "'nan'"],
     ),
+    "zero_axis": (
+        '<robot name="r">'
+        + "".join(GOOD_LINK.format(n=n) for n in "ab")
+        + '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<axis xyz="0 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        + "</robot>",
+        ["joint 'j' <axis>", "no direction", "xyz='0 0 1'"],
+    ),
+    "mimic_circle": (
+        '<robot name="r">'
+        + "".join(GOOD_LINK.format(n=n) for n in "abc")
+        + "".join(
+            f'<joint name="{j}" type="revolute"><parent link="a"/><child link="{c}"/>'
+            f'<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+            f'<mimic joint="{leader}"/></joint>'
+            for j, c, leader in (("j1", "b", "j2"), ("j2", "c", "j1"))
+        )
+        + "</robot>",
+        ["joint 'j1' <mimic>", "j1 → j2 → j1", "remove the <mimic>"],
+    ),
     "massless_moving_link": (
         '<robot name="r">'
         + GOOD_LINK.format(n="a")
