@@ -90,6 +90,18 @@ class XacroError(ConversionError):
         self.path = path
 
 
+class XacroBudgetError(ConversionError):
+    """A served xacro expansion passed its time or memory budget and was stopped."""
+
+    def __init__(self, path: str, problem: str, variable: str) -> None:
+        super().__init__(
+            f"{path}: xacro expansion {problem}, its budget, and was stopped; if the robot really "
+            f"needs more, start the world with a larger {variable} (twin stop; "
+            f"{variable}=... twin spawn ...)"
+        )
+        self.path = path
+
+
 class MalformedXMLError(ConversionError):
     """The description is not well-formed XML."""
 

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from converters.budget import XacroBudget
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
 from converters.errors import DanglingReferenceError, InputFileError, URDFStructureError
@@ -39,7 +40,11 @@ class Conversion:
 
 
 def read_description(
-    path: Path, args: Mapping[str, str], resolver: PackageResolver, report: Report
+    path: Path,
+    args: Mapping[str, str],
+    resolver: PackageResolver,
+    report: Report,
+    budget: XacroBudget | None = None,
 ) -> str:
     """The description text of `path`: xacro files are expanded, URDF and SDF read as they are.
 
@@ -58,7 +63,12 @@ def read_description(
             return path.read_text()
         except (OSError, UnicodeDecodeError) as exc:
             raise InputFileError(str(path), f"cannot be read ({exc})", "check the file") from exc
-    result = expand_xacro(path, args, resolver)
+    if budget is None:
+        result = expand_xacro(path, args, resolver)
+    else:
+        from converters.urdf.xacro_worker import expand_bounded
+
+        result = expand_bounded(path, dict(args), resolver, budget)
     for call in result.unexpanded:
         report.warn(
             f"xacro macro call {call}",
@@ -120,8 +130,8 @@ def convert_full(
     path = Path(path)
     resolver = PackageResolver.create(path, package_paths, env)
     report = Report(source=str(path))
-    text = read_description(path, dict(args or {}), resolver, report)
     options = options or ConvertOptions()
+    text = read_description(path, dict(args or {}), resolver, report, options.xacro_budget)
     robot = read_robot(
         text, str(path), path.resolve().parent, resolver, report, as_written=options.as_written
     )

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from converters.budget import XacroBudget
 from converters.collision.plan import CollisionRequest, CollisionSettings
 from converters.collision.prepare import prepare_collision_meshes
 from converters.description import RobotDescription
@@ -43,13 +44,15 @@ class ConvertOptions:
     """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan,
     `as_written`: apply what a URDF says where Gazebo's own parser drops it (inline `<surface>`,
     link surface values on named collisions) instead of simulating what Gazebo simulates, and
-    `drop_dangling`: leave out tags that name a missing link or joint instead of refusing them."""
+    `drop_dangling`: leave out tags that name a missing link or joint instead of refusing them,
+    and `xacro_budget`: expand xacro in a bounded child process (a server's conversions)."""
 
     keep_fixed: bool = False
     repair_inertia: bool = False
     collision: CollisionSettings = field(default_factory=CollisionSettings)
     as_written: bool = False
     drop_dangling: bool = False
+    xacro_budget: XacroBudget | None = None  # None: xacro runs in this process, unbounded
 
 
 def pose(T: np.ndarray) -> tuple[list[float], list[float]]:

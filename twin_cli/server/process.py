@@ -10,6 +10,7 @@ import secrets
 import signal
 import socket
 import sys
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -234,6 +235,7 @@ def serve(opts: ServeOptions) -> None:
             app, log_config=None, access_log=False, lifespan="off", timeout_graceful_shutdown=5
         )
         server = uvicorn.Server(config)
+        _end_conversions_on_exit(server)
         consumers = _start_consumers(app, world, opts)
         saver = _autosaver(app, autosave_file, opts.autosave)
         try:
@@ -255,6 +257,21 @@ def serve(opts: ServeOptions) -> None:
             saver.close()
             app.state.holder.world.stop()
             log.info("world [%s] stopped", opts.world)
+
+
+def _end_conversions_on_exit(server: Any) -> None:
+    """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every xacro
+    expansion still running: the requests waiting on them end, and the process with them."""
+    import threading
+
+    from converters.urdf.xacro_worker import stop_all
+
+    def watch() -> None:
+        while not server.should_exit:
+            time.sleep(0.1)
+        stop_all()
+
+    threading.Thread(target=watch, name="twin-conversion-stop", daemon=True).start()
 
 
 def _start_consumers(app: Any, world: Any, opts: ServeOptions) -> Any:

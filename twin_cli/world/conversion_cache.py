@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from converters.urdf.xacro_worker import READ_EVENT
 from twin_cli.package_env import PACKAGE_ENVS
 from twin_cli.spawn_request import SpawnRequest
 
@@ -44,11 +45,15 @@ _hook_installed = False
 
 
 def _audit(event: str, args: tuple) -> None:
-    """Records files opened for reading on a thread that is recording (see `recording`)."""
-    if event != "open":
+    """Records files opened for reading on a thread that is recording (see `recording`), and
+    those a child process read for it (xacro's, announced as `converters.read`)."""
+    if event not in ("open", READ_EVENT):
         return
     files = getattr(_local, "files", None)
     if files is None:
+        return
+    if event == READ_EVENT:
+        files.add(os.fsdecode(args[0]))
         return
     path, mode = args[0], args[1]
     if not isinstance(path, (str, bytes, os.PathLike)):

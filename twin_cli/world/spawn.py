@@ -99,10 +99,13 @@ def load_source(request: SpawnRequest) -> LoadedSource:
 
 def convert_options(request: SpawnRequest) -> ConvertOptions:
     """The converter's options that the request sets."""
+    from converters.budget import XacroBudget
     from converters.mjcf.builder import ConvertOptions
 
     return ConvertOptions(
-        repair_inertia=request.repair_inertia, drop_dangling=request.drop_dangling
+        repair_inertia=request.repair_inertia,
+        drop_dangling=request.drop_dangling,
+        xacro_budget=XacroBudget.from_env(),  # a served xacro runs bounded, apart from the world
     )
 
 

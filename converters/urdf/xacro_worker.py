@@ -1,0 +1,202 @@
+"""xacro in a process of its own, with a time and memory budget and no access beyond the robot.
+
+xacro is a programming language: `${9**9**9}` computes for ever while holding the interpreter
+lock, 2^25 nested macro calls fill memory, `xacro.load_yaml('/any/file')` and `$(env VAR)` read
+whatever the process can. A server that expanded xacro in its own process froze with its world
+and lent its files and environment to every description. So a served conversion expands xacro in
+a child process:
+- it is killed when it passes its time budget (wall clock) or memory budget (address space),
+  and the error says which budget and how to raise it;
+- its environment holds only the variables the spawning client sent (`$(env)`, `$(optenv)`);
+- it may open for reading only files under the description's own folder, the packages it names
+  and the package roots of those variables (plus Python's own files); anything else is refused
+  with a message that names the path and never shows its content;
+- it dies with the server (PR_SET_PDEATHSIG), so a stopped world leaves no child computing.
+The files it read are announced with the audit event `converters.read`, so a conversion cache
+that watches what a conversion read sees them too.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import resource
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
+from converters.errors import ConversionError, XacroBudgetError, XacroError
+from converters.resources.packages import PackageResolver
+from converters.urdf.xacro_expand import XacroResult
+
+READ_EVENT = "converters.read"
+
+
+def expand_bounded(
+    path: Path, args: dict[str, str], resolver: PackageResolver, budget: XacroBudget
+) -> XacroResult:
+    """`expand_xacro` in a child process under `budget` (see the module docstring).
+
+    Raises:
+        XacroBudgetError: the expansion passed its time or memory budget.
+        XacroError, PackageNotFoundError, …: what the expansion raised, as the same class.
+    """
+    request = {
+        "path": str(path),
+        "args": args,
+        "packages": {name: str(directory) for name, directory in resolver.explicit.items()},
+        "sys_path": sys.path,
+    }
+    env = {k: v for k, v in resolver.env.items() if k in _SENT}
+    child = subprocess.Popen(
+        [sys.executable, "-c", _BOOT],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        preexec_fn=_limit_memory(budget.memory_mib),  # only setrlimit: safe after fork
+    )
+    _RUNNING.add(child)
+    try:
+        out, err = child.communicate(json.dumps(request), timeout=budget.timeout_s)
+    except subprocess.TimeoutExpired as exc:
+        child.kill()
+        child.communicate()
+        raise XacroBudgetError(str(path), f"took over {budget.timeout_s:g} s", TIMEOUT_ENV) from exc
+    finally:
+        _RUNNING.discard(child)
+    if _STOPPING.is_set():
+        raise XacroError(str(path), "stopped: the world is shutting down", "spawn it again")
+    return _result(
+        path, subprocess.CompletedProcess(child.args, child.returncode, out, err), budget
+    )
+
+
+def stop_all() -> None:
+    """Kill every expansion still running (a server shutting down: its requests must end)."""
+    _STOPPING.set()
+    for child in list(_RUNNING):
+        child.kill()
+
+
+_RUNNING: set[subprocess.Popen] = set()  # children expanding right now (for `stop_all`)
+_STOPPING = threading.Event()
+
+# Package search variables: the only environment a served xacro sees (the client sends them).
+_SENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH", "GAZEBO_MODEL_PATH", "GZ_SIM_RESOURCE_PATH")
+_SENT += ("GZ_FUEL_CACHE_PATH", "GAZEBO_RESOURCE_PATH")
+
+_BOOT = (
+    "import json, sys; request = json.loads(sys.stdin.read()); sys.path[:] = request['sys_path']; "
+    "from converters.urdf.xacro_worker import serve; serve(request)"
+)
+
+
+def _limit_memory(mib: int) -> Any:
+    def limit() -> None:
+        size = mib * 1024 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (size, size))
+
+    return limit
+
+
+def _result(path: Path, done: subprocess.CompletedProcess, budget: XacroBudget) -> XacroResult:
+    """The child's answer, or its error raised again as the same class."""
+    try:
+        answer = json.loads(done.stdout.strip().splitlines()[-1])
+    except (IndexError, json.JSONDecodeError):
+        if "MemoryError" in done.stderr or done.returncode < 0:
+            problem = f"needed more than {budget.memory_mib} MiB"
+            raise XacroBudgetError(str(path), problem, MEMORY_ENV) from None
+        detail = done.stderr.strip().splitlines()[-1:] or [f"exit code {done.returncode}"]
+        raise XacroError(str(path), detail[0][-300:], "fix the xacro file") from None
+    for name in answer.get("files", []):
+        sys.audit(READ_EVENT, name)
+    if "error" in answer:
+        raise _rebuilt(answer["error"], answer["message"])
+    return XacroResult(answer["text"], tuple(answer["unexpanded"]), tuple(answer["warnings"]))
+
+
+def _rebuilt(name: str, message: str) -> ConversionError:
+    from converters import errors
+
+    cls = getattr(errors, name, None)
+    if not (isinstance(cls, type) and issubclass(cls, ConversionError)):
+        cls = ConversionError
+    exc = cls.__new__(cls)
+    Exception.__init__(exc, message)
+    return exc
+
+
+# ----------------------------------------------------------------------------- the child
+def serve(request: dict[str, Any]) -> None:
+    """The child's work: expand, print one JSON line (the result or the error) on stdout."""
+    from converters.urdf.xacro_expand import expand_xacro
+
+    _die_with_parent()
+    path = Path(request["path"])
+    resolver = PackageResolver.create(path, request["packages"], dict(os.environ))
+    import xacro  # noqa: F401 (loaded before the guard: Python's own files stay readable)
+
+    files: set[str] = set()
+    sys.addaudithook(_guard(_allowed_roots(path, resolver), files))
+    try:
+        result = expand_xacro(path, request["args"], resolver)
+        answer: dict[str, Any] = {
+            "text": result.text,
+            "unexpanded": list(result.unexpanded),
+            "warnings": list(result.warnings),
+        }
+    except ConversionError as exc:
+        answer = {"error": type(exc).__name__, "message": str(exc)}
+    answer["files"] = sorted(files)
+    sys.stdout.write(json.dumps(answer) + "\n")
+
+
+def _allowed_roots(path: Path, resolver: PackageResolver) -> tuple[str, ...]:
+    """Where the description may read: its folder and package, the packages it was given,
+    the package roots of the client's variables, and Python's own installation."""
+    roots = [path.resolve().parent, *(Path(p).resolve() for p in resolver.explicit.values())]
+    roots += [d.parent for d in path.resolve().parents if (d / "package.xml").is_file()][:1]
+    for variable in _SENT:
+        roots += [Path(p).resolve() for p in os.environ.get(variable, "").split(os.pathsep) if p]
+    python = {sys.prefix, sys.base_prefix, *(p for p in sys.path if p)}
+    return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in python)
+
+
+def _guard(roots: tuple[str, ...], files: set[str]) -> Any:
+    """An audit hook refusing reads outside `roots` (and the packages `$(find)` found so far)
+    and recording the files read inside."""
+    from converters.urdf.xacro_expand import FOUND
+
+    def hook(event: str, args: tuple) -> None:
+        if event != "open" or not isinstance(args[0], (str, bytes, os.PathLike)):
+            return
+        name = os.path.realpath(os.fsdecode(args[0]))
+        allowed = (*roots, *(os.path.realpath(p) for p in FOUND.get({}).values()))
+        if not any(name == r or name.startswith(r.rstrip(os.sep) + os.sep) for r in allowed):
+            raise PermissionError(
+                f"{name} is outside the robot's own folder and packages; a served description "
+                "may read only those (convert it with `twin convert` to read other files)"
+            )
+        if os.path.isfile(name) and not name.endswith((".py", ".pyc", ".so")):
+            files.add(name)
+
+    return hook
+
+
+def _die_with_parent() -> None:
+    """Ask the kernel to kill this child when the server that started it ends (Linux)."""
+    try:
+        import ctypes
+        import signal
+
+        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() == 1:  # the parent ended before the request took effect
+        os._exit(1)
