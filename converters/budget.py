@@ -33,11 +33,3 @@ def _positive(text: str | None, default: float) -> float:
     except ValueError:
         return default
     return value if value > 0 else default
-
-
-def _positive(text: str | None, default: float) -> float:
-    try:
-        value = float(text) if text else default
-    except ValueError:
-        return default
-    return value if value > 0 else default
