@@ -1,9 +1,10 @@
 """Validation: the physics checklist that `twin validate` runs on a robot, in-process.
 
-`scenario` reads scenario files (TOML), `checks/` holds one function per check, `runner` builds
-the robot under test and runs each check in its own World, `report` renders the results
-(terminal, JUnit, JSON, Markdown, plots). `sweep` runs the checklist on every robot × parameter
-variant (`variants`) on a process pool or Ray (`executors`); `sweep_report` renders it.
+`scenario` reads scenario files (TOML), `checks/` holds one function per check, `robot` builds
+the robot under test, `runner` runs each check in its own World (a crash is an ERROR, not a
+failure), `report` renders the results (JUnit, JSON, Markdown, plots). `sweep` runs the
+checklist on every robot × parameter variant (`variants`) on a process pool or Ray
+(`executors`); `sweep_report` renders it.
 """
 
 from __future__ import annotations

@@ -16,9 +16,12 @@ import re
 from collections.abc import Iterator
 from contextvars import ContextVar
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.errors import RequestError
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 log = logging.getLogger("twin.validate")
 RATE = 100.0  # [Hz] of sim time, `twin record`'s default
@@ -56,7 +59,12 @@ def recording_into(folder: Path | None) -> Iterator[None]:
         _target.reset(token)
 
 
-def attach(world: Any, scenario: str) -> None:
+def active() -> bool:
+    """Whether scenario runs are being recorded (`--record`)."""
+    return _target.get() is not None
+
+
+def attach(world: World, scenario: str) -> None:
     """Starts recording `world` (a scenario run's) when a recording folder is set."""
     folder = _target.get()
     if folder is None:
@@ -67,7 +75,7 @@ def attach(world: Any, scenario: str) -> None:
     try:
         _open.append(BagRecording(world, path, rate=RATE).start())
         written.append(path)
-    except Exception as exc:  # noqa: BLE001 - a bag is an artifact, never a check's outcome
+    except Exception as exc:  # a bag is an artifact, never a check's outcome
         log.warning("not recording scenario %s: %s", scenario, exc)
 
 

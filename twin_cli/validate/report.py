@@ -13,8 +13,21 @@ from twin_cli.validate.runner import ValidationRun
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-MARK = {Status.PASS: "pass", Status.WARN: "warn", Status.FAIL: "FAIL", Status.SKIP: "skip"}
-MD_MARK = {Status.PASS: "✅", Status.WARN: "⚠️", Status.FAIL: "❌", Status.SKIP: "➖"}
+MARK = {
+    Status.PASS: "pass",
+    Status.WARN: "warn",
+    Status.FAIL: "FAIL",
+    Status.NOT_APPLICABLE: "n/a",
+    Status.ERROR: "ERROR",
+}
+MD_MARK = {
+    Status.PASS: "✅",
+    Status.WARN: "⚠️",
+    Status.FAIL: "❌",
+    Status.NOT_APPLICABLE: "➖",
+    Status.ERROR: "💥",
+}
+TO_FIX = (Status.ERROR, Status.FAIL, Status.WARN)  # statuses whose hints a report lists
 
 
 def label(r: CheckResult) -> str:
@@ -28,37 +41,40 @@ def junit_xml(run: ValidationRun) -> str:
         "testsuite",
         name=f"twin validate {run.robot}",
         tests=str(len(run.results)),
-        failures=str(counts["fail"]),
-        errors="0",
-        skipped=str(counts["skip"]),
+        failures=str(counts[Status.FAIL.value]),
+        errors=str(counts[Status.ERROR.value]),
+        skipped=str(counts[Status.NOT_APPLICABLE.value]),
         time=f"{run.seconds:.3f}",
     )
     for r in run.results:
-        case = ET.SubElement(
-            suite,
-            "testcase",
-            classname=f"twin.validate.{r.kind}",
-            name=label(r),
-            time=f"{r.seconds:.3f}",
-        )
-        text = "\n".join([f"measured {r.measured}; threshold {r.threshold}", *r.hints, *r.details])
-        if r.status is Status.FAIL:
-            failure = ET.SubElement(case, "failure", message=(r.hints or (r.measured,))[0])
-            failure.text = text
-        elif r.status is Status.SKIP:
-            ET.SubElement(case, "skipped", message=(r.details or ("not applicable",))[0])
-        else:
-            ET.SubElement(case, "system-out").text = text
+        junit_case(suite, r, f"twin.validate.{r.kind}", label(r))
     root = ET.Element("testsuites", name="twin validate")
     root.append(suite)
     ET.indent(root)
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
 
 
+def junit_case(suite: ET.Element, r: CheckResult, classname: str, name: str) -> ET.Element:
+    """One <testcase>: a robot that breaks the check is a <failure>, a check that crashed an
+    <error> (a twin bug), a check that does not apply <skipped> with its reason."""
+    case = ET.SubElement(suite, "testcase", classname=classname, name=name, time=f"{r.seconds:.3f}")
+    text = "\n".join([f"measured {r.measured}; threshold {r.threshold}", *r.hints, *r.details])
+    if r.status is Status.FAIL:
+        ET.SubElement(case, "failure", message=(r.hints or (r.measured,))[0]).text = text
+    elif r.status is Status.ERROR:
+        kind = r.measured.removeprefix("crashed: ").split(":")[0]
+        ET.SubElement(case, "error", message=r.measured, type=kind).text = text
+    elif r.status is Status.NOT_APPLICABLE:
+        ET.SubElement(case, "skipped", message=(r.details or ("not applicable",))[0])
+    else:
+        ET.SubElement(case, "system-out").text = text
+    return case
+
+
 def markdown(run: ValidationRun, plots: str | None = None) -> str:
     """A Markdown summary for CI pages (e.g. $GITHUB_STEP_SUMMARY); with `plots` (the plot
     directory as the page should link it), each plot is embedded below the table."""
-    verdict = "passed" if run.passed else "FAILED"
+    verdict = "passed" if run.passed else ("CRASHED" if run.exit_code == 70 else "FAILED")
     lines = [
         f"## twin validate: `{run.robot}` {verdict}",
         "",
@@ -69,7 +85,7 @@ def markdown(run: ValidationRun, plots: str | None = None) -> str:
     ]
     for r in run.results:
         lines.append(f"| {MD_MARK[r.status]} | {label(r)} | {r.measured} | {r.threshold} |")
-    problems = [r for r in run.results if r.status in (Status.FAIL, Status.WARN)]
+    problems = [r for r in run.results if r.status in TO_FIX]
     if problems:
         lines += ["", "### What to fix", ""]
         for r in problems:

@@ -1,27 +1,34 @@
 """Runs the validation checklist on one robot, in-process, and returns typed results.
 
-A missing or non-physical inertial must still reach validation as a failed model check, so the
-robot is always converted with `ConvertOptions(repair_inertia=True)`; the converter's
-`repaired` report entries then become failures (or warnings when the user passed
-`--repair-inertia`, i.e. accepted the repairs).
+The robot is built by `robot` (converted, compiled, with the facts checks read). A check that
+raises is an ERROR naming the exception, never a FAIL: a crash says nothing about the robot,
+and a CI must tell "twin broke" (exit 70) from "the robot is broken" (exit 1).
 """
 
 from __future__ import annotations
 
 import contextlib
 import time
-from dataclasses import dataclass
+import traceback
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from twin_cli.errors import ScenarioError, TwinError, UnknownCheckError
 from twin_cli.validate import video
-from twin_cli.validate.checks import CHECKS, MODEL_CHECKS
-from twin_cli.validate.checks.base import CheckResult, DeclaredJoint, RobotUnderTest, Status, result
+from twin_cli.validate.checks import CHECKS, MODEL_CHECKS, Check
+from twin_cli.validate.checks.base import (
+    EXIT_CODES,
+    CannotApply,
+    CheckResult,
+    RobotUnderTest,
+    Status,
+    not_applicable,
+    result,
+)
+from twin_cli.validate.robot import load_robot
 from twin_cli.validate.scenario import Scenario, load_builtin, resolve, with_joints
 
-if TYPE_CHECKING:
-    from converters.description import Joint
+TRACEBACK_FRAMES = 4  # innermost frames of a crashed check kept in its report (JUnit <error>)
 
 
 @dataclass(frozen=True)
@@ -35,7 +42,14 @@ class ValidationRun:
 
     @property
     def passed(self) -> bool:
-        return not any(r.failed for r in self.results)
+        """No check failed and none crashed."""
+        return not any(r.failed or r.errored for r in self.results)
+
+    @property
+    def exit_code(self) -> int:
+        """0 when passed, 1 when a check failed, 70 when a check crashed (a twin bug: it wins,
+        so a crash is never read as a verdict on the robot)."""
+        return max((EXIT_CODES.get(r.status, 0) for r in self.results), default=0)
 
     def counts(self) -> dict[str, int]:
         """How many checks ended in each status."""
@@ -49,79 +63,11 @@ class ValidationRun:
             "robot": self.robot,
             "source": self.source,
             "passed": self.passed,
+            "exit_code": self.exit_code,
             "counts": self.counts(),
             "seconds": round(self.seconds, 3),
             "checks": [r.to_dict() for r in self.results],
         }
-
-
-def load_robot(
-    path: str | Path,
-    *,
-    args: dict[str, str] | None = None,
-    package_paths: dict[str, str] | None = None,
-    repair_inertia: bool = False,
-    collision: str | None = None,
-    as_written: bool = False,
-) -> RobotUnderTest:
-    """Convert (URDF/xacro/SDF) or load (MJCF .xml) a robot and compile it alone.
-
-    Raises:
-        ConversionError: the description cannot be converted (exit 2 at the CLI).
-    """
-    import mujoco
-
-    from converters.report import Report
-
-    path = Path(path)
-    if path.suffix.lower() == ".xml":
-        spec = mujoco.MjSpec.from_file(str(path))
-        return _robot(spec, Report(source=str(path)), path, repair_inertia, {})
-    from converters.collision.plan import CollisionSettings
-    from converters.mjcf.builder import ConvertOptions
-    from converters.pipeline import convert_full
-
-    settings = CollisionSettings(mode=collision) if collision else CollisionSettings()
-    done = convert_full(
-        path,
-        args=args,
-        package_paths=package_paths,
-        options=ConvertOptions(repair_inertia=True, collision=settings, as_written=as_written),
-    )
-    return robot_from_conversion(done, path, repair_inertia=repair_inertia)
-
-
-def robot_from_conversion(done, path: str | Path, *, repair_inertia: bool) -> RobotUnderTest:
-    """The robot under test from a `converters.Conversion` (spec, report, provenance)."""
-    body_links = {g.body: g.link for g in done.provenance.geoms if g.body == g.link}
-    joints = tuple(_declared(j) for j in done.description.joints)
-    from dataclasses import replace
-
-    robot = _robot(done.spec, done.report, Path(path), repair_inertia, body_links, joints)
-    return replace(robot, sensors=tuple(getattr(done, "sensors", ())))
-
-
-def _declared(joint: Joint) -> DeclaredJoint:
-    from converters.description import Limit
-
-    limit = joint.limit or Limit()
-    return DeclaredJoint(
-        joint.name,
-        joint.kind,
-        limit.lower,
-        limit.upper,
-        limit.effort,
-        limit.velocity,
-        joint.mimic is not None,
-    )
-
-
-def _robot(spec, report, path: Path, repair_inertia: bool, body_links, joints=()) -> RobotUnderTest:
-    model = spec.copy().compile()
-    name = report.robot or spec.modelname or path.stem.split(".")[0]
-    return RobotUnderTest(
-        name, str(path), spec, model, report, repair_inertia, body_links, tuple(joints)
-    )
 
 
 def _model_scenario(check: str) -> Scenario:
@@ -168,34 +114,53 @@ def _validate_scenario(sc: Scenario) -> None:
 
 
 def run_check(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> CheckResult:
-    """Run one scenario's check; an unexpected error becomes a failed result naming it."""
+    """Run one scenario's check; an unexpected error becomes an ERROR result naming it."""
+    return run_registered(CHECKS[sc.check], robot, sc, debug=debug)
+
+
+def run_registered(
+    check: Check, robot: RobotUnderTest, sc: Scenario, *, debug: bool = False
+) -> CheckResult:
+    """Run `check` on the robot in the scenario with the scenario's thresholds over its
+    defaults; `debug` re-raises an exception from inside the check instead of reporting it."""
     from twin_cli.validate.recording import finish
 
-    check = CHECKS[sc.check]
     thresholds = {**check.defaults, **sc.thresholds}
     start = time.perf_counter()
     try:
         with video.scenario(sc.name) if check.kind == "physics" else contextlib.nullcontext():
             outcome = check.run(robot, sc, thresholds)
         finish()
-    except Exception as exc:  # noqa: BLE001 - one broken check must not hide the others
+    except CannotApply as exc:
+        finish()
+        outcome = not_applicable(check.name, check.kind, "cannot apply", exc.reason)
+    except Exception as exc:  # one broken check must not hide the others
         finish()
         if debug:
             raise
-        outcome = result(
-            sc.check,
-            check.kind,
-            Status.FAIL,
-            "error",
-            "runs",
-            hints=[f"the check could not run: {type(exc).__name__}: {exc}"],
-        )
+        outcome = crashed(check, exc)
     return _stamp(outcome, sc, time.perf_counter() - start)
 
 
-def _stamp(outcome: CheckResult, sc: Scenario, seconds: float) -> CheckResult:
-    from dataclasses import replace
+def crashed(check: Check, exc: Exception) -> CheckResult:
+    """The ERROR result of a check that raised: the exception in the table, its innermost
+    frames in the details (JUnit <error> text)."""
+    frames = traceback.format_tb(exc.__traceback__)[-TRACEBACK_FRAMES:]
+    return result(
+        check.name,
+        check.kind,
+        Status.ERROR,
+        f"crashed: {type(exc).__name__}: {exc}",
+        "runs",
+        hints=[
+            f"the check crashed ({type(exc).__name__}: {exc}): a bug in twin, not a verdict on "
+            "the robot; report it with this robot and the traceback below"
+        ],
+        details=[line.rstrip() for line in frames],
+    )
 
+
+def _stamp(outcome: CheckResult, sc: Scenario, seconds: float) -> CheckResult:
     scenario = None if sc.source == "built-in" else sc.name
     return replace(outcome, scenario=scenario, seconds=seconds)
 
@@ -227,7 +192,7 @@ def validate(
         collision: the converter's collision-mesh mode (auto|coacd|hull|mesh); None = auto.
         joints: start posture, joint name → [rad] or [m] (`-J`), over each scenario's
             `[robot] joints`; what a scenario's `[hold]` holds.
-        debug: re-raise errors inside checks instead of reporting them as failures.
+        debug: re-raise errors inside checks instead of reporting them as ERROR results.
         as_written: apply what a URDF says where Gazebo's parser drops it.
         record: a folder for one rosbag2 MCAP file per physics scenario run (None: none).
     """

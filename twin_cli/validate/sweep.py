@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from twin_cli.errors import TwinError
-from twin_cli.validate.checks.base import CheckResult
+from twin_cli.validate.checks.base import EXIT_CODES, CheckResult
 from twin_cli.validate.margins import MARGINS
 from twin_cli.validate.sweep_errors import SweepError
 from twin_cli.validate.variants import PARAMETERS, ROBOT_PARAMETERS
@@ -127,7 +127,13 @@ class VariantRun:
 
     @property
     def passed(self) -> bool:
-        return not any(r.failed for r in self.results)
+        """No check failed and none crashed."""
+        return not any(r.failed or r.errored for r in self.results)
+
+    @property
+    def exit_code(self) -> int:
+        """0 passed, 1 a check failed, 70 a check crashed (as `ValidationRun.exit_code`)."""
+        return max((EXIT_CODES.get(r.status, 0) for r in self.results), default=0)
 
     def to_dict(self) -> dict:
         return {
@@ -199,7 +205,7 @@ def load_variant(path: str, values: Mapping[str, float], opts: Mapping):
     from converters.pipeline import build_description, read_description, read_robot
     from converters.report import Report
     from converters.resources.packages import PackageResolver
-    from twin_cli.validate.runner import load_robot, robot_from_conversion
+    from twin_cli.validate.robot import load_robot, robot_from_conversion
     from twin_cli.validate.variants import apply_to_description, foot_links
 
     repair = bool(opts.get("repair_inertia"))
@@ -217,6 +223,7 @@ def load_variant(path: str, values: Mapping[str, float], opts: Mapping):
         repair_inertia=True,
         collision=CollisionSettings(mode=collision) if collision else CollisionSettings(),
         as_written=bool(opts.get("as_written")),
+        drop_dangling=True,  # as `robot.load_robot`: a dangling sensor is a failed check
     )
     file = Path(path)
     resolver = PackageResolver.create(file, opts.get("package_paths"))
@@ -251,6 +258,11 @@ class SweepRun:
     @property
     def passed(self) -> bool:
         return all(r.passed for r in self.runs)
+
+    @property
+    def exit_code(self) -> int:
+        """The worst variant's exit code: 70 when a check crashed anywhere, else 1 or 0."""
+        return max((r.exit_code for r in self.runs), default=0)
 
     def to_dict(self) -> dict:
         return {
@@ -301,4 +313,5 @@ def sweep(
             if on_done:
                 on_done(run, count, len(tasks))
         name = executor.name
-    return SweepRun(tuple(axes), tuple(done), time.perf_counter() - start, name)  # type: ignore[arg-type]
+    # every task has filled its slot: no None is left in `done`
+    return SweepRun(tuple(axes), tuple(done), time.perf_counter() - start, name)  # pyright: ignore[reportArgumentType]

@@ -6,9 +6,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from twin_cli.validate.checks.base import CheckResult, Status
+from twin_cli.validate.checks.base import Status
 from twin_cli.validate.margins import MARGINS, margin
-from twin_cli.validate.report import MD_MARK, label
+from twin_cli.validate.report import MD_MARK, junit_case, label
 from twin_cli.validate.sweep import SweepRun, VariantRun
 
 
@@ -21,39 +21,20 @@ def junit_xml(sweep: SweepRun) -> str:
     """One <testsuite> per robot × variant, one <testcase> per check."""
     root = ET.Element("testsuites", name="twin validate sweep")
     for run in sweep.runs:
-        fails = sum(r.failed for r in run.results)
-        skips = sum(r.status is Status.SKIP for r in run.results)
         suite = ET.SubElement(
             root,
             "testsuite",
             name=f"twin validate {run.robot} [{variant_name(run)}]",
             tests=str(len(run.results)),
-            failures=str(fails),
-            errors="0",
-            skipped=str(skips),
+            failures=str(sum(r.failed for r in run.results)),
+            errors=str(sum(r.errored for r in run.results)),
+            skipped=str(sum(r.status is Status.NOT_APPLICABLE for r in run.results)),
             time=f"{run.seconds:.3f}",
         )
         for r in run.results:
-            _case(suite, run, r)
+            junit_case(suite, r, f"twin.validate.{run.robot}", f"{label(r)} [{variant_name(run)}]")
     ET.indent(root)
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
-
-
-def _case(suite: ET.Element, run: VariantRun, r: CheckResult) -> None:
-    case = ET.SubElement(
-        suite,
-        "testcase",
-        classname=f"twin.validate.{run.robot}",
-        name=f"{label(r)} [{variant_name(run)}]",
-        time=f"{r.seconds:.3f}",
-    )
-    text = "\n".join([f"measured {r.measured}; threshold {r.threshold}", *r.hints, *r.details])
-    if r.status is Status.FAIL:
-        ET.SubElement(case, "failure", message=(r.hints or (r.measured,))[0]).text = text
-    elif r.status is Status.SKIP:
-        ET.SubElement(case, "skipped", message=(r.details or ("not applicable",))[0])
-    else:
-        ET.SubElement(case, "system-out").text = text
 
 
 def markdown(sweep: SweepRun) -> str:
@@ -120,8 +101,9 @@ def _panel(ax, sweep: SweepRun, check: str, axis: str) -> None:
                 continue
             m = margin(r, run.limits.get(r.check))
             xs.append(run.values.get(axis, float(i)))
-            ys.append(m if m is not None else float(r.status is not Status.FAIL))
-            fails.append(r.failed)
+            broken = r.failed or r.errored
+            ys.append(m if m is not None else float(not broken))
+            fails.append(broken)
             unit = MARGINS[r.check][0] if m is not None else "pass (1) / fail (0)"
         ax.plot(xs, ys, "o-", label=robot)
         ax.plot(

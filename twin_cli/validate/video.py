@@ -12,7 +12,10 @@ import contextlib
 import re
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
 
 _directory: Path | None = None
 _open: list[Any] = []
@@ -55,7 +58,12 @@ def scenario(name: str) -> Iterator[None]:
         _name = None
 
 
-def film(world: Any, entity: str) -> None:
+def active() -> bool:
+    """Whether scenario runs are being filmed (`--video`)."""
+    return _directory is not None
+
+
+def film(world: World, entity: str) -> None:
     """Starts filming a new scenario run's world, when filming is on."""
     if _directory is None or _name is None:
         return

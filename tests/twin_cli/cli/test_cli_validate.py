@@ -29,20 +29,36 @@ def twin(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     )
 
 
+def statuses(report: dict) -> dict[str, str]:
+    return {f"{c['check']} ({c['scenario']})": c["status"] for c in report["checks"]}
+
+
 def test_humanoid_passes_every_check_and_writes_every_report(tmp_path):
-    junit, md, plots = tmp_path / "v.xml", tmp_path / "v.md", tmp_path / "plots"
-    done = twin(scenarios.HUMANOID, "--junit", junit, "--markdown", md, "--plots", plots, "--json")
+    """Every report written, and the verdicts those reports (and a recording) leave unchanged:
+    the same statuses as a run that writes nothing."""
+    junit, md, plots, bags = (tmp_path / n for n in ("v.xml", "v.md", "plots", "bags"))
+    done = twin(
+        scenarios.HUMANOID, "--junit", junit, "--markdown", md, "--plots", plots,
+        "--record", bags, "--json",
+    )  # fmt: skip
     assert done.returncode == 0, done.stdout + done.stderr
     report = json.loads(done.stdout)
     expected = len(MODEL_CHECKS) + len(builtin_names())
     assert report["passed"] and len(report["checks"]) == expected
+    assert report["exit_code"] == 0 and report["counts"]["error"] == 0, report["counts"]
     assert {c["check"] for c in report["checks"]} == set(CHECKS), "every check ran"
     suite = ET.parse(junit).getroot().find("testsuite")
     cases = suite.findall("testcase")
     assert int(suite.get("tests")) == len(cases) == expected, "JUnit counts the checks that ran"
     assert int(suite.get("failures")) == 0 and not suite.findall("testcase/failure")
+    assert int(suite.get("errors")) == 0 and not suite.findall("testcase/error")
+    skipped = suite.findall("testcase/skipped")
+    assert int(suite.get("skipped")) == len(skipped) and all(s.get("message") for s in skipped)
     assert "twin validate: `humanoid` passed" in md.read_text()
     assert_one_embedded_plot_per_physics_check(report["checks"], md.read_text(), plots)
+    assert (bags / "realtime.mcap").is_file(), "the realtime scenario is recorded too"
+    quiet = twin(scenarios.HUMANOID, "--json")
+    assert statuses(json.loads(quiet.stdout)) == statuses(report), "reports changed a verdict"
 
 
 def assert_one_embedded_plot_per_physics_check(checks: list[dict], text: str, plots: Path):

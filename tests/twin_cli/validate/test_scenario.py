@@ -130,7 +130,7 @@ def test_robot_joints_set_the_start_posture_that_the_hold_holds(tmp_path):
     from models import mimic_pincer, write_urdf
 
     from twin_cli.validate.checks.sim import ScenarioRun
-    from twin_cli.validate.runner import load_robot
+    from twin_cli.validate.robot import load_robot
 
     robot = load_robot(write_urdf(tmp_path, mimic_pincer(offset=0.2, multiplier=-1.0)))
     run = ScenarioRun(robot, load_scenario(write(tmp_path, PINCER_HOLD.format(lead=0.6))))

@@ -86,6 +86,8 @@ def validate(
 ) -> None:
     """Validate a robot: model checks plus physics scenarios. Exit 0 pass, 1 fail, 2 bad input.
 
+    A check that crashed (a bug, not the robot's fault) makes the exit code 70.
+
     Several robots, --sweep, --jobs or --ray run every robot × variant in worker processes.
     """
     from twin_cli.cli.output import Output
@@ -159,7 +161,7 @@ def validate(
             out.line(f"recording: {path}")
     for path in films.written if video else []:
         out.line(f"video: {path}")
-    raise typer.Exit(0 if run.passed else 1)
+    raise typer.Exit(run.exit_code)  # 0 pass, 1 a check failed, 70 a check crashed
 
 
 def register(app: typer.Typer) -> None:
@@ -174,11 +176,11 @@ def print_table(run: Any, out: Any) -> None:
     rows = [(render.label(r), r.measured, r.threshold, render.MARK[r.status]) for r in run.results]
     out.table(f"twin validate {run.robot}", ["check", "measured", "threshold", "result"], rows)
     for r in run.results:
-        if r.status in (render.Status.FAIL, render.Status.WARN):
+        if r.status in render.TO_FIX:
             for hint in r.hints or r.details:
                 out.line(f"{render.MARK[r.status]} {r.check}: {hint}")
     counts = run.counts()
     out.line(
         f"{run.robot}: {counts['pass']} passed, {counts['warn']} warned, {counts['fail']} failed,"
-        f" {counts['skip']} skipped in {run.seconds:.1f} s"
+        f" {counts.get('error', 0)} crashed, {counts['skip']} not applicable in {run.seconds:.1f} s"
     )

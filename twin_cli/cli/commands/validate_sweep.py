@@ -63,7 +63,7 @@ def run_sweep(
     if plots:
         path = render.write_margin_plot(result, Path(plots) / "sweep_margins.png")
         out.line(f"plot: {path}")
-    raise typer.Exit(0 if result.passed else 1)
+    raise typer.Exit(result.exit_code)
 
 
 def _write(path: Path, text: str) -> None:

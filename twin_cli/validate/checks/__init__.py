@@ -12,12 +12,16 @@ from dataclasses import dataclass
 
 from twin_cli.validate.checks import (
     model_collision,
+    model_effort,
     model_inertia,
     model_joints,
+    model_sensors,
     physics_contact,
     physics_dynamics,
     physics_friction,
     physics_gravity,
+    physics_imu,
+    physics_realtime,
     physics_sensors,
     physics_tracking,
 )
@@ -56,6 +60,8 @@ CHECKS: dict[str, Check] = {
             "initial_overlap", "model", model_collision.check_initial_overlap, tolerance_m=0.001
         ),
         _check("joint_definitions", "model", model_joints.check_joint_definitions),
+        _check("gravity_hold", "model", model_effort.check_gravity_hold, min_effort_ratio=1.0),
+        _check("sensor_links", "model", model_sensors.check_sensor_links),
         _check("gravity", "physics", physics_gravity.check_gravity, rel_tol=0.01),
         _check(
             "zero_gravity",
@@ -112,13 +118,21 @@ CHECKS: dict[str, Check] = {
             max_energy_gain=0.05,
             max_spin_rad_s=100.0,
         ),
-        _check("realtime", "physics", physics_dynamics.check_realtime, min_factor=0.8),
+        _check(
+            "realtime",
+            "physics",
+            physics_realtime.check_realtime,
+            min_factor=0.8,
+            min_cpu_share=0.5,
+            max_cpu_spread=1.5,
+        ),
         _check(
             "sensor_imu",
             "physics",
-            physics_sensors.check_sensor_imu,
+            physics_imu.check_sensor_imu,
             tol_m_s2=0.05,
             max_rate_rad_s=0.01,
+            max_noise_factor=3.0,
         ),
         _check("sensor_lidar", "physics", physics_sensors.check_sensor_lidar, tol_m=0.001),
         _check(

@@ -14,12 +14,38 @@ if TYPE_CHECKING:
 
 
 class Status(enum.Enum):
-    """Outcome of one check; only FAIL makes `twin validate` exit 1."""
+    """Outcome of one check (what each means: `STATUS_MEANING`); FAIL exits 1, ERROR exits 70.
+
+    NOT_APPLICABLE keeps the value "skip": JSON consumers read it and JUnit calls it <skipped>.
+    """
 
     PASS = "pass"
     WARN = "warn"
     FAIL = "fail"
-    SKIP = "skip"
+    NOT_APPLICABLE = "skip"
+    ERROR = "error"
+
+
+STATUS_MEANING: dict[Status, str] = {
+    Status.PASS: "the robot meets the check's thresholds",
+    Status.WARN: "passes; a finding worth a look (or a measurement the machine could not decide)",
+    Status.FAIL: "the robot breaks the check; each hint names the part and the fix (exit 1)",
+    Status.NOT_APPLICABLE: "the check cannot apply to this robot; the reason is given",
+    Status.ERROR: "the check itself crashed: a bug in twin, not in the robot (exit 70)",
+}
+"""What each status says about the robot, for reports and docs."""
+
+EXIT_CODES: dict[Status, int] = {Status.FAIL: 1, Status.ERROR: 70}
+"""`twin validate`'s exit code for a run whose worst status is this (others: 0)."""
+
+
+class CannotApply(Exception):
+    """Raised from inside a check (or what it builds) when the robot gives it nothing to judge;
+    the runner turns it into a NOT_APPLICABLE result with `reason`, never an ERROR."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
 
 
 @dataclass(frozen=True)
@@ -77,6 +103,11 @@ class CheckResult:
     def failed(self) -> bool:
         return self.status is Status.FAIL
 
+    @property
+    def errored(self) -> bool:
+        """The check crashed (a twin bug): neither a pass nor a verdict on the robot."""
+        return self.status is Status.ERROR
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready view (series left out; they go to plots)."""
         return {
@@ -107,13 +138,26 @@ class DeclaredJoint:
 
 
 @dataclass(frozen=True)
+class UnplacedSensor:
+    """A `<sensor>` the description attaches to a link that does not exist (`reference`)."""
+
+    name: str
+    kind: str
+    link: str
+
+
+@dataclass(frozen=True)
 class RobotUnderTest:
     """What every check receives: the converted robot and how it was converted.
 
     `spec` is never mutated by a check (physics checks spawn copies); `model` is the robot
     compiled alone, in its initial pose. `repair_inertia` says whether the user asked for
     inertia repairs (then repairs are warnings, not failures). `declared_joints` are the
-    URDF's own joint values (empty for MJCF input).
+    URDF's own joint values (empty for MJCF input). `link_names` are the description's links,
+    `geom_links` the link each named geom was declared on,
+    `unplaced_sensors` its sensors on links it does not have, `self_collide_links` the links
+    with Gazebo selfCollide and `model_self_collide` the model's `<self_collide>` (all empty
+    for MJCF input).
     """
 
     name: str
@@ -125,10 +169,26 @@ class RobotUnderTest:
     body_links: dict[str, str] = field(default_factory=dict)
     declared_joints: tuple[DeclaredJoint, ...] = ()
     sensors: tuple = ()  # the converter's Gazebo sensors (converters.description.sensors)
+    link_names: tuple[str, ...] = ()
+    geom_links: dict[str, str] = field(default_factory=dict)  # geom name → the link it came from
+    unplaced_sensors: tuple[UnplacedSensor, ...] = ()
+    self_collide_links: frozenset[str] = frozenset()
+    model_self_collide: bool = False
+
+    @property
+    def described(self) -> bool:
+        """Whether the robot came from a URDF/SDF description (not an MJCF file)."""
+        return bool(self.link_names)
 
     def link_of_body(self, body: str) -> str:
         """The URDF link name for a body name (bodies are named after links)."""
         return self.body_links.get(body, body)
+
+    def link_of_geom(self, geom: int) -> str:
+        """The URDF link a geom of `model` was declared on (a lumped link keeps its name)."""
+        name = self.model.geom(geom).name
+        body = self.model.body(int(self.model.geom_bodyid[geom])).name
+        return self.geom_links.get(name) or self.link_of_body(body)
 
 
 def result(
@@ -144,6 +204,12 @@ def result(
         if key in extra:
             extra[key] = tuple(extra[key])
     return CheckResult(check, kind, status, measured, threshold, **extra)
+
+
+def not_applicable(check: str, kind: str, measured: str, reason: str) -> CheckResult:
+    """The verdict of a check that cannot apply to this robot; `reason` says why (JUnit
+    shows it as the <skipped> message), `measured` is the short form for the table."""
+    return result(check, kind, Status.NOT_APPLICABLE, measured, "n/a", details=[reason])
 
 
 def judged(

@@ -95,7 +95,7 @@ def _mesh_solid(model, geom: int, pos: tuple[float, float, float]) -> Solid | No
         return None
     try:
         hull = trimesh.Trimesh(vertices=vertices).convex_hull
-    except Exception:  # noqa: BLE001 - qhull rejects flat point sets; such a mesh has no volume
+    except Exception:  # qhull rejects flat point sets; such a mesh has no volume
         return None
     volume = float(hull.volume)
     if volume <= 0.0:

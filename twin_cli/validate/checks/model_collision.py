@@ -1,7 +1,8 @@
 """Model checks on collision geometry: mesh complexity and overlaps in the initial pose.
 
 Overlap rule (Gazebo semantics): a pair that the model collides and that already penetrates at
-spawn makes the robot "vibrate or explode at startup", so it fails. A robot with selfCollide
+spawn (the start posture, `-J` included) makes the robot "vibrate or explode at startup", so
+it fails. A robot with selfCollide
 off has no self pairs; Gazebo would not collide its links either, so overlapping links joined
 by no joint are listed as a warning only (they start to fight the moment someone turns
 selfCollide on). Links joined by a joint never collide in Gazebo and are not checked.
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 from twin_cli.validate.checks.base import RobotUnderTest, Status, fmt_len, result
 from twin_cli.validate.checks.model_inertia import collision_geoms
+from twin_cli.validate.checks.posture import start_data
 from twin_cli.validate.scenario import Scenario
 
 MESH = 7  # mjtGeom mjGEOM_MESH
@@ -58,18 +60,6 @@ def check_mesh_complexity(robot: RobotUnderTest, scenario: Scenario, th: dict[st
     )
 
 
-def _initial_data(model):
-    """MjData in the initial pose: the `home` keyframe when there is one, else qpos0."""
-    import mujoco
-
-    data = mujoco.MjData(model)
-    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
-    if key >= 0:
-        mujoco.mj_resetDataKeyframe(model, data, key)
-    mujoco.mj_forward(model, data)
-    return data
-
-
 def _jointed(model, b1: int, b2: int) -> bool:
     """True when one body is the other's parent (joined by a joint, or lumped into it)."""
     return int(model.body_parentid[b1]) == b2 or int(model.body_parentid[b2]) == b1
@@ -115,15 +105,14 @@ def latent_overlaps(robot: RobotUnderTest, data, tol: float, skip) -> dict[tuple
 
 
 def check_initial_overlap(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
-    """Collision geometry that overlaps in the initial pose, named pair by pair."""
-    data = _initial_data(robot.model)
+    """Collision geometry that overlaps in the start posture (`-J` included), pair by pair."""
+    data = start_data(robot, scenario)
     tol = th["tolerance_m"]
     live = colliding_overlaps(robot, data, tol)
     latent = latent_overlaps(robot, data, tol, set(live))
     hints = [
         f"links {_pair_name(robot, b1, b2)} overlap by {fmt_len(-d)} at spawn and collide: the "
-        "robot will jump or vibrate at startup; move or shrink one <collision>, or turn "
-        "selfCollide off for one of them"
+        f"robot will jump or vibrate at startup; {_separation_fix(robot, b1, b2)}"
         for (b1, b2), d in sorted(live.items(), key=lambda kv: kv[1])
     ]
     details = [
@@ -143,3 +132,24 @@ def check_initial_overlap(robot: RobotUnderTest, scenario: Scenario, th: dict[st
         details=details,
         value=float(len(live)),
     )
+
+
+def _separation_fix(robot: RobotUnderTest, b1: int, b2: int) -> str:
+    """What stops this pair colliding at spawn, from what makes it collide: Gazebo collides two
+    links of one model when either has selfCollide (or the model has <self_collide>)."""
+    fixes = [
+        "move or shrink one of their <collision>s",
+        "start the robot in a posture where they are apart (-J NAME=POS, [robot] joints)",
+    ]
+    names = [robot.link_of_body(robot.model.body(b).name) for b in (b1, b2)]
+    if not robot.described:
+        pair = f"body1='{names[0]}' body2='{names[1]}'"
+        fixes.append(f"exclude the pair (<contact><exclude {pair}/>)")
+    elif robot.model_self_collide:
+        fixes.append("drop the model's <self_collide> (it makes every pair of links collide)")
+    else:
+        tagged = [n for n in names if n in robot.self_collide_links]
+        if tagged:
+            where = " and ".join(f"'{n}'" for n in tagged)
+            fixes.append(f"remove <selfCollide> from link {where}")
+    return ", or ".join(fixes)

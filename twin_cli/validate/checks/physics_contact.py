@@ -14,10 +14,9 @@ from twin_cli.validate.checks.base import (
     CheckResult,
     RobotUnderTest,
     Series,
-    Status,
     fmt_len,
     judged,
-    result,
+    not_applicable,
 )
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
@@ -69,14 +68,8 @@ def _sink_hint(run: ScenarioRun, geom: int, depth: float, limit: float) -> str:
 
 def skip_fixed(check: str) -> CheckResult:
     """The verdict for a robot welded to the world: it cannot stand, slide or be pushed."""
-    return result(
-        check,
-        "physics",
-        Status.SKIP,
-        "fixed base",
-        "n/a",
-        details=["the robot is fixed to the world (no floating base)"],
-    )
+    reason = "the robot is fixed to the world (no floating base): it cannot stand, slide or move"
+    return not_applicable(check, "physics", "fixed base", reason)
 
 
 def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
@@ -86,19 +79,23 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         return skip_fixed("ground_contact")
     deepest: dict[int, float] = {}
     speeds: list[float] = []
+    velocities: list[np.ndarray] = []  # COM velocity [m/s] per sample
     times: list[float] = []
     depths: list[tuple[float, float]] = []  # (time [s], deepest penetration now [m]) settled
-    lowest = [np.inf]
+    lowest: list = [np.inf, run.root]  # the lowest link COM height [m] seen, and its body
     previous = [run.subtree_com()]
     settle = scenario.duration * 0.5
 
     def sample(r: ScenarioRun) -> None:
         com = r.subtree_com()
-        speeds.append(float(np.linalg.norm(com - previous[0]) / (10 * r.world.model.opt.timestep)))
+        velocities.append((com - previous[0]) / (10 * r.world.model.opt.timestep))
+        speeds.append(float(np.linalg.norm(velocities[-1])))
         times.append(r.time)
         previous[0] = com
         with r.world.lock:
-            lowest[0] = min(lowest[0], min(float(r.world.data.xipos[b][2]) for b in r.bodies))
+            z, body = min((float(r.world.data.xipos[b][2]), b) for b in r.bodies)
+            if z < lowest[0]:
+                lowest[:] = [z, body]
         if r.time >= settle:
             now = 0.0
             for geom, dist in r.ground_contacts():
@@ -115,20 +112,30 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
         if d > th["max_penetration_m"]
     ]
     if lowest[0] < -th["max_penetration_m"]:
+        hints.append(_fell_hint(run, lowest[1], lowest[0]))
+    elif not deepest:
         hints.append(
-            f"a link's centre of mass went {fmt_len(-lowest[0])} below the ground: it fell "
-            "through; give the link a <collision> or stiffen its contact"
+            "the robot never touched the ground: check for links with gravity off "
+            "(turnGravityOff) and that the links it stands on have a <collision>"
         )
-    if final_speed > th["rest_speed_m_s"]:
-        hints.append(
-            f"still moving at {final_speed:.3g} m/s after {scenario.duration:g} s: the contact "
-            "bounces or the robot drifts; raise <kd> or check for overlapping collisions"
-        )
-    if not deepest:
-        hints.append(
-            "no contact with the ground after settling: the robot has no collision geometry"
-        )
-    plots = [
+    elif final_speed > th["rest_speed_m_s"]:
+        hints.append(_moving_hint(np.mean(velocities[-20:], axis=0), scenario.duration))
+    return judged(
+        "ground_contact",
+        "physics",
+        f"penetration {fmt_len(depth)}, speed {final_speed:.2g} m/s",
+        f"≤ {fmt_len(th['max_penetration_m'])}, ≤ {th['rest_speed_m_s']:g} m/s",
+        hints,
+        value=depth,
+        series=_contact_plots(depths, times, speeds, th),
+    )
+
+
+def _contact_plots(
+    depths: list[tuple[float, float]], times: list[float], speeds: list[float], th: dict
+) -> list[Series]:
+    """The deepest contact over the settled half, and the COM speed, against their limits."""
+    return [
         Series(
             "ground penetration",
             "m",
@@ -145,28 +152,44 @@ def check_ground_contact(robot: RobotUnderTest, scenario: Scenario, th: dict[str
             log=True,
         ),
     ]
-    return judged(
-        "ground_contact",
-        "physics",
-        f"penetration {fmt_len(depth)}, speed {final_speed:.2g} m/s",
-        f"≤ {fmt_len(th['max_penetration_m'])}, ≤ {th['rest_speed_m_s']:g} m/s",
-        hints,
-        value=depth,
-        series=plots,
+
+
+def _fell_hint(run: ScenarioRun, body: int, z: float) -> str:
+    return (
+        f"link '{_link(run, body)}': its centre of mass went {fmt_len(-z)} below the ground: it "
+        "fell through; give it a <collision> or stiffen its contact"
     )
+
+
+def _moving_hint(velocity: np.ndarray, duration: float) -> str:
+    """Why a robot is not at rest at the end: it bounces (mostly vertical) or it slides or
+    tips (mostly horizontal), with the fix of each."""
+    speed = float(np.linalg.norm(velocity))
+    text = f"still moving at {speed:.3g} m/s after {duration:g} s"
+    if abs(float(velocity[2])) >= float(np.linalg.norm(velocity[:2])):
+        return f"{text}, up and down: the contact bounces; raise <kd> on the links that touch"
+    return (
+        f"{text}, sideways: the robot slides or tips in this posture; start it in one it holds "
+        "(-J NAME=POS or [robot] joints), or raise mu1/mu2 on its feet"
+    )
+
+
+def _never_reached(scenario: Scenario, beyond: float) -> CheckResult:
+    """Not applicable: the push did not bring the robot to the box (its friction held it, or
+    it tipped or folded on the way), so whether it passes through cannot be seen."""
+    reason = (
+        f"the push ({scenario.name}) never brought the robot to the box: its foremost link "
+        f"centre stopped {fmt_len(-beyond)} before the near face (friction held it, or it "
+        "tipped or folded under the push), so passing through cannot be judged"
+    )
+    return not_applicable("collision", "physics", "never reached the box", reason)
 
 
 def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Pushed towards a box, the robot touches it and does not pass through."""
     if not scenario.obstacles:
-        return result(
-            "collision",
-            "physics",
-            Status.SKIP,
-            "no obstacle",
-            "n/a",
-            details=["the scenario has no [[obstacles]] to push the robot into"],
-        )
+        reason = f"the scenario has no [[obstacles]] to push the robot into ({scenario.name})"
+        return not_applicable("collision", "physics", "no obstacle", reason)
     run = ScenarioRun(robot, scenario)
     if not run.floating:
         return skip_fixed("collision")
@@ -194,13 +217,13 @@ def check_collision(robot: RobotUnderTest, scenario: Scenario, th: dict[str, flo
     run.run(scenario.duration, sample, every=5)
     beyond = furthest[0] - near_face
     hints = []
-    if not touched[0]:
-        hints.append("the robot never touched the box: make the push stronger or the gap smaller")
     if furthest[0] > far_face - th["max_intrusion_m"]:
         hints.append(
             f"a link's centre of mass reached {fmt_len(beyond)} past the box's near face: the "
             "robot passes through; give its links <collision> geometry (not only <visual>)"
         )
+    elif not touched[0]:
+        return _never_reached(scenario, beyond)
     return judged(
         "collision",
         "physics",

@@ -1,4 +1,4 @@
-"""Physics checks on dynamics: joint limits hold, inertia answers torque, stability, real time.
+"""Physics checks on dynamics: joint limits hold, inertia answers torque, stability.
 
 Inertia oracle: with every joint locked, the robot is one rigid body; a torque τ at rest gives
 α = I⁻¹τ (Euler's equations, ω = 0), where I is the composite inertia about the centre of mass,
@@ -8,18 +8,25 @@ summed in numpy from each link's mass, COM and inertia (parallel-axis theorem).
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Series, Status, bars, judged, result
+from twin_cli.validate.checks.base import (
+    CannotApply,
+    RobotUnderTest,
+    Series,
+    Status,
+    bars,
+    judged,
+    not_applicable,
+    result,
+)
 from twin_cli.validate.checks.model_joints import SLIDE, limited_range
-from twin_cli.validate.checks.sim import ScenarioRun
+from twin_cli.validate.checks.sim import NO_BODY, ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
 FREE = 0  # mjtJoint mjJNT_FREE
 TINY_RAD_S = 1e-9  # [rad/s] the floor of the spin plot's log axis (a link that never turned)
-REALTIME_CHUNKS = 5  # the capacity is timed over this many equal slices of the scenario
 REACHED_RAD = 0.01
 """A drive reached its stop when the joint came within this of it [rad or m]; a joint whose
 velocity limit keeps it from crossing its range within the drive reaches neither stop."""
@@ -78,10 +85,18 @@ def check_joint_limits(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
                     f"{bound:.3g} {unit} under {joint.effort:.3g} N m: the limit is {enforced}; "
                     "check <limit> and the joint's stopErp/stopCfm"
                 )
+    if not over:
+        return not_applicable(
+            "joint_limits",
+            "physics",
+            "no joint to drive",
+            "no joint has both a range and an effort limit to drive it against its stops "
+            "(continuous joints, or <limit effort='0'>)",
+        )
     return result(
         "joint_limits",
         "physics",
-        Status.FAIL if hints else (Status.PASS if over else Status.SKIP),
+        Status.FAIL if hints else Status.PASS,
         f"{len(over)} joint(s) driven, {reached}/{2 * len(over)} stops reached, "
         f"worst {worst:.2f}× tolerance",
         f"≤ {th['max_violation_rad']:g} rad / {th['max_violation_m']:g} m past a limit",
@@ -105,6 +120,8 @@ def rigid_copy(spec):
         if joint.type != mujoco.mjtJoint.mjJNT_FREE:
             rigid.delete(joint)
     root = rigid.worldbody.first_body()
+    if root is None:
+        raise CannotApply(NO_BODY)
     if not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in rigid.joints):
         root.add_freejoint(name="rigid_free")
     rigid.option.gravity = [0.0, 0.0, 0.0]
@@ -254,45 +271,3 @@ def _stability_hints(run: ScenarioRun, finite: bool, gain: float, spin: dict, th
             f"{float(model.body_mass[b]):.3g} kg"
         )
     return hints
-
-
-def check_realtime(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
-    """Measured capacity (simulated s per wall s, unthrottled) ≥ `min_factor` × target."""
-    run = ScenarioRun(robot, scenario)
-    w = scenario.world
-    target = w.rate * w.timestep if w.rate > 0 else 1.0
-    run.run(0.1, None, every=100)  # warm-up
-    times, factors, wall, begin = [], [], 0.0, run.time
-    for _ in range(REALTIME_CHUNKS):  # timed in slices for the plot; the verdict is the total
-        sim, start = run.time, time.perf_counter()
-        run.run(scenario.duration / REALTIME_CHUNKS, None, every=100)
-        spent = time.perf_counter() - start
-        wall += spent
-        times.append(run.time)
-        factors.append((run.time - sim) / spent)
-    factor = (run.time - begin) / wall
-    hints = []
-    if factor < th["min_factor"] * target:
-        hints.append(
-            f"the world steps at {factor:.2f}× real time, below {th['min_factor']:g}× the "
-            f"{target:g} target at {w.rate:g} Hz: simplify collision meshes (--collision hull) "
-            "or raise the timestep"
-        )
-    return judged(
-        "realtime",
-        "physics",
-        f"capacity {factor:.2f}× real time",
-        f"≥ {th['min_factor'] * target:g}×",
-        hints,
-        value=factor,
-        series=[
-            Series(
-                "capacity",
-                "× real time",
-                tuple(times),
-                {"simulated s per wall s": tuple(factors)},
-                threshold=th["min_factor"] * target,
-                log=True,
-            )
-        ],
-    )

@@ -14,12 +14,14 @@ import math
 import numpy as np
 
 from twin_cli.validate.checks.base import (
+    CheckResult,
     RobotUnderTest,
     Series,
     Status,
     bars,
     fmt_len,
     judged,
+    not_applicable,
     result,
 )
 from twin_cli.validate.checks.model_inertia import collision_geoms
@@ -31,6 +33,8 @@ GROUND_MU = 100.0  # Gazebo's stock ground plane (converters.gazebo.contact.GROU
 MAX_SLIDE_ANGLE = math.radians(80.0)  # steeper slopes are not tested for sliding
 # [rad] a foot turned this far from level has rolled over its edge: the robot tipped, not slid.
 TIPPED_OVER_RAD = 0.3
+# MuJoCo's smallest friction coefficient (mjMINMU): a surface at or below it is frictionless.
+FRICTIONLESS_MU = 1e-5
 
 
 def foot_geoms(run: ScenarioRun, within: float = 0.01) -> list[int]:
@@ -204,23 +208,46 @@ def _scenario_slope_verdict(robot, scenario, spec, name, mu, th, details) -> lis
     ]
 
 
+def _frictionless_links(robot: RobotUnderTest, run: ScenarioRun) -> list[str]:
+    """The links whose foot geoms have no friction (each foot, not one per surface)."""
+    first = min(run.robot_geoms())
+    return sorted(
+        {
+            robot.link_of_geom(g - first)
+            for g in foot_geoms(run)
+            if float(robot.model.geom_friction[g - first][0]) <= FRICTIONLESS_MU
+        }
+    )
+
+
+def _foot_surfaces(robot: RobotUnderTest, run: ScenarioRun) -> dict[tuple, int]:
+    """(μ, priority) → one robot geom id (robot model) of each distinct foot surface."""
+    by_surface: dict[tuple, int] = {}
+    first = min(run.robot_geoms())
+    for g in foot_geoms(run):
+        local = g - first  # attach appends the robot's geoms in order: world id → robot id
+        key = (
+            round(float(robot.model.geom_friction[local][0]), 6),
+            int(robot.model.geom_priority[local]),
+        )
+        by_surface.setdefault(key, local)
+    return by_surface
+
+
 def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Each foot surface sticks below tan θ = μ and slides above it, μ = min(μ_foot, μ_ground)."""
     run = ScenarioRun(robot, scenario)
     if not run.floating:
         return skip_fixed("friction_incline")
-    feet = foot_geoms(run)
-    by_surface: dict[tuple, int] = {}
-    first = min(run.robot_geoms())
-    for g in feet:
-        local = g - first  # attach appends the robot's geoms in order: world id → robot id
-        key = (
-            round(float(robot.model.geom_friction[local][0]), 6),
-            robot.model.geom_priority[local],
-        )
-        by_surface.setdefault(key, local)
+    if not run.robot_geoms():
+        return _frictionless([])
+    surfaces = _foot_surfaces(robot, run)
+    gripping = {k: g for k, g in surfaces.items() if min(k[0], GROUND_MU) > FRICTIONLESS_MU}
+    slippery = _frictionless_links(robot, run)
+    if not gripping:
+        return _frictionless(slippery)
     hints, details, mus, stuck, slides = [], [], [], {}, {}
-    for (mu_foot, _), geom in sorted(by_surface.items())[: int(th["max_probes"])]:
+    for (mu_foot, _), geom in sorted(gripping.items())[: int(th["max_probes"])]:
         mu = min(mu_foot, GROUND_MU)
         mus.append(mu)
         h, d, slid, ratio = _probe_verdicts(robot, scenario, geom, mu, th)
@@ -230,17 +257,32 @@ def check_friction_incline(robot: RobotUnderTest, scenario: Scenario, th: dict[s
         stuck[surface] = slid
         if ratio is not None:
             slides[surface] = ratio
+    if slippery:
+        details.append(f"frictionless feet not probed (μ = 0 slides at any slope): {slippery}")
     return result(
         "friction_incline",
         "physics",
-        Status.FAIL if hints else (Status.PASS if mus else Status.SKIP),
-        f"{len(mus)} foot surface(s), μ = {', '.join(f'{m:.3g}' for m in mus) or 'none'}",
+        Status.FAIL if hints else Status.PASS,
+        f"{len(mus)} foot surface(s), μ = {', '.join(f'{m:.3g}' for m in mus)}",
         f"sticks at tan θ = {th['stick_factor']:g}μ, slides at {th['slide_factor']:g}μ",
         hints=hints,
         details=details,
         value=float(len(hints)),
         series=_incline_series(stuck, slides, th),
     )
+
+
+def _frictionless(links: list[str]) -> CheckResult:
+    """Not applicable: no foot has friction, so no slope holds it and there is no sticking
+    angle to probe (Coulomb with μ = 0 slides at any θ > 0)."""
+    if not links:
+        reason = "the robot has no collision geometry at its lowest point to stand on"
+        return not_applicable("friction_incline", "physics", "no feet", reason)
+    reason = (
+        f"every foot surface is frictionless (μ ≤ {FRICTIONLESS_MU:g} on {', '.join(links)}): "
+        "it slides at any slope, so there is no angle where it should stick to test"
+    )
+    return not_applicable("friction_incline", "physics", "frictionless feet", reason)
 
 
 def _incline_series(stuck: dict, slides: dict, th: dict[str, float]) -> list[Series]:

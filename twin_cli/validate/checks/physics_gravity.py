@@ -10,13 +10,13 @@ from __future__ import annotations
 import numpy as np
 
 from twin_cli.validate.checks.base import (
+    CheckResult,
     RobotUnderTest,
     Series,
-    Status,
     bars,
     fmt_len,
     judged,
-    result,
+    not_applicable,
 )
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
@@ -24,15 +24,9 @@ from twin_cli.validate.scenario import Scenario
 TINY_M = 1e-12  # [m] the floor of the link-motion plot's log axis (a link that did not move)
 
 
-def _skip_fixed(check: str, run: ScenarioRun):
-    return result(
-        check,
-        "physics",
-        Status.SKIP,
-        "fixed base",
-        "n/a",
-        details=["the robot is fixed to the world (no floating base): it cannot fall"],
-    )
+def _skip_fixed(check: str, run: ScenarioRun) -> CheckResult:
+    reason = "the robot is fixed to the world (no floating base): it cannot fall"
+    return not_applicable(check, "physics", "fixed base", reason)
 
 
 def _fall(run: ScenarioRun) -> tuple[np.ndarray, np.ndarray]:

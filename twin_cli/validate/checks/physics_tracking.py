@@ -6,9 +6,11 @@ target and its start, followed through the trajectory controller (twin_cli.contr
 the second half. Measured per joint: settling time of the step (last time outside SETTLE_BAND
 of it), the sine's largest tracking error after its first period, and the peak speed against
 the joint's velocity limit (a joint coupled to mimic followers may pass it by ~2 %: its servo's
-gains come from its own reflected inertia, without the followers'). A speed past the limit, a
-MuJoCo warning or a NaN fails; slow settling or loose tracking only warns (the user's gains and
-limits may intend it), naming the joint.
+gains come from its own reflected inertia, without the followers'). A sine tracking error past
+its threshold fails: the sine's speed stays within SINE_SPEED of the velocity limit, so a joint
+that cannot follow it lacks effort or gains. A speed past the limit, a MuJoCo warning or a NaN
+fails too. Slow settling of the step only warns, naming the joint: a step may be limited by the
+joint's velocity limit by design (0.3 rad at 0.2 rad/s takes 1.5 s).
 """
 
 from __future__ import annotations
@@ -17,7 +19,14 @@ import math
 
 import numpy as np
 
-from twin_cli.validate.checks.base import RobotUnderTest, Status, bars, result
+from twin_cli.validate.checks.base import (
+    CheckResult,
+    RobotUnderTest,
+    Status,
+    bars,
+    not_applicable,
+    result,
+)
 from twin_cli.validate.checks.sim import ScenarioRun
 from twin_cli.validate.scenario import Scenario
 
@@ -72,7 +81,11 @@ def check_tracking(robot: RobotUnderTest, scenario: Scenario, th: dict[str, floa
     run = ScenarioRun(robot, scenario)
     steps = _step_targets(run)
     if not steps:
-        return result("tracking", "physics", Status.SKIP, "no position interface", "-")
+        reason = (
+            "no joint has a motor with a position interface and an effort limit "
+            "(<ros2_control> position command, or the converter's default motors)"
+        )
+        return not_applicable("tracking", "physics", "no position interface", reason)
     names = list(steps)
     joints = {j.name: j for j in run.joints if j.name in steps}
     vmax = {n: (joints[n].velocity or math.inf) for n in names}
@@ -119,49 +132,66 @@ def check_tracking(robot: RobotUnderTest, scenario: Scenario, th: dict[str, floa
     return _verdict(run, names, steps, late, peak, sine_err, amp, th)
 
 
-def _verdict(run, names, steps, late, peak, sine_err, amp, th):  # noqa: ANN001, ANN202
+def _failures(
+    run: ScenarioRun,
+    peak: dict[str, float],
+    sine_err: dict[str, float],
+    amp: dict[str, float],
+    th: dict[str, float],
+) -> list[str]:
+    """What breaks tracking: MuJoCo warnings, NaN, a speed past the limit, a sine not followed."""
     fails = [f"MuJoCo warnings: {run.warnings()}; lower the gains"] if run.warnings() else []
     if not np.isfinite(run.qpos()).all():
         fails.append("NaN in the state; the gains or limits make it diverge")
     fails += [
-        f"joint '{n}': peak speed {peak[n]:.3g}× its velocity limit; report it (a twin bug)"
-        for n in names
-        if peak[n] > th["max_speed_ratio"]
+        f"joint '{n}': peak speed {ratio:.3g}× its velocity limit; report it (a twin bug)"
+        for n, ratio in peak.items()
+        if ratio > th["max_speed_ratio"]
     ]
-    warns = [
-        f"joint '{n}': step of {steps[n][1]:.3g} settles after {late[n]:.3g} s; "
-        "raise its effort limit or gains"
-        for n in names
-        if late[n] > th["max_settle_s"]
-    ]
-    warns += [
-        f"joint '{n}': sine tracking error {e:.3g} (amplitude {abs(amp[n]):.3g}); "
-        "raise its effort or velocity limit"
+    fails += [
+        f"joint '{n}': sine tracking error {e:.3g} is {e / abs(amp[n]):.0%} of the amplitude "
+        f"{abs(amp[n]):.3g} (> {th['max_sine_error_fraction']:.0%}), at a speed within its "
+        "velocity limit: raise its <limit effort> (or its pos_kp gain)"
         for n, e in sine_err.items()
         if e > th["max_sine_error_fraction"] * abs(amp[n])
     ]
-    worst_settle = max(late.values())
-    worst_error = max((e / abs(amp[n]) for n, e in sine_err.items()), default=0.0)
+    return fails
+
+
+def _verdict(
+    run: ScenarioRun,
+    names: list[str],
+    steps: dict[str, tuple[float, float]],
+    late: dict[str, float],
+    peak: dict[str, float],
+    sine_err: dict[str, float],
+    amp: dict[str, float],
+    th: dict[str, float],
+) -> CheckResult:
+    fails = _failures(run, peak, sine_err, amp, th)
+    warns = [
+        f"joint '{n}': step of {steps[n][1]:.3g} settles after {late[n]:.3g} s; "
+        "raise its effort limit, velocity limit or gains"
+        for n in names
+        if late[n] > th["max_settle_s"]
+    ]
+    errors = {n: e / abs(amp[n]) for n, e in sine_err.items()}
     status = Status.FAIL if fails else Status.WARN if warns else Status.PASS
     return result(
         "tracking",
         "physics",
         status,
-        f"settle ≤ {worst_settle:.3g} s, sine error ≤ {worst_error:.1%} of amplitude, "
+        f"settle ≤ {max(late.values()):.3g} s, sine error ≤ "
+        f"{max(errors.values(), default=0.0):.1%} of amplitude, "
         f"peak speed {max(peak.values()):.3g}× limit ({len(names)} joints)",
         f"≤ {th['max_settle_s']:g} s, ≤ {th['max_sine_error_fraction']:.0%}, "
         f"≤ {th['max_speed_ratio']:g}×",
         hints=fails + warns,
-        value=worst_error,
+        value=max(errors.values(), default=0.0),
         series=[
             bars("step settling time", "s", late, th["max_settle_s"], x_label="joint"),
-            bars(
-                "sine error over amplitude",
-                "1",
-                {n: e / abs(amp[n]) for n, e in sine_err.items()},
-                th["max_sine_error_fraction"],
-                x_label="joint",
-            ),
+            bars("sine error over amplitude", "1", errors, th["max_sine_error_fraction"],
+                 x_label="joint"),
             bars("peak speed over limit", "1", peak, th["max_speed_ratio"], x_label="joint"),
         ],
-    )
+    )  # fmt: skip

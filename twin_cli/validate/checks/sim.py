@@ -13,11 +13,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin_cli.spawn_request import SpawnRequest
-from twin_cli.validate.checks.base import RobotUnderTest
+from twin_cli.validate.checks.base import CannotApply, RobotUnderTest
 from twin_cli.validate.checks.model_joints import HINGE, SLIDE, joint_effort
 from twin_cli.validate.scenario import Action, Obstacle, Scenario
 
 PLANE = 0  # mjtGeom mjGEOM_PLANE
+NO_BODY = "the robot has no body that can move (an MJCF with only world geoms): nothing to simulate"
 
 
 @dataclass(frozen=True)
@@ -65,7 +66,9 @@ class ScenarioRun:
         time: simulated time since the start [s].
     """
 
-    def __init__(self, robot: RobotUnderTest, scenario: Scenario) -> None:
+    def __init__(self, robot: RobotUnderTest, scenario: Scenario, *, observed: bool = True) -> None:
+        """Build the world and spawn the robot; `observed` False leaves it unfilmed and
+        unrecorded (`--video`, `--record`), for a run whose stepping is being timed."""
         from twin_cli.world import Pose, World, WorldSettings
 
         w = scenario.world
@@ -73,7 +76,7 @@ class ScenarioRun:
             timestep=w.timestep, rate=w.rate, gravity=w.gravity_vector(), ground=w.ground
         )
         self.scenario = scenario
-        self.world = World(settings, name=f"validate-{scenario.name}")
+        self.world: World = World(settings, name=f"validate-{scenario.name}")
         pose = Pose(**scenario.robot.pose.model_dump())
         spawned = self.world.spawn(
             SpawnRequest(
@@ -93,17 +96,19 @@ class ScenarioRun:
         self.time = 0.0
         self.q_hold = self.qpos()[[j.qpos for j in self.joints]].copy()
         self.kp, self.kd = self._hold_gains()
-        from twin_cli.validate.recording import attach
+        if observed:
+            from twin_cli.validate import video
+            from twin_cli.validate.recording import attach
 
-        attach(self.world, scenario.name)  # `twin validate --record DIR`
-        from twin_cli.validate import video
-
-        video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
+            attach(self.world, scenario.name)  # `twin validate --record DIR`
+            video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
         model = self.world.model
         prefix = f"{self.entity}/"
         self.bodies = [b for b in range(model.nbody) if model.body(b).name.startswith(prefix)]
+        if not self.bodies:
+            raise CannotApply(NO_BODY)
         self.root = min(self.bodies)
         self.joints = [
             RobotJoint(
@@ -155,12 +160,17 @@ class ScenarioRun:
         return [g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in self.bodies]
 
     def extent(self) -> tuple[np.ndarray, np.ndarray]:
-        """Axis-aligned bounds [m] (min xyz, max xyz) of the robot's geoms' bounding spheres."""
+        """Axis-aligned bounds [m] (min xyz, max xyz) of the robot's geoms' bounding spheres
+        (of its links' centres of mass when it has no geom at all)."""
         with self.world.lock:
             data, model = self.world.data, self.world.model
             geoms = self.robot_geoms()
-            centres = np.array([data.geom_xpos[g] for g in geoms])
-            radii = np.array([model.geom_rbound[g] for g in geoms])[:, None]
+            if geoms:
+                centres = np.array([data.geom_xpos[g] for g in geoms])
+                radii = np.array([model.geom_rbound[g] for g in geoms])[:, None]
+            else:
+                centres = np.array([data.xipos[b] for b in self.bodies])
+                radii = np.zeros((len(self.bodies), 1))
         return (centres - radii).min(axis=0), (centres + radii).max(axis=0)
 
     def ground_contacts(self) -> list[tuple[int, float]]:
@@ -282,7 +292,8 @@ class ScenarioRun:
 
     def close(self) -> None:
         """Release the world (no thread runs; nothing else to free)."""
-        self.world = None  # type: ignore[assignment]
+        # a closed run is never used again: dropping the world frees it
+        self.world = None  # pyright: ignore[reportAttributeAccessIssue]
 
 
 def gazebo_effort(tau: float, qvel: float, joint: RobotJoint) -> float:
