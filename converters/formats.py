@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import re
 
-# Leading XML declaration, processing instructions, comments and doctype before the root.
-_PROLOGUE = re.compile(r"\A(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)*", re.S)
+# Leading byte-order mark (a UTF-8 file read as text keeps it as U+FEFF; XML parsers skip it),
+# XML declaration, processing instructions, comments and doctype before the root.
+_PROLOGUE = re.compile(r"\A\ufeff?(?:\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)*", re.S)
 _ROOT = re.compile(r"<([A-Za-z_][\w.\-]*:)?([A-Za-z_][\w.\-]*)")
 
 # Root element → format name.

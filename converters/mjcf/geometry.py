@@ -7,11 +7,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from converters.description import Geometry, RobotDescription, Visual
-from converters.mjcf.lumping import BodyPlan
+from converters.errors import MeshError
+from converters.mjcf.lumping import WORLDBODY, BodyPlan
 from converters.mjcf.materials import VisualColour, visual_colour
 from converters.report import Report
 from converters.resources.mesh_data import MeshData
 from converters.resources.meshes import MeshCache, mesh_problem
+
+# Half thickness [m] of the box a finite plane becomes on a moving body: MuJoCo allows plane
+# geoms in static bodies only, where Gazebo (and sdformat) take them on any link.
+PLANE_HALF_THICKNESS = 5e-4
+# A Gazebo heightmap's shape name; it becomes a height field after the other geoms, as a report
+# entry with this tag says until it is built.
+HEIGHTMAP = "heightmap"
+HEIGHTMAP_NOTE = "a <heightmap> becomes a height field in a served world (`twin serve`) only"
 
 
 @dataclass(frozen=True)
@@ -71,22 +80,67 @@ def plan_geoms(robot: RobotDescription, plan: BodyPlan, report: Report) -> list[
     """Every visual and collision geom of every link, placed in its body, meshes loaded."""
     cache = MeshCache()
     out: list[GeomPlan] = []
+    static = static_bodies(plan)
     for link in robot.links:
         placement = plan.placements[link.name]
         for role, items in (("visual", link.visuals), ("collision", link.collisions)):
             for index, item in enumerate(items):
+                subject = f"link '{link.name}' {role} {index}"
+                geom = _shape(item.geometry, link.name, role, subject, cache, report)
+                if geom is not None and geom[0] == "plane" and placement.body not in static:
+                    geom = _moving_plane(geom, subject, role, report)
+                if geom is None:
+                    continue
                 T = placement.T_body_link @ item.origin
                 colour = visual_colour(item.material) if isinstance(item, Visual) else None
-                geom = _plan_one(item.geometry, link.name, cache)
-                if geom is None:
-                    report.ignored(f"link '{link.name}' {role} {index}", "no geometry")
-                    continue
                 if colour is not None and geom[2] is not None:
-                    colour = _mesh_colour(
-                        colour, geom[2], f"link '{link.name}' visual {index}", report
-                    )
+                    colour = _mesh_colour(colour, geom[2], subject, report)
                 out.append(_assemble(link.name, placement.body, role, index, geom, T, colour))
     return out
+
+
+def _shape(
+    geometry: Geometry | None, link: str, role: str, subject: str, cache: MeshCache, report: Report
+) -> tuple | None:
+    """`_plan_one`, or None (said) for no shape, a heightmap (`heightfields` builds it) and a
+    visual mesh that cannot be read (Gazebo draws nothing for it and simulates on)."""
+    if geometry is not None and geometry.shape == HEIGHTMAP:
+        report.ignored(subject, HEIGHTMAP_NOTE, HEIGHTMAP)
+        return None
+    try:
+        geom = _plan_one(geometry, link, cache)
+    except MeshError as exc:
+        if role != "visual":
+            raise
+        report.warn(subject, f"left out: {exc}")
+        return None
+    if geom is None:
+        report.ignored(subject, "no geometry")
+    return geom
+
+
+def static_bodies(plan: BodyPlan) -> set[str]:
+    """Bodies that never move: the world and every body welded to a static one (a floating
+    root moves, and so does a body with a joint)."""
+    static = {WORLDBODY}
+    for node in plan.bodies:  # parents first
+        rooted_free = node.name == plan.root_body and plan.floating
+        if node.joint is None and node.parent in static and not rooted_free:
+            static.add(node.name)
+    return static
+
+
+def _moving_plane(geom: tuple, subject: str, role: str, report: Report) -> tuple | None:
+    """A plane on a moving link: a thin box of its size, or (an infinite plane) left out."""
+    _, size, mesh, mesh_file, scale = geom
+    if size[0] <= 0 or size[1] <= 0:
+        say = report.ignored if role == "visual" else report.warn
+        say(subject, "an infinite plane on a moving link is left out (MuJoCo planes are static)")
+        return None
+    if role == "collision":
+        report.approximated(subject, "a plane on a moving link collides as a thin box of its size")
+    box = (size[0], size[1], PLANE_HALF_THICKNESS)
+    return "box", box, mesh, mesh_file, scale
 
 
 def _mesh_colour(

@@ -8,12 +8,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from converters.errors import PackageNotFoundError, ResourceNotFoundError
+from converters.errors import ConversionError, PackageNotFoundError, ResourceNotFoundError
 
 # Environment variables searched, in order, as ROS 1 / ROS 2 / Gazebo users set them.
 ROS_ENV = "ROS_PACKAGE_PATH"
 AMENT_ENV = "AMENT_PREFIX_PATH"
 MODEL_ENVS = ("GAZEBO_MODEL_PATH", "GZ_SIM_RESOURCE_PATH")
+# Where Gazebo looks for a relative `file://` resource after the model's own directory.
+RESOURCE_ENVS = ("GAZEBO_RESOURCE_PATH", "GZ_SIM_RESOURCE_PATH")
 
 _PACKAGE_NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 
@@ -124,8 +126,23 @@ class PackageResolver:
         """
         path = self._locate(uri.strip(), base_dir, element)
         if must_exist and not path.is_file():
+            tried = [path, *self._resource_paths(uri.strip())]
+            found = next((p for p in tried[1:] if p.is_file()), None)
+            if found is not None:
+                return found
+            if len(tried) > 1:
+                raise ResourceSearchError(uri, element, [str(p) for p in tried])
             raise ResourceNotFoundError(uri, element, str(path))
         return path
+
+    def _resource_paths(self, uri: str) -> list[Path]:
+        """A relative `file://` URI under each Gazebo resource path entry, as Gazebo Classic
+        (`GAZEBO_RESOURCE_PATH`) and Gazebo (`GZ_SIM_RESOURCE_PATH`) look it up."""
+        if not uri.startswith("file://") or Path(uri[len("file://") :]).is_absolute():
+            return []
+        relative = uri[len("file://") :]
+        entries = [e for var in RESOURCE_ENVS for e in _split_env(self.env.get(var))]
+        return [entry / relative for entry in entries]
 
     def _locate(self, uri: str, base_dir: Path, element: str) -> Path:
         for scheme, model in (("package://", False), ("model://", True)):
@@ -137,3 +154,18 @@ class PackageResolver:
             uri = uri[len("file://") :]
         path = Path(uri).expanduser()
         return path if path.is_absolute() else (base_dir / path).resolve()
+
+
+class ResourceSearchError(ResourceNotFoundError):
+    """A relative `file://` resource found neither beside its file nor on a resource path."""
+
+    def __init__(self, uri: str, element: str, tried: list[str]) -> None:
+        places = "\n  ".join(tried)
+        ConversionError.__init__(
+            self,
+            f"{uri!r} used by {element} was found nowhere; tried:\n  {places}\n"
+            f"fix: the filename, or add the directory it is under to {RESOURCE_ENVS[0]}",
+        )
+        self.uri = uri
+        self.path = tried[0]
+        self.tried = tried

@@ -22,8 +22,12 @@ from converters.resources.packages import PackageResolver
 
 # SDFormat versions twin reads: 1.4 (Gazebo 2) to 1.11 (Gazebo Ionic).
 VERSIONS = ("1.4", "1.5", "1.6", "1.7", "1.8", "1.9", "1.10", "1.11")
-# Pose frame semantics (`relative_to`, `<frame attached_to>`) start at 1.7.
+# Pose frame semantics (`relative_to`, `<frame attached_to>`) start at 1.7; sdformat reads an
+# older file by upgrading it, so `relative_to` and `expressed_in` count in every version.
 FRAME_SEMANTICS_FROM = (1, 7)
+# Attributes set on an element an `<include>` brought in: its file and that file's version.
+INCLUDED_SOURCE = "_twin_source"
+INCLUDED_VERSION = "_twin_version"
 
 
 def version_tuple(version: str) -> tuple[int, int]:
@@ -41,10 +45,17 @@ class SdfContext:
     report: Report = field(default_factory=Report)
     version: str = "1.11"
 
-    @property
-    def frame_semantics(self) -> bool:
-        """True from SDFormat 1.7 on (`relative_to`, `attached_to`, `expressed_in`)."""
-        return version_tuple(self.version) >= FRAME_SEMANTICS_FROM
+    def version_of(self, element: Any) -> str:
+        """The SDFormat version of the file `element` was written in (an include's own)."""
+        for ancestor in (element, *element.iterancestors()):
+            marked = ancestor.get(INCLUDED_VERSION)
+            if marked:
+                return marked
+        return self.version
+
+    def before_frames(self, element: Any) -> bool:
+        """True when `element`'s file predates pose frame semantics (SDFormat 1.4-1.6)."""
+        return version_tuple(self.version_of(element)) < FRAME_SEMANTICS_FROM
 
     def error(self, element: Any, problem: str, fix: str) -> SDFError:
         """An SDFError at `element` (in the file an `<include>` brought it from, if any)."""
@@ -98,6 +109,13 @@ class SdfContext:
             return False
         raise self.error(parent.find(tag), f"{raw!r} is not a boolean", "write true or false")
 
+    def flag_attribute(self, element: Any, name: str) -> bool:
+        """A boolean attribute (`merge="true"`), false when absent."""
+        raw = (element.get(name) or "false").strip().lower()
+        if raw in ("true", "1", "false", "0"):
+            return raw in ("true", "1")
+        raise self.error(element, f"{name}={raw!r} is not a boolean", f"write {name}='true'")
+
 
 class _SdfValues(ValueContext):
     """Gazebo's value readers (shared with URDF `<gazebo>` tags), failing as SDF errors."""
@@ -115,7 +133,7 @@ class _SdfValues(ValueContext):
 
 def source_of(element: Any, default: str) -> str:
     for ancestor in (element, *element.iterancestors()):
-        marked = ancestor.get("_twin_source")
+        marked = ancestor.get(INCLUDED_SOURCE)
         if marked:
             return marked
     return default
@@ -198,6 +216,7 @@ def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
     """The `<pose>` child of `parent` as 4×4 and its `relative_to` (None when not given).
 
     SDF 1.9+ also accepts `rotation_format="quat_xyzw"` (7 numbers) and `degrees="true"`.
+    A 1.4-1.6 `<pose frame="F">` is `relative_to="F"`: sdformat's 1.6 → 1.7 upgrade renames it.
     """
     element = parent.find("pose")
     if element is None:
@@ -220,4 +239,7 @@ def read_pose(ctx: SdfContext, parent: Any) -> tuple[np.ndarray, str | None]:
         if (element.get("degrees") or "").lower() == "true":
             values = values[:3] + tuple(math.radians(v) for v in values[3:])
         T = pose_matrix(values)
-    return T, element.get("relative_to") or None
+    relative_to = element.get("relative_to") or None
+    if relative_to is None and ctx.before_frames(element):
+        relative_to = element.get("frame") or None
+    return T, relative_to

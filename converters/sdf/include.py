@@ -13,6 +13,8 @@ from urllib.parse import unquote
 
 from converters.errors import PackageNotFoundError
 from converters.sdf.document import (
+    INCLUDED_SOURCE,
+    INCLUDED_VERSION,
     SdfContext,
     line_of,
     parse_document,
@@ -20,9 +22,9 @@ from converters.sdf.document import (
     version_tuple,
 )
 from converters.sdf.links import INCLUDED_DIR, directory_of
+from converters.sdf.merge import merge_include
 
 SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
-INCLUDED_SOURCE = "_twin_source"
 # What an <include> may bring in (a Gazebo model directory holds one of these).
 INCLUDABLE = ("model", "light", "actor")
 # Fuel models twin ships an equivalent of (OpenRobotics' "Ground Plane" and "Sun").
@@ -30,9 +32,15 @@ FUEL_SHIPPED = ("ground plane", "sun")
 
 
 def expand_includes(ctx: SdfContext, parent: Any) -> None:
-    """Replace every `<include>` under `parent` (and its nested models) by what it names."""
+    """Replace every `<include>` under `parent` (and its nested models) by what it names;
+    `merge="true"` splices the included model's parts into `parent` instead (`merge`)."""
     for include in parent.findall("include"):
-        parent.replace(include, included_element(ctx, include))
+        element = included_element(ctx, include)
+        if ctx.flag_attribute(include, "merge"):
+            expand_includes(ctx, element)  # its own includes first, as sdformat loads it whole
+            merge_include(ctx, parent, include, element)
+        else:
+            parent.replace(include, element)
     for nested in parent.findall("model"):
         expand_includes(ctx, nested)
 
@@ -54,6 +62,7 @@ def included_element(ctx: SdfContext, include: Any) -> Any:
         raise ctx.error(include, f"{path} holds no <model> or <light>", "include a model file")
     element.set(INCLUDED_DIR, str(path.parent))
     element.set(INCLUDED_SOURCE, str(path))
+    element.set(INCLUDED_VERSION, (root.get("version") or "").strip())
     _override(ctx, include, element)
     return element
 

@@ -103,17 +103,19 @@ def _axis(
 ) -> tuple[float, float, float]:
     """The axis in the child link frame.
 
-    `<xyz expressed_in="F">` (1.7+) names its frame, default the joint frame; in 1.5-1.6
-    `<use_parent_model_frame>true` means the model frame; in 1.4 the axis is always in the model
-    frame (sdformat's 1.4 → 1.5 conversion adds use_parent_model_frame for that reason).
+    `<xyz expressed_in="F">` names its frame, default the joint frame (sdformat honours it in
+    every version: it upgrades older files); in 1.5-1.6 `<use_parent_model_frame>true` means
+    the model frame, and wins (the 1.6 → 1.7 upgrade turns it into expressed_in="__model__");
+    in 1.4 the axis is always in the model frame (the 1.4 → 1.5 upgrade adds that flag).
     """
     if axis is None or axis.find("xyz") is None:
         xyz, frame = np.array([0.0, 0.0, 1.0]), None
     else:
         xyz = np.asarray(ctx.vector(axis, "xyz", 3, (0.0, 0.0, 1.0)))
-        frame = axis.find("xyz").get("expressed_in") or None if ctx.frame_semantics else None
-        if ctx.version == "1.4" or (
-            not ctx.frame_semantics and ctx.flag(axis, "use_parent_model_frame", False)
+        frame = axis.find("xyz").get("expressed_in") or None
+        version = ctx.version_of(axis)
+        if version == "1.4" or (
+            ctx.before_frames(axis) and ctx.flag(axis, "use_parent_model_frame", False)
         ):
             frame = MODEL_FRAME
     if frame is None:

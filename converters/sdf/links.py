@@ -18,16 +18,20 @@ from converters.description import (
     Material,
     Visual,
 )
+from converters.errors import PackageNotFoundError, ResourceNotFoundError
 from converters.gazebo.blocks import read_surface
 from converters.gazebo.materials import gazebo_rgba
 from converters.gazebo.tags import to_xml
 from converters.sdf.document import SdfContext, line_of, read_pose
+from converters.sdf.heightmaps import heightmap_offset, read_heightmap
 from converters.sdf.poses import PoseGraph, scoped
 
 # SDF's defaults for a link without <inertial>: 1 kg and a unit inertia (sdformat's Inertial).
 DEFAULT_MASS = 1.0
 # Link children that only rendering, sensing or other engines use.
 LINK_IGNORED = ("kinematic", "must_be_base_link", "enable_wind", "light", "audio_sink")
+# Of those, flags whose false value is what twin simulates anyway: false says nothing.
+QUIET_WHEN_FALSE = ("kinematic", "must_be_base_link", "enable_wind")
 
 
 def read_link(
@@ -40,7 +44,10 @@ def read_link(
     collisions, surfaces = [], []
     for index, c in enumerate(element.findall("collision")):
         pose = _part_pose(ctx, graph, c, prefix, X_M_L)
-        collisions.append(Collision(pose, _geometry(ctx, c, name), c.get("name")))
+        geometry = _geometry(ctx, c, name)
+        if geometry is not None and geometry.shape == "heightmap":
+            pose = pose @ heightmap_offset(ctx, c)
+        collisions.append(Collision(pose, geometry, c.get("name")))
         if c.find("surface") is not None or c.find("max_contacts") is not None:
             surface, _ = read_surface(c, ctx.values(c))
             surfaces.append(InlineSurface(name, index, surface))
@@ -49,9 +56,9 @@ def read_link(
 
 
 def _part_pose(ctx: SdfContext, graph: PoseGraph, element: Any, prefix: str, X_M_L: np.ndarray):
-    """A visual's or collision's pose in its link frame (1.8+ may name another frame)."""
+    """A visual's or collision's pose in its link frame (`relative_to` may name another frame)."""
     pose, relative_to = read_pose(ctx, element)
-    if relative_to is None or not ctx.frame_semantics:
+    if relative_to is None:
         return pose
     X_M_F = graph.pose(scoped(relative_to, prefix), element)
     return np.linalg.inv(X_M_L) @ X_M_F @ pose
@@ -86,7 +93,15 @@ def _visual(
     ctx: SdfContext, graph: PoseGraph, element: Any, link: str, prefix: str, X_M_L: np.ndarray
 ) -> Visual:
     pose = _part_pose(ctx, graph, element, prefix, X_M_L)
-    return Visual(pose, _geometry(ctx, element, link), _material(ctx, element), element.get("name"))
+    try:
+        geometry = _geometry(ctx, element, link)
+    except (PackageNotFoundError, ResourceNotFoundError) as exc:  # sdformat never opens it
+        geometry = None
+        ctx.report.warn(
+            f"link '{link}' <visual name='{element.get('name', '')}'>",
+            f"left out, as Gazebo draws nothing for it: {exc}",
+        )
+    return Visual(pose, geometry, _material(ctx, element), element.get("name"))
 
 
 def _geometry(ctx: SdfContext, owner: Any, link: str) -> Geometry | None:
@@ -98,6 +113,11 @@ def _geometry(ctx: SdfContext, owner: Any, link: str) -> Geometry | None:
     subject = f"link '{link}' <{owner.tag} name='{owner.get('name', '')}'>"
     if shape is None or shape.tag == "empty":
         return None
+    if shape.tag == "heightmap":
+        if owner.tag != "collision":  # the collision's height field is drawn
+            ctx.report.ignored(subject, "a <heightmap> visual is not drawn; its collision is")
+            return None
+        return read_heightmap(ctx, shape, subject, directory_of(ctx, shape))
     reader = _SHAPES.get(shape.tag)
     if reader is None:
         ctx.report.ignored(
@@ -186,8 +206,9 @@ def _material(ctx: SdfContext, visual: Any) -> Material | None:
 def _extension(ctx: SdfContext, link: Any, name: str) -> LinkExtension:
     """Link-level Gazebo values: gravity, self_collide, velocity_decay, sensors."""
     for tag in LINK_IGNORED:
-        if link.find(tag) is not None:
-            ctx.report.ignored(f"link '{name}' <{tag}>", "not simulated by twin")
+        if link.find(tag) is None or (tag in QUIET_WHEN_FALSE and not ctx.flag(link, tag, False)):
+            continue
+        ctx.report.ignored(f"link '{name}' <{tag}>", "not simulated by twin")
     decay = link.find("velocity_decay")
     damping = None
     if decay is not None:

@@ -8,6 +8,7 @@ joint), or is welded when the model is `<static>`; a joint to `world` anchors it
 from __future__ import annotations
 
 from collections.abc import Collection
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Any
 
@@ -18,16 +19,20 @@ from converters.description import (
     Blob,
     Frame,
     GazeboExtensions,
+    Inertial,
     Joint,
     JointExtension,
+    Link,
     LinkExtension,
     RobotDescription,
 )
 from converters.gazebo.tags import to_xml
+from converters.mjcf.inertia import from_inertial, problem
 from converters.sdf.document import SdfContext, line_of
 from converters.sdf.include import expand_includes
 from converters.sdf.joints import read_joint
 from converters.sdf.links import read_link
+from converters.sdf.names import rename_clashes
 from converters.sdf.poses import SEP, PoseGraph
 
 # Model children twin reads elsewhere or on purpose leaves to Gazebo's other engines.
@@ -41,6 +46,7 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         SDFError: a model without links, bad names, poses, joints or values (file:line).
     """
     expand_includes(ctx, model)
+    rename_clashes(ctx, model)
     graph = PoseGraph(ctx, model)
     scopes = list(_scopes(model, ""))
     links, ext_links, surfaces = [], {}, []
@@ -62,6 +68,9 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
     static = ctx.flag(model, "static", False)
     names = [link.name for link in links]
     welded = _in_static_models(ctx, scopes, names)
+    moved = {j.child for j in joints if j.kind != "fixed"}
+    still = [n for n in names if (static or n in welded) and n not in moved]
+    links = [_unused_inertia(ctx, link) if link.name in still else link for link in links]
     base, base_pose, anchors = _base(graph, names, joints, static, welded)
     _report_ignored(ctx, model)
     gazebo = GazeboExtensions(
@@ -154,6 +163,20 @@ def _base(
     return WORLD_LINK, np.eye(4), anchors
 
 
+def _unused_inertia(ctx: SdfContext, link: Link) -> Link:
+    """A link that never moves (a static model's, and no joint moves it): a non-physical
+    inertia does not matter, as Gazebo never uses it; it becomes no mass at all, said."""
+    value = from_inertial(link.inertial)
+    trouble = None if value is None else problem(value)
+    if value is None or trouble is None or (value.mass == 0 and not np.any(value.tensor)):
+        return link
+    ctx.report.repaired(
+        f"link '{link.name}' <inertial>",
+        f"{trouble}; unused in a static model, so left out (the link never moves)",
+    )
+    return replace(link, inertial=Inertial(0.0, np.zeros((3, 3))))
+
+
 def _frames(graph: PoseGraph) -> tuple[Frame, ...]:
     """Every `<frame>` as a pose in the link it is attached to."""
     out = []
@@ -181,5 +204,6 @@ def _has_values(extension: JointExtension) -> bool:
 def _report_ignored(ctx: SdfContext, model: Any) -> None:
     name = model.get("name", "")
     for tag in MODEL_IGNORED:
-        if model.find(tag) is not None:
-            ctx.report.ignored(f"model '{name}' <{tag}>", "not simulated by twin")
+        if model.find(tag) is None or (tag == "enable_wind" and not ctx.flag(model, tag, False)):
+            continue  # no wind is what twin simulates: a false flag says nothing
+        ctx.report.ignored(f"model '{name}' <{tag}>", "not simulated by twin")

@@ -4,7 +4,8 @@ The rules (SDFormat 1.7+, "pose frame semantics"): a model has an implicit frame
 a link's `<pose>` is relative to `__model__`, a joint's to its child link, a `<frame>`'s to the
 frame it is `attached_to` (default `__model__`), a nested model's to the parent's `__model__`,
 unless `relative_to` names another frame of the same scope. Nested scopes are reached with
-`::` (`arm::hand`). Before 1.7 there is no `relative_to`, and the same defaults apply.
+`::` (`arm::hand`). Files before 1.7 are read as sdformat reads them, upgraded: the same
+defaults, and a `relative_to` they write counts.
 Frames are resolved lazily and a cycle is an error naming the frames in it.
 """
 
@@ -98,12 +99,6 @@ class PoseGraph:
                 "links, joints, frames and nested models need unique names",
             )
         pose, relative_to = read_pose(self.ctx, element)
-        if relative_to is not None and not self.ctx.frame_semantics:
-            self.ctx.report.ignored(
-                f"{kind} '{name}' <pose relative_to>",
-                f"SDFormat {self.ctx.version} has no relative_to (1.7+); the default frame is used",
-            )
-            relative_to = None
         target = default if relative_to is None else scoped(relative_to, prefix)
         self.nodes[name] = FrameNode(kind, element, pose, target)
 

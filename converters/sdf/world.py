@@ -11,6 +11,7 @@ from converters.description.transforms import vec3
 from converters.sdf.document import SdfContext, read_pose
 from converters.sdf.include import expand_includes
 from converters.sdf.model import read_model
+from converters.sdf.world_frames import WorldFrames
 
 # SDF world defaults (sdf/1.11/physics.sdf, world.sdf): 1 ms at 1000 Hz, factor 1, 50 iterations.
 DEFAULT_STEP = 0.001
@@ -54,13 +55,9 @@ def read_world(ctx: SdfContext, world: Any, text: str = "") -> WorldDescription:
                 element, f"a second model named '{name}'", "give each model a unique name"
             )
         names.add(name)
-        pose, relative_to = read_pose(ctx, element)
-        if relative_to not in (None, "world"):
-            raise ctx.error(
-                element.find("pose"),
-                f"relative_to '{relative_to}' at world level",
-                "place world models relative to the world",
-            )
+    frames = WorldFrames(ctx, world)  # a model may be posed relative_to a frame or model
+    for element in world.findall("model"):
+        pose = frames.pose(element.get("name", ""))
         models.append(PlacedModel(read_model(ctx, element, text), pose))
     for tag in WORLD_IGNORED:
         if world.find(tag) is not None:

@@ -140,11 +140,13 @@ def test_nested_model_placed_relative_to_a_parent_link(tmp_path: Path) -> None:
     assert data.site_xpos[compiled.site("above_bulb").id] == pytest.approx(above, abs=TOL)
 
 
-def test_before_1_7_relative_to_is_ignored_and_reported(tmp_path: Path) -> None:
+def test_before_1_7_relative_to_counts_as_sdformat_upgrades_the_file(tmp_path: Path) -> None:
+    # sdformat reads a 1.6 file upgraded to its newest version, relative_to included:
+    # X_M_b = X_M_a · X_a_b = (1, 0, 0) + (0, 1, 0) = (1, 1, 0).
     model = '<model name="m">' + _link("a", "1 0 0 0 0 0") + _link("b", "0 1 0 0 0 0", "a")
     compiled, data, report = _kinematics(tmp_path, model + "</model>", version="1.6")
-    assert data.xpos[compiled.body("b").id] == pytest.approx([0.0, 1.0, 0.0], abs=TOL)
-    assert any("relative_to" in e.subject for e in report.of(Outcome.IGNORED))
+    assert data.xpos[compiled.body("b").id] == pytest.approx([1.0, 1.0, 0.0], abs=TOL)
+    assert not any("relative_to" in e.subject for e in report.of(Outcome.IGNORED))
 
 
 @pytest.mark.parametrize(

@@ -2,7 +2,8 @@
 
 The file's `<physics>` and `<gravity>` become the world's settings; each `<model>` (includes
 expanded, `model://ground_plane` and `model://sun` shipped with twin) becomes an entity named
-after the model at its pose, so `twin list`, `twin pose` and `twin delete` know them.
+after the model at its pose, so `twin list`, `twin pose` and `twin delete` know them; a
+`<heightmap>` collision becomes a MuJoCo height field.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ def world_from_sdf(
     """
     from converters.errors import InputFileError
     from converters.mjcf.builder import ConvertOptions
+    from converters.mjcf.heightfields import add_height_fields
     from converters.pipeline import build_description
     from converters.report import Report
     from converters.resources.packages import PackageResolver
@@ -72,6 +74,7 @@ def world_from_sdf(
         # and so does twin, repaired and said (`file_notes`).
         options = ConvertOptions(repair_inertia=True)
         done = build_description(placed.robot, options)
+        add_height_fields(done.spec, placed.robot, done.report)  # terrain: static height fields
         items.append((done.spec, placed.robot.name, pose_of(placed.pose)))
         notes += _notes(done.report, f"model '{placed.robot.name}': ")
     if items:

@@ -1,0 +1,53 @@
+"""Name clashes between a model's links, joints, frames and nested models, as sdformat settles
+them: before SDFormat 1.7 names had to be unique per element type only, so sdformat renames the
+later of two clashing elements (`arm` → `arm_joint`) and warns; from 1.7 a clash is an error
+(`poses.PoseGraph` refuses it)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from converters.sdf.document import SdfContext
+
+# Elements whose names share the model's frame namespace; the suffix sdformat adds to each.
+SUFFIXES = {"link": "_link", "joint": "_joint", "frame": "_frame"}
+
+
+def rename_clashes(ctx: SdfContext, model: Any) -> None:
+    """Rename, in `model` and its nested models of 1.4-1.6 files, each link, joint or frame
+    whose name an earlier element of another type already took, as sdformat does."""
+    if ctx.before_frames(model):
+        taken: set[str] = set()
+        for child in [c for c in model if isinstance(c.tag, str)]:
+            name = child.get("name")
+            if not name or child.tag not in (*SUFFIXES, "model"):
+                continue
+            if name in taken and child.tag in SUFFIXES and not _same_type_before(model, child):
+                child.set("name", _free(name, SUFFIXES[child.tag], taken))
+                ctx.report.mapped(
+                    f"{child.tag} '{name}'",
+                    f"renamed '{child.get('name')}': another element of the model has its name "
+                    f"(allowed before SDFormat 1.7, renamed by sdformat)",
+                )
+            taken.add(child.get("name"))
+    for nested in model.findall("model"):
+        rename_clashes(ctx, nested)
+
+
+def _same_type_before(model: Any, child: Any) -> bool:
+    """A same-type element of that name came first: a real duplicate, which stays an error."""
+    for other in model.findall(child.tag):
+        if other is child:
+            return False
+        if other.get("name") == child.get("name"):
+            return True
+    return False
+
+
+def _free(name: str, suffix: str, taken: set[str]) -> str:
+    """sdformat's choice: NAME_SUFFIX, else NAME_SUFFIX0, NAME_SUFFIX1, …"""
+    candidate, index = name + suffix, 0
+    while candidate in taken:
+        candidate = f"{name}{suffix}{index}"
+        index += 1
+    return candidate
