@@ -36,6 +36,7 @@ from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.scene import build_world_spec
 from twin_cli.world.snapshot import WorldSnapshot
+from twin_cli.world.spawn import LoadedSource
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import (
     EntityInfo,
@@ -128,7 +129,9 @@ class World:
         """Adds one entity per pose, one conversion and one compile (`spawning.spawn_batch`)."""
         return spawning.spawn_batch(self._state, request, poses=poses, names=names, base=base)
 
-    def spawn_specs(self, items: Sequence[tuple[mujoco.MjSpec, str, Pose]]) -> list[SpawnResult]:
+    def spawn_specs(
+        self, items: Sequence[tuple[mujoco.MjSpec | LoadedSource, str, Pose]]
+    ) -> list[SpawnResult]:
         """Adds a world file's models in one compile (`spawning.spawn_specs`)."""
         return spawning.spawn_specs(self._state, items)
 

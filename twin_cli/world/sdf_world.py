@@ -19,7 +19,9 @@ from twin_cli.world.pose import Pose
 from twin_cli.world.values import WorldSettings
 
 if TYPE_CHECKING:
+    from converters.pipeline import Conversion
     from converters.report import Report
+    from twin_cli.world.spawn import LoadedSource
 
 # Suffixes of Gazebo world files (`twin serve`, `twin load`).
 WORLD_SUFFIXES = (".sdf", ".world")
@@ -75,12 +77,29 @@ def world_from_sdf(
         options = ConvertOptions(repair_inertia=True)
         done = build_description(placed.robot, options)
         add_height_fields(done.spec, placed.robot, done.report)  # terrain: static height fields
-        items.append((done.spec, placed.robot.name, pose_of(placed.pose)))
+        items.append((_converted(path, done), placed.robot.name, pose_of(placed.pose)))
         notes += _notes(done.report, f"model '{placed.robot.name}': ")
     if items:
         world.spawn_specs(items)  # one compile for all of them
     world.file_notes = tuple(notes)
     return world
+
+
+def _converted(path: str | Path, done: Conversion) -> LoadedSource:
+    """A world model as a converted source: its file and model name as the entity's source
+    (`twin list`, saves), with its sensors and drive plugins."""
+    from twin_cli.world.spawn import LoadedSource, xml_or_none
+
+    name = done.description.name
+    return LoadedSource(
+        done.spec,
+        f"{Path(path).resolve()}#{name}",
+        done.report.to_dict(),
+        xml_or_none(done.spec),
+        name,
+        sensors=done.sensors,
+        plugins=done.plugins,
+    )
 
 
 def _notes(report: Report, prefix: str) -> list[str]:

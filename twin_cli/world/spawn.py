@@ -78,7 +78,7 @@ def load_source(request: SpawnRequest) -> LoadedSource:
         return _load_text(request)
     if isinstance(request.source, mujoco.MjSpec):
         spec = request.source.copy()
-        return LoadedSource(spec, "<MjSpec>", None, _xml_or_none(spec), spec.modelname or "model")
+        return LoadedSource(spec, "<MjSpec>", None, xml_or_none(spec), spec.modelname or "model")
     if request.source is None:
         raise SpawnError("model", "<none>", "no source", "give a file or the description text")
     path = Path(request.source).expanduser().resolve()
@@ -151,7 +151,7 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
         done.spec,
         label,
         done.report.to_dict(),
-        _xml_or_none(done.spec),
+        xml_or_none(done.spec),
         name,
         _urdf_or_none(done.description.text),
         done.sensors,
@@ -231,7 +231,7 @@ def _urdf_or_none(text: str) -> str | None:
     return text if text and format_of(text) == "urdf" else None
 
 
-def _xml_or_none(spec: mujoco.MjSpec) -> str | None:
+def xml_or_none(spec: mujoco.MjSpec) -> str | None:
     try:
         return spec.to_xml()
     except (ValueError, RuntimeError):

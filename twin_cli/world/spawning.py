@@ -158,16 +158,23 @@ def spawn_batch(
 
 
 def spawn_specs(
-    state: WorldState, items: Sequence[tuple[mujoco.MjSpec, str, Pose]]
+    state: WorldState, items: Sequence[tuple[mujoco.MjSpec | spawn.LoadedSource, str, Pose]]
 ) -> list[SpawnResult]:
-    """Adds one entity per (MjSpec, name, pose) in one compile of the world: a world file's
-    models. One spawn each would compile the world once per model, a cost that grows with
+    """Adds one entity per (model, name, pose) in one compile of the world: a world file's
+    models, each an MjSpec or an already converted source (which keeps its file, sensors and
+    plugins). One spawn each would compile the world once per model, a cost that grows with
     the square of their number (800 boxes: 77 s). All or nothing, as `spawn_batch`."""
     names = [spawn.check_entity_name(name) for _, name, _ in items]
     poses = [pose for _, _, pose in items]
-    requests = [SpawnRequest(source=spec) for spec, _, _ in items]
-    loaded = [spawn.load_source(request) for request in requests]
+    loaded = [_loaded(model) for model, _, _ in items]
+    requests = [SpawnRequest(source=one.spec) for one in loaded]
     return _spawn_loaded(state, loaded, requests, names, poses)
+
+
+def _loaded(model: mujoco.MjSpec | spawn.LoadedSource) -> spawn.LoadedSource:
+    if isinstance(model, spawn.LoadedSource):
+        return replace(model, spec=model.spec.copy())
+    return spawn.load_source(SpawnRequest(source=model))
 
 
 def free_name(state: WorldState, base: str) -> str:

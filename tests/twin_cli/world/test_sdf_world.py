@@ -35,6 +35,8 @@ def test_world_file_sets_physics_gravity_and_entities(world_file: Path) -> None:
     assert list(lights) == ["sun"], "the file's lights (the included sun) replace the default"
     assert model.light_type[lights["sun"]] == mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
     assert [e.name for e in world.entities()] == ["ground_plane", "crate", "table"]
+    sources = {e.name: e.source for e in world.entities()}
+    assert sources["crate"] == f"{world_file.resolve()}#crate", "the file and model, not <MjSpec>"
     assert world.get_pose("crate") == Pose(1.0, 0.0, 2.0), "model pose as in the file"
     table = world.get_pose("table")
     assert (table.x, table.y, table.z, table.yaw) == pytest.approx((-1.0, 0.5, 0.0, 0.5), abs=1e-12)
