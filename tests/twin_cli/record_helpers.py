@@ -78,3 +78,59 @@ def pose_error(composed: tuple[np.ndarray, np.ndarray], pose: Pose) -> tuple[flo
     ref_q = np.array(pose.quat())
     dq = min(np.abs(q - ref_q).max(), np.abs(q + ref_q).max())
     return float(np.abs(p - np.array(pose.position())).max()), float(dq)
+
+
+def tf_edges(bag: dict) -> dict[str, tuple[str, bool]]:
+    """child frame → (parent frame, whether on /tf_static), from the recording's first /tf and
+    /tf_static messages (one layout); a frame with two parents fails here."""
+    edges: dict[str, tuple[str, bool]] = {}
+    for topic, static in (("/tf", False), ("/tf_static", True)):
+        for t in bag[topic][0][1].transforms if topic in bag else ():
+            assert t.child_frame_id not in edges, f"{t.child_frame_id} has two parents"
+            edges[t.child_frame_id] = (t.header.frame_id, static)
+    return edges
+
+
+def tree_frames(edges: dict[str, tuple[str, bool]]) -> set[str]:
+    """Every frame of a tf tree, after checking that each one reaches `world`."""
+    for frame in edges:
+        seen = {frame}
+        while frame != "world":
+            assert frame in edges, f"{frame} does not reach world"
+            frame = edges[frame][0]
+            assert frame not in seen, f"a cycle through {frame}"
+            seen.add(frame)
+    return {*edges, "world"}
+
+
+def urdf_joints(text: str) -> list[dict[str, object]]:
+    """A URDF's joints read with ElementTree: name, type, parent, child, origin xyz and rpy,
+    mimic (joint, multiplier, offset) or None."""
+    import xml.etree.ElementTree as ET
+
+    out = []
+    for joint in ET.fromstring(text).findall("joint"):
+        origin, mimic = joint.find("origin"), joint.find("mimic")
+
+        def values(key: str, origin: object = origin) -> list[float]:
+            text = origin.get(key) if origin is not None else None
+            return [float(v) for v in (text or "0 0 0").split()]
+
+        out.append(
+            {
+                "name": joint.get("name"),
+                "type": joint.get("type"),
+                "parent": joint.find("parent").get("link"),
+                "child": joint.find("child").get("link"),
+                "xyz": values("xyz"),
+                "rpy": values("rpy"),
+                "mimic": None
+                if mimic is None
+                else (
+                    mimic.get("joint"),
+                    float(mimic.get("multiplier", "1")),
+                    float(mimic.get("offset", "0")),
+                ),
+            }
+        )
+    return out

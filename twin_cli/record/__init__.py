@@ -2,7 +2,8 @@
 
 A consumer of the world: it observes the stepping loop at its own rate through
 `World.add_observer`, copies what it needs under the world's lock and encodes outside it. The
-world never imports this package. Modules: `layout` (frames and joints per entity), `sampler`
+world never imports this package. Modules: `frames` (frame names, the URDF's tree, sensors'
+frames), `tf_tree` (each entity's tf edges), `layout` (frames and joints per entity), `sampler`
 (the copy, the kinematics), `topics` (the ROS topics and messages), `messages` (types and CDR,
 rosbags), `mcap_writer` (rosbag2 MCAP files), `foxglove` (the live server), `recorder` (the
 worker thread that ties them, for live sinks), `ring`, `encoder`, `bag_recording` (a bag

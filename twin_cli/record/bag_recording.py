@@ -53,6 +53,7 @@ class BagRecording(Follows):
         duration: float | None = None,
         overwrite: bool = False,
         ring_bytes: int = RING_BYTES,
+        frame_prefix: str | None = None,
     ) -> None:
         """Args: as `Recording`, with the output file instead of sinks; `ring_bytes` [B] is the
         shared buffer between the loop and the encoder (when full, the loop waits for it).
@@ -64,8 +65,9 @@ class BagRecording(Follows):
         self.rate = check_rate(rate)
         if duration is not None and not (math.isfinite(duration) and duration > 0):
             raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
-        self._sampler = Sampler(world, entities, descriptions)  # checks the names
+        self._sampler = Sampler(world, entities, descriptions, frame_prefix)  # checks the names
         self._entities, self._descriptions = tuple(entities), descriptions
+        self._frame_prefix = self._sampler.frame_prefix
         open_output(path, overwrite=overwrite).close()  # the errors, here and now
         self.path = Path(path).expanduser()
         self._world, self._duration = world, duration
@@ -76,7 +78,7 @@ class BagRecording(Follows):
         self._process: subprocess.Popen | None = None
         self._writer = ring.RingWriter(data, self._header, self._alive)
         self._model: mujoco.MjModel | None = None
-        self._feed = SensorFeed(world, entities)
+        self._feed = SensorFeed(world, entities, self._frame_prefix, descriptions)
         self._pump = SensorPump(self._send_readings, "record-sensors")
         self._send_lock = threading.Lock()  # the stepping and sensor threads share the pipe
         self._epoch = -1
@@ -187,10 +189,10 @@ class BagRecording(Follows):
 
     def _send_layout(self) -> None:
         view = world_view(self._world)
-        index, descriptions = self._sampler.selection(view)
+        index, sources = self._sampler.selection(view)
         self._epoch += 1
         start = self._writer.start_layout(view.model)  # sent before the layout's first record
-        self._send(("layout", self._epoch, view.model, index, descriptions, start))
+        self._send(("layout", self._epoch, view.model, index, sources, start))
         self._model = view.model
 
     def _finish_sampling(self) -> None:

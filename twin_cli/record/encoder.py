@@ -4,10 +4,10 @@ Runs in its own interpreter (a fresh `python -m`, so the server's threads are no
 no script is re-imported), so computing link poses (`mj_kinematics` on its own MjData),
 building messages, CDR-encoding them (rosbags) and writing chunks (foxglove-sdk's MCAP writer)
 never hold the stepping loop's GIL. The parent sends each layout (compiled model, entity index,
-URDF texts; MjModel pickles) over a pipe before the first record of that layout, with an epoch
-and the ring position where its records start; then "stop" with its figures (time the writer
-waited for room), after which the ring is drained and the file closed. A parent that dies
-closes the pipe: the file is finished with what the ring holds.
+what its frames are named from; MjModel pickles) over a pipe before the first record of that
+layout, with an epoch and the ring position where its records start; then "stop" with its
+figures (time the writer waited for room), after which the ring is drained and the file closed.
+A parent that dies closes the pipe: the file is finished with what the ring holds.
 """
 
 from __future__ import annotations
@@ -107,8 +107,8 @@ class _Encoder:
         from twin_cli.record.layout import make_layout
 
         if message[0] == "layout":
-            _, epoch, model, index, descriptions, start = message
-            self._layouts[epoch] = make_layout(model, index, descriptions)
+            _, epoch, model, index, sources, start = message
+            self._layouts[epoch] = make_layout(model, index, sources)
             self.reader.add_layout(start, epoch, model)
         elif message[0] == "readings":
             from twin_cli.record.sensor_messages import sensor_message

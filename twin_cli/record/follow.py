@@ -22,6 +22,7 @@ class Follows:
     sensor observers both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
 
     _sensor_handles: tuple[int, ...] | list[int] = ()  # sensor observers of `_sensor_world`
+    _frame_prefix: str = "{entity}/"  # the recording's (`frames.prefix_template`)
 
     def retarget(self, world: World) -> None:
         """Samples `world` instead of the current one, starting with a sample now.
@@ -29,7 +30,7 @@ class Follows:
         Raises:
             EntityNotFoundError: a recorded entity is not in `world` (the recording is unchanged).
         """
-        sampler = Sampler(world, self._entities, self._descriptions)
+        sampler = Sampler(world, self._entities, self._descriptions, self._frame_prefix)
         old = self._world
         if self._handle is not None:
             old.remove_observer(self._handle)
@@ -38,7 +39,7 @@ class Follows:
             old_time = float(old.data.time)
         self._stop_sensors()
         self._world, self._sampler, self._model = world, sampler, None
-        self._feed = SensorFeed(world, self._entities)
+        self._feed = SensorFeed(world, self._entities, self._frame_prefix, self._descriptions)
         if self._done.is_set():
             return
         with world.lock:

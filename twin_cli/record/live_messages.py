@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from twin_cli.record import messages as ros
-from twin_cli.record.layout import WORLD_FRAME, EntityLayout, Layout
+from twin_cli.record.layout import EntityLayout, Layout, MovingEdges
 from twin_cli.record.sampler import Samples
 from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
 
@@ -29,6 +29,7 @@ _CONJ_LEFT_SIGN = np.array(
 )
 
 _ORIGIN, _IDENTITY = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)  # a transform before the first fill
+_IDENTITY_QUAT = np.array(_IDENTITY)
 
 
 def relative_poses(
@@ -48,6 +49,51 @@ def relative_poses(
     return pos, quat
 
 
+def frame_poses(
+    pos: np.ndarray, quat: np.ndarray, edges: MovingEdges
+) -> tuple[np.ndarray, np.ndarray]:
+    """Child frames in parent frames from child bodies in parent bodies (…×m×3, …×m×4): each
+    frame's constant pose in its body on either side, O_parent⁻¹ · pose · O_child, applied only
+    to the edges whose frames are not their bodies' (lumped links, the odometry frame)."""
+    child = np.flatnonzero(_not_identity(edges.child_pos, edges.child_quat))
+    if len(child):
+        q = quat[..., child, :]
+        pos[..., child, :] += _rotate(q, edges.child_pos[child])
+        quat[..., child, :] = _multiply(q, edges.child_quat[child])
+    parent = np.flatnonzero(_not_identity(edges.parent_pos, edges.parent_quat))
+    if len(parent):
+        conj = edges.parent_quat[parent] * np.array([1.0, -1.0, -1.0, -1.0])
+        pos[..., parent, :] = _rotate(conj, pos[..., parent, :] - edges.parent_pos[parent])
+        quat[..., parent, :] = _multiply(conj, quat[..., parent, :])
+    return pos, quat
+
+
+def _not_identity(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    return np.any(pos != 0.0, axis=-1) | np.any(quat != _IDENTITY_QUAT, axis=-1)
+
+
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products of quaternions w, x, y, z (broadcast over leading axes)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Vectors v rotated by unit quaternions q: v + 2w (u × v) + 2 u × (u × v)."""
+    w, u = q[..., :1], q[..., 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
 class LiveMessages:
     """The reusable live messages of one layout; `messages` refills them sample by sample."""
 
@@ -57,18 +103,16 @@ class LiveMessages:
         self._stamp = T["builtin_interfaces/msg/Time"](sec=0, nanosec=0)
         self._clock = T[ros.CLOCK](clock=self._stamp)
         self._clock_cdr = ros.Reencoder(self._clock, ros.CLOCK)
-        entities = layout.entities
-        self._bodies = np.concatenate([e.moving for e in entities] or [np.zeros(0, int)])
-        self._parents = np.concatenate([e.moving_parents for e in entities] or [np.zeros(0, int)])
-        frames = layout.body_frames
+        edges = layout.moving
         transforms = [
-            transform_stamped(self._stamp, frames[p], frames[b], _ORIGIN, _IDENTITY)
-            for b, p in zip(self._bodies.tolist(), self._parents.tolist(), strict=True)
+            transform_stamped(self._stamp, parent, child, _ORIGIN, _IDENTITY)
+            for parent, child in zip(edges.parents, edges.children, strict=True)
         ]
         self._translations = [t.transform.translation for t in transforms]
         self._rotations = [t.transform.rotation for t in transforms]
         self._tf = T[ros.TF](transforms=transforms)
         self._tf_cdr = ros.Reencoder(self._tf, ros.TF)
+        entities = layout.entities
         self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities]
         self._odometry = [
             _Odometry(T, layout, e, self._stamp) for e in entities if e.free_qpos >= 0
@@ -79,7 +123,9 @@ class LiveMessages:
     ) -> Iterator[tuple[Message, ...]]:
         """Each sample's messages in turn, from its body poses (n×nbody×3, ×4, ×9): the same
         objects refilled, so write one sample's messages before taking the next."""
-        pos, quat = relative_poses(xpos, xquat, xmat, self._bodies, self._parents)
+        edges = self.layout.moving
+        pos, quat = relative_poses(xpos, xquat, xmat, edges.child_bodies, edges.parent_bodies)
+        pos, quat = frame_poses(pos, quat, edges)
         return zip(
             self._clocks(samples),  # first: it sets the stamp that every header shares
             self._transforms(samples, pos, quat),
@@ -142,7 +188,8 @@ class _JointStates:
 
 
 class _Odometry:
-    """`/<entity>/odom` of a floating base: its pose in the world and its twist in its own frame
+    """`/<entity>/odom` of a floating base: its root's pose in the odometry frame (the world,
+    or a diff drive's odometry frame, fixed at the world) and its twist in the root's frame
     (MuJoCo's free-joint linear velocity is global and its angular velocity local)."""
 
     def __init__(self, T: Any, layout: Layout, e: EntityLayout, stamp: Any) -> None:
@@ -159,7 +206,7 @@ class _Odometry:
         )
         self._pose, self._twist = pose, twist
         self._message = T[ros.ODOMETRY](
-            header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=WORLD_FRAME),
+            header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=e.odom_frame),
             child_frame_id=e.root_frame,
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros),
             twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros),

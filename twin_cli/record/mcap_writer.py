@@ -6,7 +6,9 @@ back with that library, an independent reader). The layout is the one rosbag2's 
 plugin writes: profile `ros2`, one `ros2msg` schema per message type (rosbags' definitions),
 `cdr` channels carrying rosbag2's `offered_qos_profiles` (transient local for latched topics, so
 `ros2 bag play` re-offers `/tf_static` and `robot_description` to late subscribers) and
-`topic_type_hash`, and a closing `rosbag2` metadata record (the bag's metadata.yaml). Messages
+`topic_type_hash`, and a closing `rosbag2` metadata record (the bag's metadata.yaml, version 9,
+read by Jazzy and later only). The QoS on the channels are numbers (Humble's form, which Jazzy
+also reads), those in the metadata record names (Jazzy's form for version 9). Messages
 are in zstd chunks with CRCs; a chunk is closed at least every `FLUSH_PERIOD_S` of wall time and
 handed to the OS, so a server killed with SIGKILL leaves a file readable up to its last chunk.
 """
@@ -30,24 +32,43 @@ CHUNK_SIZE = 1 << 20  # [B] a chunk closes when its content exceeds this
 FLUSH_PERIOD_S = 1.0  # [s] wall time: at most this much data is lost to a SIGKILL
 BAG_VERSION = 9  # rosbag2 metadata version of Jazzy (QoS written as names, not numbers)
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}  # rmw's "infinite" duration
+# QoS policies as rmw's enum values (what rosbag2 before Jazzy reads and writes) and names
+# (Jazzy's metadata version 9): keep_last, reliable, transient_local / volatile, automatic.
+_NUMBERS = {"keep_last": 1, "reliable": 1, "transient_local": 1, "volatile": 2, "automatic": 1}
 
 
-def qos_profiles(latched: bool) -> list[dict[str, Any]]:
-    """The offered QoS of a topic as rosbag2 v9 stores it (tf2's static broadcaster's for
-    latched topics: reliable, transient local, depth 1)."""
+def qos_profiles(latched: bool, *, numbers: bool = False) -> list[dict[str, Any]]:
+    """The offered QoS of a topic as rosbag2 stores it (tf2's static broadcaster's for latched
+    topics: reliable, transient local, depth 1): policies by name (metadata version 9), or by
+    number (`numbers`: the form every rosbag2 reads, see `channel_qos`)."""
+    names = {
+        "history": "keep_last",
+        "reliability": "reliable",
+        "durability": "transient_local" if latched else "volatile",
+        "liveliness": "automatic",
+    }
+    policies = {k: _NUMBERS[v] for k, v in names.items()} if numbers else names
     return [
         {
-            "history": "keep_last",
+            "history": policies["history"],
             "depth": 1 if latched else 10,
-            "reliability": "reliable",
-            "durability": "transient_local" if latched else "volatile",
+            "reliability": policies["reliability"],
+            "durability": policies["durability"],
             "deadline": _INFINITE,
             "lifespan": _INFINITE,
-            "liveliness": "automatic",
+            "liveliness": policies["liveliness"],
             "liveliness_lease_duration": _INFINITE,
             "avoid_ros_namespace_conventions": False,
         }
     ]
+
+
+def channel_qos(latched: bool) -> str:
+    """A channel's `offered_qos_profiles`: YAML with the policies as numbers. Humble's MCAP
+    storage reads only this (not the `rosbag2` metadata record) and its player converts each
+    policy with `as<int>`, so names would stop `ros2 bag play`; Jazzy reads it with the bag's
+    version but first tries numbers (a history that parses as an integer means numbers)."""
+    return yaml.safe_dump(qos_profiles(latched, numbers=True), sort_keys=False)
 
 
 def open_output(path: str | os.PathLike, *, overwrite: bool = False) -> Any:
@@ -108,7 +129,7 @@ class BagWriter:
         from twin_cli.record.foxglove import ros2_channel
 
         metadata = {
-            "offered_qos_profiles": yaml.safe_dump(qos_profiles(topic.latched), sort_keys=False),
+            "offered_qos_profiles": channel_qos(topic.latched),
             "topic_type_hash": ros.definition(topic.type).rihs01,
         }
         self._channels[topic.name] = ros2_channel(topic, self._context, metadata)

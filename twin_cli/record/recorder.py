@@ -91,6 +91,7 @@ class Recording(Follows):
         descriptions: dict[str, str] | None = None,
         duration: float | None = None,
         latest_only: bool = False,
+        frame_prefix: str | None = None,
     ) -> None:
         """Args:
         world: a `twin_cli.world.World` (stepping or not).
@@ -101,6 +102,8 @@ class Recording(Follows):
         duration: stop after this much sim time [s] (None: until `stop`).
         latest_only: while the worker is busy, keep only the newest sample (live views: never
             slows the loop, never falls behind, always ends on the latest state).
+        frame_prefix: tf frame prefix template (`{entity}` is the entity's name; None:
+            `TWIN_FRAME_PREFIX`, else `{entity}/`; "": none).
 
         Raises:
             EntityNotFoundError, InvalidRequestError: unknown entity, bad rate or duration.
@@ -109,8 +112,9 @@ class Recording(Follows):
         if duration is not None and not (math.isfinite(duration) and duration > 0):
             raise InvalidRequestError("duration", f"{duration} s", "give a positive duration")
         self._world = world
-        self._sampler = Sampler(world, entities, descriptions)
+        self._sampler = Sampler(world, entities, descriptions, frame_prefix)
         self._entities, self._descriptions = tuple(entities), descriptions
+        self._frame_prefix = self._sampler.frame_prefix
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
@@ -123,7 +127,7 @@ class Recording(Follows):
         self._samples, self._span = 0, [None, None]
         self._error: str | None = None
         self._worker = threading.Thread(target=self._work, name="twin-record", daemon=True)
-        self._feed = SensorFeed(world, entities)
+        self._feed = SensorFeed(world, entities, self._frame_prefix, descriptions)
         self._pump = SensorPump(self._queue.put, "record-sensors")  # readings to the worker
         self._sensor_topics: dict[str, Topic] = {}  # worker thread: sensor topics seen so far
         self._layout_topics: list[Topic] = []
@@ -313,6 +317,7 @@ class Publisher:
         samples = samples.finite()
         if not len(samples):
             return samples
+        exact = samples.with_exact_mimics()
         layout = samples.layout
         if new_layout:
             sink.set_topics(topics(layout) + list(extra_topics))
@@ -320,7 +325,7 @@ class Publisher:
                 sink.write(message)
         if self._live is None or self._live.layout is not layout:
             self._live = LiveMessages(layout)
-        for messages in self._live.messages(samples, *self._kinematics.poses(samples)):
+        for messages in self._live.messages(exact, *self._kinematics.poses(exact)):
             for message in messages:
                 sink.write(message)
         return samples

@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import EntityNotFoundError
+from twin_cli.record.frames import Sources, prefix_template, sources_of
 from twin_cli.record.layout import Layout, make_layout
 from twin_cli.world.observers import WorldView, world_view
 
@@ -49,12 +50,14 @@ class Sampler:
         world: World,
         entities: Sequence[str] = (),
         descriptions: dict[str, str] | None = None,
+        frame_prefix: str | None = None,
     ) -> None:
         """Args:
         world: a `twin_cli.world.World`.
         entities: entity names to observe; empty: all, including ones spawned later.
         descriptions: URDF text by entity name, overriding what the world kept (validation
             spawns an MjSpec and knows the URDF).
+        frame_prefix: the tf frame prefix template (`frames.prefix_template`).
 
         Raises:
             EntityNotFoundError: a name the world does not have.
@@ -62,6 +65,7 @@ class Sampler:
         self._world = world
         self._names = tuple(entities)
         self._descriptions = dict(descriptions or {})
+        self.frame_prefix = prefix_template(frame_prefix)
         self._model: mujoco.MjModel | None = None
         self._layout: Layout | None = None
         with world.lock:
@@ -87,11 +91,16 @@ class Sampler:
             d.mocap_quat.copy(),
         )
 
-    def selection(self, view: WorldView) -> tuple[dict, dict]:
-        """The observed entities' index (name → EntityIndex) and URDF texts in `view`."""
+    def selection(self, view: WorldView) -> tuple[dict, dict[str, Sources]]:
+        """The observed entities' index (name → EntityIndex) and what their frames are named
+        from (name → `frames.Sources`) in `view`; call with the world's lock held."""
         names = self._names or tuple(view.index)
         index = {n: view.index[n] for n in names if n in view.index}
-        return index, {**view.descriptions, **self._descriptions}
+        sources = {
+            n: sources_of(self._world, n, self.frame_prefix, self._descriptions.get(n))
+            for n in index
+        }
+        return index, sources
 
     def _relayout(self) -> None:
         view = world_view(self._world)
@@ -127,6 +136,25 @@ class Samples:
 
     def __len__(self) -> int:
         return len(self.times)
+
+    def with_exact_mimics(self) -> Samples:
+        """The samples with each mimic follower's position and speed set from its leader's
+        (copies; the samples themselves may be views into the encoder's ring)."""
+        m = self.layout.mimics
+        if not len(m.offset):
+            return self
+        qpos, qvel = self.qpos.copy(), self.qvel.copy()
+        for _ in range(len(m.offset)):  # a leader that follows another is set first
+            qpos[:, m.follower_qpos] = (
+                m.follower_ref + m.offset + m.multiplier * (qpos[:, m.leader_qpos] - m.leader_ref)
+            )
+            qvel[:, m.follower_dof] = m.multiplier * qvel[:, m.leader_dof]
+            if not np.isin(m.leader_qpos, m.follower_qpos).any():
+                break
+        return Samples(
+            self.layout, self.times, qpos, qvel, self.qfrc_actuator, self.mocap_pos,
+            self.mocap_quat,
+        )  # fmt: skip
 
     def finite(self) -> Samples:
         """The samples without the diverged ones (an entity being reset by the world)."""

@@ -11,17 +11,22 @@ thread calls `build`, which casts the lidar rays, renders the cameras and draws 
 off the stepping thread, which they would slow. A sensor that cannot be read in this process (a
 camera without offscreen GL) is left out of the recording from then on, with one warning naming
 it and the fix; the other sensors go on. Suites are rebuilt when the world's model changes.
+Each built reading names the tf frame the recording publishes for it (`frames.sensor_frame`;
+contacts: `world`, whose coordinates they are in).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+from twin_cli.record.frames import WORLD_FRAME, prefix_template, sources_of
 from twin_cli.record.sensor_messages import sensor_topic
+from twin_cli.record.tf_tree import entity_tree, model_names
 from twin_cli.record.topics import Topic
-from twin_cli.sensors import HISTORY_SAMPLES, Reading, SensorSuite
+from twin_cli.sensors import HISTORY_SAMPLES, ContactReading, Reading, SensorSuite
 from twin_cli.world.observers import world_view
 
 if TYPE_CHECKING:
@@ -40,8 +45,19 @@ Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pendin
 class SensorFeed:
     """New sensor readings of some (or all) entities of a world, as (topic, reading) pairs."""
 
-    def __init__(self, world: World, entities: Sequence[str] = ()) -> None:
+    def __init__(
+        self,
+        world: World,
+        entities: Sequence[str] = (),
+        frame_prefix: str | None = None,
+        descriptions: dict[str, str] | None = None,
+    ) -> None:
+        """Args: the world, the entities (empty: all), the tf frame prefix template and URDF
+        texts overriding the world's (as `Sampler`): the readings' frames are tf's."""
         self._world, self._names = world, tuple(entities)
+        self._template = prefix_template(frame_prefix)
+        self._descriptions = dict(descriptions or {})
+        self._frames: dict[str, dict[str, str]] = {}  # entity → sensor → its messages' frame
         self._model: mujoco.MjModel | None = None
         self._suites: dict[str, SensorSuite] = {}
         self._wanted: dict[str, list[str]] = {}  # entity → its sensors still recorded
@@ -98,10 +114,18 @@ class SensorFeed:
                 name = reading.sensor
                 topic = sensor_topic(suite.entity, name, suite.specs[name].topic, reading)
                 if topic is not None:
-                    out.append((topic, reading))
+                    out.append((topic, self._framed(suite.entity, reading)))
             for name, error in errors.items():
                 self._drop(suite.entity, name, error)
         return out
+
+    def _framed(self, entity: str, reading: Reading) -> Reading:
+        """The reading with the tf frame its data is in: contacts are in world coordinates."""
+        if isinstance(reading, ContactReading):
+            frame = WORLD_FRAME
+        else:
+            frame = self._frames.get(entity, {}).get(reading.sensor, reading.frame_id)
+        return dataclasses.replace(reading, frame_id=frame)
 
     def _since(self, entity: str, name: str, now: float) -> float:
         """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
@@ -129,8 +153,21 @@ class SensorFeed:
             for n, suite in self._suites.items()
         }
         self._kept = {n: set(suite.with_history()) for n, suite in self._suites.items()}
+        self._frames = self._sensor_frames(view)
         self._model = view.model
         self._group()
+
+    def _sensor_frames(self, view: Any) -> dict[str, dict[str, str]]:
+        """Each recorded sensor's frame, as the recording's tf tree names it."""
+        names = model_names(view.model)
+        out = {}
+        for entity in self._suites:
+            sources = sources_of(
+                self._world, entity, self._template, self._descriptions.get(entity)
+            )
+            tree = entity_tree(view.model, names, entity, view.index[entity], sources)
+            out[entity] = tree.sensor_frames
+        return out
 
     def _group(self) -> None:
         """Sensors by the observer that captures them: their own rate's, else the fastest."""

@@ -37,8 +37,9 @@ class Consumers:
         rate: float = 100.0,
         entities: Sequence[str] = (),
         duration: float | None = None,
+        frame_prefix: str | None = None,
     ) -> dict:
-        """Starts recording `world` into `path`.
+        """Starts recording `world` into `path` (`frame_prefix`: see `frames.prefix_template`).
 
         Raises:
             InvalidRequestError: a recording is running. RequestError: unwritable path.
@@ -53,7 +54,10 @@ class Consumers:
                 )
             if self.recording is not None:
                 self.recording.stop()
-            recording = BagRecording(world, path, rate=rate, entities=entities, duration=duration)
+            recording = BagRecording(
+                world, path, rate=rate, entities=entities, duration=duration,
+                frame_prefix=frame_prefix,
+            )  # fmt: skip
             self.recording, self.recording_path = recording.start(), path
             return self.record_status()
 
@@ -76,9 +80,16 @@ class Consumers:
             return status
 
     def stream(
-        self, world: World, *, port: int, host: str = "127.0.0.1", rate: float = 30.0
+        self,
+        world: World,
+        *,
+        port: int,
+        host: str = "127.0.0.1",
+        rate: float = 30.0,
+        frame_prefix: str | None = None,
     ) -> dict:
-        """Starts the Foxglove server on `host:port` (latest sample only: never slows the loop)."""
+        """Starts the Foxglove server on `host:port` (latest sample only: never slows the loop;
+        `frame_prefix`: see `frames.prefix_template`)."""
         with self._lock:
             if self.live is not None:
                 raise InvalidRequestError(
@@ -88,7 +99,9 @@ class Consumers:
                 )
             live = LiveStream(port, host)
             try:
-                recording = Recording(world, [live], rate=rate, latest_only=True)
+                recording = Recording(
+                    world, [live], rate=rate, latest_only=True, frame_prefix=frame_prefix
+                )
             except BaseException:
                 live.close()
                 raise

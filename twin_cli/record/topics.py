@@ -1,15 +1,15 @@
 """The ROS topics of a world, as robot_state_publisher and gazebo_ros publish them, per entity.
 
 - `/clock` rosgraph_msgs/Clock: sim time (every node of a Gazebo system runs on it).
-- `/tf` tf2_msgs/TFMessage: world → each entity's root, and parent → child for every link that
-  moves (a body with a joint), from the same copied qpos as `World.link_poses`, so composing
-  them gives the world's link poses.
-- `/tf_static`: fixed links and lumped links' frames, latched (transient local), republished
-  whole whenever the set of entities changes (tf2's static broadcaster does the same).
+- `/tf` tf2_msgs/TFMessage: world (or a mobile base's odometry frame) → each entity's root, and
+  parent → child for every URDF joint that moves, from the same copied qpos as
+  `World.link_poses`, so composing them gives the world's link poses (`frames`: the tree).
+- `/tf_static`: fixed joints (lumped links too), latched (transient local), republished whole
+  whenever the set of entities changes (tf2's static broadcaster does the same).
 - `/<entity>/joint_states` sensor_msgs/JointState: position, velocity, actuator effort, as
   `World.joint_states`; `/<entity>/robot_description` std_msgs/String, the URDF after xacro,
-  latched; `/<entity>/odom` nav_msgs/Odometry for floating bases (pose in `world`, twist in the
-  root link's frame, as ROS defines it).
+  latched; `/<entity>/odom` nav_msgs/Odometry for floating bases (pose in `world` or the diff
+  drive's odometry frame, twist in the root link's frame, as ROS defines it).
 Every stamp is sim time. Messages are rosbags objects; `Message.cdr` encodes them. This
 module names the topics and builds the latched messages; `live_messages` refills the per-sample
 ones.
@@ -69,28 +69,17 @@ def topics(layout: Layout) -> list[Topic]:
 
 
 def latched_messages(layout: Layout, time: float) -> list[Message]:
-    """`/tf_static` (all entities in one message) and every `robot_description`."""
+    """`/tf_static` (all entities in one message; none while no entity has a fixed frame: an
+    empty one would be the last a late subscriber gets) and every `robot_description`."""
     T = ros.types()
-    model, stamp = layout.model, ros.stamp(time)
-    transforms = []
-    for e in layout.entities:
-        for b in e.fixed:
-            parent = layout.body_frames[int(model.body_parentid[b])]
-            transforms.append(
-                transform_stamped(
-                    stamp, parent, layout.body_frames[b], model.body_pos[b].tolist(),
-                    model.body_quat[b].tolist(),
-                )
-            )  # fmt: skip
-        for s in e.sites:
-            parent = layout.body_frames[int(model.site_bodyid[s])]
-            transforms.append(
-                transform_stamped(
-                    stamp, parent, layout.site_frames[s], model.site_pos[s].tolist(),
-                    model.site_quat[s].tolist(),
-                )
-            )  # fmt: skip
-    out = [Message(TF_STATIC.name, ros.TF, time, T[ros.TF](transforms=transforms))]
+    stamp = ros.stamp(time)
+    transforms = [
+        transform_stamped(stamp, parent, child, list(pos), list(quat))
+        for parent, child, (pos, quat) in layout.static
+    ]
+    out = []
+    if transforms:
+        out.append(Message(TF_STATIC.name, ros.TF, time, T[ros.TF](transforms=transforms)))
     for e in layout.entities:
         if e.description:
             text = T[ros.STRING](data=e.description)

@@ -147,8 +147,8 @@ def test_mcap_library_validates_chunks_summary_and_rosbag2_metadata(falling):
         latched = {
             c.topic
             for c in summary.channels.values()
-            if "transient_local" in c.metadata["offered_qos_profiles"]
-        }
+            if yaml.safe_load(c.metadata["offered_qos_profiles"])[0]["durability"] == 1
+        }  # rmw's RMW_QOS_POLICY_DURABILITY_TRANSIENT_LOCAL
         assert latched == {"/tf_static", "/h/robot_description"}
         decoded = [m for _, _, _, m in reader.iter_decoded_messages(topics=["/h/joint_states"])]
         count = sum(1 for _ in reader.iter_messages())

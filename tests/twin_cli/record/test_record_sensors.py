@@ -65,7 +65,7 @@ def test_sensor_topics_carry_the_worlds_readings_at_their_rates(tmp_path):
         assert (got.x, got.y, got.z) == tuple(want.linear_acceleration)
         q = m.orientation
         assert (q.x, q.y, q.z, q.w) == tuple(want.orientation)
-        assert m.header.frame_id == want.frame_id
+        assert m.header.frame_id == f"imu/{want.frame_id}", "the link's tf frame"
     ((scan, scan_topic),) = [(k, t) for k, t in topics.items() if k.startswith("lidar/")]
     scans = bag[scan_topic]
     assert len(scans) == 4, "10 Hz over 0.3 s: t = 0, 0.1, 0.2, 0.3"

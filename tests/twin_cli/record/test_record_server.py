@@ -406,3 +406,17 @@ def test_foxglove_clients_receive_camera_images_as_sensor_msgs_image(tmp_path, s
     red_pixels = red(rgb)
     assert red_pixels.sum() > 20, "the red box is in the picture"
     assert not red_pixels[:, W // 2 :].any(), "to the camera's left: nothing red in the right half"
+
+
+def test_serve_record_begins_its_tf_static_with_the_first_entitys_frames(tmp_path, serve_world):
+    """`twin serve --record` starts on an empty world: no empty `/tf_static` comes first (a
+    late subscriber to a latched topic gets only its last message, and an empty one hides the
+    fixed frames from tools that read the first)."""
+    out = tmp_path / "served.mcap"
+    with serve_world(tmp_path, "srec", "--record", str(out)) as (client, _):
+        client.spawn(str(HUMANOID), name="h", pose={"z": 1.0})
+        until, deadline = client.stats()["sim_time"] + 0.2, time.monotonic() + 30.0
+        while client.stats()["sim_time"] < until and time.monotonic() < deadline:
+            time.sleep(0.05)
+    bag = read_bag(out)
+    assert [len(m.transforms) for _, m in bag["/tf_static"]][:1] == [1], "h/imu_link first"
