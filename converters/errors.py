@@ -69,6 +69,19 @@ class PackageNotFoundError(ConversionError):
         self.uri = uri
 
 
+class ResourceNotAFileError(ConversionError):
+    """A mesh or included file resolves to something that is not a regular file (a device, a
+    directory): reading it would never end or fail."""
+
+    def __init__(self, uri: str, element: str, path: str) -> None:
+        super().__init__(
+            f"{uri!r} used by {element} resolves to {path}, which is not a regular file (a "
+            "device or a directory); point it at a mesh or model file"
+        )
+        self.uri = uri
+        self.path = path
+
+
 class ResourceNotFoundError(ConversionError):
     """A mesh or included file resolves to a path that does not exist."""
 

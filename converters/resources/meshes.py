@@ -57,11 +57,12 @@ def load_mesh(path: Path, link: str) -> MeshData:
         key = mesh_store.key_of(path)
     except OSError as exc:
         raise MeshError(str(path), link, f"cannot be read ({exc})") from exc
-    stored = mesh_store.load(key)
-    if stored is not None:
-        return stored
-    mesh = read_mesh_file(path, link)
-    mesh_store.store(key, mesh)
+    mesh = mesh_store.load(key)
+    if mesh is None:
+        mesh = read_mesh_file(path, link)
+        mesh_store.store(key, mesh)
+    if not np.all(np.isfinite(mesh.vertices)):
+        raise MeshError(str(path), link, "holds vertices that are not numbers (NaN or infinity)")
     return mesh
 
 
@@ -71,11 +72,8 @@ def read_mesh_file(path: Path, link: str) -> MeshData:
     Raises:
         MeshError: the file cannot be parsed or holds no triangles.
     """
-    if path.suffix.lower() == ".stl":
-        mesh = read_binary_stl(path, link)
-        if mesh is not None:
-            return mesh
-    return read_with_trimesh(path, link)
+    mesh = read_binary_stl(path, link) if path.suffix.lower() == ".stl" else None
+    return mesh if mesh is not None else read_with_trimesh(path, link)
 
 
 def read_binary_stl(path: Path, link: str) -> MeshData | None:

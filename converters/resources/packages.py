@@ -8,7 +8,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from converters.errors import ConversionError, PackageNotFoundError, ResourceNotFoundError
+from converters.errors import (
+    ConversionError,
+    PackageNotFoundError,
+    ResourceNotAFileError,
+    ResourceNotFoundError,
+)
 
 # Environment variables searched, in order, as ROS 1 / ROS 2 / Gazebo users set them.
 ROS_ENV = "ROS_PACKAGE_PATH"
@@ -125,6 +130,8 @@ class PackageResolver:
             ResourceNotFoundError: the resolved file does not exist.
         """
         path = self._locate(uri.strip(), base_dir, element)
+        if must_exist and path.exists() and not path.is_file():
+            raise ResourceNotAFileError(uri, element, str(path))
         if must_exist and not path.is_file():
             tried = [path, *self._resource_paths(uri.strip())]
             found = next((p for p in tried[1:] if p.is_file()), None)

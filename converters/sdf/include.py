@@ -36,6 +36,7 @@ def expand_includes(ctx: SdfContext, parent: Any) -> None:
     `merge="true"` splices the included model's parts into `parent` instead (`merge`)."""
     for include in parent.findall("include"):
         element = included_element(ctx, include)
+        _refuse_circle(ctx, include, parent, element)
         if ctx.flag_attribute(include, "merge"):
             expand_includes(ctx, element)  # its own includes first, as sdformat loads it whole
             merge_include(ctx, parent, include, element)
@@ -43,6 +44,18 @@ def expand_includes(ctx: SdfContext, parent: Any) -> None:
             parent.replace(include, element)
     for nested in parent.findall("model"):
         expand_includes(ctx, nested)
+
+
+def _refuse_circle(ctx: SdfContext, include: Any, parent: Any, element: Any) -> None:
+    """Refuse an include of a file that is already being included above it (a → b → a),
+    which would otherwise recurse until the interpreter gives up."""
+    source = element.get(INCLUDED_SOURCE)
+    chain = [a.get(INCLUDED_SOURCE) for a in (parent, *parent.iterancestors())]
+    chain = [ctx.source, *reversed([c for c in chain if c])]
+    if source in chain:
+        circle = " → ".join([*chain[chain.index(source) :], source])
+        raise ctx.error(include, f"includes a model that includes it ({circle})", "remove "
+                        "the <include> that closes the circle")  # fmt: skip
 
 
 def included_element(ctx: SdfContext, include: Any) -> Any:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -221,3 +222,51 @@ def test_inspect_json_reports_total_mass_and_tree(tmp_path: Path) -> None:
     )
     assert stats["total_mass_kg"] == pytest.approx(declared, rel=1e-12), "total mass [kg]"
     assert stats["tree"][0]["depth"] == 0 and len(stats["center_of_mass_m"]) == 3
+
+
+def _nan_stl(path: Path) -> None:
+    """A binary STL of four triangles, one vertex NaN."""
+    import struct
+
+    with path.open("wb") as handle:
+        handle.write(b"\0" * 80 + struct.pack("<I", 4))
+        for k in range(4):
+            handle.write(struct.pack("<3f", 0, 0, 1))
+            for vertex in ((float("nan"), 0, 0), (1, 0, 0), (0, 1, k)):
+                handle.write(struct.pack("<3f", *vertex))
+            handle.write(b"\0\0")
+
+
+@pytest.mark.parametrize("mesh", ["nan.stl", "/dev/zero"])
+def test_a_nan_mesh_or_a_device_as_a_mesh_exits_2_naming_it(tmp_path: Path, mesh: str) -> None:
+    _nan_stl(tmp_path / "nan.stl")
+    body = GOOD_LINK.format(n="base").replace(
+        "</link>", f'<collision><geometry><mesh filename="{mesh}"/></geometry></collision></link>'
+    )
+    result = twin("convert", str(_robot(tmp_path, f'<robot name="r">{body}</robot>')), "-o",
+                  str(tmp_path / "out"))  # fmt: skip
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    expected = "not numbers (NaN" if mesh == "nan.stl" else "not a regular file"
+    assert mesh in result.stderr and expected in result.stderr, result.stderr
+
+
+def test_an_sdf_include_circle_exits_2_naming_the_files(tmp_path: Path) -> None:
+    for name, other in (("a", "b"), ("b", "a")):
+        folder = tmp_path / "models" / name
+        folder.mkdir(parents=True)
+        (folder / "model.config").write_text(
+            f'<?xml version="1.0"?><model><name>{name}</name><sdf version="1.6">model.sdf</sdf>'
+            "</model>"
+        )
+        (folder / "model.sdf").write_text(
+            f'<sdf version="1.6"><model name="{name}"><include><uri>model://{other}</uri>'
+            f'</include><link name="l{name}"/></model></sdf>'
+        )
+    env = {**os.environ, "GAZEBO_MODEL_PATH": str(tmp_path / "models")}
+    result = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "convert", str(tmp_path / "models/a/model.sdf"), "-o",
+         str(tmp_path / "out")],
+        capture_output=True, text=True, timeout=120, env=env,
+    )  # fmt: skip
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert "includes it" in result.stderr and "model.sdf" in result.stderr, result.stderr
