@@ -168,6 +168,7 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
+    from converters.mjcf.heightfields import add_height_fields
     from converters.gazebo.plugins import add_drive_motors, read_plugins
     from converters.gazebo.sensor_sites import add_sensors
 
@@ -178,6 +179,7 @@ def build_description(
     check_joints(robot)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
+    add_height_fields(spec, robot, report, keep_fixed=options.keep_fixed)  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
     plugins = read_plugins(robot.gazebo.plugins, robot.source)

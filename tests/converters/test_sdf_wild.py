@@ -290,3 +290,28 @@ def test_a_visual_mesh_that_cannot_be_read_is_left_out_a_collision_one_refused(
     collision = f'<link name="l">{INERTIAL.format(m=1)}<collision name="c">{mesh}</collision>'
     with pytest.raises(MeshError, match="empty.stl"):
         convert(_file(tmp_path / "c.sdf", f'<model name="c">{collision}</link></model>'))
+
+
+def test_a_heightmap_model_converts_on_its_own_to_a_height_field(tmp_path: Path) -> None:
+    """`twin convert`/`twin spawn` of a terrain model, not only a served world: a 4 m × 4 m
+    heightmap is a MuJoCo height field of half-extents 2 m × 2 m, centred on its <pos>."""
+    import numpy as np
+    from PIL import Image
+
+    from converters.pipeline import convert_full
+
+    image = np.zeros((9, 9), np.uint8)
+    image[:, 5:] = 255
+    Image.fromarray(image).save(tmp_path / "terrain.png")
+    (tmp_path / "terrain.sdf").write_text(
+        '<sdf version="1.6"><model name="terrain"><static>true</static><link name="l">'
+        '<collision name="c"><geometry><heightmap><uri>terrain.png</uri><size>4 4 2</size>'
+        "<pos>1 0 0.25</pos></heightmap></geometry></collision></link></model></sdf>"
+    )
+    model = convert_full(tmp_path / "terrain.sdf").spec.compile()
+    assert model.nhfield == 1, "one height field"
+    assert model.hfield_size[0][:2] == pytest.approx([2.0, 2.0]), "half-extents [m]"
+    import mujoco
+
+    (geom,) = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD]
+    assert model.geom_pos[geom][:2] == pytest.approx([1.0, 0.0]), "centred on <pos> x, y [m]"
