@@ -18,6 +18,7 @@ from twin_cli.record.frames import (
     urdf_tree,
 )
 from twin_cli.world.entities import MODEL_SITE, EntityIndex, element_names
+from twin_cli.world.pose import quat_multiply, rotate
 
 
 @dataclass(frozen=True)
@@ -213,31 +214,13 @@ def _body_pose(xpos: np.ndarray, xquat: np.ndarray, body: int) -> Pose:
 
 def compose(a: Pose, b: Pose) -> Pose:
     """The pose b expressed in a's parent: a ∘ b."""
-    return _add(a[0], rotate(a[1], b[0])), multiply(a[1], b[1])
+    return _add(a[0], rotate(a[1], b[0])), quat_multiply(a[1], b[1])
 
 
 def invert(a: Pose) -> Pose:
     conj = (a[1][0], -a[1][1], -a[1][2], -a[1][3])
     x, y, z = rotate(conj, a[0])
     return (-x, -y, -z), conj
-
-
-def multiply(a: tuple, b: tuple) -> tuple[float, float, float, float]:
-    """Hamilton product of quaternions w, x, y, z."""
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
-
-
-def rotate(q: tuple, v: tuple) -> tuple[float, float, float]:
-    """Vector v rotated by unit quaternion q."""
-    _, x, y, z = multiply(multiply(q, (0.0, *v)), (q[0], -q[1], -q[2], -q[3]))
-    return x, y, z
 
 
 def _add(a: tuple, b: tuple) -> tuple[float, float, float]:
