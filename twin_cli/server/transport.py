@@ -141,17 +141,5 @@ class Http:
         finally:
             connection.close()
 
-    def get(self, path: str, **kwargs: Any) -> Reply:
-        return self.request("GET", path, **kwargs)
-
-    def put(self, path: str, **kwargs: Any) -> Reply:
-        return self.request("PUT", path, **kwargs)
-
-    def post(self, path: str, **kwargs: Any) -> Reply:
-        return self.request("POST", path, **kwargs)
-
-    def delete(self, path: str, **kwargs: Any) -> Reply:
-        return self.request("DELETE", path, **kwargs)
-
     def close(self) -> None:
         """Nothing to release: connections close after each request."""

@@ -88,7 +88,8 @@ def test_malformed_pose_is_422_naming_the_field(server):
         client.request("PUT", "/entities/anything/pose", body={"x": "one metre"})
     with pytest.raises(RequestError, match="yaww"):
         client.request("PUT", "/entities/anything/pose", body={"yaww": 1.0})
-    reply = client._http.put(
+    reply = client._http.request(
+        "PUT",
         "/entities/anything/pose",
         content=b'{"x": NaN}',
         headers={"content-type": "application/json"},
