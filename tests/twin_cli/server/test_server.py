@@ -112,7 +112,7 @@ def test_file_that_fails_to_convert_is_a_4xx_with_its_message(server, files):
     client, _ = server
     before = _sim_time(client)
     names = {e["name"] for e in client.entities()}
-    reply = client._http.post("/entities", json={"source": str(files / "broken.urdf")})
+    reply = client._http.request("POST", "/entities", json={"source": str(files / "broken.urdf")})
     assert 400 <= reply.status_code < 500, f"status {reply.status_code}: {reply.text}"
     assert "broken.urdf" in reply.json()["message"], reply.text
     assert {e["name"] for e in client.entities()} == names, "a failed spawn changed the world"
