@@ -28,9 +28,6 @@ from twin_cli.validate.scenario import Scenario
 
 TWIN = Path(sys.executable).parent / "twin"
 SPIN_S = 120.0  # [s] a busy process ends by itself after this, whatever happens to the test
-# Filming the whole checklist costs ~45 s on two busy cores; these three are the filmed
-# scenarios' cost-free sample, with realtime, the one that filming used to turn into a failure.
-FILMED = ("realtime", "gravity", "zero_gravity")
 
 
 def verdicts(*args: object) -> dict[str, str]:
@@ -72,9 +69,10 @@ def test_humanoid_passes_every_check_it_can_apply(quiet):
 
 @pytest.mark.skipif(bool(egl_missing()), reason=f"video part skipped: {egl_missing()}")
 def test_filming_leaves_the_verdicts_unchanged(quiet, tmp_path):
-    only = [arg for check in FILMED for arg in ("--only", check)]
-    filmed = verdicts(*only, "--video", tmp_path / "videos")
-    assert filmed == {k: v for k, v in quiet.items() if k.split(" (")[0] in FILMED}
+    """The whole checklist filmed (~45 s on two busy cores): realtime is the check that
+    filming used to turn into a failure (0.56x, counted as the robot's cost)."""
+    filmed = verdicts("--video", tmp_path / "videos")
+    assert filmed == quiet
     assert (tmp_path / "videos" / "realtime.mp4").is_file(), "the realtime run is still filmed"
 
 
