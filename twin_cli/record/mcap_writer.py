@@ -25,6 +25,7 @@ from typing import Any
 import yaml
 
 from twin_cli.errors import RequestError
+from twin_cli.output_files import PRIVATE
 from twin_cli.record import messages as ros
 from twin_cli.record.topics import Message, Topic
 
@@ -80,8 +81,11 @@ def open_output(path: str | os.PathLike, *, overwrite: bool = False) -> Any:
     target = Path(path).expanduser()
     if target.suffix.lower() != ".mcap":
         raise RequestError(f"recording {target}", "is not a .mcap file", "name it OUT.mcap")
+    # 0600 like a save: a recording holds the world's whole course. O_NONBLOCK: a FIFO with
+    # no reader is refused at once instead of blocking the server (regular files ignore it).
+    flags = os.O_WRONLY | os.O_CREAT | os.O_NONBLOCK | (os.O_TRUNC if overwrite else os.O_EXCL)
     try:
-        return target.open("wb" if overwrite else "xb")
+        return os.fdopen(os.open(target, flags, PRIVATE), "wb")
     except FileExistsError as exc:
         raise RequestError(
             f"recording {target}", "already exists", "remove it or choose another name"

@@ -632,3 +632,20 @@ def test_the_ring_reads_runs_of_records_of_one_layout_up_to_the_limit():
     runs += reader.read(int(header[ring.WRITE]), limit=100)
     assert [(e, len(r)) for e, r in runs[3:]] == [(1, 8), (1, 2)]
     assert [float(t) for _, r in runs for t in r[:, 0]] == times
+
+
+def test_a_recording_is_private_and_a_fifo_without_reader_is_refused_at_once(tmp_path) -> None:
+    import os
+    import stat
+
+    from twin_cli.errors import RequestError
+    from twin_cli.record.mcap_writer import open_output
+
+    with open_output(tmp_path / "run.mcap") as handle:
+        handle.write(b"x")
+    assert stat.S_IMODE((tmp_path / "run.mcap").stat().st_mode) == 0o600, "0600, as a save"
+    fifo = tmp_path / "pipe.mcap"
+    os.mkfifo(fifo)
+    with pytest.raises(RequestError, match="cannot be written"):
+        open_output(fifo, overwrite=True)  # would block the server for ever without a reader
+    assert stat.S_ISFIFO(fifo.stat().st_mode), "the FIFO is untouched"
