@@ -168,9 +168,9 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
-    from converters.mjcf.heightfields import add_height_fields
     from converters.gazebo.plugins import add_drive_motors, read_plugins
     from converters.gazebo.sensor_sites import add_sensors
+    from converters.mjcf.heightfields import add_height_fields
 
     options = options or ConvertOptions()
     report = report or Report(source=robot.source)

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import subprocess
 import sys
 import threading
@@ -45,6 +44,7 @@ def expand_bounded(
         XacroError, PackageNotFoundError, …: what the expansion raised, as the same class.
     """
     request = {
+        "memory_mib": budget.memory_mib,
         "path": str(path),
         "args": args,
         "packages": {name: str(directory) for name, directory in resolver.explicit.items()},
@@ -57,8 +57,7 @@ def expand_bounded(
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=env,
-        preexec_fn=_limit_memory(budget.memory_mib),  # only setrlimit: safe after fork
+        env={**env, "OPENBLAS_NUM_THREADS": "1"},  # numpy's pools would eat the address space
     )
     _RUNNING.add(child)
     try:
@@ -90,18 +89,14 @@ _STOPPING = threading.Event()
 _SENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH", "GAZEBO_MODEL_PATH", "GZ_SIM_RESOURCE_PATH")
 _SENT += ("GZ_FUEL_CACHE_PATH", "GAZEBO_RESOURCE_PATH")
 
+# The child limits its own address space first thing (a preexec_fn is not safe in a threaded
+# server), then reads its request.
 _BOOT = (
-    "import json, sys; request = json.loads(sys.stdin.read()); sys.path[:] = request['sys_path']; "
+    "import json, resource, sys; request = json.loads(sys.stdin.read()); "
+    "size = request['memory_mib'] * 1024 * 1024; "
+    "resource.setrlimit(resource.RLIMIT_AS, (size, size)); sys.path[:] = request['sys_path']; "
     "from converters.urdf.xacro_worker import serve; serve(request)"
 )
-
-
-def _limit_memory(mib: int) -> Any:
-    def limit() -> None:
-        size = mib * 1024 * 1024
-        resource.setrlimit(resource.RLIMIT_AS, (size, size))
-
-    return limit
 
 
 def _result(path: Path, done: subprocess.CompletedProcess, budget: XacroBudget) -> XacroResult:
@@ -143,7 +138,8 @@ def serve(request: dict[str, Any]) -> None:
     import xacro  # noqa: F401 (loaded before the guard: Python's own files stay readable)
 
     files: set[str] = set()
-    sys.addaudithook(_guard(_allowed_roots(path, resolver), files))
+    refused: list[str] = []
+    sys.addaudithook(_guard(_allowed_roots(path, resolver), files, refused))
     try:
         result = expand_xacro(path, request["args"], resolver)
         answer: dict[str, Any] = {
@@ -152,41 +148,84 @@ def serve(request: dict[str, Any]) -> None:
             "warnings": list(result.warnings),
         }
     except ConversionError as exc:
-        answer = {"error": type(exc).__name__, "message": str(exc)}
+        # xacro may bury a refusal under an error of its own: the refusal is the cause.
+        error = XacroError(str(path), refused[0], REFUSED_FIX) if refused else exc
+        answer = {"error": type(error).__name__, "message": str(error)}
     answer["files"] = sorted(files)
     sys.stdout.write(json.dumps(answer) + "\n")
 
 
 def _allowed_roots(path: Path, resolver: PackageResolver) -> tuple[str, ...]:
-    """Where the description may read: its folder and package, the packages it was given,
-    the package roots of the client's variables, and Python's own installation."""
-    roots = [path.resolve().parent, *(Path(p).resolve() for p in resolver.explicit.values())]
-    roots += [d.parent for d in path.resolve().parents if (d / "package.xml").is_file()][:1]
+    """Where the description may read: its package (the nearest folder above it with a
+    `package.xml`; without one, only its own folder), the packages given with --package or
+    named by the client's variables, and Python's own installation."""
+    resolved = path.resolve()
+    package = next((d for d in resolved.parents if (d / "package.xml").is_file()), None)
+    roots = [package if package is not None else resolved.parent]
+    roots += [Path(p).resolve() for p in resolver.explicit.values()]
     for variable in _SENT:
         roots += [Path(p).resolve() for p in os.environ.get(variable, "").split(os.pathsep) if p]
     python = {sys.prefix, sys.base_prefix, *(p for p in sys.path if p)}
     return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in python)
 
 
-def _guard(roots: tuple[str, ...], files: set[str]) -> Any:
-    """An audit hook refusing reads outside `roots` (and the packages `$(find)` found so far)
-    and recording the files read inside."""
+REFUSED_FIX = (
+    "a served description may only read its own package (the folder with its package.xml); "
+    "twin convert reads freely"
+)
+_PACKAGE_FILES = ("package.xml", "model.config")  # what `$(find)` reads to name a package
+# What an expression could do besides reading a file; none of it is xacro's business.
+_FORBIDDEN = (
+    "subprocess.Popen", "os.system", "os.exec", "os.posix_spawn", "os.spawn", "os.fork",
+    "os.forkpty", "os.kill", "os.killpg", "ctypes.dlopen", "ctypes.dlsym", "socket.connect",
+    "socket.bind", "socket.sendto", "os.remove", "os.rename",
+    "os.rmdir", "os.mkdir", "os.chmod", "os.chown", "os.symlink", "os.link", "shutil.rmtree",
+)  # fmt: skip
+
+
+def _guard(roots: tuple[str, ...], files: set[str], refused: list[str]) -> Any:
+    """An audit hook refusing what a description has no business doing: starting processes,
+    opening sockets, listing folders, writing, and reading outside `roots` (and the packages
+    `$(find)` found so far). Records the files read, and each refusal."""
     from converters.urdf.xacro_expand import FOUND
 
+    def refuse(what: str) -> None:
+        refused.append(what)
+        raise PermissionError(f"{what}; {REFUSED_FIX}")
+
     def hook(event: str, args: tuple) -> None:
+        if event in _FORBIDDEN:
+            refuse(f"an expression tried {event}, which a description may not do")
+        if event in ("os.listdir", "os.scandir"):  # imports list folders: only allowed ones
+            listed = os.path.realpath(os.fsdecode(args[0] if args[0] is not None else "."))
+            if not _inside(listed, (*roots, *FOUND.get({}).values())):
+                refuse(f"{listed} is outside the robot's own package")
+            return
         if event != "open" or not isinstance(args[0], (str, bytes, os.PathLike)):
             return
         name = os.path.realpath(os.fsdecode(args[0]))
-        allowed = (*roots, *(os.path.realpath(p) for p in FOUND.get({}).values()))
-        if not any(name == r or name.startswith(r.rstrip(os.sep) + os.sep) for r in allowed):
-            raise PermissionError(
-                f"{name} is outside the robot's own folder and packages; a served description "
-                "may read only those (convert it with `twin convert` to read other files)"
-            )
+        mode, flags = args[1], args[2] if len(args) > 2 else 0
+        writing = (isinstance(mode, str) and any(m in mode for m in "wax+")) or (
+            isinstance(flags, int) and flags & (os.O_WRONLY | os.O_RDWR)
+        )
+        if writing:
+            refuse(f"{name} was opened for writing, which a description may not do")
+        metadata = os.path.basename(name) in _PACKAGE_FILES  # the package search reads them
+        if not metadata and not _inside(name, (*roots, *FOUND.get({}).values())):
+            refuse(f"{name} is outside the robot's own package")
         if os.path.isfile(name) and not name.endswith((".py", ".pyc", ".so")):
             files.add(name)
 
     return hook
+
+
+def _inside(name: str, roots: tuple[str, ...]) -> bool:
+    """Whether the resolved path `name` is one of `roots` or below one."""
+    for root in roots:
+        real = os.path.realpath(root)
+        if name == real or name.startswith(real.rstrip(os.sep) + os.sep):
+            return True
+    return False
 
 
 def _die_with_parent() -> None:

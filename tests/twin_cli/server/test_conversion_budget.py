@@ -119,3 +119,56 @@ def test_a_served_xacro_reads_no_file_outside_its_robot_and_no_server_variable(r
     refused = _twin(runtime, "spawn", str(peek))
     assert refused.returncode == 2 and "server-secret" not in refused.stderr, refused.stderr
     assert "TWIN_TEST_SECRET" in refused.stderr, refused.stderr
+
+
+POPEN = """<robot name="pop" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <link name="${{[l := [], l.append((x.gi_frame.f_back.f_back.f_globals['os'].popen('cat {secret}')
+    .read() for x in l)), python.list(l[0])][2][0]}}"/>
+</robot>"""
+BESIDE = """<robot name="beside" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="s" value="${{xacro.load_yaml('{secret}')}}"/>
+  <link name="${{s['token']}}"/>
+</robot>"""
+
+
+def _bounded(path: Path):  # noqa: ANN202
+    from converters.budget import XacroBudget
+    from converters.resources.packages import PackageResolver
+    from converters.urdf.xacro_worker import expand_bounded
+
+    return expand_bounded(path, {}, PackageResolver.create(path, {}, {}), XacroBudget(60, 4096))
+
+
+@pytest.mark.parametrize(("payload", "said"), [(POPEN, "subprocess.Popen"), (BESIDE, "outside")])
+def test_a_served_xacro_can_neither_run_a_program_nor_read_beside_its_package(
+    tmp_path: Path, payload: str, said: str
+) -> None:
+    """A frame walk to `os.popen`, and a file next to the package folder (a robot cloned
+    into ~/robot must not open ~/.kube/config)."""
+    from converters.errors import XacroError
+
+    secret = tmp_path / "secret.txt"
+    secret.write_text("token: hunter2\n")
+    package = tmp_path / "pkg"
+    (package / "urdf").mkdir(parents=True)
+    (package / "package.xml").write_text("<package><name>pkg</name></package>")
+    robot = package / "urdf" / "r.urdf.xacro"
+    robot.write_text(payload.format(secret=secret))
+    with pytest.raises(XacroError) as caught:
+        _bounded(robot)
+    assert said in str(caught.value) and "hunter2" not in str(caught.value), str(caught.value)
+
+
+def test_a_served_xacro_includes_a_sibling_folder_of_its_own_package(tmp_path: Path) -> None:
+    (tmp_path / "robot" / "urdf").mkdir(parents=True)
+    (tmp_path / "robot" / "package.xml").write_text("<package><name>robot</name></package>")
+    (tmp_path / "robot" / "common").mkdir()
+    (tmp_path / "robot" / "common" / "m.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="common_link"/></robot>'
+    )
+    robot = tmp_path / "robot" / "urdf" / "a.urdf.xacro"
+    robot.write_text(
+        '<robot name="rel" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:include filename="../common/m.xacro"/></robot>'
+    )
+    assert 'name="common_link"' in _bounded(robot).text
