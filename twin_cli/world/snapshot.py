@@ -101,9 +101,13 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
                 f"{layout_of(state.model)} with {size}",
                 "restore into a world that spawned the same sources in the same order",
             )
-        for entity in snapshot.entities:
-            spawn_state = typed_like(state.entities[entity.name].spawn_state, entity.spawn_state)
-            state.entities[entity.name] = replace(entity, spawn_state=spawn_state)
+        records = {  # all checked before any is replaced: a bad one changes nothing
+            e.name: replace(
+                e, spawn_state=typed_like(state.entities[e.name].spawn_state, e.spawn_state)
+            )
+            for e in snapshot.entities
+        }
+        state.entities.update(records)
         mujoco.mj_setState(state.model, state.data, np.asarray(snapshot.state, float), STATE)
         state.iterations, state.divergences = snapshot.iterations, snapshot.divergences
         state.paused = snapshot.paused

@@ -205,16 +205,17 @@ def _spawn_loaded(
             placed, (model, data, index) = _seed(
                 state, loaded[0].source, requests, names, poses, homes
             )
+            results, records = [], {}
+            for one, request, n, start in zip(loaded, requests, names, placed, strict=True):
+                records[n] = make_entity(n, one, request, start)
+                starting = placement.start_warnings(model, data, index, n, start.pose.z)
+                warnings = [*one.notes, *conversion_warnings(one.report), *starting]
+                results.append(SpawnResult(n, one.source, warnings, one.report, one.cached))
         except BaseException:
             for n in names:
                 spawn.remove_entity(state.spec, n)
             raise
-        results = []
-        for one, request, n, start in zip(loaded, requests, names, placed, strict=True):
-            state.entities[n] = make_entity(n, one, request, start)
-            starting = placement.start_warnings(model, data, index, n, start.pose.z)
-            warnings = [*one.notes, *conversion_warnings(one.report), *starting]
-            results.append(SpawnResult(n, one.source, warnings, one.report, one.cached))
+        state.entities.update(records)  # nothing is recorded until everything succeeded
         commit(state, state.spec, (model, data, index))
         return results
 
