@@ -3,9 +3,10 @@
 A pytest plugin (loaded by conftest.py) plus the watcher it starts. The controlling pytest puts
 a run id in its environment, so every process a test starts (worlds that `twin spawn` detaches
 into a session of their own, their supervisors and recorders) inherits it. At the end of the run
-the controller ends every process that carries the id. A watcher in a session of its own holds
-the read end of a pipe from the controller; when the controller dies any other way (Ctrl-C,
-SIGTERM, SIGKILL), the pipe closes and the watcher ends those processes instead.
+the controller ends every process that carries the id. A watcher in a session of its own polls
+the controller's pid; when the controller dies any other way (Ctrl-C, SIGTERM, SIGKILL), the
+watcher ends those processes instead. (It polls rather than waits for a pipe to close: a child a
+test forks would hold the pipe open after pytest died.)
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from pathlib import Path
 
 RUN_ENV = "TWIN_TEST_RUN"
 GRACE_S = 5.0  # [s] SIGTERM first: a world finishes its recording and log, then SIGKILL
+POLL_S = 0.2  # [s] how often the watcher looks at the controlling pytest
 
 
 def processes_with(variable: str, value: str) -> list[int]:
@@ -70,11 +72,12 @@ def pytest_configure(config) -> None:
     if _is_worker(config):
         return
     run_id = uuid.uuid4().hex
-    os.environ[RUN_ENV] = run_id  # a nested run (a test of this plugin) gets its own id
+    config._twin_reaper_previous = os.environ.get(RUN_ENV)  # a nested run gets its own id
+    os.environ[RUN_ENV] = config._twin_reaper_id = run_id
     watcher_env = {k: v for k, v in os.environ.items() if k != RUN_ENV}
     config._twin_reaper = subprocess.Popen(
-        [sys.executable, __file__, run_id],
-        stdin=subprocess.PIPE,
+        [sys.executable, __file__, run_id, str(os.getpid())],
+        stdin=subprocess.DEVNULL,
         start_new_session=True,
         env=watcher_env,
     )
@@ -84,20 +87,39 @@ def pytest_unconfigure(config) -> None:
     watcher = getattr(config, "_twin_reaper", None)
     if watcher is None:
         return
-    left = reap(os.environ[RUN_ENV])
+    left = reap(config._twin_reaper_id)
     if left:
         print(f"\nreaper: ended {len(left)} process(es) that tests left running: {left}")
-    watcher.stdin.close()  # the watcher finds nothing more and exits
+    watcher.terminate()  # nothing is left for it to do
     watcher.wait(timeout=GRACE_S + 5)
+    previous = config._twin_reaper_previous
+    if previous is None:
+        os.environ.pop(RUN_ENV, None)
+    else:
+        os.environ[RUN_ENV] = previous
 
 
-def _watch(run_id: str) -> None:
-    """Wait until the controlling pytest closes the pipe (or dies), then end the run's processes."""
+def _watch(run_id: str, controller: int) -> None:
+    """Poll the controlling pytest; once it is gone, end the run's processes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C meant for pytest must not stop us
-    while sys.stdin.buffer.read(1 << 16):
-        pass
+    while _alive(controller):
+        time.sleep(POLL_S)
     reap(run_id)
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:  # an ended process its parent has not reaped yet counts as gone
+        stat = Path(f"/proc/{pid}/stat").read_text()
+        return stat.rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return True
+
+
 if __name__ == "__main__":
-    _watch(sys.argv[1])
+    _watch(sys.argv[1], int(sys.argv[2]))

@@ -76,7 +76,10 @@ def expand_bounded(
 
 
 def stop_all() -> None:
-    """Kill every expansion still running (a server shutting down: its requests must end)."""
+    """Kill every expansion still running (a server shutting down: its requests must end).
+
+    For a process that is ending: from then on every served expansion in it fails at once.
+    """
     _STOPPING.set()
     for child in list(_RUNNING):
         child.kill()
