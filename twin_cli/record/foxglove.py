@@ -5,6 +5,12 @@ recording, so Foxglove decodes them as it decodes a ROS 2 bag. The server advert
 capability and broadcasts sim time, so Foxglove's clock is the world's. Channels open and close
 as entities are spawned and deleted. A latched topic's last message is sent again when a client
 subscribes to it (the WebSocket protocol has no transient-local durability).
+
+What guards it: foxglove-sdk's server (0.30) has no authentication and no Host or Origin check
+(only TLS), so twin binds loopback and refuses any other address unless the caller passes
+`allow_public`. Clients can only read: no capability that acts on the world is advertised
+(no client publish, parameters or services), so a page of another site that reaches the port
+(or a DNS-rebound name) can watch the world's topics but not drive it.
 """
 
 from __future__ import annotations
@@ -21,6 +27,10 @@ from twin_cli.record.topics import Message, Topic
 log = logging.getLogger("twin.foxglove")
 DEFAULT_PORT = 8765  # Foxglove's own default
 LOOPBACK = "127.0.0.1"
+PUBLIC_WARNING = (
+    "the Foxglove stream listens on {host}:{port}, not only on this machine: it has no "
+    "password, and anyone who reaches that port can watch the world's topics"
+)
 
 
 class _Subscriptions:
@@ -46,12 +56,20 @@ class _Subscriptions:
 class LiveStream:
     """A Foxglove WebSocket server carrying the world's topics (a recording sink)."""
 
-    def __init__(self, port: int = DEFAULT_PORT, host: str = LOOPBACK, name: str = "twin") -> None:
-        """Raises: RequestError: the port is in use or the address is not valid."""
+    def __init__(
+        self,
+        port: int = DEFAULT_PORT,
+        host: str = LOOPBACK,
+        name: str = "twin",
+        *,
+        allow_public: bool = False,
+    ) -> None:
+        """Raises: RequestError: the port is in use, the address is not valid, or it is not
+        loopback and `allow_public` is not given."""
         import foxglove
         from foxglove.websocket import Capability
 
-        _check_address(host, port)
+        _check_address(host, port, allow_public=allow_public)
         self._context = foxglove.Context()
         self._listener = _Subscriptions()
         try:
@@ -70,8 +88,10 @@ class LiveStream:
                 f"cannot be opened ({exc})",
                 "choose another port (e.g. --port 8766), or stop what listens there",
             ) from exc
+        self.warning: str | None = None  # what the reply and the terminal must say
         if not ipaddress.ip_address(host).is_loopback:
-            log.warning("Foxglove server on non-loopback %s:%d: anyone there can watch", host, port)
+            self.warning = PUBLIC_WARNING.format(host=host, port=self.port)
+            log.warning(self.warning)
         self._channels: dict[str, Any] = {}
         self._latched: dict[str, bytes] = {}
         self._last_time = -1
@@ -134,12 +154,19 @@ def ros2_channel(topic: Topic, context: Any, metadata: dict[str, str] | None = N
     )
 
 
-def _check_address(host: str, port: int) -> None:
+def _check_address(host: str, port: int, *, allow_public: bool) -> None:
     try:
-        ipaddress.ip_address(host)
+        address = ipaddress.ip_address(host)
     except ValueError as exc:
         raise RequestError(
             f"Foxglove host {host}", "is not an IP address", "use 127.0.0.1"
         ) from exc
     if not 0 <= port <= 65535:
         raise RequestError(f"Foxglove port {port}", "is out of range", "use 1-65535 (0: any)")
+    if not address.is_loopback and not allow_public:
+        raise RequestError(
+            f"Foxglove host {host}",
+            "is not loopback, and the stream has no password or Origin check: anyone who "
+            "reaches the port could watch the world",
+            "use 127.0.0.1 and reach it through a tunnel (`ssh -L 8765:127.0.0.1:8765 HOST`)",
+        )

@@ -10,6 +10,7 @@ from typing import Any
 
 from fastapi import APIRouter, Request
 
+from twin_cli.server.error_replies import error_reply
 from twin_cli.server.holder import WorldDep
 from twin_cli.server.models import SnapshotBody, ViewBody
 
@@ -28,15 +29,32 @@ def view_service(state: Any) -> Any:
         from twin_cli.view.service import ViewService
 
         holder = state.holder
-        state.views = ViewService(lambda: holder.world)
+        state.views = ViewService(lambda: holder.world, lambda: _world_token(state))
     return state.views
 
 
+def _world_token(state: Any) -> str | None:
+    """The world's bearer token, when it serves TCP (`--tcp` writes it to a 0600 file)."""
+    from twin_cli.server import runtime
+
+    path = runtime.world_paths(getattr(state, "world_name", "default")).token
+    try:
+        return path.read_text().strip() or None
+    except FileNotFoundError:
+        return None
+
+
 @router.post("/view", status_code=201)
-def start_view(body: ViewBody, request: Request) -> dict:
-    """Serve MuJoCo's web viewer on this world (`twin view`); replies with its URL."""
-    status = views(request).start(host=body.host, port=body.port)
-    log.info("viewer on %s", status["url"])
+def start_view(body: ViewBody, request: Request) -> Any:
+    """Serve MuJoCo's web viewer on this world (`twin view`); replies with its URL (and the
+    token it needs off loopback); 409 when one runs with another host or port."""
+    from twin_cli.view.service import ViewConflictError
+
+    try:
+        status = views(request).start(host=body.host, port=body.port)
+    except ViewConflictError as exc:
+        return error_reply(409, "InvalidRequestError", str(exc))
+    log.info("viewer on %s:%d", status["host"], status["port"])  # the URL may carry the token
     return status
 
 

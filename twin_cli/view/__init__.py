@@ -2,9 +2,10 @@
 
 A consumer of the world, like `twin_cli.record`: it reads the world under its lock
 and acts on it only through `World`'s methods. Modules: `bridge` (the page's actions → World),
-`host` (the viewer thread, its bind address, the sync thread), `service` (the server's one
-viewer), `offscreen` (PNG snapshots with mujoco.Renderer on EGL). Exports load lazily, so that
-importing the package imports neither mujoco nor the viewer.
+`host` (the viewer thread, its bind address, the sync thread), `guard` (the Host, Origin and
+token checks on its port), `service` (the server's one viewer), `offscreen` (PNG snapshots
+with mujoco.Renderer on EGL). Exports load lazily, so that importing the package imports
+neither mujoco nor the viewer.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ _WHERE = {
     "WorldBridge": "twin_cli.view.bridge",
     "WebHost": "twin_cli.view.host",
     "ViewAddress": "twin_cli.view.host",
+    "ViewGuard": "twin_cli.view.guard",
     "ViewService": "twin_cli.view.service",
     "CameraView": "twin_cli.view.offscreen",
     "snapshot_png": "twin_cli.view.offscreen",

@@ -16,8 +16,10 @@ import io
 import ipaddress
 import logging
 import queue
+import socket
 import threading
 import time
+import urllib.parse
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -25,6 +27,7 @@ from typing import Any
 from mujoco.studio import messages
 
 from twin_cli.view.bridge import WorldBridge
+from twin_cli.view.guard import ViewGuard, armed, protect
 
 log = logging.getLogger("twin.view")
 
@@ -36,16 +39,17 @@ LOOPBACK = "127.0.0.1"
 
 @dataclass(frozen=True)
 class ViewAddress:
-    """Where the page is served: `host` as bound, `port`, and the URL to open."""
+    """Where the page is served: `host` as bound, `port`, the token it needs (off loopback),
+    and the URL to open (with the token in its query)."""
 
     host: str
     port: int
+    token: str | None = None
 
     @property
     def url(self) -> str:
-        shown = "localhost" if ipaddress.ip_address(self.host).is_loopback else self.host
-        shown = f"[{shown}]" if ":" in shown else shown
-        return f"http://{shown}:{self.port}/"
+        query = f"?{urllib.parse.urlencode({'token': self.token})}" if self.token else ""
+        return ViewGuard(self.host, self.port).example_url() + query
 
     @property
     def public(self) -> bool:
@@ -53,8 +57,9 @@ class ViewAddress:
         return not ipaddress.ip_address(self.host).is_loopback
 
 
-def _viewer_class(host: str) -> type:
-    """`WebViewer` bound to `host` instead of the "::" (all interfaces) it hard-codes.
+def _viewer_class(host: str, token: str | None) -> type:
+    """`WebViewer` bound to `host` instead of the "::" (all interfaces) it hard-codes, its
+    server behind twin's Host, Origin and token checks (`twin_cli.view.guard`).
 
     `WebViewer.__init__` assigns `self._host = "::"` and binds right after; a class property
     whose setter ignores that assignment makes it bind `host` (MuJoCo 4.0.0 has no option).
@@ -70,12 +75,27 @@ def _viewer_class(host: str) -> type:
         def _host(self, _ignored: str) -> None:
             pass
 
+        def _start_server(self) -> None:
+            """Registers the guard for the bound socket before MuJoCo's server starts on it."""
+            protect(self._http_sock, ViewGuard(host, self._http_port, token))
+            super()._start_server()
+
         @messages.handler(priority=messages.Priority.INTERNAL)
         def _on_post_model(self, event: messages.PostModelEvent) -> None:
             """Serves the new model; the page swaps it in place (MuJoCo's prints a line)."""
             self._update_model()
 
     return BoundWebViewer
+
+
+def _wait_listening(sock: socket.socket) -> None:
+    """Returns once MuJoCo's server thread listens on `sock`: the URL twin prints then works
+    (the socket is bound before that thread starts, and a request in between is refused)."""
+    deadline = time.monotonic() + START_TIMEOUT_S
+    while not sock.getsockopt(socket.SOL_SOCKET, socket.SO_ACCEPTCONN):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"the viewer did not listen within {START_TIMEOUT_S:.0f} s")
+        time.sleep(0.01)
 
 
 class WebHost:
@@ -86,6 +106,7 @@ class WebHost:
         host: address to bind; 127.0.0.1 unless the user asked otherwise.
         port: TCP port; 0 takes the first free one from 8080 on (MuJoCo's rule).
         rate: syncs per second of wall time.
+        token: what every request must carry (None: no token, for loopback).
     """
 
     def __init__(
@@ -95,9 +116,11 @@ class WebHost:
         host: str = LOOPBACK,
         port: int = 0,
         rate: float = SYNC_HZ,
+        token: str | None = None,
     ) -> None:
         self._current = current_world
         self._host, self._port, self._period = host, port, 1.0 / rate
+        self._token = token
         self._bridge = WorldBridge(current_world())
         self._handle: Any = None
         self._stop = threading.Event()
@@ -115,7 +138,7 @@ class WebHost:
         from mujoco.studio import launch_thread, viewer_protocol
 
         bound: queue.Queue[Any] = queue.Queue()
-        viewer_class = _viewer_class(self._host)
+        viewer_class = _viewer_class(self._host, self._token)
         config = viewer_protocol.ViewerConfig(gfx="web", http_port=self._port, title="twin")
 
         def run(endpoint: Any) -> None:
@@ -126,7 +149,7 @@ class WebHost:
             except BaseException as exc:
                 bound.put(exc)
                 raise
-            bound.put(viewer._http_port)  # noqa: SLF001 (the port it bound; no public name)
+            bound.put(viewer._http_sock)  # noqa: SLF001 (the socket it bound; no public name)
             viewer_protocol.run_viewer_loop(viewer)
 
         self._handle = launch_thread.launch_thread(run, sim_plugins=[self._bridge])
@@ -134,13 +157,19 @@ class WebHost:
         if isinstance(reply, BaseException):
             self._handle = None
             raise RuntimeError(str(reply)) from reply
-        self.address = ViewAddress(self._host, int(reply))
+        _wait_listening(reply)
+        if not armed(reply):
+            raise RuntimeError(
+                "MuJoCo's viewer server started without twin's Host/Origin checks (its "
+                "web_server module changed); not serving it: use the mujoco version twin pins"
+            )
+        self.address = ViewAddress(self._host, int(reply.getsockname()[1]), self._token)
         world = self._current()
         with world.lock:
             self._handle.set_model(world.model, data=world.data)
         self._thread = threading.Thread(target=self._run, name="twin-view-sync", daemon=True)
         self._thread.start()
-        log.info("viewer on %s (bound to %s)", self.address.url, self._host)
+        log.info("viewer on port %d (bound to %s)", self.address.port, self._host)
         return self.address
 
     @property

@@ -32,8 +32,10 @@ def view(
 ) -> None:
     """Show the running world in MuJoCo's web viewer (like gzclient); prints the page's URL.
 
-    The page can pause, run and reset the world and push bodies (Ctrl+drag). With --host other
-    than 127.0.0.1 anyone who reaches the port can do the same: there is no password.
+    The page can pause, run and reset the world and push bodies (Ctrl+drag). It answers only
+    requests for its own address from its own pages; with --host other than loopback the page
+    also needs a token, which the printed URL carries: anyone with that URL who reaches the
+    port can drive the world.
     """
     from twin_cli.server.connection import connect
 
