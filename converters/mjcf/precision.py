@@ -38,6 +38,7 @@ FINDERS = {
     "velocity": "actuator",
     "general": "actuator",
     "equality": "equality",
+    "light": "light",
 }
 # Relative agreement that proves a written number is the rounding of a spec value (6 digits).
 ROUNDING = 5e-6

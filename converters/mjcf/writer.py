@@ -43,7 +43,10 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 
 def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
     """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
+    from converters.mjcf.world_rules import finish_robot_spec
+
     copy = spec.copy()
+    finish_robot_spec(copy)  # priorities and solrefs as a world attaches the robot
     copy.modelfiledir = str(assets_dir.parent)  # to_xml compiles: let it find the new files
     for mesh in copy.meshes:
         if len(mesh.uservert) == 0:
@@ -61,24 +64,18 @@ def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
 
 
 def scene_xml(robot_file: str, model_name: str) -> str:
-    """A scene with Gazebo's ground plane (via `add_gazebo_ground`), a light, the robot included,
-    and the options a twin world steps with (`world_options`: integrator, solver, iterations,
-    tolerance, gravity, timestep), so plain MuJoCo runs the physics `twin validate` proved.
+    """The empty world a twin World starts from (`world_rules.world_spec`: Gazebo's ground, the
+    sun, the world's options and flags) with the robot included, so plain MuJoCo runs the
+    physics `twin validate` proved.
 
     The robot is included after the ground, as a world attaches it: the same body, geom and
     contact order gives the same trajectory as the world to rounding.
     """
-    import mujoco
+    from converters.mjcf.precision import restore_precision
+    from converters.mjcf.world_rules import world_spec
 
-    from converters.gazebo.contact import add_gazebo_ground
-    from converters.mjcf.world_options import apply_world_options
-
-    scene = mujoco.MjSpec()
-    scene.modelname = f"{model_name} scene"
-    add_gazebo_ground(scene)
-    scene.worldbody.add_light(name="sun", pos=[0, 0, 5], dir=[0, 0, -1])
-    apply_world_options(scene)
-    text = scene.to_xml()
+    scene = world_spec(name=f"{model_name} scene")
+    text = restore_precision(scene.to_xml(), scene)
     head, sep, rest = text.rpartition("</mujoco>")
     return f'{head}  <include file="{robot_file}"/>\n{sep}{rest}'
 

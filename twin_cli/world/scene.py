@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import mujoco
 
-from converters.mjcf.world_options import INTEGRATOR, SOLVER, WorldOptions, apply_world_options
+from converters.mjcf.world_options import INTEGRATOR, SOLVER, WorldOptions
+from converters.mjcf.world_rules import apply_world_physics, world_spec
 from twin_cli.world.pose import vec3
 
 if TYPE_CHECKING:
@@ -48,22 +49,9 @@ class SceneSettings:
 
 
 def build_world_spec(settings: SceneSettings) -> mujoco.MjSpec:
-    """An empty world: Gazebo's ground (μ=100, μ2=50) if asked, a sun light, the physics."""
-    from converters.gazebo.contact import add_gazebo_ground
-
-    spec = mujoco.MjSpec()
-    spec.modelname = "world"
-    if settings.ground:
-        add_gazebo_ground(spec)
-    # Gazebo's empty.world sun: directional, from above, casting shadows.
-    spec.worldbody.add_light(
-        name="sun",
-        pos=[0.0, 0.0, 10.0],
-        dir=[-0.5, 0.1, -0.9],
-        castshadow=True,
-    )
-    apply_physics(spec, settings)
-    return spec
+    """An empty world: Gazebo's ground (μ=100, μ2=50) if asked, a sun light, the physics; the
+    same spec `twin convert` exports as scene.xml (`converters.mjcf.world_rules.world_spec`)."""
+    return world_spec(world_options(settings), ground=settings.ground)
 
 
 def replace_lights(spec: mujoco.MjSpec, lights: Sequence[Light]) -> None:
@@ -89,19 +77,21 @@ def replace_lights(spec: mujoco.MjSpec, lights: Sequence[Light]) -> None:
         )
 
 
-def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:
-    """Writes the world's options (the same ones `twin convert` exports in scene.xml) into
-    `spec.option`, and disables MuJoCo's auto-reset."""
-    options = WorldOptions(
+def world_options(settings: SceneSettings) -> WorldOptions:
+    """The MuJoCo options of `settings`."""
+    return WorldOptions(
         settings.timestep,
         vec3(settings.gravity),
         settings.iterations,
         settings.solver,
         settings.integrator,
     )
-    apply_world_options(spec, options)
-    # A diverging entity must not reset the whole world (twin resets only that entity).
-    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+
+
+def apply_physics(spec: mujoco.MjSpec, settings: SceneSettings) -> None:
+    """Writes the world's options and flags (the ones `twin convert` exports in scene.xml) into
+    `spec.option`; MuJoCo's auto-reset is disabled (`world_rules.apply_world_physics`)."""
+    apply_world_physics(spec, world_options(settings))
 
 
 _OPTION_FIELDS = (

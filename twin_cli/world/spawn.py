@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
+from converters.mjcf.world_rules import min_friction_priorities
 from twin_cli.errors import InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import shared_meshes
@@ -261,7 +262,7 @@ def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | No
     home pose is read here and seeded by the world instead.
     """
     _name_unnamed(child)
-    _min_friction_priorities(child)
+    min_friction_priorities(child)  # Gazebo's min-μ rule, as the exported scene has it
     adopt_world_globals(child, world)
     if len(child.keys) == 0:
         return None
@@ -295,21 +296,6 @@ def _name_unnamed(child: mujoco.MjSpec) -> None:
         for i, item in enumerate(items):
             if not item.name:
                 item.name = f"{kind}{i}"
-
-
-def _min_friction_priorities(child: mujoco.MjSpec) -> None:
-    """Gives geoms without a priority the converter's min-μ priority (MJCF and MjSpec sources).
-
-    MuJoCo combines friction by maximum unless priorities differ; Gazebo by minimum. Converted
-    robots already carry `friction_priority(μ)`; a plain MJCF geom (priority 0) would otherwise
-    take the ground's μ=100, which MuJoCo's pyramidal cone cannot resolve: measured, a 1 kg
-    ball falls through such a ground.
-    """
-    from converters.gazebo.contact import friction_priority
-
-    for geom in child.geoms:
-        if geom.priority == 0:
-            geom.priority = friction_priority(float(geom.friction[0]))
 
 
 def attach(world: mujoco.MjSpec, child: mujoco.MjSpec, name: str, pose: Pose) -> None:
