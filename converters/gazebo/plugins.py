@@ -7,7 +7,9 @@ converter reads its parameters, under both spellings gazebo_ros_pkgs accepts: RO
 plugin's own defaults. Each wheel joint gets a motor (`ctrlrange` = ±max wheel torque, the
 joint's `fmax` in Gazebo) when it has none, so the world's velocity servo can drive it.
 `gazebo_ros2_control` / `gazebo_ros_control` plugins enable the robot's command interfaces
-(mapped elsewhere); every other plugin is reported by name as not run.
+(mapped elsewhere); gz-sim's MulticopterMotorModel becomes actuators per rotor
+(`converters.gazebo.multicopter`); LiftDrag and the underwater systems are reported with what they
+would need; every other plugin is reported by name as not run.
 """
 
 from __future__ import annotations
@@ -22,6 +24,13 @@ import numpy as np
 from converters.control_text import set_control_record
 from converters.description.gazebo import Blob
 from converters.errors import GazeboTagError
+from converters.gazebo.multicopter import (
+    Rotor,
+    add_rotors,
+    is_motor_model,
+    missing_names,
+    read_rotor,
+)
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -35,6 +44,18 @@ DEFAULT_DIAMETER = 0.15  # [m]
 DEFAULT_TORQUE = 5.0  # [N m]
 DEFAULT_ACCELERATION = 0.0  # [m/s²] at the wheel rim; 0 = unlimited
 DEFAULT_RATE = 100.0  # [Hz]
+# Systems twin does not run, with what running them would need (one report line each).
+NEEDS = {
+    "gz-sim-lift-drag-system": "LiftDrag: not run; needs lift and drag along the blade's "
+    "velocity at its centre of pressure (quadratic in speed, by angle of attack), which no "
+    "MuJoCo actuator expresses without code at every step",
+    "gz-sim-hydrodynamics-system": "Hydrodynamics: not run; needs added mass and linear and "
+    "quadratic damping in the body frame (MuJoCo's fluid model covers only part of it)",
+    "gz-sim-buoyancy-system": "Buoyancy: not run; needs a fluid density and each link's "
+    "displaced volume (MuJoCo's `density` option gives it only for a fully submerged world)",
+    "gz-sim-thruster-system": "Thruster: not run; needs a propeller thrust ρ·Kt·D⁴·ω|ω| as a "
+    "site actuator, like the multicopter rotors",
+}
 
 
 @dataclass(frozen=True)
@@ -66,13 +87,18 @@ class DiffDrive:
 
 
 def plugin_kind(blob: Blob) -> str:
-    """ "diff_drive", "command_interfaces" or "not_run", from the plugin's filename."""
+    """ "diff_drive", "command_interfaces", "multicopter", a NEEDS key or "not_run", from the
+    plugin's filename."""
     filename = (blob.kind or "").rsplit("/", 1)[-1]
     if filename in DIFF_DRIVE_FILES:
         return "diff_drive"
     if filename in CONTROL_FILES:
         return "command_interfaces"
-    return "not_run"
+    if is_motor_model(blob):
+        return "multicopter"
+    system = filename.removeprefix("lib").removesuffix(".so").replace("ignition-gazebo", "gz-sim")
+    system = "gz-sim-lift-drag-system" if system == "LiftDragPlugin" else system  # Classic
+    return system if system in NEEDS else "not_run"
 
 
 def read_diff_drive(blob: Blob, source: str) -> DiffDrive:
@@ -139,19 +165,26 @@ def _odometry_source(root: ET.Element, ctx: tuple[str, str]) -> str:
     return "world"
 
 
-def read_plugins(blobs: tuple[Blob, ...], source: str) -> tuple[DiffDrive, ...]:
-    """Every diff drive among a model's plugins."""
-    return tuple(read_diff_drive(b, source) for b in blobs if plugin_kind(b) == "diff_drive")
+def read_plugins(blobs: tuple[Blob, ...], source: str) -> tuple[DiffDrive | Rotor, ...]:
+    """Every diff drive and multicopter rotor among a model's plugins."""
+    drives = [read_diff_drive(b, source) for b in blobs if plugin_kind(b) == "diff_drive"]
+    rotors = [read_rotor(b, source) for b in blobs if plugin_kind(b) == "multicopter"]
+    return (*drives, *(r for r in rotors if r is not None))
 
 
-def add_drive_motors(spec: mujoco.MjSpec, drives: tuple[DiffDrive, ...], report: Report) -> None:
-    """Gives each wheel joint of each drive a motor (±max wheel torque) unless it has one.
+def add_drive_motors(
+    spec: mujoco.MjSpec, plugins: tuple[DiffDrive | Rotor, ...], report: Report
+) -> None:
+    """Gives each wheel joint of each drive a motor (±max wheel torque) unless it has one, and
+    each multicopter rotor its actuators (`converters.gazebo.multicopter.add_rotors`).
 
     Raises:
-        GazeboTagError: a wheel joint the plugin names is not a joint of the model.
+        GazeboTagError: a wheel or rotor joint the plugin names is not a joint of the model.
     """
     import mujoco
 
+    add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
+    drives = [p for p in plugins if isinstance(p, DiffDrive)]
     driven = {a.target for a in spec.actuators}
     for drive in drives:
         for joint in drive.left_joints + drive.right_joints:
@@ -188,11 +221,17 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         "diff_drive": "run by twin as a diff-drive controller (`twin drive`, `twin odom`)",
         "command_interfaces": "enables the robot's <ros2_control>/<transmission> command "
         "interfaces",
+        "multicopter": "rotor thrust, yaw moment, drag and lag as MuJoCo actuators (`twin "
+        "command ENTITY ROTOR_JOINT=ω --mode velocity`, ω in rad/s)",
     }
     for blob in blobs:
         kind = plugin_kind(blob)
         label = " ".join(x for x in (blob.name and f"'{blob.name}'", blob.kind) if x)
         if kind == "not_run":
             report.ignored("model", f"<plugin> {label}: not run by twin", tag="plugin")
+        elif kind in NEEDS:
+            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}", tag="plugin")
+        elif kind == "multicopter" and missing_names(blob):
+            report.ignored("model", f"<plugin> {label}: {missing_names(blob)}", tag="plugin")
         else:
             report.mapped("model", f"<plugin> {label}: {reasons[kind]}", tag="plugin")

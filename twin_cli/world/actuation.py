@@ -6,6 +6,9 @@ servo *inside MuJoCo* by rewriting its gain and bias (force = kp·(target − q)
 ±effort through `forcerange`), so the PD runs in C at every step with no Python in the hot path,
 and `implicitfast` integrates the kv term implicitly. Commands are rewritten into each new model
 after a recompile, since compiling restores the spec's motor.
+
+A multicopter rotor's joint actuator (converters.gazebo.multicopter) also sets, per command, its
+thrust and drag actuators (`<actuator>:thrust`, `:drag_x`, `:drag_y`) and the motor lag.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 from twin_cli.world import sleeping
 
 MODES = ("position", "velocity", "effort")
+ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
 VELOCITY_BAND = 0.01  # fraction of the velocity limit over which Gazebo's rule fades the effort
 GAZEBO_STEP = 0.001  # [s] dampingFactor is the velocity fraction lost per Gazebo step
 _AFFINE = mujoco.mjtBias.mjBIAS_AFFINE
@@ -119,6 +123,27 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
         model.actuator_gainprm[a, 0] = cmd.kv / gear
     model.actuator_biasprm[a, 2] = -cmd.kv / gear
     data.ctrl[a] = cmd.target
+    _apply_rotor(model, data, a, cmd)
+
+
+def _apply_rotor(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
+    """A rotor speed ω [rad/s] (clamped at the rotor's maximum) as thrust ctrl ω|ω| and drag
+    ctrl |ω|; the lag is timeConstantUp when ω|ω| rises above the thrust's activation, else
+    timeConstantDown (kept in dynprm[1:3]). A no-op for other actuators."""
+    name = model.actuator(a).name
+    thrust = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name + ":thrust")
+    if thrust < 0 or cmd.mode != "velocity":
+        return
+    omega = min(max(cmd.target, -cmd.velocity_limit), cmd.velocity_limit)
+    push = omega * abs(omega)
+    rising = push > data.act[model.actuator_actadr[thrust]]
+    tau = float(model.actuator_dynprm[thrust, 1 if rising else 2])
+    parts = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name + p) for p in ROTOR_PARTS]
+    for part in (a, thrust, *(p for p in parts if p >= 0)):
+        model.actuator_dynprm[part, 0] = tau
+        data.ctrl[part] = abs(omega)
+    data.ctrl[a] = omega
+    data.ctrl[thrust] = push
 
 
 def _apply_effort(
