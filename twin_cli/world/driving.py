@@ -208,6 +208,8 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
     model, ix = state.model, state.require(name)
     out = {}
     for a in ix.actuators:
+        if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
+            continue  # a site actuator (a rotor's thrust or drag) drives no joint of its own
         key = element_names(model, model.name_actuatoradr[[a]])[0]
         j = int(model.actuator_trnid[a][0])
         joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
