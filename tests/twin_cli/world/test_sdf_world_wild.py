@@ -106,3 +106,34 @@ def test_boxes_dropped_on_a_heightmap_rest_at_the_images_heights(tmp_path: Path)
     expected = {"low": 0.85196, "high": 2.35, "middle": 1.35392}
     for name, z in expected.items():
         assert world.get_pose(name).z == pytest.approx(z, abs=0.01), name
+
+
+def test_a_concave_static_mesh_in_a_world_holds_a_ball_inside_it(tmp_path: Path, monkeypatch):
+    """A static cup (a concave mesh) in a world file is decomposed, not replaced by its hull:
+    a ball dropped into it rests on its floor (floor + radius), well below its rim, where the
+    hull would hold it at the rim."""
+    import numpy as np
+    import trimesh
+
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+    floor, rim, inner, outer, radius = 0.08, 0.6, 0.35, 0.42, 0.1  # [m]
+    profile = np.array([[0, 0], [outer, 0], [outer, rim], [inner, rim], [inner, floor], [0, floor]])
+    trimesh.creation.revolve(profile, sections=16).export(tmp_path / "cup.stl")
+    ball = (
+        '<model name="ball"><pose>0 0 1.5 0 0 0</pose><link name="b"><inertial><mass>1</mass>'
+        "<inertia><ixx>0.004</ixx><iyy>0.004</iyy><izz>0.004</izz></inertia></inertial>"
+        f'<collision name="c"><geometry><sphere><radius>{radius}</radius></sphere></geometry>'
+        "</collision></link></model>"
+    )
+    world_file = tmp_path / "cup.world"
+    _write(
+        world_file,
+        '<world name="w"><model name="cup"><static>true</static><link name="l">'
+        '<collision name="c"><geometry><mesh><uri>cup.stl</uri></mesh></geometry></collision>'
+        f"</link></model>{ball}</world>",
+    )
+    world = world_from_sdf(world_file)
+    world.step(2000)
+    z = world.get_pose("ball").z
+    assert z == pytest.approx(floor + radius, abs=0.01), f"ball centre at {z:.3f} m"
+    assert z < rim, "inside the cup, not on its hull"
