@@ -114,7 +114,15 @@ def _reader_gone() -> NoReturn:
 
 def _run_app(argv: list[str]) -> None:
     """Runs the Typer app, its click errors left to `main`'s boundary (not standalone mode)."""
-    code = build_app()(args=argv, prog_name=PROG, standalone_mode=False)
+    try:
+        code = build_app()(args=argv, prog_name=PROG, standalone_mode=False)
+    except SystemExit as exit_:
+        # rich (help pages) and click meet a closed pipe (`twin spawn --help | head -1`) by
+        # exiting 1; for twin a reader that went away is not a failure
+        pacified = type(sys.stdout).__name__.lstrip("_") == "PacifyFlushWrapper"
+        if pacified or isinstance(exit_.__context__, BrokenPipeError):
+            _reader_gone()
+        raise
     if isinstance(code, int) and code:  # click's Exit (an exit code, e.g. 130 after Ctrl-C)
         sys.exit(code)
 

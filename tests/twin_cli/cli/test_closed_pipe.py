@@ -28,7 +28,14 @@ def world(tmp_path_factory, serve_world):
 
 
 @pytest.mark.parametrize(
-    "args", [["list"], ["list", "--json"], ["stats", "-d", "0.3"], ["joints", "ball_0"]]
+    "args",
+    [
+        ["list"],
+        ["list", "--json"],
+        ["stats", "-d", "0.3"],
+        ["joints", "ball_0"],
+        ["spawn", "--help"],
+    ],
 )
 def test_a_closed_pipe_ends_the_command_with_exit_0_and_no_traceback(world, args) -> None:
     read, write = os.pipe()
