@@ -16,6 +16,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -127,8 +128,15 @@ class BagRecording(Follows):
                 self._world.remove_observer(self._handle)
                 self._handle = None
 
-    def stop(self) -> RecordingStatus:
-        """Stops sampling, lets the encoder write what is queued and close the file."""
+    def stop(self, patience: float | None = None) -> RecordingStatus:
+        """Stops sampling, lets the encoder write what is queued and close the file.
+
+        Args:
+            patience: at most this long [s] to wait for the encoder (None: as long as its
+                backlog takes). Past it the encoder is let go, not killed: it has "stop", so it
+                drains the ring, closes the file with its summary and exits on its own (a
+                server shutting down must end before `twin stop` loses patience).
+        """
         self._finish_sampling()
         if not self._closed:
             self._closed = True
@@ -139,16 +147,27 @@ class BagRecording(Follows):
                 self._send(("stop", figures))
             except OSError:
                 pass  # the encoder has ended (a full disk): its "done" may wait in the pipe
-            try:
-                while self._conn.poll(START_TIMEOUT_S + self._backlog_s()):
-                    kind, error = self._conn.recv()
-                    self._error = error or self._error  # the encoder's cause comes first
-                    if kind == "done":
-                        break
-            except (EOFError, OSError):
-                self._error = self._error or "the encoder process ended unexpectedly"
-            self._end_process()
+            wait = START_TIMEOUT_S + self._backlog_s() if patience is None else patience
+            if self._await_done(wait):
+                self._end_process()
+            else:
+                self._conn.close()
+                self._error = self._error or "the encoder finishes the file in the background"
         return self.status()
+
+    def _await_done(self, timeout: float) -> bool:
+        """Waits up to `timeout` [s] for the encoder's "done" (or its end); False: still busy."""
+        deadline = time.monotonic() + timeout
+        try:
+            while self._conn.poll(max(0.0, deadline - time.monotonic())):
+                kind, error = self._conn.recv()
+                self._error = error or self._error  # the encoder's cause comes first
+                if kind == "done":
+                    return True
+        except (EOFError, OSError):
+            self._error = self._error or "the encoder process ended unexpectedly"
+            return True
+        return False
 
     def wait(self, timeout: float | None = None) -> bool:
         """Waits until the duration is over (or `stop`); True when sampling has ended."""

@@ -7,13 +7,14 @@ never hold the stepping loop's GIL. The parent sends each layout (compiled model
 what its frames are named from; MjModel pickles) over a pipe before the first record of that
 layout, with an epoch and the ring position where its records start; then "stop" with its
 figures (time the writer waited for room), after which the ring is drained and the file closed.
-A parent that dies closes the pipe: the file is finished with what the ring holds.
+A parent that dies (even by SIGKILL, even while it waits for "done") closes the pipe, and the
+encoder is re-parented: either way the file is finished with what the ring holds, and the
+encoder exits. Idle or not, written messages reach the file within `FLUSH_PERIOD_S`.
 """
 
 from __future__ import annotations
 
 import os
-import time
 from typing import Any
 
 NICE = 10  # added niceness of the encoder process
@@ -27,25 +28,34 @@ def main(argv: list[str]) -> None:
 
     from twin_cli.record import ring
 
+    parent = os.getppid()
+    _signals()
+    _warm_up()
     ring_fd, pipe_fd, path = int(argv[0]), int(argv[1]), argv[2]
     # Below the loop's priority: on a busy machine the loop keeps its CPU and the encoder works
     # in the gaps; the ring holds the backlog (the loop waits, measured, only when it is full).
+    # Lowered only after the imports: niced on a busy machine, their second of CPU would get a
+    # tenth of a core, and every sample of that time would wait in the ring, lost to a kill.
     os.nice(NICE)
-    encode_main(ring.attach(ring_fd), Connection(pipe_fd), path)
+    encode_main(ring.attach(ring_fd), Connection(pipe_fd), path, parent)
 
 
-def encode_main(memory: Any, conn: Any, path: str) -> None:
-    """Encodes until told to stop (or the parent is gone)."""
+def encode_main(memory: Any, conn: Any, path: str, parent: int | None = None) -> None:
+    """Encodes until told to stop, or until the parent (pid `parent`) is gone; then drains the
+    ring and closes the file with its summary."""
     from twin_cli.record import ring
     from twin_cli.record.recorder import BagSink
 
     buf, head, times = ring.views(memory)
     reader = ring.RingReader(buf, head)
-    encoder = _Encoder(BagSink(path, overwrite=True), times, reader)
-    conn.send(("ready", None))
-    error = None
+    encoder = _Encoder(BagSink(path, overwrite=True), times, reader, parent)
+    error, stop = None, None
     try:
-        stop = None
+        conn.send(("ready", None))
+    except OSError:
+        pass  # let go before the imports ended: what it sent is still read, then its end
+
+    try:
         while True:
             write = int(head[ring.WRITE])  # first: the layouts of these records are sent
             stop = encoder.poll(conn)  # layouts, sensor readings, stop
@@ -53,16 +63,12 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
             for epoch, records in runs:
                 encoder.encode(epoch, records)
             head[ring.SAMPLES] = encoder.samples
-            if runs:
-                continue
-            if stop is not None and int(head[ring.READ]) < int(head[ring.WRITE]):
-                continue  # records written after `write` was read, before "stop"
-            if stop is not None and (encoder.parent_gone or not conn_pending(conn)):
-                break
-            if stop is None:
-                conn_pending(conn, IDLE_S)  # the ring fills meanwhile; a message wakes it
-            else:
-                time.sleep(IDLE_S)
+            if runs or (stop is not None and int(head[ring.READ]) < int(head[ring.WRITE])):
+                continue  # (records written after `write` was read, before "stop")
+            if stop is not None:  # never wait on the pipe after "stop": a parent that dies
+                break  # then leaves it readable (at its end) for ever
+            encoder.writer.writer.flush_if_due()  # idle: what is written reaches the file
+            conn_pending(conn, IDLE_S)  # the ring fills meanwhile; a message wakes it
     except Exception as exc:  # disk full...: report it to the parent
         error = f"{type(exc).__name__}: {exc}"
     finally:
@@ -77,10 +83,31 @@ def encode_main(memory: Any, conn: Any, path: str) -> None:
             pass
 
 
+_TERMINATED: list[int] = []  # the signal that asked this process to end, once one did
+
+
+def _signals() -> None:
+    """Ctrl-C reaches the whole foreground group: the server decides when the recording ends
+    (it sends "stop"). SIGTERM (a group or a cgroup ended) finishes the file as a stop does."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, lambda signum, frame: _TERMINATED.append(signum))
+
+
+def _warm_up() -> None:
+    """Imports (and builds rosbags' message types) at the server's priority, before `NICE`."""
+    import foxglove  # noqa: F401
+
+    from twin_cli.record import layout, messages, recorder, sensor_messages  # noqa: F401
+
+    messages.typestore()
+
+
 class _Encoder:
     """Turns records into messages with the layouts the parent sent."""
 
-    def __init__(self, writer: Any, times: Any, reader: Any) -> None:
+    def __init__(self, writer: Any, times: Any, reader: Any, parent: int | None) -> None:
         from twin_cli.record.recorder import Publisher
 
         self.writer = writer
@@ -92,6 +119,7 @@ class _Encoder:
         self._publisher = Publisher()
         self._stop: dict | None = None
         self.parent_gone = False  # its pipe closed without "stop": finish with what is in the ring
+        self._parent = parent  # its pid: re-parented means gone, even if the pipe stayed open
 
     def poll(self, conn: Any) -> dict | None:
         """Takes waiting control messages; the stop figures once the parent said stop."""
@@ -99,9 +127,16 @@ class _Encoder:
             while self._stop is None and conn.poll():
                 self._take(conn.recv())
         except (EOFError, OSError):  # the parent is gone: finish the file
-            self._stop = self._stop or {"parent": "gone"}
-            self.parent_gone = True
+            self._parent_gone()
+        if self._stop is None and self._parent is not None and os.getppid() != self._parent:
+            self._parent_gone()
+        if self._stop is None and _TERMINATED:
+            self._stop = {"signal": str(_TERMINATED[0])}
         return self._stop
+
+    def _parent_gone(self) -> None:
+        self._stop = self._stop or {"parent": "gone"}
+        self.parent_gone = True
 
     def _take(self, message: tuple) -> None:
         from twin_cli.record.layout import make_layout

@@ -9,8 +9,10 @@ plugin writes: profile `ros2`, one `ros2msg` schema per message type (rosbags' d
 `topic_type_hash`, and a closing `rosbag2` metadata record (the bag's metadata.yaml, version 9,
 read by Jazzy and later only). The QoS on the channels are numbers (Humble's form, which Jazzy
 also reads), those in the metadata record names (Jazzy's form for version 9). Messages
-are in zstd chunks with CRCs; a chunk is closed at least every `FLUSH_PERIOD_S` of wall time and
-handed to the OS, so a server killed with SIGKILL leaves a file readable up to its last chunk.
+are in zstd chunks with CRCs; a chunk is closed and handed to the OS once `FLUSH_PERIOD_S` of wall
+time or of sim time (the messages' stamps) has passed since the last, and by `flush_if_due` when
+no message comes (an idle encoder), so a server killed with SIGKILL leaves a file that a
+streaming reader reads up to its last chunk: at most about a second of sim time is lost.
 """
 
 from __future__ import annotations
@@ -30,7 +32,9 @@ from twin_cli.record import messages as ros
 from twin_cli.record.topics import Message, Topic
 
 CHUNK_SIZE = 1 << 20  # [B] a chunk closes when its content exceeds this
-FLUSH_PERIOD_S = 1.0  # [s] wall time: at most this much data is lost to a SIGKILL
+FLUSH_PERIOD_S = 1.0  # [s] of wall or sim time: at most this much data is lost to a SIGKILL
+FLUSH_MIN_S = 0.25  # [s] wall: an unthrottled world's chunks still hold several sim seconds
+_FLUSH_NS = int(FLUSH_PERIOD_S * 1e9)
 BAG_VERSION = 9  # rosbag2 metadata version of Jazzy (QoS written as names, not numbers)
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}  # rmw's "infinite" duration
 # QoS policies as rmw's enum values (what rosbag2 before Jazzy reads and writes) and names
@@ -123,7 +127,9 @@ class BagWriter:
         self._topics: dict[str, Topic] = {}
         self._counts: dict[str, int] = {}
         self._span = [2**63 - 1, 0]  # first and last log time [ns]
-        self._flushed = time.monotonic()
+        self._flushed = time.monotonic()  # wall time of the last flush
+        self._flushed_stamp = 0  # [ns] the stamp of the last message before it
+        self._dirty = False  # messages written since the last flush
         self.custom_data: dict[str, str] = {}  # rosbag2 metadata's custom_data (figures)
 
     def add_topic(self, topic: Topic) -> None:
@@ -152,14 +158,24 @@ class BagWriter:
             span[0] = stamp
         if stamp > span[1]:
             span[1] = stamp
-        if time.monotonic() - self._flushed > FLUSH_PERIOD_S:
+        self._dirty = True
+        wall = time.monotonic() - self._flushed
+        if wall > FLUSH_PERIOD_S or (
+            abs(stamp - self._flushed_stamp) > _FLUSH_NS and wall > FLUSH_MIN_S
+        ):
+            self._flushed_stamp = stamp
+            self.flush()
+
+    def flush_if_due(self) -> None:
+        """Flushes messages written more than `FLUSH_PERIOD_S` ago (for a writer that idles)."""
+        if self._dirty and time.monotonic() - self._flushed > FLUSH_PERIOD_S:
             self.flush()
 
     def flush(self) -> None:
         """Closes the chunk in progress and hands everything written so far to the OS."""
         with self._file.checked():
             self._writer.flush()
-        self._flushed = time.monotonic()
+        self._flushed, self._dirty = time.monotonic(), False
 
     @property
     def message_count(self) -> int:

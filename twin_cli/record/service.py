@@ -19,6 +19,8 @@ from twin_cli.record.recorder import Recording
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
 
+SHUTDOWN_WAIT_S = 5.0  # [s] a server's shutdown waits this long at most for its encoder
+
 
 class Consumers:
     """One server's recording and live stream; start/stop are thread safe."""
@@ -138,9 +140,10 @@ class Consumers:
         return out
 
     def close(self) -> None:
-        """Stops both (server shutdown): the recording's file gets its summary."""
+        """Stops both (server shutdown): the recording's file gets its summary, from the
+        encoder, which finishes it on its own if it takes longer than `SHUTDOWN_WAIT_S`."""
         if self.recording is not None:
-            self.recording.stop()
+            self.recording.stop(patience=SHUTDOWN_WAIT_S)
             self.recording = None
         if self.live is not None:
             self.live[0].stop()
