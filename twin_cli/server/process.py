@@ -252,6 +252,8 @@ def serve(opts: ServeOptions) -> None:
             with contextlib.suppress(KeyboardInterrupt):
                 server.run(sockets=sockets)
         finally:
+            # already ending: a second SIGTERM (twin stop's) must not cut the cleanup short
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)
             _close_views(app)
             consumers.close()
             saver.close()
