@@ -16,7 +16,8 @@ import stat
 import tempfile
 from pathlib import Path
 
-PRIVATE = 0o600
+PRIVATE = 0o600  # a save or snapshot: a world's state
+REPORT = 0o644  # a report (JUnit, Markdown): meant to be read by CI and colleagues
 
 
 class OutputFileError(OSError):
@@ -27,6 +28,9 @@ class OutputFileError(OSError):
         self.filename = str(path)
         self.problem = problem
         self.fix = fix
+
+    def __str__(self) -> str:  # OSError's own would show "[Errno None]"
+        return f"{self.filename}: {self.problem}; {self.fix}"
 
 
 def checked_target(path: str | os.PathLike) -> Path:

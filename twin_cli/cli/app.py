@@ -57,13 +57,14 @@ def __getattr__(name: str) -> Any:
 
 
 def _known(exc: Exception) -> bool:
-    """Whether `exc` is a TwinError or ConversionError, whose message is meant for the user.
+    """Whether `exc` is a TwinError, OutputFileError or ConversionError, meant for the user.
 
     `converters.errors` is imported only here, on the error path (~14 ms a command saves).
     """
     from twin_cli.errors import TwinError
+    from twin_cli.output_files import OutputFileError
 
-    if isinstance(exc, TwinError):
+    if isinstance(exc, TwinError | OutputFileError):
         return True
     from converters.errors import ConversionError
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -207,3 +209,33 @@ def test_start_posture_reaches_the_standing_check():
     (check,) = json.loads(lean.stdout)["checks"]
     assert check["value"] > 0.05, f"leaning robot slipped only {check['value']} m"
     assert "tips over" in " ".join(check["hints"]), check["hints"]
+
+
+@pytest.mark.parametrize("kind", ["directory", "fifo"])
+def test_a_report_target_that_is_not_a_regular_file_exits_2_before_any_check(tmp_path, kind):
+    """`--junit` naming a directory or a pipe is refused at once, naming it, and left as it was
+    (a rename over it would have replaced it; a write to a pipe with no reader would hang)."""
+    target = tmp_path / "report.xml"
+    if kind == "directory":
+        target.mkdir()
+        (target / "kept").write_text("x")
+    else:
+        os.mkfifo(target)
+    done = twin(scenarios.HUMANOID, "--junit", target)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "report.xml" in done.stderr and "regular file" in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and "humanoid" not in done.stdout, "no check ran"
+    if kind == "directory":
+        assert (target / "kept").read_text() == "x"
+    else:
+        assert stat.S_ISFIFO(target.lstat().st_mode)
+
+
+def test_reports_are_written_atomically_and_readable_by_others(tmp_path):
+    junit = tmp_path / "r" / "v.xml"
+    junit.parent.mkdir()
+    done = twin(scenarios.HUMANOID, "--only", "inertial", "--junit", junit)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert ET.parse(junit).getroot().find("testsuite") is not None
+    assert stat.S_IMODE(junit.stat().st_mode) == 0o644
+    assert sorted(p.name for p in junit.parent.iterdir()) == ["v.xml"], "no temporary file left"

@@ -7,7 +7,14 @@ from typing import Annotated, Any
 
 import typer
 
-from twin_cli.cli.commands.validate_sweep import JobsOpt, RayOpt, SweepOpt, run_sweep
+from twin_cli.cli.commands.validate_sweep import (
+    JobsOpt,
+    RayOpt,
+    SweepOpt,
+    check_report_targets,
+    run_sweep,
+    write_report,
+)
 from twin_cli.cli.options import (
     ArgOpt,
     JointOpt,
@@ -95,6 +102,7 @@ def validate(
     from twin_cli.validate import video as films
     from twin_cli.validate.runner import validate as run_validation
 
+    check_report_targets(junit, markdown)
     if sweep or len(robots) > 1 or jobs is not None or ray is not None:
         if video or record:
             raise typer.BadParameter(
@@ -142,15 +150,14 @@ def validate(
     else:
         print_table(run, out)
     if junit:
-        junit.write_text(render.junit_xml(run), encoding="utf-8")
+        write_report(junit, render.junit_xml(run))
     if markdown:
-        markdown.parent.mkdir(parents=True, exist_ok=True)
         linked = None
         if plots:  # linked from where the Markdown file is, if the plots are below it
             base = markdown.resolve().parent
             target = plots.resolve()
             linked = str(target.relative_to(base)) if target.is_relative_to(base) else str(target)
-        markdown.write_text(render.markdown(run, plots=linked), encoding="utf-8")
+        write_report(markdown, render.markdown(run, plots=linked))
     if plots:
         for path in render.write_plots(run, plots):
             out.line(f"plot: {path}")

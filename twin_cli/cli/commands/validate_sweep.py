@@ -57,20 +57,35 @@ def run_sweep(
     else:
         _print_matrix(result, out)
     if junit:
-        _write(junit, render.junit_xml(result))
+        write_report(junit, render.junit_xml(result))
     if markdown:
-        _write(markdown, render.markdown(result))
+        write_report(markdown, render.markdown(result))
     if plots:
         path = render.write_margin_plot(result, Path(plots) / "sweep_margins.png")
         out.line(f"plot: {path}")
     raise typer.Exit(result.exit_code)
 
 
-def _write(path: Path, text: str) -> None:
-    """Write atomically: a temporary file beside the target, then a rename."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
+def check_report_targets(*paths: Path | None) -> None:
+    """Refuses a report path that is a directory, device or pipe before any check runs (its
+    Markdown folder is made): a long run must not end in a file it cannot write.
+
+    Raises:
+        OutputFileError: exit 2, naming the path.
+    """
+    from twin_cli.output_files import checked_target
+
+    for path in paths:
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            checked_target(path)
+
+
+def write_report(path: Path, text: str) -> None:
+    """Atomically, to a regular file only (`twin_cli.output_files`), readable by others."""
+    from twin_cli.output_files import REPORT, write_atomically
+
+    write_atomically(path, text.encode("utf-8"), REPORT)
 
 
 class _progress:
