@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
@@ -19,13 +21,16 @@ START_TIMEOUT_S = 60.0  # [s] a cold start imports mujoco and FastAPI on a loade
 
 @contextmanager
 def served_world(
-    runtime_dir: Path, world: str, *serve_args: str
+    runtime_dir: Path, world: str, *serve_args: str, new_session: bool = False
 ) -> Iterator[tuple[Client, subprocess.Popen]]:
     """Runs `twin serve --world <world> <serve_args>` with its runtime files in `runtime_dir`.
 
     Yields a connected client and the server process; on exit closes the client, sends SIGTERM
-    and waits for the process (its output goes to `runtime_dir/serve.out`).
+    and waits for the process (its output goes to `runtime_dir/serve.out`). `new_session`: the
+    server leads its own process group (what a terminal's Ctrl-C reaches), and the whole group,
+    encoder included, is killed on exit whatever the test did to it.
     """
+    runtime_dir.mkdir(parents=True, exist_ok=True)
     patch = pytest.MonkeyPatch()
     patch.setenv(runtime.RUNTIME_ENV, str(runtime_dir))
     env = {**os.environ, runtime.RUNTIME_ENV: str(runtime_dir)}
@@ -35,6 +40,7 @@ def served_world(
             stdout=log,
             stderr=log,
             env=env,
+            start_new_session=new_session,
         )
     client = Client(world)
     try:
@@ -42,7 +48,11 @@ def served_world(
         yield client, proc
     finally:
         client.close()
-        proc.terminate()
+        if new_session:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, signal.SIGKILL)
+        else:
+            proc.terminate()
         proc.wait(timeout=20)
         patch.undo()
 

@@ -11,8 +11,6 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -24,41 +22,12 @@ from twin_cli.server.client import Client
 HUMANOID = str(scenarios.HUMANOID)
 STOP_PATIENCE_S = 15.0  # [s] `twin stop` escalates to SIGTERM after this
 LOST_MAX_S = 2.0  # [s] of sim time a SIGKILL of every twin process may lose, on any topic
-START_TIMEOUT_S = 60.0
 
 
 def _twin(runtime_dir: Path, *args: str) -> subprocess.CompletedProcess:
     env = {**os.environ, runtime.RUNTIME_ENV: str(runtime_dir)}
     cmd = [sys.executable, "-m", "twin_cli.cli.app", *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=120, env=env)
-
-
-@contextmanager
-def _server(runtime_dir: Path, world: str, *args: str) -> Iterator[tuple[Client, subprocess.Popen]]:
-    """`twin serve` in its own session (its process group is what a terminal's Ctrl-C hits),
-    killed with its whole group on exit whatever the test did."""
-    runtime_dir.mkdir(exist_ok=True)
-    patch = pytest.MonkeyPatch()
-    patch.setenv(runtime.RUNTIME_ENV, str(runtime_dir))
-    env = {**os.environ, runtime.RUNTIME_ENV: str(runtime_dir)}
-    with open(runtime_dir / "serve.out", "wb") as log:
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", world, *args],
-            stdout=log,
-            stderr=log,
-            env=env,
-            start_new_session=True,
-        )
-    client = Client(world)
-    try:
-        runtime.wait_until(client.paths, client.alive, proc, START_TIMEOUT_S)
-        yield client, proc
-    finally:
-        client.close()
-        for pid in (*_descendants(proc.pid), proc.pid):
-            _kill(pid)
-        proc.wait(timeout=20)
-        patch.undo()
 
 
 def _kill(pid: int) -> None:
@@ -151,13 +120,13 @@ ENDINGS = ["twin stop", "SIGTERM", "SIGINT to the group", "SIGTERM to the group"
 
 @pytest.mark.parametrize("ending", ENDINGS)
 def test_a_recording_world_that_is_stopped_leaves_a_finished_file_and_no_process(
-    tmp_path: Path, ending: str
+    tmp_path: Path, ending: str, serve_world
 ) -> None:
     """Recording from the start (`--record`), a humanoid spawned: however the world is asked to
     end, it ends well within `twin stop`'s patience, the file has its summary and rosbag2
     metadata, and no encoder is left behind. A signal to the group reaches the encoder too."""
     out, rt = tmp_path / "run.mcap", tmp_path / "rt"
-    with _server(rt, "ends", "--record", str(out)) as (client, proc):
+    with serve_world(rt, "ends", "--record", str(out), new_session=True) as (client, proc):
         client.spawn(HUMANOID, name="h", pose={"z": 1.0})
         encoder = _encoder_of(proc.pid)
         _wait_sim(client, 1.0)
@@ -257,7 +226,7 @@ def test_a_bag_is_flushed_every_second_of_sim_time_and_when_idle(tmp_path):
 
 
 def test_a_sigkill_of_every_twin_process_on_a_loaded_machine_loses_under_two_seconds(
-    tmp_path: Path,
+    tmp_path: Path, serve_world
 ) -> None:
     """Two busy processes take both cores; the recording starts on them (the encoder imports
     under load), runs at factor 1 for six seconds of sim time, and server and encoder are
@@ -266,7 +235,7 @@ def test_a_sigkill_of_every_twin_process_on_a_loaded_machine_loses_under_two_sec
     out, rt = tmp_path / "killed.mcap", tmp_path / "rt"
     busy = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(2)]
     try:
-        with _server(rt, "killall") as (client, proc):
+        with serve_world(rt, "killall", new_session=True) as (client, proc):
             client.spawn(HUMANOID, name="h", pose={"z": 1.0})
             client.request("POST", "/record", body={"path": str(out), "rate": 100})
             sim = _wait_sim(client, 6.0)
