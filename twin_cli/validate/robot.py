@@ -38,14 +38,12 @@ def load_robot(
     Raises:
         ConversionError: the description cannot be converted (exit 2 at the CLI).
     """
-    import mujoco
 
     from converters.report import Report
 
     path = Path(path)
     if path.suffix.lower() == ".xml":
-        spec = mujoco.MjSpec.from_file(str(path))
-        return _robot(spec, Report(source=str(path)), path, repair_inertia, {})
+        return _robot(_mjcf_spec(path), Report(source=str(path)), path, repair_inertia, {})
     from converters.collision.plan import CollisionSettings
     from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
@@ -56,6 +54,27 @@ def load_robot(
     )
     done = convert_full(path, args=args, package_paths=package_paths, options=options)
     return robot_from_conversion(done, path, repair_inertia=repair_inertia)
+
+
+def _mjcf_spec(path: Path) -> mujoco.MjSpec:
+    """An MJCF robot's spec; a missing or malformed file is the user's input error (exit 2).
+
+    Raises:
+        InputFileError: naming the file, and MuJoCo's parse message.
+    """
+    import mujoco
+
+    from converters.errors import InputFileError
+
+    if not path.is_file():
+        raise InputFileError(
+            str(path), "no such file", "give the path of an MJCF, URDF or SDF file"
+        )
+    try:
+        return mujoco.MjSpec.from_file(str(path))
+    except ValueError as exc:
+        message = " ".join(str(exc).split())
+        raise InputFileError(str(path), f"not valid MJCF ({message})", "fix the file") from exc
 
 
 def robot_from_conversion(

@@ -154,6 +154,7 @@ def test_user_scenario_thresholds_decide_pass_or_fail(tmp_path):
     ("args", "needle"),
     [
         (["no_such_robot.urdf"], "no such file"),
+        (["no_such_robot.xml"], "no_such_robot.xml: no such file"),
         ([str(scenarios.HUMANOID), "--only", "levitation"], "unknown validation check"),
         ([str(scenarios.HUMANOID), "--scenario", "nope"], "no such scenario"),
         ([str(scenarios.HUMANOID), "--arg", "foot_mu"], "NAME:=VALUE"),
@@ -163,6 +164,15 @@ def test_malformed_input_exits_2_with_a_message(args, needle):
     done = twin(*args)
     assert done.returncode == 2, done.stdout + done.stderr
     assert needle in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_malformed_mjcf_exits_2_naming_the_file_and_the_line(tmp_path):
+    robot = tmp_path / "broken.xml"
+    robot.write_text('<mujoco><worldbody><body><geom size="0.1"/></worldbody></mujoco>')
+    done = twin(robot)
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "broken.xml: not valid MJCF" in done.stderr and "Line number=1" in done.stderr
+    assert "Traceback" not in done.stderr and "internal error" not in done.stderr, done.stderr
 
 
 def test_malformed_scenario_file_exits_2_naming_file_and_key(tmp_path):
