@@ -76,6 +76,7 @@ class TrajectoryFollower:
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
             self._block = _References(trajectory, self.start, rate)
+            self._period = 1.0 / UPDATE_RATE  # [s] ahead of the reference each target is
             self._max: np.ndarray | None = None  # the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)
 
@@ -112,19 +113,20 @@ class TrajectoryFollower:
         if done:
             self.report.final_error = dict(zip(names, errors.tolist(), strict=True))
         self.report.elapsed = t
-        self._write(nxt, speed)
+        self._write(reference, nxt, speed)
         if done:
             self.stop()
 
-    def _write(self, positions: np.ndarray, speeds: np.ndarray) -> None:
+    def _write(self, reference: np.ndarray, positions: np.ndarray, speeds: np.ndarray) -> None:
         """Moves each position servo's target and damping reference: ctrl and the bias constant.
 
-        Only those two numbers change (see actuation.apply_command), written as arrays; actuator
+        Only those numbers change (see twin_cli.world.servos.follow), written as arrays; actuator
         ids and gains are looked up again after a recompile. The world's command records get the
         last reference when the follower stops.
         """
         import numpy as np
 
+        from twin_cli.world.servos import follow
         from twin_cli.world.sleeping import wake_actuated
 
         world = self.world
@@ -136,9 +138,9 @@ class TrajectoryFollower:
             gear[gear == 0] = 1.0
             self._kv = np.array([c.kv for c in commands]) / gear
             self._hold = np.array([c.hold for c in commands]) / gear
-        world.data.ctrl[self._ids] = positions
+        bias = self._kv * speeds + self._hold
+        follow(world.model, world.data, self._ids, (reference, positions, self._period), bias)
         wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
-        world.model.actuator_biasprm[self._ids, 0] = self._kv * speeds + self._hold
         self._last = (positions, speeds)
 
     def _record_last(self) -> None:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin_cli.world import sleeping
+from twin_cli.world import servos, sleeping
 
 MODES = ("position", "velocity", "effort")
 ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
@@ -44,8 +44,10 @@ class JointCommand:
         velocity_limit: the joint's velocity limit [rad/s or m/s] (inf when none).
         feedforward: velocity the position servo's damping tracks [rad/s or m/s] (trajectories).
         rule: where the gains came from (`twin joints` shows it).
-        hold: constant force [N m or N] the position servo adds: the gravity load of the target
-            posture (fixed-base entities).
+        hold: force [N m or N] the position servo adds at its target: the gravity load of the
+            target posture (fixed-base entities). hold_slope: [N m/rad or N/m] how that force
+            changes with the joint's position, so that it is the start posture's load at the
+            start of a move (`twin_cli.world.servos`).
     """
 
     actuator: str
@@ -58,6 +60,7 @@ class JointCommand:
     feedforward: float = 0.0
     rule: str = ""
     hold: float = 0.0
+    hold_slope: float = 0.0
 
 
 def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
@@ -111,8 +114,14 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
     model.actuator_ctrllimited[a] = 0
     model.actuator_forcelimited[a] = int(math.isfinite(limit))
     model.actuator_forcerange[a] = (-limit, limit) if math.isfinite(limit) else (0.0, 0.0)
+    reference = servos.has_reference(model, a)
     if cmd.mode == "effort":
-        _apply_effort(model, data, a, cmd, gear)
+        if reference:
+            servos.release(model, a)
+        _apply_effort(model, data, a, cmd, gear, on_bias=reference)
+        return
+    if reference:
+        servos.apply(model, data, a, cmd)
         return
     model.actuator_biastype[a] = _AFFINE
     if cmd.mode == "position":
@@ -147,21 +156,38 @@ def _apply_rotor(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointC
 
 
 def _apply_effort(
-    model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand, gear: float
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    a: int,
+    cmd: JointCommand,
+    gear: float,
+    *,
+    on_bias: bool = False,
 ) -> None:
+    """Effort u as a motor (ctrl = u), or under Gazebo's velocity rule. `on_bias`: the actuator's
+    input is its reference activation (`twin_cli.world.servos`), so the force is written as bias
+    terms alone (gain 0) and ctrl keeps u for whoever reads it."""
     u, v = cmd.target / gear, cmd.velocity_limit
     if not math.isfinite(v):
-        model.actuator_gainprm[a, 0] = 1.0
-        model.actuator_biastype[a] = _NONE
+        if on_bias:
+            model.actuator_biastype[a] = _AFFINE
+            model.actuator_biasprm[a, 0] = u
+        else:
+            model.actuator_gainprm[a, 0] = 1.0
+            model.actuator_biastype[a] = _NONE
         data.ctrl[a] = u
         return
     full = abs(cmd.target)  # the band is VELOCITY_BAND·v wide whatever the effort
     gain = max(full, 1e-9) / (VELOCITY_BAND * v) / gear
     model.actuator_biastype[a] = _AFFINE
-    model.actuator_gainprm[a, 0] = gain
     model.actuator_biasprm[a, 2] = -gain
     model.actuator_forcelimited[a] = 1
     model.actuator_forcerange[a] = (min(0.0, u), max(0.0, u))
+    if on_bias:
+        model.actuator_biasprm[a, 0] = gain * math.copysign(v, u)
+        data.ctrl[a] = u
+        return
+    model.actuator_gainprm[a, 0] = gain
     data.ctrl[a] = math.copysign(v, u)
 
 

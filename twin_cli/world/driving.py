@@ -11,10 +11,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import mujoco
+import numpy as np
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import joint_control
+from twin_cli.world import joint_control, servo_watch, servos
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -105,8 +106,12 @@ def command_joints(
         positions = {
             int(state.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
         }
-        loads = joint_control.posture_loads(state.model, state.data, positions)
-        return [_set_command(state, c, loads, ix.free_qpos < 0) for c in checked]
+        dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
+        rolling = dofs if mode == "velocity" else dofs[:0]
+        loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
+        fixed = ix.free_qpos < 0
+        start = joint_control.posture_loads(state.model, state.data, {})[1] if fixed else None
+        return [_set_command(state, c, loads, start) for c in checked]
 
 
 def _checked(
@@ -136,22 +141,46 @@ def _checked(
 
 
 def _set_command(
-    state: WorldState, checked: tuple, loads: tuple, fixed: bool
+    state: WorldState, checked: tuple, loads: tuple, start: np.ndarray | None
 ) -> control.JointCommand:
-    """Writes one checked command; a fixed-base position servo holds its target's load."""
+    """Writes one checked command. A fixed-base position servo holds the static load of the
+    posture (`start`: the loads where the entity is now; None for a free-base entity), from the
+    start posture's to the target's as the joint moves."""
     key, a, j, mode, value, effort, limits = checked
-    inertia, load = loads
+    inertia, load, carried = loads
     dof = int(state.model.jnt_dofadr[j])
-    hold = float(load[dof]) if fixed and mode == "position" else 0.0
-    step = abs(value - float(state.data.qpos[state.model.jnt_qposadr[j]]))
+    here = float(state.data.qpos[state.model.jnt_qposadr[j]])
+    hold = float(load[dof]) if start is not None and mode == "position" else 0.0
+    step = abs(value - here)
+    slope = 0.0
+    if start is not None and mode == "position" and step > 1e-9:
+        slope = (hold - float(start[dof])) / (value - here)
+    reference = servos.has_reference(state.model, a)
     kp, kv, rule = joint_control.servo_rule(
-        mode, limits, effort, float(inertia[dof]), state.model.opt.timestep, step
+        mode,
+        limits,
+        effort,
+        float(inertia[dof]),
+        state.model.opt.timestep,
+        step,
+        reference=reference,
+        carried=float(carried[dof]),
     )
     if math.isfinite(effort):
         hold = min(max(hold, -effort), effort)
-    cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold)
+    slope = min(slope, 0.5 * kp) if servos.has_reference(state.model, a) else 0.0  # stays stiff
+    previous = state.commands.get(key)
+    if reference and mode == "velocity" and previous and previous.mode == mode:
+        kp, kv, rule = previous.kp, previous.kv, previous.rule  # its integral stays what it was
+    cmd = control.JointCommand(
+        key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
+    )
+    if reference:
+        servos.start(state.model, state.data, a, mode, previous.mode if previous else "")
     control.apply_command(state.model, state.data, a, cmd)
     state.commands[key] = cmd
+    if reference and mode != "effort":
+        servo_watch.watch(state)
     return cmd
 
 

@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 from converters.description import MODES
+from twin_cli.world import servos
 
 MAX_OMEGA_DT = 0.5  # ω·dt of the position servo's spring (explicit in implicitfast: < 2)
 SPEED_MARGIN = 0.95  # position servo's design speed, as a fraction of the velocity limit
@@ -87,13 +88,26 @@ def _text_json(model: mujoco.MjModel, name: str) -> dict | None:
 
 
 def posture_loads(
-    model: mujoco.MjModel, data: mujoco.MjData, targets: dict[int, float]
-) -> tuple[np.ndarray, np.ndarray]:
-    """Reflected inertia 1/(M⁻¹)ᵢᵢ [kg m² or kg] and static load [N m or N] of every dof.
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    targets: dict[int, float],
+    dofs: np.ndarray | None = None,
+    rolling: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reflected inertia [kg m² or kg] and static load [N m or N] of every dof, and the inertia
+    each dof of `dofs` carries: with every other joint held by its servo, and for the dofs of
+    `rolling` (velocity commands: wheels, tracks) through their contacts too.
 
     Computed at rest in the posture with the position `targets` (qpos address → value) written
     over the current one, on a scratch copy so the world's data (and warm start) stays untouched.
-    The load is what holds that posture against gravity and springs: qfrc_bias − qfrc_passive.
+    The reflected inertia is 1/(M⁻¹)ᵢᵢ: what a torque at the joint accelerates, everything else
+    free. The load is what holds that posture against gravity and springs: qfrc_bias −
+    qfrc_passive. The carried inertia is Mᵢᵢ (every other joint held by its servo: an arm moving
+    all its joints at once; at most HELD_RATIO times the reflected inertia), or, if larger, what
+    a rolling joint moves through its contacts and equalities (`carried_inertia`: a wheel on the
+    ground carries its robot). Only rolling joints count their contacts: a link that lies on the
+    ground slides rather than rolls, and counted as gripping, it made an arm's position servo a
+    hundred times too soft.
     """
     scratch = mujoco.MjData(model)
     scratch.qpos[:] = data.qpos
@@ -103,19 +117,88 @@ def posture_loads(
     full = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, scratch, full)  # MuJoCo 4 signature: (m, d, dst)
     load = np.array(scratch.qfrc_bias) - np.array(scratch.qfrc_passive)
-    return 1.0 / np.diag(np.linalg.inv(full)), load
+    inverse = np.linalg.inv(full)
+    own = 1.0 / np.diag(inverse)
+    carried = own.copy()
+    if dofs is not None and len(dofs):  # every other joint held by its servo, up to a bound
+        carried[dofs] = np.minimum(np.diag(full)[dofs], HELD_RATIO * own[dofs])
+    if rolling is not None and len(rolling):
+        through = carried_inertia(model, scratch, inverse, np.asarray(rolling))
+        carried[rolling] = np.maximum(carried[rolling], through)
+    return own, load, carried
+
+
+HELD_RATIO = 3.0
+"""Most a joint's carried inertia counts from Mᵢᵢ, as a multiple of its own 1/(M⁻¹)ᵢᵢ. A fixed
+arm's Mᵢᵢ is 1-4.4 times its own (UR5e); a free-standing robot's Mᵢᵢ also counts its base as held
+(444 times for a UR5e's shoulder pan), which a servo whose damping is own/h cannot move quickly
+anyway: tuned on all of it the servo only got slower. Past the bound the damping ratio may drop to
+√(HELD_RATIO·own/Mᵢᵢ), 0.14 for that shoulder on the ground."""
+CARRIED_CONSTRAINTS = (
+    int(mujoco.mjtConstraint.mjCNSTR_EQUALITY),
+    int(mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS),
+    int(mujoco.mjtConstraint.mjCNSTR_CONTACT_PYRAMIDAL),
+    int(mujoco.mjtConstraint.mjCNSTR_CONTACT_ELLIPTIC),
+)
+MAX_CARRIED_RATIO = 1e4  # a joint its contacts lock completely counts as carrying this much
+
+
+def carried_inertia(
+    model: mujoco.MjModel, scratch: mujoco.MjData, inverse: np.ndarray, dofs: np.ndarray
+) -> np.ndarray:
+    """1/(M_c⁻¹)ᵢᵢ of each dof i of `dofs`, M_c⁻¹ = M⁻¹ − M⁻¹Jᵀ(J M⁻¹ Jᵀ)⁺J M⁻¹, where J are the
+    active contact and equality rows that move with dof i itself, held rigid (`scratch` has
+    been through mj_forward). A driven wheel that grips moves its robot with it, and a servo
+    tuned on the wheel alone rings on that load; the robot's other contacts are left free
+    (held rigid too, a wheel, a caster and a second wheel would lock the robot in place)."""
+    own = 1.0 / np.diag(inverse)[dofs]
+    if scratch.nefc == 0:
+        return own
+    jac = np.zeros((scratch.nefc, model.nv))
+    if mujoco.mj_isSparse(model):
+        mujoco.mju_sparse2dense(
+            jac, scratch.efc_J, scratch.efc_J_rownnz, scratch.efc_J_rowadr, scratch.efc_J_colind
+        )
+    else:
+        jac[:] = np.asarray(scratch.efc_J).reshape(scratch.nefc, model.nv)
+    active = np.isin(scratch.efc_type, CARRIED_CONSTRAINTS) & (
+        scratch.efc_state != int(mujoco.mjtConstraintState.mjCNSTRSTATE_SATISFIED)
+    )
+    reduced = np.diag(inverse)[dofs].copy()
+    for i, dof in enumerate(dofs):
+        rows = jac[active & (jac[:, dof] != 0)]
+        if len(rows):
+            mjt = inverse @ rows.T
+            reduced[i] -= mjt[dof] @ np.linalg.pinv(rows @ mjt, rcond=1e-10) @ mjt[dof]
+    floor = 1.0 / (MAX_CARRIED_RATIO * own)
+    return 1.0 / np.maximum(reduced, floor)
 
 
 def servo_rule(
-    mode: str, limits: JointLimits, effort: float, inertia: float, timestep: float, step: float
+    mode: str,
+    limits: JointLimits,
+    effort: float,
+    inertia: float,
+    timestep: float,
+    step: float,
+    *,
+    reference: bool = False,
+    carried: float = 0.0,
 ) -> tuple[float, float, str]:
     """(kp, kv, rule) for a command; `step` is |target − q| [rad or m] (position mode).
 
     Args:
         mode: the command's mode. limits: the motor's record. effort: effort limit [N m or N].
         inertia: reflected inertia [kg m² or kg]. timestep: [s].
+        reference: the motor tracks a reference in its activation (`twin_cli.world.servos`);
+            otherwise the older rules below (a hand-written model's own actuators).
+        carried: the inertia the joint carries through its contacts (`carried_inertia`).
     """
     pid = limits.pid.get(mode)
+    if reference:
+        speed = servos.SPEED_MARGIN * limits.velocity if step > 0 else math.inf  # inf: a hold
+        motion = (speed, step)
+        return _reference_rule(mode, pid, effort, (inertia, carried), timestep, motion)
     vmax = limits.velocity
     if mode == "position":
         kp, kv = _position_gains(inertia, timestep, step, SPEED_MARGIN * vmax)
@@ -128,6 +211,35 @@ def servo_rule(
             return 0.0, inertia / timestep, f"{rule}, capped at I/h"
         return 0.0, kv, rule
     return 0.0, 0.0, "Gazebo velocity rule" if math.isfinite(vmax) else "effort"
+
+
+def _reference_rule(
+    mode: str,
+    pid: tuple | None,
+    effort: float,
+    inertia: tuple[float, float],
+    timestep: float,
+    motion: tuple[float, float],
+) -> tuple[float, float, str]:
+    """(kp, kv, rule) of a servo on a reference: `servos.gains` unless the tag gives a PID.
+
+    `motion` is (ramp speed, step) of a position command. A tag's damping above I/h is capped
+    there when the joint has an effort limit (a clamped step is explicit, see `_velocity_gain`);
+    its stiffness is used as written.
+    """
+    if mode == "effort":
+        return 0.0, 0.0, "effort"
+    own = inertia[0]
+    kp, kv = servos.gains(mode, inertia, timestep, effort, *motion)
+    rule = "carried inertia"
+    if pid and mode == "position":
+        kp, kv, rule = pid[0], max(pid[2], 2.0 * math.sqrt(pid[0] * own)), "tag PID (pos_*)"
+    elif pid:
+        kp = pid[1] if pid[1] > 0 else kp
+        kv, rule = pid[0], "tag PID (vel_kp" + (", vel_ki)" if pid[1] > 0 else ")")
+    if pid and math.isfinite(effort) and kv > own / timestep:
+        kv, rule = own / timestep, f"{rule}, damping capped at I/h"
+    return kp, kv, rule
 
 
 def _velocity_gain(

@@ -95,6 +95,7 @@ class SavedCommand(Strict):
     feedforward: Finite = 0.0
     rule: str = ""
     hold: Finite = 0.0
+    hold_slope: Finite = 0.0
 
 
 class SavedPush(Strict):

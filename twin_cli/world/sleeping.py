@@ -66,3 +66,17 @@ def wake_actuated(model: mujoco.MjModel, data: mujoco.MjData, actuators: Iterabl
     """Wakes the trees that `actuators` move, when any tree sleeps (cheap otherwise)."""
     if data.ntree_awake < model.ntree:
         wake_trees(data, actuator_trees(model, actuators))
+
+
+def hold_awake(model: mujoco.MjModel, trees: Iterable[int], awake: bool) -> None:
+    """Keeps `trees` from sleeping while a servo moves them (`awake`), or lets them sleep again.
+
+    A servo that ramps its reference from where the joint is (`twin_cli.world.servos`) starts
+    with almost no force, so a tree woken by the command fell asleep again within its first
+    steps and never moved. Only the automatic policies are switched; a policy the model states
+    is kept.
+    """
+    policy = model.tree_sleep_policy
+    for tree in trees:
+        if 0 <= tree < len(policy) and int(policy[tree]) in (AUTO_NEVER, AUTO_ALLOWED):
+            policy[tree] = AUTO_NEVER if awake else AUTO_ALLOWED

@@ -18,7 +18,7 @@ import numpy as np
 from converters.mjcf.world_rules import min_friction_priorities
 from twin_cli.errors import InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest
-from twin_cli.world import shared_meshes
+from twin_cli.world import servos, shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
@@ -257,12 +257,14 @@ def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | No
     """Makes `child` safe to attach; returns its `home` keyframe qpos (its own layout) or None.
 
     Names every unnamed body, joint, actuator and equality (state moves by name, and an unnamed
-    free joint cannot be found again), adopts the world's global settings, and removes the
+    free joint cannot be found again), gives its motors a servo reference, adopts the world's
+    global settings, and removes the
     child's keyframes: attached keyframes get lost or collide ("repeated name 'home'"), so the
     home pose is read here and seeded by the world instead.
     """
     _name_unnamed(child)
     min_friction_priorities(child)  # Gazebo's min-μ rule, as the exported scene has it
+    servos.give_reference(child)  # motors hold their targets under load (servos module)
     adopt_world_globals(child, world)
     if len(child.keys) == 0:
         return None

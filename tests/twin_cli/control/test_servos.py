@@ -1,0 +1,116 @@
+"""Joint servos against Gazebo's joint motor: a velocity held under load while the effort limit
+allows, saturation at that limit beyond it, a zero command that holds, and position moves at the
+velocity limit without overshoot. Oracles: the commanded values, Newton's law on the disc
+(I·dω/dt = load − effort when overloaded), and the move's own geometry (Δ/v)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from models import _control_inertial, write_urdf
+
+from twin_cli.world import Pose, World
+
+EFFORT = 0.1  # [N m] the wheel's effort limit
+MOMENT = 1e-3  # [kg m²] the disc's moment about its axle
+SPEED = 3.0  # [rad/s] the command
+
+
+def _wheel(moment: float = MOMENT) -> str:
+    """A disc on a continuous joint 'spin' (effort EFFORT, 10 rad/s) above a fixed base."""
+    return f"""<robot name="w"><link name="world"/>
+<link name="base">{_control_inertial(1, 1)}</link>
+<link name="disc">{_control_inertial(0.2, moment)}</link>
+<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="spin" type="continuous"><parent link="base"/><child link="disc"/>
+  <axis xyz="0 0 1"/><limit effort="{EFFORT}" velocity="10"/></joint>
+<ros2_control name="r" type="system"><joint name="spin">
+  <command_interface name="velocity"/><command_interface name="position"/>
+</joint></ros2_control></robot>"""
+
+
+def _arm(effort: float) -> str:
+    """A 1 kg bob 0.2 m out on hinge 'j' about y (±3 rad, `effort`, 1 rad/s), under gravity."""
+    return f"""<robot name="a"><link name="world"/>
+<link name="base">{_control_inertial(1, 1)}</link>
+<link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+  <limit lower="-3" upper="3" effort="{effort}" velocity="1"/></joint></robot>"""
+
+
+def _speeds(world: World, n: int, every: int = 10) -> np.ndarray:
+    out = []
+    for _ in range(n):
+        world.step(every)
+        out.append(world.joint_states("w")[0].velocity)
+    return np.array(out)
+
+
+def _load(world: World, torque: float) -> None:
+    """A torque [N m] about the axle on the disc, held (a push that outlasts the test)."""
+    world.push("w", torque=(0.0, 0.0, torque), link="disc", duration=1e3)
+
+
+@pytest.fixture
+def wheel(tmp_path) -> World:
+    world = World()
+    world.spawn(write_urdf(tmp_path, _wheel()), name="w", pose=Pose(z=1.0))
+    world.command("w", "spin", mode="velocity", value=SPEED)
+    world.step(500)
+    return world
+
+
+def test_a_wheel_holds_its_speed_under_half_its_effort_limit(wheel: World) -> None:
+    _load(wheel, -EFFORT / 2)
+    speeds = _speeds(wheel, 100)  # 1 s
+    assert speeds[-50:] == pytest.approx(SPEED, rel=0.01), f"last 0.5 s: {speeds[-50:]}"
+    assert speeds.min() > 0.9 * SPEED, f"dipped to {speeds.min():.3f} rad/s when loaded"
+
+
+def test_an_overloaded_wheel_saturates_at_its_effort_and_recovers_without_a_burst(wheel):
+    load = -1.5 * EFFORT
+    _load(wheel, load)
+    speeds = _speeds(wheel, 50)  # 0.5 s: decelerates at (load + effort)/I
+    slope = np.polyfit(np.arange(10, 50) * 0.01, speeds[10:], 1)[0]
+    assert slope == pytest.approx((load + EFFORT) / MOMENT, rel=0.02), "I·dω/dt = load + effort"
+    _load(wheel, -load)  # the load removed (the pushes add up to 0)
+    after = _speeds(wheel, 200)
+    assert after.max() < 1.05 * SPEED, f"a catch-up burst to {after.max():.2f} rad/s"
+    assert after[-20:] == pytest.approx(SPEED, rel=0.01)
+
+
+def test_a_zero_velocity_command_holds_the_wheel_still_under_load(wheel: World) -> None:
+    wheel.command("w", "spin", mode="velocity", value=0.0)
+    wheel.step(200)
+    _load(wheel, -EFFORT / 2)
+    wheel.step(500)
+    start = wheel.joint_states("w")[0].position
+    wheel.step(2000)
+    state = wheel.joint_states("w")[0]
+    assert abs(state.position - start) < 1e-6 and abs(state.velocity) < 1e-6, state
+
+
+@pytest.mark.parametrize("effort", [50.0, 5.0])
+def test_a_position_move_runs_at_the_velocity_limit_and_settles_without_overshoot(
+    tmp_path, effort
+) -> None:
+    world = World()
+    world.spawn(write_urdf(tmp_path, _arm(effort)), name="a", pose=Pose(z=1.0))
+    world.command("a", "j", mode="position", value=0.0)
+    world.step(1000)
+    world.command("a", "j", mode="position", value=1.0)
+    q, v = [], []
+    for _ in range(2500):
+        world.step(1)
+        state = world.joint_states("a")[0]
+        q.append(state.position)
+        v.append(state.velocity)
+    q = np.array(q)
+    outside = np.flatnonzero(np.abs(q - 1.0) > 0.01)
+    settle = (outside[-1] + 2) * 1e-3 if len(outside) else 0.0
+    assert settle < 1.5, f"settled within 1 % after {settle:.3f} s (a 1 rad move at 1 rad/s)"
+    assert q.max() - 1.0 < 0.01, f"overshoot {q.max() - 1.0:.4f} rad"
+    assert max(v) <= 1.0, f"peak speed {max(v):.3f} rad/s over the 1 rad/s limit"
+    assert q[-1] == pytest.approx(1.0, abs=1e-4), "holds its target under gravity"
