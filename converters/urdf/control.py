@@ -20,6 +20,7 @@ from converters.description import (
     CommandInterface,
     JointControl,
     PidGains,
+    merge_controls,
 )
 from converters.errors import URDFStructureError
 
@@ -28,24 +29,24 @@ PID_INTERFACES = {"position_pid": ("position", "pos_"), "velocity_pid": ("veloci
 
 
 def read_controls(root: ET.Element, source: str) -> tuple[JointControl, ...]:
-    """Every joint's declared command interfaces: `<ros2_control>` first, then transmissions.
-
-    A joint named by both keeps the `<ros2_control>` record (ROS 2's own tag wins).
+    """Every joint's declared command interfaces, all of them: `<ros2_control>` first, then
+    transmissions, merged per joint (`merge_controls`), since a joint may be named by several
+    transmissions and by both tags.
 
     Raises:
         URDFStructureError: a `min`/`max`/gain param that is not a number.
     """
-    out: dict[str, JointControl] = {}
+    declared: dict[str, list[JointControl]] = {}
     for block in root.iter("ros2_control"):
         where = f"<ros2_control name='{block.get('name', '')}'>"
         for joint in block.findall("joint"):
             control = _ros2_joint(joint, where, source)
-            out.setdefault(control.joint, control)
+            declared.setdefault(control.joint, []).append(control)
     for block in root.iter("transmission"):
         where = f"<transmission name='{block.get('name', '')}'>"
         for control in _transmission(block, where):
-            out.setdefault(control.joint, control)
-    return tuple(out.values())
+            declared.setdefault(control.joint, []).append(control)
+    return tuple(merge_controls(parts) for parts in declared.values())
 
 
 def _number(value: str | None, source: str, subject: str) -> float | None:
