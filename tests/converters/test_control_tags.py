@@ -132,7 +132,7 @@ def test_the_report_gives_one_modes_line_per_group_of_alike_joints(tmp_path):
 
 
 def test_panda_arm_joints_offer_position_velocity_and_effort_in_one_report_line(tmp_path):
-    from arm_models import PANDA_JOINTS, panda_arm
+    from interface_models import PANDA_JOINTS, panda_arm
 
     spec, report = convert(write_urdf(tmp_path, panda_arm()))
     model = spec.compile()

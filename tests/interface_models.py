@@ -1,8 +1,9 @@
-"""A 7-joint arm tagged as franka_description tags Franka's Panda for Gazebo (gazebo:=true).
+"""Robots whose joints declare several command interfaces, in both tag forms.
 
-The kinematics, joint limits and identified inertias are the Panda's, as franka_description
-publishes them (inertias from Gaz et al.'s identification); the meshes are left out, so the
-test needs no package. The tags are the ones that lose interfaces: three same-named
+`panda_arm()`: a 7-joint arm tagged as franka_description tags Franka's Panda for Gazebo
+(gazebo:=true). The kinematics, joint limits and identified inertias are the Panda's, as
+franka_description publishes them (inertias from Gaz et al.'s identification); the meshes are
+left out, so the test needs no package. The tags are the ones that lose interfaces: three same-named
 `<transmission>`s per arm joint (position, velocity, effort), franka_hw's state and model
 transmissions that twin cannot drive, and `libgazebo_ros_control.so`.
 """
@@ -128,3 +129,39 @@ def panda_arm() -> str:
   </plugin><self_collide>true</self_collide></gazebo>
 </robot>
 """
+
+
+def _disc(name: str) -> str:
+    # a 1 kg disc of radius 0.1 m spinning about z: I = m r²/2 = 0.005 kg m²
+    return (
+        f'<link name="{name}"><inertial><mass value="1"/><inertia ixx="0.003" iyy="0.003" '
+        f'izz="0.005" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    )
+
+
+# Three discs on vertical axes (no gravity load), fixed to `world`, effort 5 N m, 4 rad/s:
+# d0 by <ros2_control> (position bounded to ±1, velocity) and a transmission (effort);
+# d1 by one transmission only (position); d2 by one transmission naming two interfaces.
+SEVERAL_INTERFACES = (
+    '<robot name="discs"><link name="world"/>'
+    '<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>'
+    + _disc("base")
+    + "".join(
+        _disc(f"disc{i}") + f'<joint name="d{i}" type="revolute"><origin xyz="{0.3 * i} 0 0.1"/>'
+        f'<parent link="base"/><child link="disc{i}"/><axis xyz="0 0 1"/>'
+        f'<limit lower="-3" upper="3" effort="5" velocity="4"/></joint>'
+        for i in range(3)
+    )
+    + """<ros2_control name="discs" type="system"><joint name="d0">
+      <command_interface name="position"><param name="min">-1</param>
+        <param name="max">1</param></command_interface>
+      <command_interface name="velocity"/><state_interface name="position"/></joint>
+    </ros2_control>"""
+    + _transmission("d0", "EffortJointInterface")
+    + _transmission("d1", "PositionJointInterface")
+    + """<transmission name="d2_both"><type>transmission_interface/SimpleTransmission</type>
+      <joint name="d2"><hardwareInterface>VelocityJointInterface</hardwareInterface>
+      <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+      <actuator name="d2_motor"/></transmission>
+    <gazebo><plugin name="control" filename="libgazebo_ros2_control.so"/></gazebo></robot>"""
+)
