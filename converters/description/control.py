@@ -70,6 +70,8 @@ class JointControl:
         interfaces: the modes it accepts, first one first (the tag's order).
         gains: mode → PID gains from the tag (position_pid / velocity_pid only).
         where: the tag, for messages (e.g. `<ros2_control name='arm'>`).
+        ignored: interfaces it declares that twin does not drive (acceleration, gpio,
+            franka_hw/FrankaStateInterface...), as written, for the report.
     """
 
     joint: str
@@ -77,6 +79,7 @@ class JointControl:
     interfaces: tuple[CommandInterface, ...]
     gains: tuple[tuple[str, PidGains], ...] = ()
     where: str = ""
+    ignored: tuple[str, ...] = ()
 
     @property
     def modes(self) -> tuple[str, ...]:
@@ -92,7 +95,7 @@ def merge_controls(parts: Sequence[JointControl]) -> JointControl:
     (position, velocity, effort) give three modes, not the first one. A mode declared twice
     keeps its first declaration's bounds and gains (document order: `<ros2_control>` blocks,
     then transmissions). Tags that declare no mode twin drives (franka_hw's state interface)
-    add nothing.
+    add only their names to `ignored`.
 
     Args:
         parts: the joint's records, one per tag, in document order (at least one).
@@ -111,4 +114,5 @@ def merge_controls(parts: Sequence[JointControl]) -> JointControl:
         tuple(interfaces.values()),
         tuple(gains.items()),
         ", ".join(dict.fromkeys(p.where for p in declaring)),
+        tuple(dict.fromkeys(name for p in parts for name in p.ignored)),
     )

@@ -70,7 +70,7 @@ def _params(element: ET.Element) -> dict[str, str]:
 def _ros2_joint(joint: ET.Element, where: str, source: str) -> JointControl:
     name = joint.get("name", "")
     subject = f"{where} joint '{name}'"
-    interfaces, gains = [], []
+    interfaces, gains, ignored = [], [], []
     for element in joint.findall("command_interface"):
         kind = element.get("name", "")
         params = _params(element)
@@ -82,7 +82,11 @@ def _ros2_joint(joint: ET.Element, where: str, source: str) -> JointControl:
             gains.append((mode, _gains(_params(joint), prefix, source, subject)))
         elif kind in MODES:
             interfaces.append(CommandInterface(kind, low, high))
-    return JointControl(name, "ros2_control", tuple(interfaces), tuple(gains), where)
+        else:
+            ignored.append(kind)
+    return JointControl(
+        name, "ros2_control", tuple(interfaces), tuple(gains), where, tuple(ignored)
+    )
 
 
 def _gains(params: dict[str, str], prefix: str, source: str, subject: str) -> PidGains:
@@ -98,9 +102,13 @@ def _transmission(block: ET.Element, where: str) -> list[JointControl]:
     out = []
     for joint in block.findall("joint"):
         named = [(h.text or "").strip() for h in joint.findall("hardwareInterface")]
-        modes = [_mode(h) for h in (named or actuator)]
-        interfaces = tuple(CommandInterface(m) for m in dict.fromkeys(m for m in modes if m))
-        out.append(JointControl(joint.get("name", ""), "transmission", interfaces, (), where))
+        modes = {h: _mode(h) for h in (named or actuator)}
+        interfaces = tuple(
+            CommandInterface(m) for m in dict.fromkeys(m for m in modes.values() if m)
+        )
+        ignored = tuple(h for h, m in modes.items() if m is None and h)
+        name = joint.get("name", "")
+        out.append(JointControl(name, "transmission", interfaces, (), where, ignored))
     return out
 
 

@@ -145,3 +145,23 @@ def test_panda_arm_joints_offer_position_velocity_and_effort_in_one_report_line(
     assert len(lines) == 1 and lines[0].subject.startswith("7 joints 'panda_joint1'"), lines
     assert lines[0].detail.startswith("position, velocity, effort from <transmission>;"), lines
     assert "libgazebo_ros_control.so" in lines[0].detail, lines
+
+
+def test_interfaces_twin_does_not_drive_are_reported_as_ignored(tmp_path):
+    tags = (
+        """<ros2_control name="arm" type="system"><joint name="j0">
+          <command_interface name="acceleration"/></joint></ros2_control>"""
+        + _transmission("j1", "hardware_interface/EffortJointInterface")
+        + _transmission("j1", "franka_hw/FrankaStateInterface").replace("t_j1", "state")
+    )
+    _, report = convert(write_urdf(tmp_path, f'<robot name="r">{LINKS}{tags}</robot>'))
+    ignored = {e.subject: e.detail for e in report.entries if e.outcome.value == "ignored"}
+    assert set(ignored) == {
+        "joint 'j0' interfaces acceleration",
+        "joint 'j1' interfaces franka_hw/FrankaStateInterface",
+    }, ignored
+    modes = {e.subject: e.detail for e in report.entries if "command modes" in e.subject}
+    assert modes["joint 'j0' command modes"].startswith(
+        "position, velocity, effort (its tags declare none twin drives)"
+    ), modes
+    assert modes["joint 'j1' command modes"].startswith("effort from <transmission>"), modes
