@@ -178,6 +178,14 @@ def _check_points(world: World, entity: str, trajectory: Trajectory) -> None:
         if j < 0:
             continue  # command_joints names the unknown joint with the known ones
         limits = limits_of(model, entity, joint)
+        if "position" not in limits.modes:
+            raise InvalidRequestError(
+                f"trajectory joint [{joint}] of [{entity}]",
+                f"its tags offer only {', '.join(limits.modes)}, and a trajectory drives "
+                "position interfaces",
+                f"leave it out of joint_names, or drive it with twin command --mode "
+                f"{limits.modes[0]}",
+            )
         low, high = allowed_range(model, j, "position", limits, math.inf)
         for k, point in enumerate(trajectory.points):
             value = point.positions[i]

@@ -10,6 +10,7 @@ from corpus_registry import CORPUS, PACKAGES_ROOT, package_paths
 from interface_models import PANDA_JOINTS, SEVERAL_INTERFACES, panda_arm
 from models import write_urdf
 
+from twin_cli.control import follow_trajectory, tracking_report, trajectory_from_dict
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError
 from twin_cli.world import Pose, World, WorldSettings
 
@@ -101,8 +102,6 @@ def test_a_switch_under_gravity_drops_the_position_servos_hold(tmp_path):
 
 
 def test_switching_a_followed_joint_stops_the_trajectory_and_keeps_the_new_command(tmp_path):
-    from twin_cli.control import follow_trajectory, tracking_report, trajectory_from_dict
-
     world = _spawn_panda(tmp_path)
     names = ["panda_joint1", "panda_joint2", "panda_joint3"]
     points = [{"positions": [0.4, 0.4, 0.4], "time_from_start": 2.0}]
@@ -140,6 +139,11 @@ def test_a_mode_the_joint_does_not_offer_is_refused_naming_the_offered_ones(tmp_
     assert (after[0] == before[0]).all() and (after[1] == before[1]).all()
     for joint, mode in (("d0", "effort"), ("d1", "position"), ("d2", "effort")):
         world.command_joints("discs", {joint: 0.1}, mode=mode)  # the offered ones work
+    points = [{"positions": [0.1], "time_from_start": 1.0}]  # JTC claims position only
+    with pytest.raises(InvalidRequestError, match=re.escape("[d2] of [discs]: its tags offer")):
+        follow_trajectory(
+            world, "discs", trajectory_from_dict({"joint_names": ["d2"], "points": points})
+        )
     modes = {j: (c["mode"], c["modes"]) for j, c in world.joint_commands("discs").items()}
     assert modes == {
         "d0": ("effort", ["position", "velocity", "effort"]),
