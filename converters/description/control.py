@@ -66,7 +66,8 @@ class JointControl:
 
     Attributes:
         joint: the joint's name.
-        source: "ros2_control" or "transmission" (which tag declared it).
+        source: "ros2_control" or "transmission" (which tag declared it); both, joined by
+            "+", once `merge_controls` has combined a joint's tags.
         interfaces: the modes it accepts, first one first (the tag's order).
         gains: mode → PID gains from the tag (position_pid / velocity_pid only).
         where: the tag, for messages (e.g. `<ros2_control name='arm'>`).
