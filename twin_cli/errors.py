@@ -117,9 +117,11 @@ class ModeNotOfferedError(InvalidRequestError):
         self, entity: str, joint: str, mode: str, offered: tuple[str, ...], source: str
     ) -> None:
         kinds = source.split("+")
-        tags = " and ".join(f"<{k}>" for k in kinds) if source else "record"
+        tagged = all(k in self.TAG_SOURCES for k in kinds)
+        # a plugin's record (diff_drive, multicopter_motor_model) is no tag a user can extend
+        who = " and ".join(f"<{k}>" for k in kinds) + " tags" if tagged else f"{source} plugin"
         fix = f"use --mode {' or '.join(offered)}"
-        if all(k in self.TAG_SOURCES for k in kinds):
+        if tagged:
             fix += (
                 f', or declare {mode} for it (<command_interface name="{mode}"/> in its '
                 f"<ros2_control> joint, or a <transmission> with hardware_interface/"
@@ -127,7 +129,7 @@ class ModeNotOfferedError(InvalidRequestError):
             )
         super().__init__(
             f"{mode} command for joint [{joint}] of [{entity}]",
-            f"its {tags} tags offer only {', '.join(offered)}",
+            f"its {who} offer{'' if tagged else 's'} only {', '.join(offered)}",
             fix,
         )
         self.offered = offered

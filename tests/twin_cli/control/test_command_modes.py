@@ -8,7 +8,7 @@ import re
 import pytest
 from corpus_registry import CORPUS
 from interface_models import PANDA_JOINTS, SEVERAL_INTERFACES, panda_arm
-from models import write_urdf
+from models import two_wheel_bot, write_urdf
 
 from twin_cli.control import follow_trajectory, tracking_report, trajectory_from_dict
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError
@@ -154,6 +154,22 @@ def test_a_mode_the_joint_does_not_offer_is_refused_naming_the_offered_ones(tmp_
         "d1": ("position", ["position"]),
         "d2": ("effort", ["velocity", "effort"]),
     }, modes
+
+
+def test_a_plugins_wheel_refuses_other_modes_without_suggesting_a_tag(tmp_path):
+    # libgazebo_ros_diff_drive drives its wheels by velocity: a plugin, not a tag to extend.
+    plugin = (
+        '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>lj</left_joint>'
+        "<right_joint>rj</right_joint><wheel_separation>0.2</wheel_separation>"
+        "<wheel_diameter>0.1</wheel_diameter></plugin>"
+    )
+    world = World()
+    world.spawn(write_urdf(tmp_path, two_wheel_bot(plugin)), name="bot", pose=Pose(z=1.0))
+    with pytest.raises(ModeNotOfferedError) as caught:
+        world.command_joints("bot", {"lj": 0.1}, mode="effort")
+    message = str(caught.value)
+    assert "its diff_drive plugin offers only velocity; use --mode velocity" in message, message
+    assert "declare" not in message, message
 
 
 @pytest.mark.skipif("franka_panda" not in CORPUS, reason="corpus: no franka_panda entry")
