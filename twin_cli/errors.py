@@ -107,6 +107,34 @@ class InvalidRequestError(TwinError):
         self.what = what
 
 
+class ModeNotOfferedError(InvalidRequestError):
+    """A joint command in a mode none of the joint's command interfaces offers: no ros2_control
+    controller could claim it, so twin refuses it rather than drive the joint another way."""
+
+    TAG_SOURCES = ("ros2_control", "transmission")
+
+    def __init__(
+        self, entity: str, joint: str, mode: str, offered: tuple[str, ...], source: str
+    ) -> None:
+        kinds = source.split("+")
+        tagged = all(k in self.TAG_SOURCES for k in kinds)
+        # a plugin's record (diff_drive, multicopter_motor_model) is no tag a user can extend
+        who = " and ".join(f"<{k}>" for k in kinds) + " tags" if tagged else f"{source} plugin"
+        fix = f"use --mode {' or '.join(offered)}"
+        if tagged:
+            fix += (
+                f', or declare {mode} for it (<command_interface name="{mode}"/> in its '
+                f"<ros2_control> joint, or a <transmission> with hardware_interface/"
+                f"{mode.capitalize()}JointInterface), then delete the entity and spawn it again"
+            )
+        super().__init__(
+            f"{mode} command for joint [{joint}] of [{entity}]",
+            f"its {who} offer{'' if tagged else 's'} only {', '.join(offered)}",
+            fix,
+        )
+        self.offered = offered
+
+
 class PartNotFoundError(TwinError):
     """A request named a joint or link that the entity does not have."""
 

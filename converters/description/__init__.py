@@ -14,6 +14,7 @@ from converters.description.control import (
     CommandInterface,
     JointControl,
     PidGains,
+    merge_controls,
 )
 from converters.description.gazebo import (
     Blob,
@@ -50,6 +51,7 @@ __all__ = [
     "CommandInterface",
     "JointControl",
     "PidGains",
+    "merge_controls",
     "JOINT_TYPES",
     "SHAPES",
     "WORLD_LINK",

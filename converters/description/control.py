@@ -10,6 +10,7 @@ bias and force ranges at command time.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 # The modes a joint can be driven in, in the order a joint without tags offers them.
@@ -65,10 +66,13 @@ class JointControl:
 
     Attributes:
         joint: the joint's name.
-        source: "ros2_control" or "transmission" (which tag declared it).
+        source: "ros2_control" or "transmission" (which tag declared it); both, joined by
+            "+", once `merge_controls` has combined a joint's tags.
         interfaces: the modes it accepts, first one first (the tag's order).
         gains: mode → PID gains from the tag (position_pid / velocity_pid only).
         where: the tag, for messages (e.g. `<ros2_control name='arm'>`).
+        ignored: interfaces it declares that twin does not drive (acceleration, gpio,
+            franka_hw/FrankaStateInterface...), as written, for the report.
     """
 
     joint: str
@@ -76,8 +80,40 @@ class JointControl:
     interfaces: tuple[CommandInterface, ...]
     gains: tuple[tuple[str, PidGains], ...] = ()
     where: str = ""
+    ignored: tuple[str, ...] = ()
 
     @property
     def modes(self) -> tuple[str, ...]:
         """The modes, in the tag's order, without repeats."""
         return tuple(dict.fromkeys(i.mode for i in self.interfaces))
+
+
+def merge_controls(parts: Sequence[JointControl]) -> JointControl:
+    """One joint's declarations, from every tag that names it, as one record offering them all.
+
+    ros2_control's resource manager exports every command interface a joint declares and lets
+    a controller claim any one, so franka_description's three `<transmission>`s per joint
+    (position, velocity, effort) give three modes, not the first one. A mode declared twice
+    keeps its first declaration's bounds and gains (document order: `<ros2_control>` blocks,
+    then transmissions). Tags that declare no mode twin drives (franka_hw's state interface)
+    add only their names to `ignored`.
+
+    Args:
+        parts: the joint's records, one per tag, in document order (at least one).
+    """
+    interfaces: dict[str, CommandInterface] = {}
+    gains: dict[str, PidGains] = {}
+    for part in parts:
+        for interface in part.interfaces:
+            interfaces.setdefault(interface.mode, interface)
+        for mode, pid in part.gains:
+            gains.setdefault(mode, pid)
+    declaring = [p for p in parts if p.interfaces] or list(parts[:1])
+    return JointControl(
+        parts[0].joint,
+        "+".join(dict.fromkeys(p.source for p in declaring)),
+        tuple(interfaces.values()),
+        tuple(gains.items()),
+        ", ".join(dict.fromkeys(p.where for p in declaring)),
+        tuple(dict.fromkeys(name for p in parts for name in p.ignored)),
+    )

@@ -51,26 +51,56 @@ def add_control_data(
     robot: RobotDescription,
     report: Report,
 ) -> None:
-    """Each motor's record in the `control` text, and a report line saying which rule applies."""
+    """Each motor's record in the `control` text, and report lines saying which modes each
+    joint offers and which rule applies: one line per group of joints whose lines would read
+    the same (a Panda's seven arm joints are one line, not seven)."""
     controls = {c.joint: c for c in robot.controls}
     plugins = [p.kind for p in robot.gazebo.plugins if p.kind in CONTROL_PLUGINS]
     enabled = plugins[0] if plugins else None
+    groups: dict[str, list[str]] = {}
+    ignored: dict[tuple[str, ...], list[str]] = {}
     for joint in joints:
         if joint.name not in motors:
             continue
-        record = control_record(joint, controls.get(joint.name), enabled)
+        control = controls.get(joint.name)
+        record = control_record(joint, control, enabled)
         set_control_record(spec, joint.name, record)
-        report.mapped(f"joint '{joint.name}' command modes", _rule_text(record))
+        groups.setdefault(_rule_text(record, control), []).append(joint.name)
+        if control is not None and control.ignored:
+            ignored.setdefault(control.ignored, []).append(joint.name)
+    for text, names in groups.items():
+        report.mapped(f"{_joints_text(names)} command modes", text)
+    for interfaces, names in ignored.items():
+        report.ignored(
+            f"{_joints_text(names)} interfaces {', '.join(interfaces)}",
+            "not a command interface twin drives (position, velocity and effort are)",
+        )
 
 
-def _rule_text(record: dict) -> str:
-    modes = "/".join(record["modes"])
+def _joints_text(names: list[str]) -> str:
+    quoted = ", ".join(f"'{name}'" for name in names)
+    return f"joint {quoted}" if len(names) == 1 else f"{len(names)} joints {quoted}"
+
+
+def _rule_text(record: dict, control: JointControl | None) -> str:
+    modes = ", ".join(_mode_text(mode, record.get("bounds", {})) for mode in record["modes"])
     if record["source"] == "default":
-        return f"{modes} (no control tag); servo gains from the reflected inertia"
+        why = "no control tag" if control is None else "its tags declare none twin drives"
+        return f"{modes} ({why}); servo gains from the reflected inertia"
     gains = ", ".join(
         f"{mode} PID kp={g[0]:g} kd={g[2]:g}" + (f" (ki={g[1]:g} not run)" if g[1] else "")
         for mode, g in record["pid"].items()
     )
     rule = gains or "servo gains from the reflected inertia"
     plugin = record["plugin"] or "no gazebo_ros(2)_control plugin: Gazebo would not drive it"
-    return f"{modes} from {record['where']}; {rule}; {plugin}"
+    tags = " and ".join(f"<{kind}>" for kind in record["source"].split("+"))
+    return f"{modes} from {tags}; {rule}; {plugin}"
+
+
+def _mode_text(mode: str, bounds: dict) -> str:
+    low, high = bounds.get(mode, (None, None))
+    if low is None and high is None:
+        return mode
+    low_text = "-inf" if low is None else f"{low:g}"
+    high_text = "inf" if high is None else f"{high:g}"
+    return f"{mode} in [{low_text}, {high_text}]"

@@ -20,6 +20,7 @@ from converters.description import (
     CommandInterface,
     JointControl,
     PidGains,
+    merge_controls,
 )
 from converters.errors import URDFStructureError
 
@@ -28,24 +29,24 @@ PID_INTERFACES = {"position_pid": ("position", "pos_"), "velocity_pid": ("veloci
 
 
 def read_controls(root: ET.Element, source: str) -> tuple[JointControl, ...]:
-    """Every joint's declared command interfaces: `<ros2_control>` first, then transmissions.
-
-    A joint named by both keeps the `<ros2_control>` record (ROS 2's own tag wins).
+    """Every joint's declared command interfaces, all of them: `<ros2_control>` first, then
+    transmissions, merged per joint (`merge_controls`), since a joint may be named by several
+    transmissions and by both tags.
 
     Raises:
         URDFStructureError: a `min`/`max`/gain param that is not a number.
     """
-    out: dict[str, JointControl] = {}
+    declared: dict[str, list[JointControl]] = {}
     for block in root.iter("ros2_control"):
         where = f"<ros2_control name='{block.get('name', '')}'>"
         for joint in block.findall("joint"):
             control = _ros2_joint(joint, where, source)
-            out.setdefault(control.joint, control)
+            declared.setdefault(control.joint, []).append(control)
     for block in root.iter("transmission"):
         where = f"<transmission name='{block.get('name', '')}'>"
         for control in _transmission(block, where):
-            out.setdefault(control.joint, control)
-    return tuple(out.values())
+            declared.setdefault(control.joint, []).append(control)
+    return tuple(merge_controls(parts) for parts in declared.values())
 
 
 def _number(value: str | None, source: str, subject: str) -> float | None:
@@ -69,7 +70,7 @@ def _params(element: ET.Element) -> dict[str, str]:
 def _ros2_joint(joint: ET.Element, where: str, source: str) -> JointControl:
     name = joint.get("name", "")
     subject = f"{where} joint '{name}'"
-    interfaces, gains = [], []
+    interfaces, gains, ignored = [], [], []
     for element in joint.findall("command_interface"):
         kind = element.get("name", "")
         params = _params(element)
@@ -81,7 +82,11 @@ def _ros2_joint(joint: ET.Element, where: str, source: str) -> JointControl:
             gains.append((mode, _gains(_params(joint), prefix, source, subject)))
         elif kind in MODES:
             interfaces.append(CommandInterface(kind, low, high))
-    return JointControl(name, "ros2_control", tuple(interfaces), tuple(gains), where)
+        else:
+            ignored.append(kind)
+    return JointControl(
+        name, "ros2_control", tuple(interfaces), tuple(gains), where, tuple(ignored)
+    )
 
 
 def _gains(params: dict[str, str], prefix: str, source: str, subject: str) -> PidGains:
@@ -97,9 +102,13 @@ def _transmission(block: ET.Element, where: str) -> list[JointControl]:
     out = []
     for joint in block.findall("joint"):
         named = [(h.text or "").strip() for h in joint.findall("hardwareInterface")]
-        modes = [_mode(h) for h in (named or actuator)]
-        interfaces = tuple(CommandInterface(m) for m in dict.fromkeys(m for m in modes if m))
-        out.append(JointControl(joint.get("name", ""), "transmission", interfaces, (), where))
+        modes = {h: _mode(h) for h in (named or actuator)}
+        interfaces = tuple(
+            CommandInterface(m) for m in dict.fromkeys(m for m in modes.values() if m)
+        )
+        ignored = tuple(h for h, m in modes.items() if m is None and h)
+        name = joint.get("name", "")
+        out.append(JointControl(name, "transmission", interfaces, (), where, ignored))
     return out
 
 

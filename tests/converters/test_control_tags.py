@@ -82,3 +82,86 @@ def test_a_bad_number_in_a_param_names_the_joint(tmp_path):
     </joint></ros2_control>"""
     with pytest.raises(ConversionError, match="joint 'j0'.*min.*'low' is not a number"):
         _records(tmp_path, tags)
+
+
+def test_every_interface_of_a_joint_is_kept_across_tags_and_transmissions(tmp_path):
+    # j0: one <ros2_control> joint with two interfaces, one of them bounded, plus a transmission
+    # adding effort. j1: three same-named transmissions (franka_description's form) and a
+    # franka_hw state transmission twin cannot drive. j2: one transmission, two interfaces.
+    tags = (
+        """<ros2_control name="arm" type="system"><joint name="j0">
+          <command_interface name="position"><param name="min">-0.5</param></command_interface>
+          <command_interface name="velocity"/></joint></ros2_control>"""
+        + _transmission("j0", "hardware_interface/EffortJointInterface")
+        + "".join(
+            _transmission("j1", f"hardware_interface/{kind}JointInterface")
+            for kind in ("Velocity", "Effort", "Position")
+        )
+        + _transmission("j1", "franka_hw/FrankaStateInterface").replace("t_j1", "state")
+        + """<transmission name="both"><joint name="j2">
+          <hardwareInterface>PositionJointInterface</hardwareInterface>
+          <hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>
+          </joint><actuator name="m2"/></transmission>"""
+    )
+    records = _records(tmp_path, tags)
+    assert records["j0"]["modes"] == ["position", "velocity", "effort"], records["j0"]
+    assert records["j0"]["source"] == "ros2_control+transmission"
+    assert records["j0"]["bounds"] == {"position": [-0.5, None]}, "bounds stay with their mode"
+    assert records["j1"]["modes"] == ["velocity", "effort", "position"], "in the files' order"
+    assert records["j1"]["where"] == "<transmission name='t_j1'>", "a state interface adds none"
+    assert records["j2"]["modes"] == ["position", "effort"] and records["j2"]["source"] == (
+        "transmission"
+    )
+
+
+def test_the_report_gives_one_modes_line_per_group_of_alike_joints(tmp_path):
+    tags = "".join(
+        _transmission(j, f"hardware_interface/{kind}JointInterface")
+        for j in ("j0", "j1")
+        for kind in ("Position", "Velocity")
+    ) + _transmission("j2", "hardware_interface/EffortJointInterface")
+    _, report = convert(write_urdf(tmp_path, f'<robot name="r">{LINKS}{tags}</robot>'))
+    lines = {e.subject: e.detail for e in report.entries if "command modes" in e.subject}
+    assert lines == {
+        "2 joints 'j0', 'j1' command modes": "position, velocity from <transmission>; servo "
+        "gains from the reflected inertia; no gazebo_ros(2)_control plugin: Gazebo would not "
+        "drive it",
+        "joint 'j2' command modes": "effort from <transmission>; servo gains from the reflected "
+        "inertia; no gazebo_ros(2)_control plugin: Gazebo would not drive it",
+    }, lines
+
+
+def test_panda_arm_joints_offer_position_velocity_and_effort_in_one_report_line(tmp_path):
+    from interface_models import PANDA_JOINTS, panda_arm
+
+    spec, report = convert(write_urdf(tmp_path, panda_arm()))
+    model = spec.compile()
+    records = json.loads(bytes(model.text_data[: model.text_size[0] - 1]).decode())
+    assert set(records) == set(PANDA_JOINTS), "a motor on each arm joint, none on joint8"
+    for joint, (*_, velocity, _) in PANDA_JOINTS.items():
+        assert records[joint]["modes"] == ["position", "velocity", "effort"], joint
+        assert records[joint]["velocity_limit"] == velocity, joint
+    lines = [e for e in report.entries if "command modes" in e.subject]
+    assert len(lines) == 1 and lines[0].subject.startswith("7 joints 'panda_joint1'"), lines
+    assert lines[0].detail.startswith("position, velocity, effort from <transmission>;"), lines
+    assert "libgazebo_ros_control.so" in lines[0].detail, lines
+
+
+def test_interfaces_twin_does_not_drive_are_reported_as_ignored(tmp_path):
+    tags = (
+        """<ros2_control name="arm" type="system"><joint name="j0">
+          <command_interface name="acceleration"/></joint></ros2_control>"""
+        + _transmission("j1", "hardware_interface/EffortJointInterface")
+        + _transmission("j1", "franka_hw/FrankaStateInterface").replace("t_j1", "state")
+    )
+    _, report = convert(write_urdf(tmp_path, f'<robot name="r">{LINKS}{tags}</robot>'))
+    ignored = {e.subject: e.detail for e in report.entries if e.outcome.value == "ignored"}
+    assert set(ignored) == {
+        "joint 'j0' interfaces acceleration",
+        "joint 'j1' interfaces franka_hw/FrankaStateInterface",
+    }, ignored
+    modes = {e.subject: e.detail for e in report.entries if "command modes" in e.subject}
+    assert modes["joint 'j0' command modes"].startswith(
+        "position, velocity, effort (its tags declare none twin drives)"
+    ), modes
+    assert modes["joint 'j1' command modes"].startswith("effort from <transmission>"), modes

@@ -100,7 +100,8 @@ def joints(*, name: str, world: str, json: bool) -> None:
     with connect_world(world) as c:
         rows = c.joints(name)
         control = {j["name"]: j for j in c.joint_control(name)}
-    for row in rows:  # each actuated joint's command: mode ("none": zero effort) and target
+    # each actuated joint's active mode ("none": zero effort), target and offered modes
+    for row in rows:
         extra = control.get(row["name"], {})
         row.update(mode=extra.get("mode"), target=extra.get("target"), modes=extra.get("modes"))
     out = Output(json)
@@ -109,9 +110,10 @@ def joints(*, name: str, world: str, json: bool) -> None:
         return
     out.table(
         f"joints of {name}",
-        ["joint", "mode", "target", "position", "velocity", "effort"],
+        ["joint", "mode", "offers", "target", "position", "velocity", "effort"],
         [
-            [j["name"], j["mode"] or "-", j["target"], j["position"], j["velocity"], j["effort"]]
+            [j["name"], j["mode"] or "-", ",".join(j["modes"] or []) or "-", j["target"]]
+            + [j["position"], j["velocity"], j["effort"]]
             for j in rows
         ],
     )

@@ -21,9 +21,12 @@ from twin_cli.control.trajectory import Trajectory, TrajectoryPoint, sample, seg
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import mujoco
     import numpy as np
 
+    from twin_cli.world.actuation import JointCommand
     from twin_cli.world.engine import World
 
 UPDATE_RATE = 100.0  # [Hz] controller_manager's usual update_rate
@@ -71,7 +74,7 @@ class TrajectoryFollower:
                 entity, dict(zip(trajectory.joint_names, self.start, strict=True)), mode="position"
             )
             self.keys = [c.actuator for c in commands]
-            self._keyset = frozenset(self.keys)  # all still commanded: the follower's own
+            self._held = commands  # the servos it claimed, as the world holds them
             self._qpos_model, self.qpos = world.model, self._addresses(world.model)
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
@@ -98,8 +101,8 @@ class TrajectoryFollower:
 
         world = self.world
         t = float(world.data.time) - self.t0
-        if t < -1e-9 or not world.commands().keys() >= self._keyset:
-            self.stop()  # the world was reset or the commands were replaced
+        if t < -1e-9 or not self._holds_its_joints(world.commands()):
+            self.stop()  # the world was reset, or a command released a joint's position servo
             return
         reference, nxt, speed = self._block.at(t)
         if world.model is not self._qpos_model:  # a spawn or delete moved the joints' addresses
@@ -116,6 +119,16 @@ class TrajectoryFollower:
         self._write(reference, nxt, speed)
         if done:
             self.stop()
+
+    def _holds_its_joints(self, commands: Mapping[str, JointCommand]) -> bool:
+        """Whether every followed joint still has the position servo the follower claimed.
+
+        Another command on one of them (`twin command`, in any mode) claims the joint's
+        interface, as a ros2_control controller switch does, and the controller that held it
+        stops: writing its targets into a velocity or effort servo would drive the joint in
+        the wrong mode, and into a new position servo would undo the new target.
+        """
+        return all(commands.get(c.actuator) is c for c in self._held)
 
     def _write(self, reference: np.ndarray, positions: np.ndarray, speeds: np.ndarray) -> None:
         """Moves each position servo's target and damping reference: ctrl and the bias constant.
@@ -167,6 +180,14 @@ def _check_points(world: World, entity: str, trajectory: Trajectory) -> None:
         if j < 0:
             continue  # command_joints names the unknown joint with the known ones
         limits = limits_of(model, entity, joint)
+        if "position" not in limits.modes:
+            raise InvalidRequestError(
+                f"trajectory joint [{joint}] of [{entity}]",
+                f"its tags offer only {', '.join(limits.modes)}, and a trajectory drives "
+                "position interfaces",
+                f"leave it out of joint_names, or drive it with twin command --mode "
+                f"{limits.modes[0]}",
+            )
         low, high = allowed_range(model, j, "position", limits, math.inf)
         for k, point in enumerate(trajectory.points):
             value = point.positions[i]

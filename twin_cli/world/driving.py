@@ -13,7 +13,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
-from twin_cli.errors import InvalidRequestError, PartNotFoundError
+from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
 from twin_cli.world import joint_control, servo_watch, servos
 from twin_cli.world.entities import EntityIndex, element_names
@@ -120,11 +120,7 @@ def _checked(
     a, j = _motor_of(state, name, ix, joint)
     limits = joint_control.limits_of(state.model, name, joint)
     if mode not in limits.modes:
-        raise InvalidRequestError(
-            f"command mode [{mode}] of joint [{joint}] of [{name}]",
-            f"its {limits.source} tags offer only {', '.join(limits.modes)}",
-            f"use --mode {limits.modes[0]}",
-        )
+        raise ModeNotOfferedError(name, joint, mode, limits.modes, limits.source)
     key = element_names(state.model, state.model.name_actuatoradr[[a]])[0]
     old = state.commands.get(key)
     effort = old.effort if old else control.effort_limit(state.model, a)
@@ -210,11 +206,12 @@ def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjDa
 
 def record_targets(state: WorldState, targets: Mapping[str, tuple[float, float]]) -> None:
     """Records where a controller left position servos (actuator → target, feedforward), so
-    `twin joints` and a save show them; commands that no longer exist are skipped."""
+    `twin joints` and a save show them; commands that no longer exist, or were switched to
+    another mode since (whose targets are not positions), are skipped."""
     with state.lock:
         for key, (target, feedforward) in targets.items():
             cmd = state.commands.get(key)
-            if cmd is not None:
+            if cmd is not None and cmd.mode == "position":
                 state.commands[key] = replace(cmd, target=target, feedforward=feedforward)
 
 

@@ -133,10 +133,10 @@ def gains(
 
 
 def start(model: mujoco.MjModel, data: mujoco.MjData, a: int, mode: str, previous: str) -> None:
-    """Sets the reference of a new command: continuing a servo keeps it (a velocity change keeps
-    the load it learnt, a new position target ramps on from where the last ramp was), otherwise
-    it starts at the joint's position."""
-    if mode in ("position", "velocity") and previous in ("position", "velocity"):
+    """Sets the reference of a new command: a servo continuing in its mode keeps it (a velocity
+    change keeps the load it learnt, a new position target ramps on from where the last ramp
+    was); a new servo, or a switch of mode, starts it at the joint's position."""
+    if mode in ("position", "velocity") and previous == mode:
         return
     joint = int(model.actuator_trnid[a, 0])
     data.act[model.actuator_actadr[a]] = float(data.qpos[model.jnt_qposadr[joint]])

@@ -48,7 +48,13 @@ def command(
     entity: Annotated[str, typer.Argument(help="The entity whose joints to drive.")],
     targets: Annotated[list[str], typer.Argument(help="JOINT=VALUE pairs [rad, m, /s, N m, N].")],
     mode: Annotated[
-        str, typer.Option("--mode", "-m", help="position | velocity | effort.")
+        str,
+        typer.Option(
+            "--mode",
+            "-m",
+            help="position | velocity | effort: any mode the joint offers (twin joints); "
+            "a joint in another mode switches at once.",
+        ),
     ] = "position",
     world: WorldOpt = "default",
     json: JsonOpt = False,
