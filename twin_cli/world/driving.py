@@ -172,7 +172,7 @@ def _set_command(
         key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
     )
     if reference:
-        servos.start(state.model, state.data, a, mode, previous.mode if previous else "")
+        servos.start(state.model, state.data, a, cmd, previous.mode if previous else "")
     control.apply_command(state.model, state.data, a, cmd)
     state.commands[key] = cmd
     if reference and mode != "effort":

@@ -132,14 +132,29 @@ def gains(
     return kv / tau, kv
 
 
-def start(model: mujoco.MjModel, data: mujoco.MjData, a: int, mode: str, previous: str) -> None:
-    """Sets the reference of a new command: a servo continuing in its mode keeps it (a velocity
-    change keeps the load it learnt, a new position target ramps on from where the last ramp
-    was); a new servo, or a switch of mode, starts it at the joint's position."""
-    if mode in ("position", "velocity") and previous == mode:
+def start(
+    model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand, previous: str
+) -> None:
+    """Sets the reference of a new command `cmd` (mode `previous` before, "" for none).
+
+    A servo continuing in its mode keeps its reference: a velocity change keeps the load it
+    learnt, a new position target ramps on from where the last ramp was. A new position servo
+    starts its ramp at the joint's position. A velocity servo that takes over from a position
+    servo starts with its integral carrying the force that servo applied (bumpless transfer):
+    it holds an arm's weight from its first step instead of letting the arm sag until its
+    integral has learnt the load again. (An effort command's force is a command, not a load.)
+    """
+    if previous == cmd.mode:
         return
     joint = int(model.actuator_trnid[a, 0])
-    data.act[model.actuator_actadr[a]] = float(data.qpos[model.jnt_qposadr[joint]])
+    reference = float(data.qpos[model.jnt_qposadr[joint]])
+    if cmd.mode == "velocity" and previous == "position" and cmd.kp > 0:
+        gear = abs(model.actuator_gear[a][0]) or 1.0
+        carried = float(data.actuator_force[a]) * gear
+        if math.isfinite(cmd.effort):
+            carried = min(max(carried, -cmd.effort), cmd.effort)
+        reference += carried / cmd.kp
+    data.act[model.actuator_actadr[a]] = reference
 
 
 def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
