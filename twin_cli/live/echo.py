@@ -24,7 +24,7 @@ import numpy as np
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.live.catalogue import LiveTopic
-from twin_cli.record.recorder import Publisher, check_rate
+from twin_cli.record.recorder import MAX_RATE, Publisher
 from twin_cli.record.sampler import Sampler, Samples
 from twin_cli.record.sensor_feed import SensorFeed
 from twin_cli.record.sensor_messages import sensor_message
@@ -68,7 +68,7 @@ def echo_rate(topic: LiveTopic, rate: float | None) -> float:
     """The rate [Hz] of sim time the echo samples at: the topic's, or `rate` for state topics.
 
     Raises:
-        InvalidRequestError: a rate outside (0, 1000] Hz, or one given for a sensor's or a
+        InvalidRequestError: a rate outside (0, MAX_RATE] Hz, or one given for a sensor's or a
             latched topic (those come when the sensor or the world makes them).
     """
     if rate is None:
@@ -78,7 +78,13 @@ def echo_rate(topic: LiveTopic, rate: float | None) -> float:
         raise InvalidRequestError(
             f"--rate for {topic.name}", f"its messages come from {what}", "leave out --rate"
         )
-    return check_rate(rate)
+    if not (math.isfinite(rate) and 0.0 < rate <= MAX_RATE):
+        raise InvalidRequestError(
+            f"--rate for {topic.name}",
+            f"{rate:g} Hz is not in (0, {MAX_RATE:g}]",
+            "give e.g. --rate 10",
+        )
+    return rate
 
 
 class Echo:

@@ -228,6 +228,8 @@ def test_model_shows_joints_modes_drives_and_sensors(world):
         (["topics", "echo", "/rig/joint_state"], ["/rig/joint_state]", "/rig/joint_states"]),
         (["model", "nobody"], ["[nobody]", "humanoid", "twin list"]),
         (["topics", "echo", "/box/imu", "--rate", "5"], ["/box/imu", "leave out --rate"]),
+        (["topics", "echo", "/clock", "--rate", "0"], ["/clock", "0 Hz is not in (0, 1000]"]),
+        (["topics", "echo", "/clock", "--rate", "nan"], ["/clock", "nan Hz"]),
     ],
 )
 def test_bad_names_exit_2_with_one_message_naming_them(world, args, words):
