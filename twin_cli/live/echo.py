@@ -7,7 +7,8 @@ would cost the stepping thread a futex call each: `twin_cli.record.sensor_pump`)
 ROS messages with the recorder's `Publisher` or `sensor_message`, so an echoed message is the
 one a bag would hold, and hands each one to `deliver` as plain JSON-ready values. Past
 MAX_BACKLOG captures waiting, the oldest are dropped (a ROS subscriber's queue does the same):
-an echo never holds the world back.
+an echo never holds the world back. A world faster than real time is thinned to the echo's
+wall-clock budget (`budget`).
 """
 
 from __future__ import annotations
@@ -17,12 +18,14 @@ import dataclasses
 import logging
 import math
 import threading
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.live.budget import WALL_SPEEDUP, WallBudget
 from twin_cli.live.catalogue import LiveTopic
 from twin_cli.record.recorder import MAX_RATE, Publisher
 from twin_cli.record.sampler import Sampler, Samples
@@ -158,16 +161,18 @@ class Echo:
     # ------------------------------------------------------------ the echo's thread
     def _run(self) -> None:
         publisher, layout = Publisher(), None
+        budget = WallBudget(WALL_SPEEDUP * self.rate)
         try:
             while not self._stopping.wait(POLL_S):
-                while self._backlog and not self._stopping.is_set():
-                    item = self._backlog.popleft()
-                    if self._feed is not None:
-                        self._send_readings(item)
-                    else:
-                        new = item.layout is not layout
-                        publisher.publish(Samples.of(item), self, new_layout=new)
-                        layout = item.layout
+                items = [self._backlog.popleft() for _ in range(len(self._backlog))]
+                if self._feed is not None:
+                    self._send_readings(items, budget)
+                    continue
+                for sample in items if self._topic.latched else budget.take(items):
+                    new = sample.layout is not layout
+                    publisher.publish(Samples.of(sample), self, new_layout=new)
+                    layout = sample.layout
+                    time.sleep(0)  # hand the GIL to the stepping thread between samples
         except Exception:  # a failing build ends this echo only; the world goes on
             log.exception("echo of %s failed", self._topic.name)
         finally:
@@ -175,11 +180,16 @@ class Echo:
             for handle in self._handles:
                 self._world.remove_observer(handle)
 
-    def _send_readings(self, captured: Any) -> None:
+    def _send_readings(self, captures: list, budget: WallBudget) -> None:
         assert self._feed is not None
-        for topic, reading in self._feed.build(captured):
-            if topic.name == self._topic.name:
-                self.write(sensor_message(topic, reading))
+        readings = [
+            (topic, reading)
+            for captured in captures
+            for topic, reading in self._feed.build(captured)
+            if topic.name == self._topic.name
+        ]
+        for topic, reading in budget.take(readings):
+            self.write(sensor_message(topic, reading))
 
     # `Publisher`'s sink: every message of a sample passes here; this topic's are sent
     def set_topics(self, topics: list) -> None:

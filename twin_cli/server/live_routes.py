@@ -96,6 +96,9 @@ async def _stream(
             except asyncio.TimeoutError:  # noqa: UP041 (a distinct class before Python 3.11)
                 yield "\n"
                 continue
+            while not lines.empty() and (not count or sent + 1 < count):  # one write for all
+                line += lines.get_nowait()
+                sent += 1
             yield line
             sent += 1
     finally:
