@@ -45,7 +45,15 @@ def model(name: str, world: WorldDep) -> dict:
     return describe(world, name)
 
 
-@router.get("/topics/echo", response_class=StreamingResponse)
+ECHO_REPLY = {
+    200: {
+        "description": "one JSON object per line: topic, type, time [s], message",
+        "content": {"application/x-ndjson": {"schema": {"type": "string"}}},
+    }
+}
+
+
+@router.get("/topics/echo", response_class=StreamingResponse, responses=ECHO_REPLY)
 async def echo(
     request: Request,
     world: WorldDep,
