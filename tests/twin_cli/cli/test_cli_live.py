@@ -219,7 +219,7 @@ def test_model_shows_joints_modes_drives_and_sensors(world):
     assert drive["kind"] == "DiffDrive" and drive["left_joints"] == ["lj"], drive
     assert "bot/odo" in {f["name"] for f in bot["frames"]}, "the drive's odometry frame"
     text = twin(world, "model", "rig").stdout
-    assert "spin" in text and "velocity" in text and "slide" in text, text
+    assert all(w in text for w in ("spin", "velocity", "slide", "/rig/joint_states")), text
 
 
 @pytest.mark.parametrize(

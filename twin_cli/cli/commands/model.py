@@ -81,6 +81,14 @@ def _tables(reply: dict[str, Any]) -> list[tuple[str, list[str], list[list[Any]]
                 for s in reply["sensors"]
             ],  # fmt: skip
         ),
+        (
+            "topics",
+            ["topic", "type", "rate"],
+            [
+                [t["name"], t["type"], "latched" if t["latched"] else f"{t['rate']:g} Hz"]
+                for t in reply["topics"]
+            ],
+        ),
     ]
 
 
