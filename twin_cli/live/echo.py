@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twin_cli.errors import InvalidRequestError
+from twin_cli.errors import InvalidRequestError, RequestError
 from twin_cli.live.budget import WALL_SPEEDUP, WallBudget
 from twin_cli.live.catalogue import LiveTopic
 from twin_cli.record.recorder import MAX_RATE, Publisher
@@ -104,7 +104,8 @@ class Echo:
     ) -> None:
         """Args:
         world: the world to observe; topic: one of its `live_topics`.
-        deliver: called in the echo's thread with `{"topic", "type", "time", "message"}`.
+        deliver: called in the echo's thread with `{"topic", "type", "time", "message"}`,
+            or at the end with `{"error", "message"}` when the topic cannot be read.
         rate: [Hz] of sim time for a state topic (default: the topic's own).
         truncate: see `plain`.
 
@@ -173,8 +174,11 @@ class Echo:
                     publisher.publish(Samples.of(sample), self, new_layout=new)
                     layout = sample.layout
                     time.sleep(0)  # hand the GIL to the stepping thread between samples
-        except Exception:  # a failing build ends this echo only; the world goes on
+        except Exception as exc:  # a failing build ends this echo only; the world goes on
             log.exception("echo of %s failed", self._topic.name)
+            what = f"echo of {self._topic.name}"
+            problem = f"internal error {type(exc).__name__}: {exc}"
+            self._end_with(RequestError(what, problem, "see `twin logs`; the world still runs"))
         finally:
             self._stopping.set()
             for handle in self._handles:
@@ -190,6 +194,18 @@ class Echo:
         ]
         for topic, reading in budget.take(readings):
             self.write(sensor_message(topic, reading))
+        why = self._feed.dropped.get((self._topic.entity, self._topic.sensor))
+        if why is not None:  # e.g. a camera in a server without offscreen GL
+            problem = f"sensor '{self._topic.sensor}' cannot be read in this server: {why}"
+            fix = "echo it again once that is fixed"
+            self._end_with(InvalidRequestError(f"echo of {self._topic.name}", problem, fix))
+
+    def _end_with(self, error: Exception) -> None:
+        """Sends `error` as the last line (`{"error": class, "message"}`: the client raises it
+        again) and ends the echo."""
+        if not self._stopping.is_set():
+            self._deliver({"error": type(error).__name__, "message": str(error)})
+        self._stopping.set()
 
     # `Publisher`'s sink: every message of a sample passes here; this topic's are sent
     def set_topics(self, topics: list) -> None:

@@ -184,8 +184,12 @@ class Client:
     def _objects(self, lines: Iterator[bytes]) -> Generator[dict, None, None]:
         try:
             for line in lines:
-                if line.strip():
-                    yield json.loads(line)
+                if not line.strip():
+                    continue
+                item = json.loads(line)
+                if "error" in item and "topic" not in item:  # the stream's last line
+                    raise rebuild_error(500, item)
+                yield item
         except NOT_ANSWERING as exc:  # the server ended mid-stream (`twin stop`)
             raise NotRunningError(self.world) from exc
         finally:

@@ -63,7 +63,8 @@ async def echo(
     truncate: Annotated[int, Query(ge=0, description="array/string items shown (0: all)")] = 128,
 ) -> StreamingResponse:
     """The topic's messages as they come, one JSON object per line: `{"topic", "type", "time",
-    "message"}` (sim time [s]); an unknown topic is a 404 naming the topics there are."""
+    "message"}` (sim time [s]); an unknown topic is a 404 naming the topics there are, and a
+    topic that cannot be read ends the stream with `{"error", "message"}`."""
     from twin_cli.live import Echo, find_topic
 
     loop = asyncio.get_running_loop()
@@ -109,5 +110,7 @@ async def _stream(
                 sent += 1
             yield line
             sent += 1
+            if any(part.startswith('{"error"') for part in line.splitlines()):
+                return  # the echo ended with an error line
     finally:
         echo.stop()

@@ -263,3 +263,31 @@ def test_echo_prints_text_and_ends_cleanly_on_ctrl_c_and_a_closed_pipe(world):
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 0 and "Traceback" not in err, f"Ctrl-C: {proc.returncode} {err}"
+
+
+@pytest.mark.parametrize("gl", ["egl", "glfw"])
+def test_a_camera_echoes_its_image_or_ends_naming_why_it_cannot(tmp_path, serve_world, gl):
+    """With offscreen GL the image comes cut to 128 bytes of data; without (a desktop backend
+    and no display) the echo ends at once, exit 2, naming the sensor and the fix."""
+    from camera_models import POST
+
+    patch = pytest.MonkeyPatch()
+    patch.setenv("MUJOCO_GL", gl)
+    patch.delenv("DISPLAY", raising=False)
+    patch.delenv("WAYLAND_DISPLAY", raising=False)
+    try:
+        with serve_world(tmp_path, WORLD) as (client, _):
+            (tmp_path / "post.urdf").write_text(POST)
+            client.spawn(str(tmp_path / "post.urdf"), name="post")
+            done = twin((client, tmp_path), "topics", "echo", "/post/cam/image_raw", "-n", "1",
+                        "--json", check=False)  # fmt: skip
+    finally:
+        patch.undo()
+    if gl == "glfw":
+        assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+        assert "sensor 'cam'" in done.stderr and "MUJOCO_GL=egl" in done.stderr, done.stderr
+        return
+    assert done.returncode == 0, done.stderr
+    image = json.loads(done.stdout)["message"]
+    assert (image["encoding"], image["step"]) == ("rgb8", 3 * image["width"]), image
+    assert len(image["data"]) == 129 and image["data"][-1] == "...", "128 bytes, then ..."
