@@ -39,16 +39,18 @@ def describe(world: World, name: str) -> dict[str, Any]:
         record = world.entity(name)
         view = world_view(world)
         sources = sources_of(world, name, prefix_template(), None)
-        qpos, mocap = (
-            view.data.qpos.copy(),
-            (view.data.mocap_pos.copy(), view.data.mocap_quat.copy()),
+        data = view.data
+        qpos, mocap_pos, mocap_quat = (
+            data.qpos.copy(),
+            data.mocap_pos.copy(),
+            data.mocap_quat.copy(),
         )
-        time = float(view.data.time)
+        time = float(data.time)
         pose = world.get_pose(name).to_dict()
         states = world.joint_states(name)
         commands = world.joint_commands(name)
     model, ix = view.model, view.index[name]
-    xpos, xquat = _body_poses(model, qpos, *mocap)
+    xpos, xquat = _body_poses(model, qpos, mocap_pos, mocap_quat)
     tree = entity_tree(model, model_names(model), name, ix, sources)
     frames = _frames(tree, xpos, xquat)
     topics = [t for t in live_topics(world) if t.entity == name]
