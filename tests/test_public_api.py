@@ -19,6 +19,7 @@ PACKAGES = [
     "scenarios",
     "twin_cli",
     "twin_cli.cli",
+    "twin_cli.live",
     "twin_cli.record",
     "twin_cli.sensors",
     "twin_cli.control",

@@ -25,7 +25,8 @@ class EntityNotFoundError(TwinError):
 
     def __init__(self, name: str, known: list[str]) -> None:
         names = ", ".join(sorted(known)) or "none"
-        super().__init__(f"Entity [{name}] does not exist; entities in this world: {names}")
+        fix = "give one of those names (`twin list`)" if known else "spawn one with `twin spawn`"
+        super().__init__(f"Entity [{name}] does not exist; entities in this world: {names}; {fix}")
         self.name = name
 
 
@@ -142,6 +143,18 @@ class PartNotFoundError(TwinError):
         names = ", ".join(sorted(known)) or "none"
         super().__init__(f"entity [{entity}] has no {kind} [{name}]; its {kind}s: {names}")
         self.entity = entity
+        self.name = name
+
+
+class TopicNotFoundError(TwinError):
+    """`twin topics echo` named a topic the running world does not offer."""
+
+    def __init__(self, name: str, known: list[str]) -> None:
+        names = ", ".join(known) or "none"
+        super().__init__(
+            f"topic [{name}] is not offered by this world; its topics: {names} "
+            "(`twin topics` lists them with types and rates)"
+        )
         self.name = name
 
 

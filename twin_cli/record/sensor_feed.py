@@ -51,10 +51,13 @@ class SensorFeed:
         entities: Sequence[str] = (),
         frame_prefix: str | None = None,
         descriptions: dict[str, str] | None = None,
+        sensors: Sequence[str] = (),
     ) -> None:
         """Args: the world, the entities (empty: all), the tf frame prefix template and URDF
-        texts overriding the world's (as `Sampler`): the readings' frames are tf's."""
+        texts overriding the world's (as `Sampler`): the readings' frames are tf's; `sensors`:
+        only these sensor names (empty: all; `twin topics echo` follows one sensor)."""
         self._world, self._names = world, tuple(entities)
+        self._only = frozenset(sensors)
         self._template = prefix_template(frame_prefix)
         self._descriptions = dict(descriptions or {})
         self._frames: dict[str, dict[str, str]] = {}  # entity → sensor → its messages' frame
@@ -73,7 +76,7 @@ class SensorFeed:
         with self._world.lock:
             self._refresh()
             self._rates = sorted(
-                {self._rate(e, n) for e, u in self._suites.items() for n in u.names}, reverse=True
+                {self._rate(e, n) for e, names in self._wanted.items() for n in names}, reverse=True
             )
             self._group()
         return list(self._rates)
@@ -149,13 +152,16 @@ class SensorFeed:
         suites = {n: SensorSuite(self._world, n) for n in names if n in view.index}
         self._suites = {n: s for n, s in suites.items() if s.names}
         self._wanted = {
-            n: [s for s in suite.names if (n, s) not in self.dropped]
+            n: [s for s in suite.names if (n, s) not in self.dropped and self._chosen(s)]
             for n, suite in self._suites.items()
         }
         self._kept = {n: set(suite.with_history()) for n, suite in self._suites.items()}
         self._frames = self._sensor_frames(view)
         self._model = view.model
         self._group()
+
+    def _chosen(self, sensor: str) -> bool:
+        return not self._only or sensor in self._only
 
     def _sensor_frames(self, view: Any) -> dict[str, dict[str, str]]:
         """Each recorded sensor's frame, as the recording's tf tree names it."""

@@ -14,6 +14,14 @@ from typing import Any
 
 import numpy as np
 
+from converters.description.sensors import (
+    CameraSpec,
+    ContactSpec,
+    ForceTorqueSpec,
+    ImuSpec,
+    RaySpec,
+    SensorSpec,
+)
 from twin_cli.record import messages as ros
 from twin_cli.record.contact_types import CONTACTS
 from twin_cli.record.topics import Message, Topic
@@ -37,13 +45,29 @@ TYPES = {
     ContactReading: CONTACTS,
     ImageReading: IMAGE,
 }
+# The same types by the sensor's record, so a sensor's topic is named before any reading.
+SPEC_TYPES = {
+    ImuSpec: IMU,
+    RaySpec: SCAN,
+    ForceTorqueSpec: WRENCH,
+    ContactSpec: CONTACTS,
+    CameraSpec: IMAGE,
+}
 PIXEL_BYTES = {"rgb8": 3, "32FC1": 4}
 _UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
 
 
 def sensor_topic(entity: str, name: str, topic: str, reading: Reading) -> Topic | None:
     """The topic of one sensor's readings (None: a kind that is not published)."""
-    kind = TYPES.get(type(reading))
+    return _named(entity, name, topic, TYPES.get(type(reading)))
+
+
+def spec_topic(entity: str, spec: SensorSpec) -> Topic | None:
+    """The topic a sensor's readings will go to, from its record (None: not published)."""
+    return _named(entity, spec.name, spec.topic, SPEC_TYPES.get(type(spec)))
+
+
+def _named(entity: str, name: str, topic: str, kind: str | None) -> Topic | None:
     if kind is None:
         return None
     suffix = "/image_raw" if kind == IMAGE else ""  # as gazebo_ros' cameras (image_transport)

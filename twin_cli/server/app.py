@@ -14,7 +14,13 @@ from typing import Any
 
 from fastapi import APIRouter, FastAPI, Request
 
-from twin_cli.server import consumer_routes, control_routes, sensor_routes, view_routes
+from twin_cli.server import (
+    consumer_routes,
+    control_routes,
+    live_routes,
+    sensor_routes,
+    view_routes,
+)
 from twin_cli.server.body_limit import BodyLimit
 from twin_cli.server.error_replies import ERROR_RESPONSES, install_handlers
 from twin_cli.server.holder import WorldDep, WorldHolder
@@ -263,6 +269,7 @@ def create_app(
         consumer_routes.router,
         sensor_routes.router,
         control_routes.router,
+        live_routes.router,
         view_routes.router,
     ):
         app.include_router(routes, responses=ERROR_RESPONSES)

@@ -7,7 +7,9 @@ own start-up.
 
 from __future__ import annotations
 
+import json
 import os
+from collections.abc import Generator, Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -161,6 +163,39 @@ class Client:
             return self.request("GET", "/health", timeout=2.0).get("world") == self.world
         except (NotRunningError, RequestError):
             return False
+
+    def stream(self, path: str) -> Generator[dict, None, None]:
+        """The JSON objects of a streamed reply (`/topics/echo`), one per line, as they come;
+        heartbeat lines are skipped. Closing the iterator closes the connection.
+
+        Raises:
+            NotRunningError: no server listens. TwinError: the server's error, as its class.
+        """
+        try:
+            error, lines = self._http.lines(path)
+        except TimeoutError as exc:
+            raise NoReplyError(self.world, f"GET {path}", DEFAULT_TIMEOUT_S) from exc
+        except NOT_ANSWERING as exc:
+            raise NotRunningError(self.world) from exc
+        if error is not None:
+            _decoded(error)
+        return self._objects(lines)
+
+    def _objects(self, lines: Iterator[bytes]) -> Generator[dict, None, None]:
+        try:
+            for line in lines:
+                if not line.strip():
+                    continue
+                item = json.loads(line)
+                if "error" in item and "topic" not in item:  # the stream's last line
+                    raise rebuild_error(500, item)
+                yield item
+        except NOT_ANSWERING as exc:  # the server ended mid-stream (`twin stop`)
+            raise NotRunningError(self.world) from exc
+        finally:
+            close = getattr(lines, "close", None)
+            if close is not None:
+                close()
 
     # World commands, one per endpoint (see docs/api.md).
     def stats(self) -> dict:

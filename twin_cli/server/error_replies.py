@@ -22,6 +22,7 @@ from twin_cli.errors import (
     EntityNotFoundError,
     PartNotFoundError,
     RequestError,
+    TopicNotFoundError,
     TwinError,
 )
 
@@ -31,6 +32,7 @@ log = logging.getLogger("twin.server")
 ERROR_STATUS: dict[type[Exception], int] = {
     EntityNotFoundError: 404,
     PartNotFoundError: 404,
+    TopicNotFoundError: 404,
     EntityExistsError: 409,
 }
 
@@ -49,7 +51,7 @@ ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     for status, text in (
         (400, "bad request: the message names the value and the fix"),
         (401, "TCP request without the bearer token"),
-        (404, "no such entity, joint, link or sensor"),
+        (404, "no such entity, joint, link, sensor or topic"),
         (409, "the name is taken"),
         (413, "the request body is over the server's limit"),
         (422, "the body does not match the request schema"),

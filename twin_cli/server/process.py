@@ -235,6 +235,7 @@ def serve(opts: ServeOptions) -> None:
             app, log_config=None, access_log=False, lifespan="off", timeout_graceful_shutdown=5
         )
         server = uvicorn.Server(config)
+        app.state.exiting = lambda: server.should_exit  # streamed replies end on their own
         _end_conversions_on_exit(server)
         consumers = _start_consumers(app, world, opts)
         saver = _autosaver(app, autosave_file, opts.autosave)

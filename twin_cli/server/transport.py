@@ -17,7 +17,7 @@ import json as jsonlib
 import select
 import socket
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from typing import Any
 from urllib.parse import quote, urlsplit
@@ -141,5 +141,40 @@ class Http:
         finally:
             connection.close()
 
+    def lines(
+        self, path: str, *, timeout: float | None = None
+    ) -> tuple[Reply | None, Iterator[bytes]]:
+        """`GET path` whose reply is streamed line by line (`/topics/echo`).
+
+        Returns (the error reply, nothing) when the status is an error, else (None, the body's
+        lines as they arrive, each with its newline; a blank line is the server's heartbeat).
+        `timeout` [s] bounds the connection and the wait for the reply's head; lines are
+        then waited for without a limit. The connection closes when the iterator ends or is
+        closed.
+        """
+        connection = self._connection(self._timeout if timeout is None else timeout)
+        try:
+            connection.request("GET", path, headers=dict(self._headers))
+            response = connection.getresponse()
+        except BaseException:
+            connection.close()
+            raise
+        if response.status >= 400:
+            try:
+                return Reply(response.status, response.read()), iter(())
+            finally:
+                connection.close()
+        if connection.sock is not None:
+            connection.sock.settimeout(None)  # a paused world may send nothing for long
+        return None, _lines(connection, response)
+
     def close(self) -> None:
         """Nothing to release: connections close after each request."""
+
+
+def _lines(connection: http.client.HTTPConnection, response: Any) -> Iterator[bytes]:
+    try:
+        while line := response.readline():
+            yield line
+    finally:
+        connection.close()

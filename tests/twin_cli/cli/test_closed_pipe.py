@@ -34,6 +34,10 @@ def world(tmp_path_factory, serve_world):
         ["list", "--json"],
         ["stats", "-d", "0.3"],
         ["joints", "ball_0"],
+        ["topics"],
+        ["topics", "echo", "/clock"],
+        ["topics", "echo", "/tf", "--json"],
+        ["model", "ball_0"],
         ["spawn", "--help"],
     ],
 )

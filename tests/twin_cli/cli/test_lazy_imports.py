@@ -150,3 +150,21 @@ def test_view_and_snapshot_import_neither_physics_nor_the_viewer(tmp_path, monke
         client.close()
         server.terminate()
         server.wait(timeout=20)
+
+
+def test_topics_echo_and_model_import_no_physics(tmp_path, serve_world):
+    """The live look inside only asks the server, which names, samples and poses everything."""
+    box = tmp_path / "box.urdf"
+    box.write_text(block(size=0.2, name="box"))
+    with serve_world(tmp_path / "rt", WORLD) as (client, _):
+        client.spawn(str(box), name="box", pose={"z": 1.0})
+        env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path / "rt")}
+        env.pop("TWIN_WORLD", None)
+        for args in (
+            ["topics"],
+            ["topics", "echo", "/box/joint_states", "-n", "2"],
+            ["model", "box"],
+        ):
+            proc, modules = _imported([*args, "--world", WORLD], env)
+            assert proc.returncode == 0, f"twin {args}: {proc.stderr[-500:]}"
+            assert not modules & set(HEAVY), f"twin {args} imported {modules & set(HEAVY)}"

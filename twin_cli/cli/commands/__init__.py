@@ -14,6 +14,8 @@ MODULES = (
     "world",
     "record",
     "sensors",
+    "topics",
+    "model",
     "validate",
     "control",
     "drive",
