@@ -7,15 +7,25 @@ decreasing function of μ, quantised on log10 μ, so the lower-μ geom always wi
 friction is min(μ) for robot–ground, robot–robot and robot–obstacle pairs alike, provided every
 geom of the world takes its priority from this one function.
 
-Stiffness. MuJoCo's soft contact with constant impedance d (solimp d0 = d1 = d) and direct
-solref (-S, -B) obeys, along the normal (MuJoCo "Solver parameters"; checked numerically):
+Stiffness (see docs/contacts.md for the derivation). Gazebo's ODE does not run kp/kd as an
+explicit spring: it turns them into ERP = h·kp/(h·kp + kd) and CFM = 1/(h·kp + kd) and solves
+every contact at the velocity level, which is an implicit (backward Euler) spring-damper, and it
+caps the speed at which it pushes a penetration out at the surface's `max_vel` (0.01 m/s by
+default). So a Gazebo contact rests at m·g/kp without ringing and takes a drop without a bounce.
+MuJoCo's contact with constant impedance d (solimp d0 = d1 = d) and direct solref (-S, -B) obeys
     a = (1 - d)·a0 - B·v - S·r,    rest penetration r = (1 - d)·a0 / S
-where a0 is the unconstrained acceleration. Gazebo's contact is a spring-damper per contact
-point: rest penetration m·g/kp, damping ratio ζ = kd / (2·sqrt(kp·m)). Matching the rest
-penetration gives S = (1 - d)·kp / m and keeping ζ gives B = 2·ζ·sqrt(S). m is the mass of the
-body that carries the geom (after lumping); the force a contact row delivers scales with the
-effective mass MuJoCo sees at that point (1/A_ii), so a contact through the centre of mass (a
-ball) reproduces kp exactly, while a cube resting on a face has m/4 at each corner (kp/4 each).
+(a0 the unconstrained acceleration; checked numerically). twin keeps Gazebo's rest penetration
+m·g/kp exactly (S = (1 - d)·kp/m, m the mass of the geom's body) and its behaviour around it:
+  - the correction rate h²·S stays at most MAX_CORRECTION_ERP per step, and at most ODE's own
+    ERP: with ODE's ERP ≈ 1 and no `max_vel` cap, MuJoCo handed a 0.2 m drop back as a 65 mm
+    bounce, and a resting box's normal force swung between 0 and 2·m·g;
+  - B = 4·√S (damping ratio 2, never above 1/h): overdamped like ODE's capped correction, so a
+    drop does not bounce (0.000 mm from 0.2 m, against 13.8 mm at the former ratio 0.5);
+  - d = SOFT_IMPEDANCE, or higher when the correction cap binds (d = 1 - m·S/kp, at most
+    HARD_IMPEDANCE): friction rows share d, and a body on a slope below its friction angle
+    creeps as (1 - d)/B (3.1 mm in 10 s on a 34° slope at d 0.95; 0.006 mm at 0.9999).
+A contact through the centre of mass (a ball) reproduces kp exactly; a cube resting on a face
+has m/4 at each corner (kp/4 each), as before.
 """
 
 from __future__ import annotations
@@ -54,9 +64,20 @@ MU_MAX = 1e9
 PRIORITY_PER_DECADE = 1000
 """Priority steps per decade of μ: two μ closer than 0.23 % may share a priority (then max)."""
 
-IMPEDANCE = 0.95
-"""Constant solimp impedance d for kp/kd contacts: rest penetration is exact for any d; a larger d
-lets stiffer springs be resolved (S = (1-d)·kp/m) and makes static friction creep less."""
+MAX_CORRECTION_ERP = 1.0 / 16.0
+"""Largest fraction of a penetration a contact removes per step (h²·S). ODE's own ERP is ≈ 1
+for stiff surfaces, but ODE caps the push-out speed at `max_vel`; MuJoCo has no such cap, and
+at ERP 1 (or 1/4, MuJoCo's own bound τ = 2h) a drop came back as a bounce (65 mm, 3.1 mm from
+0.2 m). At 1/16 a box dropped from 0.2 m, a 0.05 kg one and a 400 kg one rest with no bounce
+and a normal force steady to 1e-4 of m·g."""
+SOFT_IMPEDANCE = 0.9
+"""Impedance d of a contact whose kp is soft enough to be reproduced below the correction cap;
+MuJoCo's friction rows share it, and (1 - d) sets how fast a body creeps under a tangential
+load it should hold."""
+HARD_IMPEDANCE = 0.9999
+"""MuJoCo's largest impedance (mjMAXIMP): a rigid surface (SDF's default kp 1e12)."""
+DAMPING_RATIO = 2.0
+"""B = 2·DAMPING_RATIO·√S: overdamped, as ODE's capped correction never pushes back fast."""
 SOLIMP_WIDTH = 0.001
 """solimp width [m]; irrelevant when d0 = d1, kept at MuJoCo's default."""
 DEFAULT_LIMIT_ERP = 0.2
@@ -64,19 +85,15 @@ DEFAULT_LIMIT_ERP = 0.2
 LIMIT_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 """solimplimit of every joint: constant impedance d = 0.9999 (MuJoCo's largest, mjMAXIMP), the
 nearest MuJoCo gets to ODE's cfm 0: the limit gives way by (1 − d)/d of what it resists."""
-MIN_DAMPING_RATIO = 0.5
-"""Floor on the contact damping ratio. MuJoCo's friction rows share the contact's damping B, and a
-nearly undamped contact lets a body creep at (1-d)·g·sinθ/B down a slope it should stick to.
-Gazebo's own per-body correction cap (`max_vel` 0.01 m/s) also keeps such contacts from bouncing."""
 
 
 @dataclass(frozen=True)
 class ContactSoftness:
     """MuJoCo settings for one Gazebo kp/kd pair on a body of a given mass.
 
-    `solref` is direct (-S [1/s²], -B [1/s]); `clamped` is True when kp/m was stiffer than the
-    timestep resolves (then S is the stiffest stable value); `damping_ratio_gazebo` is
-    kd/(2·sqrt(kp·m)) and `damping_ratio` the one used (floored at MIN_DAMPING_RATIO).
+    `solref` is direct (-S [1/s²], -B [1/s]); `clamped` is True when the surface is stiffer
+    than HARD_IMPEDANCE reproduces; `damping_ratio_gazebo` is kd/(2·sqrt(kp·m)) and
+    `damping_ratio` the one used, B/(2·√S).
     """
 
     solref: tuple[float, float]
@@ -107,14 +124,14 @@ def friction_priority(mu: float) -> int:
 
 
 def max_contact_stiffness(timestep: float = GAZEBO_STEP) -> float:
-    """Stiffest stable S [1/s²]: natural period 2·timestep·2π, MuJoCo's refsafe bound τ ≥ 2·h."""
-    return 1.0 / (2.0 * timestep) ** 2
+    """Stiffest S [1/s²] a contact gets at `timestep`: MAX_CORRECTION_ERP / h²."""
+    return MAX_CORRECTION_ERP / timestep**2
 
 
 def contact_softness(
     kp: float | None, kd: float | None, mass: float, timestep: float = GAZEBO_STEP
 ) -> ContactSoftness:
-    """Map Gazebo's per-contact spring-damper onto MuJoCo's direct solref and solimp.
+    """Map Gazebo's kp/kd (ODE's ERP/CFM) onto MuJoCo's direct solref and solimp.
 
     Args:
         kp: contact stiffness [N/m] (SDF default 1e12 when None).
@@ -124,18 +141,25 @@ def contact_softness(
 
     Returns:
         The settings, with the rest sinkage under 9.8 m/s² in Gazebo and in MuJoCo [m].
+        `clamped` is True when Gazebo's surface is stiffer than HARD_IMPEDANCE reproduces (the
+        sinkage is then larger than Gazebo's, still microns).
     """
     kp = DEFAULT_KP if kp is None else kp
     kd = DEFAULT_KD if kd is None else kd
     mass = max(mass, 1e-9)
-    stiffness = (1.0 - IMPEDANCE) * kp / mass
-    limit = max_contact_stiffness(timestep)
-    clamped = stiffness > limit
-    stiffness = min(stiffness, limit)
+    erp = timestep * kp / (timestep * kp + kd) if kp > 0 else 0.0
+    limit = min(max_contact_stiffness(timestep), max(erp, 1e-9) / timestep**2)
+    d = SOFT_IMPEDANCE
+    stiffness = (1.0 - d) * kp / mass
+    clamped = False
+    if stiffness > limit:
+        stiffness = limit
+        d = 1.0 - mass * stiffness / kp
+        clamped = d > HARD_IMPEDANCE
+        d = min(d, HARD_IMPEDANCE)
+    stiffness = max(stiffness, 1e-9)
+    damping = min(max(2.0 * DAMPING_RATIO * math.sqrt(stiffness), kd / mass), 1.0 / timestep)
     zeta_gazebo = kd / (2.0 * math.sqrt(kp * mass)) if kp > 0 else math.inf
-    zeta = max(zeta_gazebo, MIN_DAMPING_RATIO)
-    damping = min(2.0 * zeta * math.sqrt(stiffness), 1.0 / timestep)
-    d = IMPEDANCE
     return ContactSoftness(
         solref=(-stiffness, -damping),
         solimp=(d, d, SOLIMP_WIDTH, 0.5, 2.0),

@@ -108,10 +108,21 @@ def command_joints(
         }
         dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
         rolling = dofs if mode == "velocity" else dofs[:0]
-        loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
+        change = [c[4] - _speed_before(state, c[0], int(d)) for c, d in zip(checked, dofs)]
+        loads = joint_control.posture_loads(
+            state.model, state.data, positions, dofs, rolling, np.array(change)
+        )
         fixed = ix.free_qpos < 0
         start = joint_control.posture_loads(state.model, state.data, {})[1] if fixed else None
         return [_set_command(state, c, loads, start) for c in checked]
+
+
+def _speed_before(state: WorldState, key: str, dof: int) -> float:
+    """The speed a velocity command changes from: the last one's target, else the joint's."""
+    previous = state.commands.get(key)
+    if previous is not None and previous.mode == "velocity":
+        return previous.target
+    return float(state.data.qvel[dof])
 
 
 def _checked(
@@ -143,7 +154,7 @@ def _set_command(
     posture (`start`: the loads where the entity is now; None for a free-base entity), from the
     start posture's to the target's as the joint moves."""
     key, a, j, mode, value, effort, limits = checked
-    inertia, load, carried = loads
+    inertia, load, carried, impulse = loads
     dof = int(state.model.jnt_dofadr[j])
     here = float(state.data.qpos[state.model.jnt_qposadr[j]])
     hold = float(load[dof]) if start is not None and mode == "position" else 0.0
@@ -172,7 +183,8 @@ def _set_command(
         key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
     )
     if reference:
-        servos.start(state.model, state.data, a, cmd, previous.mode if previous else "")
+        lead = float(impulse[dof]) / kv if mode == "velocity" and kv > 0 else 0.0
+        servos.start(state.model, state.data, a, cmd, previous.mode if previous else "", lead)
     control.apply_command(state.model, state.data, a, cmd)
     state.commands[key] = cmd
     if reference and mode != "effort":

@@ -93,10 +93,12 @@ def posture_loads(
     targets: dict[int, float],
     dofs: np.ndarray | None = None,
     rolling: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    change: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Reflected inertia [kg m² or kg] and static load [N m or N] of every dof, and the inertia
     each dof of `dofs` carries: with every other joint held by its servo, and for the dofs of
-    `rolling` (velocity commands: wheels, tracks) through their contacts too.
+    `rolling` (velocity commands: wheels, tracks) through their contacts too; and the impulse
+    [N m s or N s] that changes the speeds of `rolling` together by `change` (`speed_impulses`).
 
     Computed at rest in the posture with the position `targets` (qpos address → value) written
     over the current one, on a scratch copy so the world's data (and warm start) stays untouched.
@@ -122,10 +124,13 @@ def posture_loads(
     carried = own.copy()
     if dofs is not None and len(dofs):  # every other joint held by its servo, up to a bound
         carried[dofs] = np.minimum(np.diag(full)[dofs], HELD_RATIO * own[dofs])
+    impulse = np.zeros(model.nv)
     if rolling is not None and len(rolling):
         through = carried_inertia(model, scratch, inverse, np.asarray(rolling))
         carried[rolling] = np.maximum(carried[rolling], through)
-    return own, load, carried
+        if change is not None:
+            impulse[rolling] = speed_impulses(model, scratch, inverse, np.asarray(rolling), change)
+    return own, load, carried, impulse
 
 
 HELD_RATIO = 3.0
@@ -143,17 +148,30 @@ CARRIED_CONSTRAINTS = (
 MAX_CARRIED_RATIO = 1e4  # a joint its contacts lock completely counts as carrying this much
 
 
-def carried_inertia(
-    model: mujoco.MjModel, scratch: mujoco.MjData, inverse: np.ndarray, dofs: np.ndarray
+def speed_impulses(
+    model: mujoco.MjModel,
+    scratch: mujoco.MjData,
+    inverse: np.ndarray,
+    dofs: np.ndarray,
+    change: np.ndarray,
 ) -> np.ndarray:
-    """1/(M_c⁻¹)ᵢᵢ of each dof i of `dofs`, M_c⁻¹ = M⁻¹ − M⁻¹Jᵀ(J M⁻¹ Jᵀ)⁺J M⁻¹, where J are the
-    active contact and equality rows that move with dof i itself, held rigid (`scratch` has
-    been through mj_forward). A driven wheel that grips moves its robot with it, and a servo
-    tuned on the wheel alone rings on that load; the robot's other contacts are left free
-    (held rigid too, a wheel, a caster and a second wheel would lock the robot in place)."""
-    own = 1.0 / np.diag(inverse)[dofs]
+    """The impulses at `dofs` that change their speeds together by `change`, the contacts that
+    move with them held rigid and everything else free: (M_c⁻¹ restricted to dofs)⁺·Δv. Two
+    wheels driven together share their robot; a mode the contacts lock (four wheels turning
+    unequally) counts as needing none."""
+    jac = _constraint_rows(model, scratch)
+    rows = jac[(np.abs(jac[:, dofs]) > 0).any(axis=1)] if len(jac) else jac
+    reduced = inverse[np.ix_(dofs, dofs)]
+    if len(rows):
+        mjt = inverse @ rows.T
+        reduced = reduced - mjt[dofs] @ np.linalg.pinv(rows @ mjt, rcond=1e-10) @ mjt[dofs].T
+    return np.linalg.pinv(reduced, rcond=1e-8) @ np.asarray(change, dtype=float)
+
+
+def _constraint_rows(model: mujoco.MjModel, scratch: mujoco.MjData) -> np.ndarray:
+    """The active contact and equality rows of `scratch`'s constraint Jacobian (dense)."""
     if scratch.nefc == 0:
-        return own
+        return np.zeros((0, model.nv))
     jac = np.zeros((scratch.nefc, model.nv))
     if mujoco.mj_isSparse(model):
         mujoco.mju_sparse2dense(
@@ -164,9 +182,22 @@ def carried_inertia(
     active = np.isin(scratch.efc_type, CARRIED_CONSTRAINTS) & (
         scratch.efc_state != int(mujoco.mjtConstraintState.mjCNSTRSTATE_SATISFIED)
     )
+    return jac[active]
+
+
+def carried_inertia(
+    model: mujoco.MjModel, scratch: mujoco.MjData, inverse: np.ndarray, dofs: np.ndarray
+) -> np.ndarray:
+    """1/(M_c⁻¹)ᵢᵢ of each dof i of `dofs`, M_c⁻¹ = M⁻¹ − M⁻¹Jᵀ(J M⁻¹ Jᵀ)⁺J M⁻¹, where J are the
+    active contact and equality rows that move with dof i itself, held rigid (`scratch` has
+    been through mj_forward). A driven wheel that grips moves its robot with it, and a servo
+    tuned on the wheel alone rings on that load; the robot's other contacts are left free
+    (held rigid too, a wheel, a caster and a second wheel would lock the robot in place)."""
+    own = 1.0 / np.diag(inverse)[dofs]
+    active = _constraint_rows(model, scratch)
     reduced = np.diag(inverse)[dofs].copy()
     for i, dof in enumerate(dofs):
-        rows = jac[active & (jac[:, dof] != 0)]
+        rows = active[active[:, dof] != 0]
         if len(rows):
             mjt = inverse @ rows.T
             reduced[i] -= mjt[dof] @ np.linalg.pinv(rows @ mjt, rcond=1e-10) @ mjt[dof]

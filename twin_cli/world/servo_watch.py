@@ -8,8 +8,6 @@ arrived sleep again (`sleeping.hold_awake`); when none moves it removes itself.
 
 from __future__ import annotations
 
-import math
-
 import mujoco
 
 from twin_cli.world import servos, sleeping
@@ -36,7 +34,7 @@ def _tend(state: WorldState) -> None:
             continue
         if cmd.mode == "velocity":
             moving += 1
-            if math.isfinite(cmd.effort) and cmd.kp > 0:
+            if cmd.kp > 0:
                 windup.append((a, cmd))
         elif servos.moving(model, data, a, cmd):
             moving += 1

@@ -133,7 +133,12 @@ def gains(
 
 
 def start(
-    model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand, previous: str
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    a: int,
+    cmd: JointCommand,
+    previous: str,
+    lead: float = 0.0,
 ) -> None:
     """Sets the reference of a new command `cmd` (mode `previous` before, "" for none).
 
@@ -143,8 +148,15 @@ def start(
     servo starts with its integral carrying the force that servo applied (bumpless transfer):
     it holds an arm's weight from its first step instead of letting the arm sag until its
     integral has learnt the load again. (An effort command's force is a command, not a load.)
+
+    A velocity change then steps the reference back by `lead` [rad or m], the lag the damping
+    term builds while it brings the joint to its new speed (the impulse the change needs / kv):
+    an integral that stored that lag would give it back later, as overshoot, or as a stopped
+    robot turning its wheels back for a minute after a drive.
     """
+    address = model.actuator_actadr[a]
     if previous == cmd.mode:
+        data.act[address] -= lead
         return
     joint = int(model.actuator_trnid[a, 0])
     reference = float(data.qpos[model.jnt_qposadr[joint]])
@@ -154,7 +166,7 @@ def start(
         if math.isfinite(cmd.effort):
             carried = min(max(carried, -cmd.effort), cmd.effort)
         reference += carried / cmd.kp
-    data.act[model.actuator_actadr[a]] = reference
+    data.act[address] = reference - lead
 
 
 def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
@@ -220,14 +232,15 @@ def limit_windup(
     its speed, or leaves a stall, without a catch-up burst.
 
     Args:
-        servos: (actuator id, its velocity command) with a finite effort and kp > 0.
+        servos: (actuator id, its velocity command) with kp > 0.
     """
     for a, cmd in servos:
         joint = int(model.actuator_trnid[a, 0])
         q = float(data.qpos[model.jnt_qposadr[joint]])
         damping = cmd.kv * (cmd.target - float(data.qvel[model.jnt_dofadr[joint]]))
-        low = min(0.0, (-cmd.effort - damping) / cmd.kp)
-        high = max(0.0, (cmd.effort - damping) / cmd.kp)
+        effort = cmd.effort if math.isfinite(cmd.effort) else math.inf
+        low = min(0.0, (-effort - damping) / cmd.kp)
+        high = max(0.0, (effort - damping) / cmd.kp)
         address = int(model.actuator_actadr[a])
         data.act[address] = q + float(np.clip(data.act[address] - q, low, high))
 
