@@ -130,7 +130,7 @@ def test_encoder_odometry_tracks_the_world_pose_without_slip() -> None:
     ("entity", "linear", "duration", "error", "needle"),
     [
         ("ghost", 0.2, None, EntityNotFoundError, "ghost"),
-        ("box", 0.2, None, InvalidRequestError, "no diff-drive plugin"),
+        ("box", 0.2, None, InvalidRequestError, "no drive plugin"),
         ("tb3", math.nan, None, InvalidRequestError, "not a finite number"),
         ("tb3", math.inf, None, InvalidRequestError, "not a finite number"),
         ("tb3", 0.2, -1.0, InvalidRequestError, "not a positive number"),
