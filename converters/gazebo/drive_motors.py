@@ -13,9 +13,11 @@ site actuators (`<plugin>:vx`, `:vy` along the link's own x and y, `:wz` about i
 velocity servo force = kv·(target − velocity) in the link's frame, computed by MuJoCo at every
 step with no Python: a constant body-frame command needs no writes while it holds, where a servo
 on the free joint (world-frame x, y) would need new targets as the heading turns, and an
-`xfrc_applied` PD would act only at the controller's rate. kv = M/PLANAR_TAU (I_zz/PLANAR_TAU for
-the yaw), integrated implicitly by implicitfast, so the twist is reached within a few steps and
-a friction load μ·M·g leaves only μ·g·PLANAR_TAU of error (1 mm/s at μ = 1).
+`xfrc_applied` PD would act only at the controller's rate. The site sits at the robot's centre
+of mass, so the force does not pitch the base (at the link origin, below it, a 0.3 m/s step
+flipped a box on four feet). kv = M/PLANAR_TAU (I_zz/PLANAR_TAU for the yaw), integrated
+implicitly by implicitfast, so the twist is reached within a few steps and a friction load
+μ·M·g leaves only μ·g·PLANAR_TAU of error (1 mm/s at μ = 1).
 """
 
 from __future__ import annotations
@@ -128,14 +130,15 @@ def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
 
 
 def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
-    """Three velocity servos on the root link (see the module docstring)."""
+    """Three velocity servos at the robot's centre of mass on the root link (see the module
+    docstring): a force there turns the base without pitching it, as a set velocity does."""
     import mujoco
 
     root = spec.worldbody.first_body()
     if root is None:
         return
-    mass, yaw_inertia = _planar_inertia(spec)
-    site = root.add_site(name=PLANAR_SITE.format(name=drive.name))
+    mass, yaw_inertia, centre = _planar_inertia(spec)
+    site = root.add_site(name=PLANAR_SITE.format(name=drive.name), pos=centre)
     for axis, gear in PLANAR_AXES:
         servo = spec.add_actuator(name=planar_actuator(drive.name, axis), target=site.name)
         servo.trntype = mujoco.mjtTrn.mjTRN_SITE
@@ -144,19 +147,23 @@ def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
         servo.set_to_velocity(kv=kv)
 
 
-def _planar_inertia(spec: mujoco.MjSpec) -> tuple[float, float]:
-    """The robot's mass [kg] and its inertia about the root link's z axis [kg m²]."""
+def _planar_inertia(spec: mujoco.MjSpec) -> tuple[float, float, np.ndarray]:
+    """The robot's mass [kg], its inertia about the vertical through its centre of mass
+    [kg m²] and that centre [m] in the root link's frame (zero posture)."""
     import mujoco
 
     model = spec.copy().compile()
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
+    mujoco.mj_comPos(model, data)
+    centre = np.array(data.subtree_com[1])
     mass, izz = 0.0, 0.0
     for b in range(1, model.nbody):
         m = float(model.body_mass[b])
         rot = data.ximat[b].reshape(3, 3)
         inertia = rot @ np.diag(model.body_inertia[b]) @ rot.T
-        offset = data.xipos[b] - data.xpos[1]
+        offset = data.xipos[b] - centre
         mass += m
         izz += float(inertia[2, 2]) + m * float(offset[0] ** 2 + offset[1] ** 2)
-    return mass, max(izz, 1e-9)
+    root_rot = data.xmat[1].reshape(3, 3)
+    return mass, max(izz, 1e-9), root_rot.T @ (centre - data.xpos[1])
