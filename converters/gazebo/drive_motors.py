@@ -138,7 +138,8 @@ def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
     if root is None:
         return
     mass, yaw_inertia, centre = _planar_inertia(spec)
-    site = root.add_site(name=PLANAR_SITE.format(name=drive.name), pos=centre)
+    site = root.add_site(name=PLANAR_SITE.format(name=drive.name))
+    site.pos = centre
     for axis, gear in PLANAR_AXES:
         servo = spec.add_actuator(name=planar_actuator(drive.name, axis), target=site.name)
         servo.trntype = mujoco.mjtTrn.mjTRN_SITE
