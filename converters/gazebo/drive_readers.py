@@ -34,12 +34,13 @@ from converters.gazebo.wheel_geometry import WheelGeometry
 
 @dataclass(frozen=True)
 class ReadContext:
-    """What a reader needs besides the plugin: the file, the model's name (gz-sim's default
-    frame names use it) and the robot's measured wheels."""
+    """What a reader needs besides the plugin: the file, the model's name and its canonical
+    (base) link (gz-sim's default frame names use them) and the robot's measured wheels."""
 
     source: str
     model: str
     geometry: WheelGeometry | None
+    base_link: str = "base_link"
 
 
 def plugin_key(blob: Blob) -> str:
@@ -116,7 +117,7 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         update_rate=p.number(50.0, "odom_publish_frequency"),
         family="gz_diff_drive",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
-        robot_base_frame=p.text(f"{ctx.model}/base", "child_frame_id"),
+        robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         max_linear_velocity=p.number(math.inf, "max_linear_velocity", "max_velocity"),
         max_angular_velocity=p.number(math.inf, "max_angular_velocity"),
     )
@@ -181,7 +182,7 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         update_rate=p.number(50.0, "odom_publish_frequency"),
         odometry_source="encoder",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
-        robot_base_frame=p.text(f"{ctx.model}/base", "child_frame_id"),
+        robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         family="gz_ackermann_steering",
         angular_is_steering=False,
     )
@@ -247,7 +248,7 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
         wheelbase=p.number(1.0, "wheelbase"),
         max_linear_velocity=p.number(math.inf, "max_velocity"),
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
-        robot_base_frame=p.text(f"{ctx.model}/base", "child_frame_id"),
+        robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         notes=(
             "rollers: their 45° friction (fdir1, mu2) has no MuJoCo counterpart on a cylinder; "
             "the base is driven by its twist as planar move, the wheels spun to match",

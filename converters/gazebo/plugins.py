@@ -105,20 +105,25 @@ def plugin_kind(blob: Blob) -> str:
 
 
 def read_plugins(
-    blobs: tuple[Blob, ...], source: str, spec: mujoco.MjSpec | None = None, model: str = ""
+    blobs: tuple[Blob, ...],
+    source: str,
+    spec: mujoco.MjSpec | None = None,
+    model: str = "",
+    base_link: str = "base_link",
 ) -> tuple[DriveRecord | Rotor, ...]:
     """Every drive, joint controller and multicopter rotor among a model's plugins.
 
     Args:
         blobs: the model's `<plugin>` elements; source: the file, for messages; spec: the
             robot (gazebo_ros' Ackermann and tricycle plugins measure their wheels on it);
-            model: the model's name (gz-sim's default odometry frames use it).
+            model, base_link: the model's name and canonical link (gz-sim's default odometry
+            frames are `<model>/odom` and `<model>/<link>`).
 
     Raises:
         GazeboTagError: a parameter is not what its plugin needs, or a joint is not the model's.
     """
     geometry = WheelGeometry(spec, source) if spec is not None else None
-    ctx = ReadContext(source, model or "model", geometry)
+    ctx = ReadContext(source, model or "model", geometry, base_link)
     out: list[DriveRecord | Rotor] = []
     for blob in blobs:
         kind = plugin_kind(blob)
