@@ -281,7 +281,10 @@ def test_vendor_plugin_is_reported_tag_by_tag(tmp_path: Path) -> None:
 
 
 def test_an_unknown_plugin_is_reported_by_name_with_its_parameters(tmp_path: Path) -> None:
-    plugin = '<plugin name="lights" filename="libacme_blinker.so"><rate>2</rate><colour>red</colour></plugin>'
+    plugin = (
+        '<plugin name="lights" filename="libacme_blinker.so"><rate>2</rate><colour>red</colour>'
+        "</plugin>"
+    )
     report = _convert(tmp_path, dm.two_wheel_base(plugin), "urdf").report
     lines = [e.detail for e in report.entries if e.tag == "plugin"]
     assert (
