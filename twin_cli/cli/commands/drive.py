@@ -107,6 +107,7 @@ def _rows(reply: dict[str, Any]) -> tuple[list[str], list[list[Any]]]:
     position, rpy = reply["pose"]["position"], reply["pose"]["rpy"]
     linear, angular = reply["twist"]["linear"], reply["twist"]["angular"]
     rows = [
+        ["frames (odometry, base)", reply["odometry_frame"], reply["robot_base_frame"], ""],
         ["position [m]", *(f"{v:.4f}" for v in position)],
         ["roll pitch yaw [rad]", *(f"{v:.4f}" for v in rpy)],
         ["linear [m/s]", *(f"{v:.4f}" for v in linear)],
