@@ -333,3 +333,13 @@ def test_limits_of_no_limit_are_null_in_json(tmp_path: Path) -> None:
     assert (
         math.isinf(record.max_linear_velocity) and record.to_dict()["max_linear_velocity"] is None
     )
+
+
+def test_docs_list_every_plugin_and_system_twin_recognises() -> None:
+    from converters.gazebo.drive_readers import READERS
+    from converters.gazebo.plugins import NEEDS, SYSTEM_NAMES
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "plugins.md").read_text()
+    names = [*READERS, *NEEDS, *SYSTEM_NAMES]
+    missing = [n for n in names if n not in text]
+    assert not missing, f"docs/plugins.md does not name {missing}"

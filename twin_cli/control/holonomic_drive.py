@@ -2,9 +2,10 @@
 
 Gazebo's planar move sets the model's planar velocity itself. The converter gave the root link
 three velocity servos in its own frame (`converters.gazebo.drive_motors`: x, y and yaw, computed
-by MuJoCo at every step); this controller writes the command (vx, vy, ωz) into their `ctrl` once
-per change, waking the robot if it sleeps, and reports the world pose as odometry. A held command
-costs no writes, and the servos hold a zero twist between commands, as the plugin does.
+by MuJoCo at every step); this controller ramps the command (vx, vy, ωz) into their `ctrl`
+(LINEAR_RAMP, ANGULAR_RAMP), waking the robot if it sleeps, and reports the world pose as
+odometry. A held command costs no writes, and the servos hold a zero twist between commands, as
+the plugin does.
 """
 
 from __future__ import annotations
