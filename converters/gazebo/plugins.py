@@ -12,10 +12,12 @@ parameters, as not run.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from converters.description.gazebo import Blob
 from converters.gazebo.drive_motors import add_drive_motors
+from converters.gazebo.drive_notes import drive_notes
 from converters.gazebo.drive_readers import READERS, ReadContext, plugin_key
 from converters.gazebo.drive_records import DiffDrive, DriveRecord
 from converters.gazebo.multicopter import Rotor, is_motor_model, missing_names, read_rotor
@@ -129,7 +131,10 @@ def read_plugins(
         kind = plugin_kind(blob)
         if kind in ("drive", "joint_drive"):
             key = drive_key(blob) or ""
-            out.append(READERS[key](Params.of(blob, source), blob, ctx))
+            params = Params.of(blob, source)
+            record = READERS[key](params, blob, ctx)
+            notes = drive_notes(key, params, getattr(record, "initial", 0.0))
+            out.append(replace(record, notes=record.notes + notes))
         elif kind == "vendor_drive":
             out.append(read_vendor_diff_drive(Params.of(blob, source), blob))
         elif kind == "multicopter":

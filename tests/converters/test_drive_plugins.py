@@ -343,3 +343,23 @@ def test_docs_list_every_plugin_and_system_twin_recognises() -> None:
     names = [*READERS, *NEEDS, *SYSTEM_NAMES]
     missing = [n for n in names if n not in text]
     assert not missing, f"docs/plugins.md does not name {missing}"
+
+
+def test_a_known_drives_approximations_and_unused_tags_are_reported_tag_by_tag(
+    tmp_path: Path,
+) -> None:
+    extra = (
+        "<left_steering_pid_gain>1500 0 1</left_steering_pid_gain><publish_odom>true"
+        "</publish_odom><steering_wheel_joint>steering_joint</steering_wheel_joint>"
+        "<ros><namespace>demo</namespace></ros></plugin>"
+    )
+    report = _convert(tmp_path, dm.ackermann_car(ROS_ACKERMANN.replace("</plugin>", extra)), "urdf")
+    notes = [e.detail for e in report.report.entries if e.outcome.name == "APPROXIMATED"]
+    assert any("open differential" in n for n in notes), notes
+    for tag, says in (
+        ("left_steering_pid_gain", "not used by twin"),
+        ("steering_wheel_joint", "not used by twin"),
+        ("publish_odom", "twin publishes no ROS topics"),
+        ("ros", "twin publishes no ROS topics"),
+    ):
+        assert any(f"<{tag}>" in n and says in n for n in notes), f"<{tag}>: {says}"
