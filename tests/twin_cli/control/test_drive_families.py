@@ -81,6 +81,13 @@ TRICYCLE = (
     "<actuated_wheel_diameter>0.1</actuated_wheel_diameter><max_wheel_torque>5</max_wheel_torque>"
     "<odometry_source>0</odometry_source></plugin>"
 )
+MECANUM = (
+    '<plugin filename="gz-sim-mecanum-drive-system" name="gz::sim::systems::MecanumDrive">'
+    "<front_left_joint>left_front_joint</front_left_joint><front_right_joint>right_front_joint"
+    "</front_right_joint><back_left_joint>left_rear_joint</back_left_joint><back_right_joint>"
+    "right_rear_joint</back_right_joint><wheel_separation>0.3</wheel_separation><wheelbase>0.12"
+    "</wheelbase><wheel_radius>0.05</wheel_radius></plugin>"
+)
 PLANAR = (
     '<plugin name="mover" filename="libgazebo_ros_planar_move.so"><update_rate>100</update_rate>'
     "<odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
@@ -130,6 +137,9 @@ FAMILIES = {
     ),
     "gazebo_ros_tricycle_drive": Family(
         lambda: dm.tricycle(TRICYCLE), "urdf", "bicycle", {"steering": 0.4}
+    ),
+    "gz_mecanum_drive": Family(
+        lambda: dm.skid_steer_bot(MECANUM), "urdf", "holonomic", {"angular": 0.5, "lateral": 0.1}
     ),
     "gazebo_ros_planar_move": Family(
         lambda: dm.planar_base(PLANAR), "urdf", "holonomic", {"angular": 0.5, "lateral": 0.1}
