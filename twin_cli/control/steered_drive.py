@@ -68,7 +68,8 @@ class SteeredDriveController(DriveController):
             return TRICYCLE_LOCK
         p = self.plugin
         # gz-sim clamps the turning radius at L/sin(limit) when it turns a yaw rate into one
-        gz_rate = p.family == "gz_ackermann_steering" and self.twist.steering is None
+        from_rate = self.twist.steering is None and self.twist.curvature is None
+        gz_rate = p.family == "gz_ackermann_steering" and from_rate
         return math.atan(math.sin(p.steering_limit)) if gz_rate else p.steering_limit
 
     def goals(self) -> tuple[float, float]:
