@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from converters.control_text import set_control_record
-from converters.errors import GazeboTagError
+from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     AckermannDrive,
     DiffDrive,
@@ -85,8 +85,10 @@ def add_drive_motors(
     and a report line for each approximation a drive makes.
 
     Raises:
-        GazeboTagError: a joint the plugin names is not a joint of the model.
+        PluginJointError: a joint the plugin names is not a joint of the model.
     """
+    import mujoco
+
     add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
     driven = {a.target for a in spec.actuators}
     for record in plugins:
@@ -94,8 +96,9 @@ def add_drive_motors(
             continue
         for joint, mode, effort, pid in joint_modes(record):
             if spec.joint(joint) is None:
-                model = spec.modelname or "model"
-                raise GazeboTagError(model, "", "plugin/*joint*", joint, "a joint of the model")
+                free = mujoco.mjtJoint.mjJNT_FREE
+                joints = [j.name for j in spec.joints if j.type != free]
+                raise PluginJointError(report.source, record.name, "", joint, joints)
             if joint not in driven:
                 _motor(spec, joint, effort)
                 set_control_record(spec, joint, _record(record, mode, pid))

@@ -122,7 +122,8 @@ def read_plugins(
             frames are `<model>/odom` and `<model>/<link>`).
 
     Raises:
-        GazeboTagError: a parameter is not what its plugin needs, or a joint is not the model's.
+        GazeboTagError: a parameter is not what its plugin needs. PluginJointError: a joint
+            the plugin names is not the model's.
     """
     geometry = WheelGeometry(spec, source) if spec is not None else None
     ctx = ReadContext(source, model or "model", geometry, base_link)
@@ -132,6 +133,8 @@ def read_plugins(
         if kind in ("drive", "joint_drive"):
             key = drive_key(blob) or ""
             params = Params.of(blob, source)
+            if geometry is not None:
+                geometry.plugin = blob.name or key
             record = READERS[key](params, blob, ctx)
             notes = drive_notes(key, params, getattr(record, "initial", 0.0))
             out.append(replace(record, notes=record.notes + notes))

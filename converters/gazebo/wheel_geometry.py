@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from converters.errors import GazeboTagError
+from converters.errors import GazeboTagError, PluginJointError
 
 if TYPE_CHECKING:
     import mujoco
@@ -26,6 +26,7 @@ class WheelGeometry:
 
     def __init__(self, spec: mujoco.MjSpec, source: str) -> None:
         self.spec, self.source = spec, source
+        self.plugin = ""  # the plugin being read, for messages
         self._compiled: tuple | None = None
 
     def _model(self) -> tuple:
@@ -44,7 +45,8 @@ class WheelGeometry:
         model, _ = self._model()
         j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
         if j < 0:
-            raise GazeboTagError(self.source, "", f"plugin/{tag}", joint, "a joint of the model")
+            joints = [model.joint(i).name for i in range(model.njnt) if model.jnt_type[i] != 0]
+            raise PluginJointError(self.source, self.plugin, tag, joint, joints)
         return j
 
     def centre(self, joint: str, tag: str) -> np.ndarray:
@@ -52,7 +54,7 @@ class WheelGeometry:
         the joint's anchor), in the robot's frame.
 
         Raises:
-            GazeboTagError: no such joint.
+            PluginJointError: no such joint.
         """
         model, data = self._model()
         j = self._joint(joint, tag)
@@ -66,7 +68,7 @@ class WheelGeometry:
         half the largest extent of its first collision.
 
         Raises:
-            GazeboTagError: no such joint, or its link has no collision.
+            PluginJointError: no such joint. GazeboTagError: its link has no collision.
         """
         import mujoco
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import drive_models as dm
 import pytest
 
-from converters.errors import GazeboTagError
+from converters.errors import ConversionError, PluginJointError
 from converters.pipeline import convert_full
 
 SKID = (
@@ -315,15 +315,19 @@ def test_a_wheel_without_a_drive_keeps_a_passive_motor(tmp_path: Path) -> None:
 def test_bad_drive_values_name_the_tag_and_the_fix(
     tmp_path: Path, swap: tuple[str, str], needle: str
 ) -> None:
-    with pytest.raises(GazeboTagError, match=needle) as caught:
+    with pytest.raises(ConversionError, match=needle) as caught:
         _convert(tmp_path, dm.skid_steer_bot(SKID.replace(*swap)), "urdf")
-    assert "write" in str(caught.value), "the message names the fix"
+    fix = "name one of its joints" if needle == "nope" else "write"
+    assert fix in str(caught.value), "the message names the fix"
 
 
 def test_an_ackermann_plugin_naming_a_missing_joint_is_refused(tmp_path: Path) -> None:
     text = dm.ackermann_car(ROS_ACKERMANN.replace(">rear_left_joint<", ">rear_nope<"))
-    with pytest.raises(GazeboTagError, match="rear_nope"):
+    with pytest.raises(PluginJointError, match="rear_nope") as caught:
         _convert(tmp_path, text, "urdf")
+    message = str(caught.value)
+    assert "<rear_left_joint>" in message and "rear_right_joint" in message, "valid names"
+    assert "floating_base" not in message, "only joints a plugin can name"
 
 
 def test_limits_of_no_limit_are_null_in_json(tmp_path: Path) -> None:
