@@ -78,9 +78,9 @@ def drive(
         raise InvalidRequestError(
             "drive duration", f"{duration} s is not a positive number", "give e.g. --duration 5"
         )
-    controller = controller_of(world, entity)
     twist = Twist(linear, angular, lateral, steering, curvature)
-    _check_options(entity, controller, twist)
+    _check_options(entity, *_drive_of(world, entity), twist)  # before a controller exists
+    controller = controller_of(world, entity)
     controller.command(twist, duration)
     with world.lock:
         applied = controller.command_reply()
@@ -116,15 +116,25 @@ def controller_of(world: World, entity: str) -> DriveController:
         controller = controllers.get(entity)
         if controller is not None and found is controller.entity_record:
             return controller
-        drives = [p for p in found.plugins if type(p).__name__ in CONTROLLERS]
-        if not drives:
-            raise _no_drive(world, entity)
+        cls, record = _drive_of(world, entity)
         if controller is not None:
             controller.stop()  # an entity respawned under the same name
-        controller = CONTROLLERS[type(drives[0]).__name__](world, entity, drives[0])
+        controller = cls(world, entity, record)
         controller.entity_record = found
         controllers[entity] = controller
         return controller
+
+
+def _drive_of(world: World, entity: str) -> tuple[type[DriveController], Any]:
+    """The controller class and the record of the entity's first drive.
+
+    Raises:
+        EntityNotFoundError: no such entity. InvalidRequestError: it has no drive.
+    """
+    drives = [p for p in world.entity(entity).plugins if type(p).__name__ in CONTROLLERS]
+    if not drives:
+        raise _no_drive(world, entity)
+    return CONTROLLERS[type(drives[0]).__name__], drives[0]
 
 
 def _no_drive(world: World, entity: str) -> InvalidRequestError:
@@ -142,10 +152,10 @@ def _no_drive(world: World, entity: str) -> InvalidRequestError:
     return InvalidRequestError(f"entity [{entity}]", f"has no drive plugin ({DRIVE_NAMES})", fix)
 
 
-def _check_options(entity: str, controller: DriveController, twist: Twist) -> None:
+def _check_options(entity: str, cls: type[DriveController], record: Any, twist: Twist) -> None:
     """Refuses options the entity's drive does not take, naming the ones it does."""
-    family = controller.plugin.family
-    steered = isinstance(controller, SteeredDriveController)
+    family = record.family
+    steered = issubclass(cls, SteeredDriveController)
     if not steered and (twist.steering is not None or twist.curvature is not None):
         raise InvalidRequestError(
             f"drive of [{entity}] ({family})",
@@ -164,7 +174,7 @@ def _check_options(entity: str, controller: DriveController, twist: Twist) -> No
             "takes a yaw rate (--angular) or a steering angle/curvature, not both",
             "give one of them",
         )
-    if twist.lateral and not isinstance(controller, HolonomicController):
+    if twist.lateral and not issubclass(cls, HolonomicController):
         raise InvalidRequestError(
             f"drive of [{entity}] ({family})",
             "cannot move sideways (--lateral is for planar move and mecanum bases)",

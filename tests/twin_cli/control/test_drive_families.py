@@ -232,3 +232,30 @@ def test_drive_follows_its_kinematic_model_and_odometry_the_world_pose(
         f"{name}: {odom['source']} odometry ({ox:.4f}, {oy:.4f}) vs world ({end.x:.4f}, "
         f"{end.y:.4f})"
     )
+
+
+@pytest.mark.parametrize(
+    ("name", "command", "needle"),
+    [
+        ("gazebo_ros_ackermann_drive", {"lateral": 0.1}, "cannot move sideways"),
+        ("vendor_kobuki", {"steering": 0.2}, "steered bases"),
+        ("gazebo_ros_tricycle_drive", {"angular": 0.2, "curvature": 1.0}, "not both"),
+    ],
+)
+def test_an_option_its_drive_does_not_take_leaves_the_world_unchanged(
+    tmp_path: Path, name: str, command: dict, needle: str
+) -> None:
+    from world_helpers import full_state
+
+    from twin_cli.errors import InvalidRequestError
+
+    family = FAMILIES[name]
+    path = tmp_path / f"{name}.{family.suffix}"
+    path.write_text(family.robot())
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    before = full_state(world)
+    with pytest.raises(InvalidRequestError, match=needle):
+        drive(world, "base", 0.3, **command)
+    assert (full_state(world) == before).all(), "state, controls and time unchanged"
+    assert not world.commands() and not world._state.observers, "no command, no controller"
