@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from converters.description.gazebo import Blob
+from converters.gazebo.drive_notes import ROS_TOPICS
 from converters.gazebo.drive_records import DEFAULT_RATE, DEFAULT_TORQUE, DiffDrive
 from converters.gazebo.plugin_params import Params
 
@@ -58,7 +59,7 @@ def read_vendor_diff_drive(p: Params, blob: Blob) -> DiffDrive:
     diameter = number("wheel diameter [m]", 0.0) or 2.0 * number("wheel radius [m]", 0.0)
     roles = roles_of(p)
     notes = tuple(
-        f"<{tag}>{value}: read as the {roles[tag]}" if tag in roles else f"<{tag}>: ignored"
+        f"<{tag}>{value}: read as the {roles[tag]}" if tag in roles else _unused(tag)
         for tag, value in p.given().items()
     )
     return DiffDrive(
@@ -76,6 +77,12 @@ def read_vendor_diff_drive(p: Params, blob: Blob) -> DiffDrive:
         robot_base_frame=_frame(p, by_role, "robot base frame", "base_footprint"),
         notes=notes,
     )
+
+
+def _unused(tag: str) -> str:
+    if any(word in tag.lower() for word in ROS_TOPICS):
+        return f"<{tag}>: ignored (twin publishes no ROS topics; see twin odom)"
+    return f"<{tag}>: ignored"
 
 
 def _frame(p: Params, by_role: dict[str, str], role: str, default: str) -> str:
