@@ -41,8 +41,26 @@ def _gazebo_example(expected: str) -> str:
         "a number > 0": "1e5",
         "an integer": "10",
         "three numbers": "1 0 0",
+        "a finite number": "0.5",
+        "a finite number >= 0": "0.5",
+        "0 (encoder) or 1 (world)": "1",
+        "a wheel joint name": "wheel_left_joint",
     }
     return examples.get(expected, "true")
+
+
+class PluginJointError(ConversionError):
+    """A plugin names a joint the model does not have."""
+
+    def __init__(self, source: str, plugin: str, tag: str, joint: str, joints: list[str]) -> None:
+        valid = ", ".join(joints) or "none"
+        where = f" in <{tag}>" if tag else ""
+        super().__init__(
+            f"{source}: <plugin> '{plugin}' names joint '{joint}'{where}, which the model does "
+            f"not have; name one of its joints ({valid})"
+        )
+        self.source = source
+        self.joint = joint
 
 
 # --- Converter core: packages, xacro, URDF structure, inertia, meshes -----------------------

@@ -36,7 +36,7 @@ class Conversion:
     provenance: Provenance
     description: RobotDescription
     sensors: tuple[SensorSpec, ...] = ()
-    plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (run by twin_cli.control)
+    plugins: tuple = ()  # converters.gazebo.drive_records records (run by twin_cli.control)
 
 
 def read_description(
@@ -171,6 +171,7 @@ def build_description(
     from converters.gazebo.plugins import add_drive_motors, read_plugins
     from converters.gazebo.sensor_sites import add_sensors
     from converters.mjcf.heightfields import add_height_fields
+    from converters.mjcf.passive_motors import add_passive_motors
 
     options = options or ConvertOptions()
     report = report or Report(source=robot.source)
@@ -182,8 +183,9 @@ def build_description(
     add_height_fields(spec, robot, report, keep_fixed=options.keep_fixed)  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
-    plugins = read_plugins(robot.gazebo.plugins, robot.source)
+    plugins = read_plugins(robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link)
     add_drive_motors(spec, plugins, report)
+    add_passive_motors(spec, robot, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)
 
 

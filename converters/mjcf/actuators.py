@@ -62,7 +62,8 @@ def add_motors(
     for joint in joints:
         effort = _effort(joint)
         if effort <= 0 and joint.name not in tagged:
-            report.warn(f"joint '{joint.name}'", "no positive effort limit; no motor added")
+            if joint.kind == "prismatic":  # revolute ones stay passive (mjcf.passive_motors)
+                report.warn(f"joint '{joint.name}'", "no positive effort limit; no motor added")
             continue
         actuator = spec.add_actuator(name=joint.name, target=joint.name)
         actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT

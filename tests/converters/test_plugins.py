@@ -9,7 +9,7 @@ import mujoco
 import pytest
 from models import two_wheel_bot
 
-from converters.errors import GazeboTagError
+from converters.errors import ConversionError
 from converters.gazebo.plugins import DiffDrive
 from converters.pipeline import convert_full
 
@@ -97,5 +97,5 @@ def test_report_names_each_plugin_run_or_not_run(tmp_path: Path) -> None:
     ],
 )
 def test_bad_plugin_values_name_the_tag(tmp_path: Path, swap: tuple[str, str], needle: str) -> None:
-    with pytest.raises(GazeboTagError, match=needle):
+    with pytest.raises(ConversionError, match=needle):
         _convert(tmp_path, ROS2.replace(*swap))

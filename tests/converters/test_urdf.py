@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import mujoco
@@ -51,8 +52,12 @@ def test_transmissions_choose_the_actuated_joints(tmp_path: Path) -> None:
     path.write_text(
         f'<robot name="r">{links}{_joint("ja", "a")}{_joint("jb", "b")}{transmission}</robot>'
     )
-    model = convert_full(path).spec.compile()
-    assert [model.actuator(i).name for i in range(model.nu)] == ["jb"], "only transmission joints"
+    spec = convert_full(path).spec
+    model = spec.compile()
+    assert [model.actuator(i).name for i in range(model.nu)] == ["jb", "ja"], "motors"
+    records = json.loads(spec.text("control").data)
+    assert records["jb"]["modes"] == ["effort"], "the transmission's interface"
+    assert (records["ja"]["source"], records["ja"]["modes"]) == ("passive", ["effort", "velocity"])
 
 
 @pytest.mark.parametrize(

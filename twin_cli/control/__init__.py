@@ -4,7 +4,8 @@ Each controller is a world observer at its own update rate (no Python per physic
 only through the engine's API (joint commands). `trajectory` reads
 trajectory_msgs/JointTrajectory files and interpolates them as joint_trajectory_controller does;
 `follower` follows one on an entity at the controller manager's update rate and reports the
-tracking error; `kinematics`, `diff_drive` and `drives` run gazebo_ros' diff-drive plugin.
+tracking error; `drives` runs a robot's drive plugin (`drive_base` with `diff_drive`,
+`steered_drive`, `holonomic_drive`; maths in `kinematics` and `steering`).
 
 Exports are lazy (`twin_cli.lazy`): `twin trajectory` reads its file with `trajectory` on the
 client, which must not import mujoco or numpy through this package.
@@ -16,6 +17,10 @@ from twin_cli.lazy import lazy_getattr
 
 _WHERE = {
     "DiffDriveController": "twin_cli.control.diff_drive",
+    "DriveController": "twin_cli.control.drive_base",
+    "HolonomicController": "twin_cli.control.holonomic_drive",
+    "SteeredDriveController": "twin_cli.control.steered_drive",
+    "Twist": "twin_cli.control.drive_base",
     "controller_of": "twin_cli.control.drives",
     "drive": "twin_cli.control.drives",
     "odometry": "twin_cli.control.drives",

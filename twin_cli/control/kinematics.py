@@ -1,4 +1,4 @@
-"""Differential-drive kinematics: (v, ω) → wheel speeds, the acceleration ramp, encoder odometry.
+"""Differential-drive kinematics: (v, ω) → wheel speeds, the acceleration ramp, odometry.
 
 Pure functions of numbers, testable without a world. The rules are gazebo_ros_diff_drive's:
 rim speeds v ∓ ω·b/2 for the left/right wheel (b the wheel separation); the commanded rim speed
@@ -38,26 +38,17 @@ def ramp(current: float, target: float, acceleration: float, dt: float) -> float
     return current + math.copysign(step, target - current)
 
 
-def integrate_encoders(
-    pose: Pose2D, left: float, right: float, radius: float, separation: float, dt: float
-) -> Pose2D:
-    """The pose after the wheels turned at `left`/`right` [rad/s] for `dt` [s].
-
-    Args:
-        pose: start pose in the odometry frame.
-        left, right: wheel joint speeds [rad/s]; radius [m]; separation [m]; dt [s].
-    """
-    s_left, s_right = left * radius * dt, right * radius * dt
-    travel, turn = (s_left + s_right) / 2.0, (s_right - s_left) / separation
-    heading = pose.theta + turn / 2.0
-    return Pose2D(
-        pose.x + travel * math.cos(heading),
-        pose.y + travel * math.sin(heading),
-        pose.theta + turn,
-    )
-
-
 def body_twist(left: float, right: float, radius: float, separation: float) -> tuple[float, float]:
     """Forward speed [m/s] and yaw rate [rad/s] from wheel joint speeds [rad/s]."""
     v_left, v_right = left * radius, right * radius
     return (v_left + v_right) / 2.0, (v_right - v_left) / separation
+
+
+def integrate_twist(pose: Pose2D, linear: float, angular: float, dt: float) -> Pose2D:
+    """The pose after moving at (v [m/s], ω [rad/s]) for `dt` [s], heading at mid-update."""
+    heading = pose.theta + angular * dt / 2.0
+    return Pose2D(
+        pose.x + linear * dt * math.cos(heading),
+        pose.y + linear * dt * math.sin(heading),
+        pose.theta + angular * dt,
+    )

@@ -65,7 +65,7 @@ class Sources:
     Attributes:
         prefix: the frame prefix of its links (the template filled in).
         description: URDF text after xacro, or None (the model's body tree is used).
-        drive: (odometry frame, base frame) of its diff-drive plugin, or None.
+        drive: (odometry frame, base frame) of its drive plugin, or None.
         sensors: its sensors' frames.
     """
 
@@ -83,8 +83,25 @@ def sources_of(world: World, name: str, template: str, description: str | None) 
     sensors = tuple(
         SensorFrame(s.name, s.link, s.frame_id, not any(s.pose)) for s in record.sensors
     )
-    drive = drive_frames(text) if any(isinstance(p, DiffDrive) for p in record.plugins) else None
+    drive = record_frames(record.plugins)
+    if any(
+        isinstance(p, DiffDrive) and p.family == "gazebo_ros_diff_drive" for p in record.plugins
+    ):
+        drive = drive_frames(text)
     return Sources(template.replace("{entity}", name), text, drive, sensors)
+
+
+def record_frames(plugins: Sequence[object]) -> tuple[str, str] | None:
+    """(odometry frame, base frame) of the first drive among an entity's plugin records (every
+    drive family names them: `converters.gazebo.drive_records`), or None."""
+    for plugin in plugins:
+        odom, base = (
+            getattr(plugin, "odometry_frame", None),
+            getattr(plugin, "robot_base_frame", None),
+        )
+        if odom and base:
+            return odom.strip("/"), base.strip("/")
+    return None
 
 
 @lru_cache(maxsize=64)

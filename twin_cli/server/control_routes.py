@@ -46,7 +46,20 @@ class TrajectoryBody(Body):
 @router.post("/entities/{name}/commands")
 def commands(name: str, body: CommandsBody, world: WorldDep) -> dict:
     done = world.command_joints(name, dict(body.targets), mode=body.mode)
-    return {"commanded": name, "mode": body.mode, "joints": [c.actuator for c in done]}
+    with world.lock:
+        rows = world.joint_commands(name)
+    passive = [j for j in body.targets if rows.get(j, {}).get("source") == "passive"]
+    notes = [
+        f"joint [{j}] has no control tag or drive plugin: passive in Gazebo, driven by twin's "
+        f"motor at this {body.mode} command"
+        for j in passive
+    ]
+    return {
+        "commanded": name,
+        "mode": body.mode,
+        "joints": [c.actuator for c in done],
+        "notes": notes,
+    }
 
 
 @router.get("/entities/{name}/control")
@@ -92,10 +105,14 @@ def trajectory_status(name: str, world: WorldDep) -> dict:
 
 
 class DriveRequest(BaseModel):
-    """geometry_msgs/Twist's forward and yaw speeds, held for `duration` [s] of sim time."""
+    """geometry_msgs/Twist's speeds (or a steered base's angle or curvature), held for
+    `duration` [s] of sim time."""
 
     linear: float = Field(0.0, description="forward speed [m/s] (Twist linear.x)")
     angular: float = Field(0.0, description="yaw rate [rad/s] (Twist angular.z)")
+    lateral: float = Field(0.0, description="sideways speed [m/s] (holonomic bases)")
+    steering: float | None = Field(None, description="bicycle steering angle [rad] (steered)")
+    curvature: float | None = Field(None, description="path curvature [1/m] (steered bases)")
     duration: float | None = Field(
         None, description="sim seconds before the wheels stop (default: until replaced)"
     )
@@ -103,10 +120,19 @@ class DriveRequest(BaseModel):
 
 @router.post("/entities/{name}/drive")
 def drive_entity(name: str, body: DriveRequest, world: WorldDep) -> dict:
-    """Commands the entity's diff drive; errors: unknown entity, no drive plugin, not finite."""
+    """Commands the entity's drive; errors: unknown entity, no drive plugin, not finite."""
     from twin_cli.control import drive
 
-    return drive(world, name, body.linear, body.angular, body.duration)
+    return drive(
+        world,
+        name,
+        body.linear,
+        body.angular,
+        body.duration,
+        lateral=body.lateral,
+        steering=body.steering,
+        curvature=body.curvature,
+    )
 
 
 @router.get("/entities/{name}/odom")

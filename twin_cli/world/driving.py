@@ -108,7 +108,9 @@ def command_joints(
         }
         dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
         rolling = dofs if mode == "velocity" else dofs[:0]
-        change = [c[4] - _speed_before(state, c[0], int(d)) for c, d in zip(checked, dofs)]
+        change = [
+            c[4] - _speed_before(state, c[0], int(d)) for c, d in zip(checked, dofs, strict=True)
+        ]
         loads = joint_control.posture_loads(
             state.model, state.data, positions, dofs, rolling, np.array(change)
         )

@@ -82,7 +82,7 @@ class Entity:
         xml: MJCF text of an MjSpec or text source (for save/load), else None.
         description: the URDF text after xacro (for `/robot_description`), else None.
         sensors: its Gazebo sensors (`converters.description.sensors.SensorSpec`), if any.
-        plugins: its drive plugins (`converters.gazebo.plugins.DiffDrive`), if any.
+        plugins: its drive and rotor plugins (`converters.gazebo.drive_records`), if any.
     """
 
     name: str

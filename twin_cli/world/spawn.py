@@ -63,7 +63,7 @@ class LoadedSource:
     notes: tuple[str, ...] = ()
     cached: bool = False
     mesh_keys: dict[str, str] | None = None
-    plugins: tuple = ()  # converters.gazebo.plugins.DiffDrive records (URDF/SDF)
+    plugins: tuple = ()  # converters.gazebo.drive_records records (URDF/SDF)
 
 
 def load_source(request: SpawnRequest) -> LoadedSource:

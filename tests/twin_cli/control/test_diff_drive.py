@@ -89,6 +89,24 @@ def test_turtlebot3_ends_within_5_percent_of_the_unicycle(driven: dict) -> None:
     assert heading <= POSE_TOLERANCE * turned, f"heading {heading:.4f} rad off of {turned:.3f}"
 
 
+@pytest.mark.xfail(
+    reason="wheel velocity servos sag under load (kv capped at I/h): the inner wheel turns at "
+    "4.798 rad/s for 4.848; measured 2.02 % of the path in position, 1.0 % of the turn in "
+    "heading; to re-check once the servos hold their targets"
+)
+def test_turtlebot3_ends_within_2_percent_of_the_unicycle(driven: dict) -> None:
+    """The bound every drive family is held to (test_drive_families.py)."""
+    plugin, start = driven["plugin"], driven["start"]
+    (x, y, th), path = _unicycle(
+        plugin.wheel_separation, plugin.max_wheel_acceleration, (start.x, start.y, start.yaw)
+    )
+    end = driven["world"].get_pose("tb3")
+    error = math.hypot(end.x - x, end.y - y)
+    assert error <= 0.02 * path, f"position {error:.4f} m off over a {path:.3f} m path"
+    heading = abs(math.remainder(end.yaw - th, 2 * math.pi))
+    assert heading <= 0.02 * (th - start.yaw), f"heading {heading:.4f} rad off"
+
+
 def test_wheels_never_exceed_their_commanded_speed(driven: dict) -> None:
     plugin = driven["plugin"]
     radius = plugin.wheel_diameter / 2
@@ -130,7 +148,7 @@ def test_encoder_odometry_tracks_the_world_pose_without_slip() -> None:
     ("entity", "linear", "duration", "error", "needle"),
     [
         ("ghost", 0.2, None, EntityNotFoundError, "ghost"),
-        ("box", 0.2, None, InvalidRequestError, "no diff-drive plugin"),
+        ("box", 0.2, None, InvalidRequestError, "no drive plugin"),
         ("tb3", math.nan, None, InvalidRequestError, "not a finite number"),
         ("tb3", math.inf, None, InvalidRequestError, "not a finite number"),
         ("tb3", 0.2, -1.0, InvalidRequestError, "not a positive number"),

@@ -73,10 +73,10 @@ def test_drive_moves_the_robot_and_odom_reports_the_world_pose(served: Path) -> 
     ("args", "needle"),
     [
         (("drive", "ghost", "--linear", "0.2"), "ghost"),
-        (("drive", "box", "--linear", "0.2"), "no diff-drive plugin"),
+        (("drive", "box", "--linear", "0.2"), "no drive plugin"),
         (("drive", "tb3", "--linear", "nan"), "not finite"),
         (("drive", "tb3", "--angular", "inf"), "not finite"),
-        (("odom", "box"), "no diff-drive plugin"),
+        (("odom", "box"), "no drive plugin"),
     ],
 )
 def test_bad_drive_input_is_one_message_and_exit_2(served: Path, args: tuple, needle: str) -> None:

@@ -73,6 +73,8 @@ def command(
         out.data(done)
         return
     out.line(f"{entity}: {mode} " + " ".join(f"{j}={v:g}" for j, v in parsed.items()))
+    for note in done.get("notes", []):
+        out.line(note)
 
 
 def trajectory(

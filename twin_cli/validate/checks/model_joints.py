@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 from twin_cli.validate.checks.base import DeclaredJoint, RobotUnderTest, judged
 from twin_cli.validate.scenario import Scenario
 
@@ -27,12 +29,35 @@ def joint_effort(model, joint: int) -> float | None:
 
 
 def has_actuator(model, joint: int) -> bool:
-    """True when a motor drives this joint."""
+    """True when a motor drives this joint (a passive joint's zero-effort motor does not: no
+    tag asks for one, so no effort limit is missing)."""
+    if model.joint(joint).name in passive_joints(model):
+        return False
     return any(
         int(model.actuator_trntype[a]) == JOINT_TRANSMISSION
         and int(model.actuator_trnid[a][0]) == joint
         for a in range(model.nu)
     )
+
+
+def passive_joints(model) -> set[str]:
+    """Joints whose motor the converter added only so that they can be commanded (record
+    source "passive" in the model's `control` text)."""
+    import mujoco
+
+    out: set[str] = set()
+    for t in range(model.ntext):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_TEXT, t) or ""
+        if name != "control" and not name.endswith("/control"):
+            continue
+        start = model.text_adr[t]
+        try:
+            records = json.loads(bytes(model.text_data[start : start + model.text_size[t] - 1]))
+        except ValueError:
+            continue
+        prefix = name.removesuffix("control")
+        out |= {prefix + j for j, r in records.items() if r.get("source") == "passive"}
+    return out
 
 
 def limited_range(model, joint: int) -> tuple[float, float] | None:

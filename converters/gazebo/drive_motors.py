@@ -1,0 +1,173 @@
+"""Motors for the drives twin runs: each wheel and steering joint a drive plugin names gets one,
+and a holonomic base gets a planar velocity servo on its root link.
+
+Gazebo's drive plugins command their joints directly (a joint velocity with `fmax`, a force, a
+position) whatever `<transmission>` or `<ros2_control>` says, so their joints need a motor even
+without those tags. A joint that already has one keeps it (its tags decide its modes); a new one
+offers only the mode the plugin uses, bounded by the plugin's torque (unbounded when the plugin
+sets velocities directly, as gz-sim's systems do).
+
+Planar move (and MecanumDrive, whose rollers MuJoCo cannot model) drives the base's planar twist.
+Gazebo's planar move overwrites the model's velocity every step; twin gives the root link three
+site actuators (`<plugin>:vx`, `:vy` along the link's own x and y, `:wz` about its z), each a
+velocity servo force = kv·(target − velocity) in the link's frame, computed by MuJoCo at every
+step with no Python: a constant body-frame command needs no writes while it holds, where a servo
+on the free joint (world-frame x, y) would need new targets as the heading turns, and an
+`xfrc_applied` PD would act only at the controller's rate. The site sits at the robot's centre
+of mass, so the force does not pitch the base (at the link origin, below it, a 0.3 m/s step
+flipped a box on four feet). kv = M/PLANAR_TAU (I_zz/PLANAR_TAU for the yaw), integrated
+implicitly by implicitfast, so the twist is reached within a few steps and a friction load
+μ·M·g leaves only μ·g·PLANAR_TAU of error (1 mm/s at μ = 1).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from converters.control_text import set_control_record
+from converters.errors import PluginJointError
+from converters.gazebo.drive_records import (
+    AckermannDrive,
+    DiffDrive,
+    DriveRecord,
+    HolonomicDrive,
+    JointDrive,
+    TricycleDrive,
+)
+from converters.gazebo.multicopter import Rotor, add_rotors
+from converters.report import Report
+
+if TYPE_CHECKING:
+    import mujoco
+
+PLANAR_TAU = 1e-4  # [s] time constant of the planar velocity servo (implicit: any value is stable)
+PLANAR_AXES = (("vx", (1, 0, 0, 0, 0, 0)), ("vy", (0, 1, 0, 0, 0, 0)), ("wz", (0, 0, 0, 0, 0, 1)))
+PLANAR_SITE = "planar:{name}"
+
+
+def planar_actuator(plugin: str, axis: str) -> str:
+    """The name of a holonomic drive's servo along `axis` ("vx", "vy" or "wz")."""
+    return f"planar:{plugin}:{axis}"
+
+
+JointMode = tuple[str, str, float, "tuple[float, float, float] | None"]
+
+
+def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
+    """(joint, mode, effort bound [N m or N], pid) for each joint the drive commands."""
+    if isinstance(record, DiffDrive):
+        return [(j, "velocity", record.max_wheel_torque, None) for j in record.wheel_joints()]
+    if isinstance(record, AckermannDrive):
+        wheels = record.left_joints + record.right_joints
+        steering = record.left_steering_joints + record.right_steering_joints
+        return [(j, "velocity", record.max_wheel_torque, None) for j in wheels] + [
+            (j, "position", math.inf, None) for j in steering
+        ]
+    if isinstance(record, TricycleDrive):
+        return [
+            (record.actuated_wheel_joint, "velocity", record.max_wheel_torque, None),
+            (record.steering_joint, "position", math.inf, None),
+        ]
+    if isinstance(record, JointDrive):
+        return [(j, record.mode, record.max_force, record.pid) for j in record.joints]
+    return []
+
+
+def add_drive_motors(
+    spec: mujoco.MjSpec, plugins: tuple[DriveRecord | Rotor, ...], report: Report
+) -> None:
+    """Motors for every drive's joints (unless they have one), planar servos for holonomic
+    bases, each multicopter rotor its actuators (`converters.gazebo.multicopter.add_rotors`),
+    and a report line for each approximation a drive makes.
+
+    Raises:
+        PluginJointError: a joint the plugin names is not a joint of the model.
+    """
+    import mujoco
+
+    add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
+    driven = {a.target for a in spec.actuators}
+    for record in plugins:
+        if isinstance(record, Rotor):
+            continue
+        for joint, mode, effort, pid in joint_modes(record):
+            if spec.joint(joint) is None:
+                free = mujoco.mjtJoint.mjJNT_FREE
+                joints = [j.name for j in spec.joints if j.type != free]
+                raise PluginJointError(report.source, record.name, "", joint, joints)
+            if joint not in driven:
+                _motor(spec, joint, effort)
+                set_control_record(spec, joint, _record(record, mode, pid))
+                driven.add(joint)
+        if isinstance(record, HolonomicDrive):
+            _planar_servos(spec, record)
+        for note in record.notes:
+            report.approximated("model", f"<plugin> '{record.name}': {note}", tag="plugin")
+
+
+def _motor(spec: mujoco.MjSpec, joint: str, effort: float) -> None:
+    import mujoco
+
+    motor = spec.add_actuator(name=joint, target=joint)
+    motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
+    if math.isfinite(effort):
+        motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        motor.ctrlrange = np.array([-effort, effort])
+
+
+def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
+    """The plugin's joints take only the mode it commands them in."""
+    return {
+        "modes": [mode],
+        "source": drive.family,
+        "where": drive.where,
+        "bounds": {},
+        "pid": {mode: list(pid)} if pid else {},
+        "velocity_limit": None,
+        "plugin": None,
+    }
+
+
+def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
+    """Three velocity servos at the robot's centre of mass on the root link (see the module
+    docstring): a force there turns the base without pitching it, as a set velocity does."""
+    import mujoco
+
+    root = spec.worldbody.first_body()
+    if root is None:
+        return
+    mass, yaw_inertia, centre = _planar_inertia(spec)
+    site = root.add_site(name=PLANAR_SITE.format(name=drive.name))
+    site.pos = centre
+    for axis, gear in PLANAR_AXES:
+        servo = spec.add_actuator(name=planar_actuator(drive.name, axis), target=site.name)
+        servo.trntype = mujoco.mjtTrn.mjTRN_SITE
+        servo.gear = np.array(gear, dtype=float)
+        kv = (yaw_inertia if axis == "wz" else mass) / PLANAR_TAU
+        servo.set_to_velocity(kv=kv)
+
+
+def _planar_inertia(spec: mujoco.MjSpec) -> tuple[float, float, np.ndarray]:
+    """The robot's mass [kg], its inertia about the vertical through its centre of mass
+    [kg m²] and that centre [m] in the root link's frame (zero posture)."""
+    import mujoco
+
+    model = spec.copy().compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_comPos(model, data)
+    centre = np.array(data.subtree_com[1])
+    mass, izz = 0.0, 0.0
+    for b in range(1, model.nbody):
+        m = float(model.body_mass[b])
+        rot = data.ximat[b].reshape(3, 3)
+        inertia = rot @ np.diag(model.body_inertia[b]) @ rot.T
+        offset = data.xipos[b] - centre
+        mass += m
+        izz += float(inertia[2, 2]) + m * float(offset[0] ** 2 + offset[1] ** 2)
+    root_rot = data.xmat[1].reshape(3, 3)
+    return mass, max(izz, 1e-9), root_rot.T @ (centre - data.xpos[1])

@@ -1,0 +1,193 @@
+"""What each drive plugin's tags became, for the report: approximated behaviour, and every given
+tag twin does not use.
+
+twin reads a drive's kinematic and limit tags (`drive_readers`); the rest of a plugin's tags
+publish ROS topics and TF, set covariances or tune the plugin's own PIDs, which twin replaces by
+its servos. The report lists them tag by tag, so a user sees exactly what did not carry over.
+"""
+
+from __future__ import annotations
+
+from converters.gazebo.plugin_params import Params
+
+ROS_TOPICS = ("ros", "publish", "topic", "covariance", "broadcast", "namespace", "legacy")
+"""Tags (by substring) that only publish or name ROS topics and TF: twin's odometry is `twin
+odom`, its topics a recording's."""
+
+USED: dict[str, set[str]] = {
+    "gazebo_ros_diff_drive": {
+        "left_joint",
+        "right_joint",
+        "leftJoint",
+        "rightJoint",
+        "wheel_separation",
+        "wheelSeparation",
+        "wheel_diameter",
+        "wheelDiameter",
+        "max_wheel_torque",
+        "wheelTorque",
+        "max_wheel_acceleration",
+        "wheelAcceleration",
+        "odometry_source",
+        "odometrySource",
+        "update_rate",
+        "updateRate",
+        "odometry_frame",
+        "odometryFrame",
+        "robot_base_frame",
+        "robotBaseFrame",
+    },
+    "gazebo_ros_skid_steer_drive": {
+        "leftFrontJoint",
+        "rightFrontJoint",
+        "leftRearJoint",
+        "rightRearJoint",
+        "wheelSeparation",
+        "wheelDiameter",
+        "torque",
+        "updateRate",
+        "odometryFrame",
+        "robotBaseFrame",
+    },
+    "gz-sim-diff-drive-system": {
+        "left_joint",
+        "right_joint",
+        "wheel_separation",
+        "wheel_radius",
+        "max_linear_acceleration",
+        "max_acceleration",
+        "odom_publish_frequency",
+        "frame_id",
+        "child_frame_id",
+        "max_linear_velocity",
+        "max_velocity",
+        "max_angular_velocity",
+    },
+    "gazebo_ros_ackermann_drive": {
+        "front_left_joint",
+        "front_right_joint",
+        "rear_left_joint",
+        "rear_right_joint",
+        "left_steering_joint",
+        "right_steering_joint",
+        "max_steer",
+        "max_speed",
+        "update_rate",
+        "odometry_frame",
+        "robot_base_frame",
+    },
+    "gz-sim-ackermann-steering-system": {
+        "left_joint",
+        "right_joint",
+        "left_steering_joint",
+        "right_steering_joint",
+        "wheel_base",
+        "wheel_separation",
+        "kingpin_width",
+        "wheel_radius",
+        "steering_limit",
+        "max_velocity",
+        "max_acceleration",
+        "odom_publish_frequency",
+        "frame_id",
+        "child_frame_id",
+    },
+    "gazebo_ros_tricycle_drive": {
+        "steering_joint",
+        "actuated_wheel_joint",
+        "encoder_wheel_left_joint",
+        "encoder_wheel_right_joint",
+        "actuated_wheel_diameter",
+        "encoder_wheel_diameter",
+        "wheel_separation",
+        "max_wheel_torque",
+        "max_wheel_acceleration",
+        "max_wheel_deceleration",
+        "max_steering_speed",
+        "update_rate",
+        "odometry_source",
+        "odometry_frame",
+        "robot_base_frame",
+    },
+    "gazebo_ros_planar_move": {
+        "update_rate",
+        "odometryRate",
+        "odometry_frame",
+        "odometryFrame",
+        "robot_base_frame",
+        "robotBaseFrame",
+    },
+    "gz-sim-mecanum-drive-system": {
+        "front_left_joint",
+        "front_right_joint",
+        "back_left_joint",
+        "back_right_joint",
+        "wheel_radius",
+        "wheel_separation",
+        "wheelbase",
+        "max_velocity",
+        "odom_publish_frequency",
+        "frame_id",
+        "child_frame_id",
+    },
+    "gz-sim-joint-controller-system": {
+        "joint_name",
+        "use_force_commands",
+        "p_gain",
+        "cmd_max",
+    },
+    "gz-sim-joint-position-controller-system": {
+        "joint_name",
+        "use_velocity_commands",
+        "p_gain",
+        "i_gain",
+        "d_gain",
+        "cmd_max",
+    },
+}
+
+APPROXIMATED: dict[str, tuple[str, ...]] = {
+    "gazebo_ros_skid_steer_drive": (
+        "four wheels driven as the two sides of a diff drive, as the plugin does; in a turn they "
+        "slip sideways, so the base turns slower than the unicycle model (as in Gazebo)",
+    ),
+    "gz-sim-diff-drive-system": (
+        "max_linear_acceleration applied at the wheel rims; wheels as velocity servos without a "
+        "force bound (gz-sim sets their velocity)",
+    ),
+    "gazebo_ros_ackermann_drive": (
+        "rear wheels as velocity servos at their no-slip speeds (the plugin's one PID force on "
+        "both is an open differential, which settles at the same speeds); steering joints as "
+        "position servos at their Ackermann angles instead of its steering PIDs; wheel base, "
+        "track and radius measured on the model, as the plugin does",
+    ),
+    "gz-sim-ackermann-steering-system": (
+        "steering joints as position servos at their Ackermann angles instead of its P "
+        "controller on their velocity; wheels as velocity servos without a force bound",
+    ),
+    "gazebo_ros_tricycle_drive": (
+        "steering joint as a position servo (the plugin sets the angle directly); the wheel base "
+        "measured on the model",
+    ),
+    "gazebo_ros_planar_move": (
+        "the planar velocity through three velocity servos at the centre of mass, a new command "
+        "ramped at 3 m/s² and 6 rad/s² (the plugin sets the velocity in one step)",
+    ),
+}
+
+
+def drive_notes(key: str, params: Params, initial: float = 0.0) -> tuple[str, ...]:
+    """The report notes of one drive plugin: its approximations, then each given tag twin does
+    not use (ROS publishing tags named as such)."""
+    notes = list(APPROXIMATED.get(key, ()))
+    used = USED.get(key, set())
+    for tag in params.given():
+        if tag in used:
+            continue
+        if any(word in tag.lower() for word in ROS_TOPICS):
+            notes.append(f"<{tag}>: not used (twin publishes no ROS topics; see twin odom)")
+        elif tag.startswith("initial_"):
+            notes.append(f"<{tag}>{initial:g}: not applied at spawn; send it with twin command")
+        else:
+            notes.append(f"<{tag}>: not used by twin")
+    return tuple(notes)

@@ -1,0 +1,228 @@
+"""The drive plugins twin runs, typed: one record per kinematic family, each with its plugin's
+own parameter names and defaults.
+
+- `DiffDrive`: gazebo_ros diff drive and skid steer, gz-sim DiffDrive, and vendor plugins read as
+  a differential drive (unicycle kinematics).
+- `AckermannDrive`: gazebo_ros Ackermann drive and gz-sim AckermannSteering (bicycle kinematics,
+  each front wheel steered on its own Ackermann angle).
+- `TricycleDrive`: gazebo_ros tricycle drive (a steered, driven front wheel; bicycle kinematics).
+- `HolonomicDrive`: gazebo_ros planar move and gz-sim MecanumDrive (the base's planar twist).
+- `JointDrive`: gz-sim JointController (a velocity on joints) and JointPositionController.
+
+Units are SI: [m], [m/s], [m/s²], [rad], [N m], [Hz]; `math.inf` is "no limit".
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Any
+
+# Defaults of gazebo_ros_diff_drive (ROS 2 `Load`, ROS 1 `getParameter` defaults).
+DEFAULT_SEPARATION = 0.34  # [m]
+DEFAULT_DIAMETER = 0.15  # [m]
+DEFAULT_TORQUE = 5.0  # [N m]
+DEFAULT_ACCELERATION = 0.0  # [m/s²] at the wheel rim; 0 = unlimited
+DEFAULT_RATE = 100.0  # [Hz]
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None  # JSON has no infinity: null is "no limit"
+    return value
+
+
+class _Record:
+    """JSON for the server's drive listing and replies (inf limits become null)."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain values for JSON; `kind` names the record's family."""
+        out = {f.name: _plain(getattr(self, f.name)) for f in fields(self)}  # type: ignore[arg-type]
+        return {"kind": type(self).__name__, **out}
+
+
+@dataclass(frozen=True)
+class DiffDrive(_Record):
+    """A differential drive, typed.
+
+    Attributes:
+        name: the plugin's name attribute; where: file and element, for messages.
+        left_joints, right_joints: wheel joint names (several pairs: skid steer, ROS 2, gz-sim).
+        wheel_separation [m], wheel_diameter [m], max_wheel_torque [N m] (inf: unbounded, as
+        gz-sim's velocity commands), max_wheel_acceleration [m/s² at the rim; 0 = unlimited, as
+        in the plugin's code], odometry_source: "world" or "encoder"; update_rate [Hz] (0 = every
+        step). family: the plugin (`gazebo_ros_diff_drive`, `gazebo_ros_skid_steer_drive`,
+        `gz_diff_drive`, `vendor:<filename>`); odometry_frame, robot_base_frame: the odometry's
+        frame names; max_linear_velocity [m/s], max_angular_velocity [rad/s] (gz-sim's limits);
+        notes: what was approximated or ignored, one entry per tag.
+    """
+
+    name: str
+    where: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    wheel_separation: float = DEFAULT_SEPARATION
+    wheel_diameter: float = DEFAULT_DIAMETER
+    max_wheel_torque: float = DEFAULT_TORQUE
+    max_wheel_acceleration: float = DEFAULT_ACCELERATION
+    odometry_source: str = "world"
+    update_rate: float = DEFAULT_RATE
+    family: str = "gazebo_ros_diff_drive"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    max_linear_velocity: float = math.inf
+    max_angular_velocity: float = math.inf
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """Every joint the drive turns."""
+        return self.left_joints + self.right_joints
+
+
+@dataclass(frozen=True)
+class AckermannDrive(_Record):
+    """A car-like base: driven wheels on one axle, the front wheels steered.
+
+    Attributes:
+        left_joints, right_joints: driven wheel joints. left_steering_joints,
+        right_steering_joints: steering joints. wheel_base [m] (axle to axle), wheel_separation
+        [m] (driven wheels' track), kingpin_width [m] (steering pivots' spacing), wheel_radius
+        [m], steering_limit [rad], max_velocity [m/s], max_acceleration [m/s²] (0 = none),
+        max_wheel_torque [N m] (inf = unbounded), update_rate [Hz], odometry_source,
+        odometry_frame, robot_base_frame, family, notes: as `DiffDrive`. angular_is_steering:
+        the plugin reads cmd_vel's angular.z as the steering angle (gazebo_ros) rather than a
+        yaw rate (gz-sim).
+    """
+
+    name: str
+    where: str
+    left_joints: tuple[str, ...]
+    right_joints: tuple[str, ...]
+    left_steering_joints: tuple[str, ...]
+    right_steering_joints: tuple[str, ...]
+    wheel_base: float
+    wheel_separation: float
+    kingpin_width: float
+    wheel_radius: float
+    steering_limit: float
+    max_velocity: float = math.inf
+    max_acceleration: float = 0.0
+    max_wheel_torque: float = math.inf
+    update_rate: float = DEFAULT_RATE
+    odometry_source: str = "world"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    family: str = "gazebo_ros_ackermann_drive"
+    angular_is_steering: bool = True
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """Every joint the drive turns or steers."""
+        return (
+            self.left_joints
+            + self.right_joints
+            + self.left_steering_joints
+            + self.right_steering_joints
+        )
+
+
+@dataclass(frozen=True)
+class TricycleDrive(_Record):
+    """gazebo_ros_tricycle_drive: one steered and driven wheel, two encoder wheels behind.
+
+    Attributes:
+        steering_joint, actuated_wheel_joint, encoder_left_joint, encoder_right_joint: joints.
+        actuated_wheel_diameter [m], encoder_wheel_diameter [m], wheel_separation [m] (encoder
+        wheels), wheel_base [m] (the steered wheel to the encoder axle, measured from the model),
+        max_wheel_torque [N m], max_wheel_acceleration, max_wheel_deceleration [rad/s² of the
+        wheel, as the plugin compares joint speeds], max_steering_speed [rad/s] (0 = none),
+        update_rate [Hz], odometry_source, odometry_frame, robot_base_frame, family, notes.
+    """
+
+    name: str
+    where: str
+    steering_joint: str
+    actuated_wheel_joint: str
+    encoder_left_joint: str
+    encoder_right_joint: str
+    actuated_wheel_diameter: float
+    encoder_wheel_diameter: float
+    wheel_separation: float
+    wheel_base: float
+    max_wheel_torque: float = 0.15
+    max_wheel_acceleration: float = 0.0
+    max_wheel_deceleration: float = 0.0
+    max_steering_speed: float = 0.0
+    update_rate: float = DEFAULT_RATE
+    odometry_source: str = "world"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_link"
+    family: str = "gazebo_ros_tricycle_drive"
+    angular_is_steering: bool = True
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """The joints the drive turns or steers (the encoder wheels roll freely)."""
+        return (self.actuated_wheel_joint, self.steering_joint)
+
+
+@dataclass(frozen=True)
+class HolonomicDrive(_Record):
+    """A base driven by its planar twist (vx, vy, ωz in its own frame).
+
+    Attributes:
+        family: `gazebo_ros_planar_move` or `gz_mecanum_drive`; update_rate [Hz];
+        wheel_joints_named: the mecanum wheels (spun at their kinematic speeds), else ();
+        wheel_radius, wheel_separation, wheelbase [m] (mecanum); max_linear_velocity [m/s],
+        max_angular_velocity [rad/s]; odometry_frame, robot_base_frame, notes.
+    """
+
+    name: str
+    where: str
+    family: str = "gazebo_ros_planar_move"
+    update_rate: float = DEFAULT_RATE
+    wheel_joints_named: tuple[str, ...] = ()
+    wheel_radius: float = 0.0
+    wheel_separation: float = 0.0
+    wheelbase: float = 0.0
+    max_linear_velocity: float = math.inf
+    max_angular_velocity: float = math.inf
+    odometry_source: str = "world"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """The mecanum wheels (none for planar move)."""
+        return self.wheel_joints_named
+
+
+@dataclass(frozen=True)
+class JointDrive(_Record):
+    """gz-sim's JointController (velocity) or JointPositionController (position) on joints.
+
+    Attributes:
+        joints: the joints it commands; mode: "velocity" or "position"; pid: (p, i, d) when the
+        system runs its own PID on the joint's force, else None (it sets the joint's velocity);
+        max_force [N m or N] (inf: none), initial: the system's initial command, notes.
+    """
+
+    name: str
+    where: str
+    joints: tuple[str, ...]
+    mode: str
+    pid: tuple[float, float, float] | None = None
+    max_force: float = math.inf
+    initial: float = 0.0
+    family: str = "gz_joint_controller"
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """The joints it commands."""
+        return self.joints
+
+
+BaseDrive = DiffDrive | AckermannDrive | TricycleDrive | HolonomicDrive
+DriveRecord = BaseDrive | JointDrive

@@ -1,0 +1,195 @@
+"""Mobile bases the drive tests write: one per kinematic family, URDF and SDF, with the plugin
+given as XML. Every base's root link origin is the kinematic model's reference point (the fixed
+axle's midpoint), so its world pose is what the model predicts.
+
+Geometry [m, kg]: wheels of radius R on continuous joints about their y axis (a positive speed
+rolls forward), a chassis box above them; steering joints turn about z (positive: left).
+"""
+
+from __future__ import annotations
+
+R = 0.05  # wheel radius [m]
+TRACK = 0.30  # left-right wheel spacing [m]
+WHEEL_BASE = 0.40  # fixed axle to steered axle [m]
+WIDTH = (
+    0.004  # wheel width [m]: MuJoCo puts a contact at each rim edge, wider wheels scrub in turns
+)
+
+
+def _inertial(mass: float, i: float, xyz: str = "0 0 0") -> str:
+    return (
+        f'<inertial><origin xyz="{xyz}"/><mass value="{mass}"/><inertia ixx="{i}" iyy="{i}" '
+        f'izz="{i}" ixy="0" ixz="0" iyz="0"/></inertial>'
+    )
+
+
+def _wheel(name: str, width: float = WIDTH) -> str:
+    return (
+        f'<link name="{name}">{_inertial(0.3, 4e-4)}<collision><origin rpy="1.5708 0 0"/>'
+        f'<geometry><cylinder radius="{R}" length="{width}"/></geometry></collision></link>'
+    )
+
+
+def _continuous(name: str, parent: str, child: str, xyz: str) -> str:
+    return (
+        f'<joint name="{name}" type="continuous"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/><axis xyz="0 1 0"/></joint>'
+    )
+
+
+def _steer(name: str, parent: str, child: str, xyz: str) -> str:
+    return (
+        f'<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}"/><axis xyz="0 0 1"/>'
+        '<limit lower="-0.8" upper="0.8" effort="50" velocity="4"/></joint>'
+    )
+
+
+def _chassis(length: float, x: float, mass: float = 6.0) -> str:
+    return (
+        f'<link name="base_link">{_inertial(mass, 0.05, f"{x} 0 0.05")}<collision>'
+        f'<origin xyz="{x} 0 0.06"/><geometry><box size="{length} 0.2 0.05"/></geometry>'
+        "</collision></link>"
+    )
+
+
+def _caster(name: str, x: float) -> str:
+    """A frictionless ball fixed under the chassis at `x` (keeps a two-wheeled base level)."""
+    return (
+        f'<link name="{name}">{_inertial(0.05, 1e-5)}<collision><geometry>'
+        f'<sphere radius="{R}"/></geometry></collision></link>'
+        f'<joint name="{name}_fix" type="fixed"><parent link="base_link"/>'
+        f'<child link="{name}"/><origin xyz="{x} 0 0"/></joint>'
+        f'<gazebo reference="{name}"><mu1>0</mu1><mu2>0</mu2></gazebo>'
+    )
+
+
+def skid_steer_bot(plugin: str, wheelbase: float = 0.12) -> str:
+    """Four wheels `left_front_joint` ... `right_rear_joint`, `wheelbase` apart front to rear."""
+    half = wheelbase / 2
+    parts = [_chassis(0.3, 0.0)]
+    for side, y in (("left", TRACK / 2), ("right", -TRACK / 2)):
+        for end, x in (("front", half), ("rear", -half)):
+            parts.append(_wheel(f"{side}_{end}"))
+            parts.append(
+                _continuous(f"{side}_{end}_joint", "base_link", f"{side}_{end}", f"{x} {y} 0")
+            )
+    return f'<robot name="skid">{"".join(parts)}<gazebo>{plugin}</gazebo></robot>'
+
+
+def two_wheel_base(
+    plugin: str,
+    left: str = "wheel_left_joint",
+    right: str = "wheel_right_joint",
+    width: float = WIDTH,
+) -> str:
+    """Two driven wheels `width` [m] wide on the axle through the origin, frictionless casters
+    fore and aft."""
+    parts = [_chassis(0.3, 0.0), _caster("caster_front", 0.12), _caster("caster_rear", -0.12)]
+    parts += [_wheel("wheel_left", width), _wheel("wheel_right", width)]
+    parts.append(_continuous(left, "base_link", "wheel_left", f"0 {TRACK / 2} 0"))
+    parts.append(_continuous(right, "base_link", "wheel_right", f"0 {-TRACK / 2} 0"))
+    return f'<robot name="base">{"".join(parts)}<gazebo>{plugin}</gazebo></robot>'
+
+
+def ackermann_car(plugin: str) -> str:
+    """Rear wheels `rear_left_joint`/`rear_right_joint` on the origin's axle; front wheels
+    `front_left_joint`/`front_right_joint` under steering joints `left_steering_joint`/
+    `right_steering_joint`, WHEEL_BASE ahead."""
+    parts = [_chassis(0.5, WHEEL_BASE / 2)]
+    for side, y in (("left", TRACK / 2), ("right", -TRACK / 2)):
+        parts.append(_wheel(f"rear_{side}"))
+        parts.append(_continuous(f"rear_{side}_joint", "base_link", f"rear_{side}", f"0 {y} 0"))
+        parts.append(f'<link name="{side}_knuckle">{_inertial(0.1, 1e-4)}</link>')
+        parts.append(
+            _steer(f"{side}_steering_joint", "base_link", f"{side}_knuckle", f"{WHEEL_BASE} {y} 0")
+        )
+        parts.append(_wheel(f"front_{side}"))
+        parts.append(
+            _continuous(f"front_{side}_joint", f"{side}_knuckle", f"front_{side}", "0 0 0")
+        )
+    return f'<robot name="car">{"".join(parts)}<gazebo>{plugin}</gazebo></robot>'
+
+
+def tricycle(plugin: str) -> str:
+    """Encoder wheels `left_wheel_joint`/`right_wheel_joint` on the origin's axle; the front wheel
+    `front_wheel_joint` under `front_steering_joint`, WHEEL_BASE ahead."""
+    parts = [_chassis(0.5, WHEEL_BASE / 2)]
+    for side, y in (("left", TRACK / 2), ("right", -TRACK / 2)):
+        parts.append(_wheel(f"{side}_wheel"))
+        parts.append(_continuous(f"{side}_wheel_joint", "base_link", f"{side}_wheel", f"0 {y} 0"))
+    parts.append(f'<link name="fork">{_inertial(0.1, 1e-4)}</link>')
+    parts.append(_steer("front_steering_joint", "base_link", "fork", f"{WHEEL_BASE} 0 0"))
+    parts.append(_wheel("front_wheel"))
+    parts.append(_continuous("front_wheel_joint", "fork", "front_wheel", "0 0 0"))
+    return f'<robot name="trike">{"".join(parts)}<gazebo>{plugin}</gazebo></robot>'
+
+
+def planar_base(plugin: str) -> str:
+    """A box on four balls (μ = 0.5) with no wheels: driven only by its planar move plugin."""
+    feet = "".join(
+        f'<collision><origin xyz="{x} {y} 0"/><geometry><sphere radius="{R}"/></geometry>'
+        "</collision>"
+        for x in (-0.15, 0.15)
+        for y in (-0.1, 0.1)
+    )
+    base = f'<link name="base_link">{_inertial(8.0, 0.1, "0 0 0.05")}{feet}</link>'
+    tags = '<gazebo reference="base_link"><mu1>0.5</mu1><mu2>0.5</mu2></gazebo>'
+    return f'<robot name="mover">{base}{tags}<gazebo>{plugin}</gazebo></robot>'
+
+
+def _sdf_wheel(name: str, parent: str, xyz: str) -> str:
+    return (
+        f'<link name="{name}"><pose relative_to="{name}_joint"/><inertial><mass>0.3</mass>'
+        "<inertia><ixx>4e-4</ixx><iyy>4e-4</iyy><izz>4e-4</izz></inertia></inertial>"
+        f'<collision name="c"><pose>0 0 0 1.5708 0 0</pose><geometry><cylinder><radius>{R}'
+        f"</radius><length>{WIDTH}</length></cylinder></geometry></collision></link>"
+        f'<joint name="{name}_joint" type="revolute"><pose relative_to="{parent}">{xyz} 0 0 0'
+        f"</pose><parent>{parent}</parent><child>{name}</child><axis><xyz>0 1 0</xyz><limit>"
+        "<lower>-1e16</lower><upper>1e16</upper></limit></axis></joint>"
+    )
+
+
+def _sdf_chassis(x: float, length: float = 0.5) -> str:
+    return (
+        f'<link name="base_link"><inertial><pose>{x} 0 0.05 0 0 0</pose><mass>6</mass><inertia>'
+        "<ixx>0.05</ixx><iyy>0.05</iyy><izz>0.05</izz></inertia></inertial>"
+        f'<collision name="body"><pose>{x} 0 0.06 0 0 0</pose><geometry><box><size>{length} 0.2 '
+        "0.05</size></box></geometry></collision></link>"
+    )
+
+
+def sdf_diff_drive(plugin: str) -> str:
+    """`two_wheel_base` as an SDF model: wheels `wheel_left_joint`/`wheel_right_joint` on the
+    origin's axle, frictionless casters fore and aft."""
+    casters = "".join(
+        f'<collision name="caster_{n}"><pose>{x} 0 0 0 0 0</pose><geometry><sphere><radius>{R}'
+        "</radius></sphere></geometry><surface><friction><ode><mu>0</mu><mu2>0</mu2></ode>"
+        "</friction></surface></collision>"
+        for n, x in (("front", 0.12), ("rear", -0.12))
+    )
+    chassis = _sdf_chassis(0.0, 0.3).replace("</link>", casters + "</link>", 1)
+    wheels = _sdf_wheel("wheel_left", "base_link", f"0 {TRACK / 2} 0") + _sdf_wheel(
+        "wheel_right", "base_link", f"0 {-TRACK / 2} 0"
+    )
+    return f'<sdf version="1.8"><model name="dd">{chassis}{wheels}{plugin}</model></sdf>'
+
+
+def sdf_ackermann(plugin: str) -> str:
+    """An SDF car: rear wheels `rear_left_joint`/`rear_right_joint` on the origin's axle, front
+    wheels under `left_steering_joint`/`right_steering_joint`, WHEEL_BASE ahead."""
+    parts = [_sdf_chassis(WHEEL_BASE / 2)]
+    for side, y in (("left", TRACK / 2), ("right", -TRACK / 2)):
+        parts.append(_sdf_wheel(f"rear_{side}", "base_link", f"0 {y} 0"))
+        parts.append(
+            f'<link name="{side}_knuckle"><pose relative_to="{side}_steering_joint"/><inertial>'
+            "<mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy><izz>1e-4</izz></inertia>"
+            f'</inertial></link><joint name="{side}_steering_joint" type="revolute">'
+            f'<pose relative_to="base_link">{WHEEL_BASE} {y} 0 0 0 0</pose><parent>base_link'
+            f"</parent><child>{side}_knuckle</child><axis><xyz>0 0 1</xyz><limit><lower>-0.8"
+            "</lower><upper>0.8</upper><effort>50</effort><velocity>4</velocity></limit></axis>"
+            "</joint>"
+        )
+        parts.append(_sdf_wheel(f"front_{side}", f"{side}_knuckle", "0 0 0"))
+    body = "".join(parts)
+    return f'<sdf version="1.8"><model name="car">{body}{plugin}</model></sdf>'

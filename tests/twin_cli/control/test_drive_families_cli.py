@@ -1,0 +1,149 @@
+"""`twin drive`, `twin odom` and `twin command` as a user types them, on bases whose drives are
+not diff drives, against a real (paused) world server: an Ackermann car takes a steering angle,
+a curvature or a yaw rate; odometry names the plugin's frames; an option a base's drive does not
+take, a base without a drive, and the fix that error names (run here as printed)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import drive_models as dm
+import pytest
+
+WORLD_NAME = "drive_families_cli"
+ACKERMANN = (
+    '<plugin name="ack" filename="libgazebo_ros_ackermann_drive.so"><front_left_joint>'
+    "front_left_joint</front_left_joint><front_right_joint>front_right_joint</front_right_joint>"
+    "<rear_left_joint>rear_left_joint</rear_left_joint><rear_right_joint>rear_right_joint"
+    "</rear_right_joint><left_steering_joint>left_steering_joint</left_steering_joint>"
+    "<right_steering_joint>right_steering_joint</right_steering_joint><max_steer>0.6</max_steer>"
+    "<odometry_frame>odom_car</odometry_frame><robot_base_frame>base_link</robot_base_frame>"
+    "</plugin>"
+)
+KOBUKI = (
+    '<plugin name="kobuki_controller" filename="libgazebo_ros_kobuki.so">'
+    "<wheel_left_joint_name>wheel_left_joint</wheel_left_joint_name><wheel_right_joint_name>"
+    "wheel_right_joint</wheel_right_joint_name><wheel_separation>0.3</wheel_separation>"
+    "<wheel_diameter>0.1</wheel_diameter></plugin>"
+)
+BOX = '<sdf version="1.6"><model name="box"><link name="l"><collision name="c"><geometry><box>'
+BOX += "<size>0.2 0.2 0.2</size></box></geometry></collision></link></model></sdf>"
+
+
+def _twin(runtime: Path, *args: str) -> subprocess.CompletedProcess:
+    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime)}
+    env.pop("TWIN_WORLD", None)
+    return subprocess.run(
+        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD_NAME],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def _ok(runtime: Path, *args: str) -> str:
+    proc = _twin(runtime, *args)
+    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
+    return proc.stdout
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory, serve_world):
+    """A paused world with an Ackermann car, a vendor diff-drive base, a base whose wheels no
+    plugin drives, and a box."""
+    root = tmp_path_factory.mktemp("drive_families_cli")
+    robots = {
+        "car": dm.ackermann_car(ACKERMANN),
+        "kobuki": dm.two_wheel_base(KOBUKI),
+        "cart": dm.two_wheel_base(""),
+    }
+    with serve_world(root, WORLD_NAME, "--paused"):
+        for i, (name, text) in enumerate(robots.items()):
+            path = root / f"{name}.urdf"
+            path.write_text(text)
+            _ok(root, "spawn", str(path), "--name", name, "-y", str(2.0 * i), "--on-ground")
+        _ok(root, "spawn", "--xml", BOX, "--name", "box", "-x", "3", "-z", "0.1")
+        _ok(root, "step", "300")
+        yield root
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "phi"),
+    [
+        ("--steering", "0.3", 0.3),
+        ("--curvature", "1.0", math.atan(dm.WHEEL_BASE * 1.0)),
+        ("--angular", "0.5", math.atan(dm.WHEEL_BASE * 0.5 / 0.3)),  # the bicycle model
+    ],
+)
+def test_an_ackermann_car_takes_a_steering_angle_curvature_or_yaw_rate(
+    served: Path, option: str, value: str, phi: float
+) -> None:
+    reply = json.loads(
+        _ok(served, "drive", "car", "--linear", "0.3", option, value, "-d", "0.5", "--json")
+    )
+    applied = reply["applied"]
+    assert applied["steering_angle"] == pytest.approx(phi, abs=1e-12), "bicycle angle [rad]"
+    assert applied["yaw_rate"] == pytest.approx(0.3 * math.tan(phi) / dm.WHEEL_BASE, abs=1e-12)
+    left, right = applied["steering_angles"].values()
+    assert left > phi > right > 0, "the inner (left) wheel steers more: Ackermann geometry"
+    text = _ok(served, "drive", "car", "--linear", "0.3", option, value, "-d", "0.5")
+    assert f"steering={phi:.4g} rad" in text and "gazebo_ros_ackermann_drive" in text
+
+
+def test_odom_names_the_plugins_frames_and_follows_the_car(served: Path) -> None:
+    _ok(served, "drive", "car", "--linear", "0.3", "--steering", "0.3", "-d", "1")
+    _ok(served, "step", "1500")
+    odom = json.loads(_ok(served, "odom", "car", "--json"))
+    pose = json.loads(_ok(served, "pose", "car", "--json"))
+    assert (odom["odometry_frame"], odom["robot_base_frame"]) == ("odom_car", "base_link")
+    assert odom["pose"]["position"][:2] == pytest.approx([pose["x"], pose["y"]], abs=1e-9)
+    assert pose["yaw"] > 0.1, "the car turned left"
+    rows = {r.split("\t")[0]: r.split("\t")[1:] for r in _ok(served, "odom", "car").splitlines()}
+    assert rows["frames (odometry, base)"][:2] == ["odom_car", "base_link"], "piped: a row"
+
+
+@pytest.mark.parametrize(
+    ("args", "needle", "fix"),
+    [
+        (("drive", "kobuki", "--steering", "0.3"), "steered bases", "--angular"),
+        (("drive", "car", "--lateral", "0.1"), "cannot move sideways", "--linear"),
+        (("drive", "car", "--angular", "0.2", "--steering", "0.1"), "not both", "one of them"),
+        (("drive", "box", "--linear", "0.2"), "no drive plugin", "no joint to command"),
+        (("odom", "cart"), "no drive plugin", "twin command cart"),
+    ],
+)
+def test_bad_drive_input_is_one_message_naming_the_fix_and_exit_2(
+    served: Path, args: tuple, needle: str, fix: str
+) -> None:
+    before = _ok(served, "pose", "car", "--json")
+    proc = _twin(served, *args)
+    assert proc.returncode == 2, proc.stderr
+    assert needle in proc.stderr and fix in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert _ok(served, "pose", "car", "--json") == before, "the world is unchanged"
+
+
+def test_the_fix_named_for_a_base_without_a_drive_works(served: Path) -> None:
+    """The error names `twin command cart wheel_left_joint=2 --mode velocity`; run as printed,
+    it turns the passive wheel and says Gazebo would leave it passive."""
+    proc = _twin(served, "drive", "cart", "--linear", "0.2")
+    found = re.search(r"twin (command cart \S+=\S+ --mode velocity)", proc.stderr)
+    assert found, proc.stderr
+    said = _ok(served, *shlex.split(found.group(1)))
+    assert "passive in Gazebo" in said, said
+    _ok(served, "step", "500")
+    joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "cart", "--json"))}
+    speed = joints["wheel_left_joint"]["velocity"]
+    assert speed == pytest.approx(2.0, rel=0.05), f"wheel at {speed:.3f} rad/s (commanded 2)"
+    reply = json.loads(
+        _ok(served, "command", "cart", "wheel_right_joint=0.5", "--mode", "effort", "--json")
+    )
+    assert any("passive in Gazebo" in n for n in reply["notes"]), reply

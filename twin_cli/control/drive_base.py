@@ -1,0 +1,211 @@
+"""What every drive controller shares: a world observer in sim time, the command's duration,
+reset handling, encoder odometry integration and the nav_msgs/Odometry reply.
+
+A controller is a world observer (`World.add_observer`) at the plugin's update rate (at least
+MIN_RATE while its targets move), so the stepping loop calls it between batches, in simulated time,
+with the world's lock held: no Python per physics step. A subclass says how a command becomes
+joint targets (`_apply`, which returns whether the targets reached their goal) and, for encoder
+odometry, the body twist its wheels measure (`_encoder_twist`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import mujoco
+import numpy as np
+
+from twin_cli.control.kinematics import Pose2D, integrate_twist
+
+if TYPE_CHECKING:
+    from twin_cli.world.engine import World
+    from twin_cli.world.entities import Entity
+
+FALLBACK_RATE = 100.0  # [Hz] for update_rate 0 ("every step" in Gazebo): no per-step Python
+MIN_RATE = 250.0
+"""[Hz] slowest controller rate while targets move. The world's velocity servo reaches full effort
+at 1 rad/s of error, and a wheel of a light robot has tiny inertia (turtlebot3: 2e-5 kg m²):
+measured, at the plugin's 30 Hz each ramp step (1 rad/s) saturated the 10 N m motor and the wheels
+ran away to 175 rad/s; at 100 Hz they held their targets but the robot reared up on each step; at
+250 Hz the start is smooth (heading within 4 % of the unicycle's after 5 s). Limits are applied per
+elapsed sim time, so they are the plugin's at any rate."""
+
+
+@dataclass(frozen=True)
+class Twist:
+    """A base command: forward speed `linear` [m/s], `lateral` [m/s] (holonomic bases), yaw
+    rate `angular` [rad/s], or for steered bases a steering angle [rad] or a curvature [1/m]."""
+
+    linear: float = 0.0
+    angular: float = 0.0
+    lateral: float = 0.0
+    steering: float | None = None
+    curvature: float | None = None
+
+
+STOP = Twist()
+
+
+class DriveController:
+    """One entity's drive: commands in, joint targets out, odometry on request.
+
+    Args:
+        world: the `twin_cli.world.World` (its lock is re-entrant; callbacks hold it).
+        entity: entity name; plugin: its record from `converters.gazebo.drive_records`.
+    """
+
+    def __init__(self, world: World, entity: str, plugin: Any) -> None:
+        self.world, self.entity, self.plugin = world, entity, plugin
+        self.plugin_rate = plugin.update_rate if plugin.update_rate > 0 else FALLBACK_RATE
+        self.rate = max(self.plugin_rate, MIN_RATE)
+        self.twist = STOP
+        self.until = math.inf  # [s] sim time the command stops at
+        self.updates = 0
+        self.entity_record: Entity | None = None  # the entity this controller was made for
+        self._written: dict = {}  # the world's commands after our last write (reset clears them)
+        self._start()
+        self.handle = world.add_observer(self._update, self.rate)
+        self.observed_rate = self.rate
+
+    # ------------------------------------------------------------------ subclass hooks
+    def _reset_targets(self) -> None:
+        """Forgets ramp state after a world reset (the world stopped the joints)."""
+
+    def _apply(self, dt: float, force: bool) -> bool:
+        """Moves the targets towards the command by dt [s]; writes them when they changed (or
+        `force`); returns whether they reached the command's goal."""
+        raise NotImplementedError
+
+    def _encoder_twist(self) -> tuple[float, float]:
+        """(v [m/s], ω [rad/s]) the encoder wheels measure now."""
+        raise NotImplementedError
+
+    def command_reply(self) -> dict[str, Any]:
+        """What the command became (wheel and steering goals), for the drive reply."""
+        return {}
+
+    # ------------------------------------------------------------------ commands
+    def _start(self) -> None:
+        """Odometry frame = the entity's pose now (Gazebo's encoder odometry starts at zero)."""
+        pose = self.world.get_pose(self.entity)
+        self.encoder = Pose2D(pose.x, pose.y, pose.yaw)
+        self.last_time = float(self.world.data.time)
+
+    def command(self, twist: Twist, duration: float | None) -> None:
+        """Holds `twist` for `duration` [s] of sim time (None: until replaced)."""
+        with self.world.lock:
+            self.twist = twist
+            now = float(self.world.data.time)
+            self.until = math.inf if duration is None else now + duration
+            self._observe_at(self.rate)  # targets move: the fast rate (see MIN_RATE)
+
+    def _observe_at(self, rate: float) -> None:
+        """Re-registers the update at `rate` [Hz] (no-op when already there)."""
+        if rate != self.observed_rate:
+            if self.observed_rate:
+                self.world.remove_observer(self.handle)
+            self.handle = self.world.add_observer(self._update, rate)
+            self.observed_rate = rate
+
+    def stop(self) -> None:
+        """Stops calling the controller (entity deleted or world replaced); targets stay."""
+        self.world.remove_observer(self.handle)
+        self.observed_rate = 0.0
+
+    def resume(self) -> None:
+        """Calls the controller again after `stop` (at the fast rate until targets settle)."""
+        with self.world.lock:
+            self.last_time = float(self.world.data.time)
+            self._observe_at(self.rate)
+
+    def _update(self) -> None:
+        """One plugin update (world lock held): odometry, timeout, targets."""
+        if self.entity not in self.world.entity_names():
+            self.stop()
+            return
+        now = float(self.world.data.time)
+        if now < self.last_time:  # the world was reset: start over, wheels stopped
+            self.twist, self.until = STOP, math.inf
+            self._reset_targets()
+            self._start()
+            return
+        dt, self.last_time = now - self.last_time, now
+        if self.plugin.odometry_source == "encoder" and dt > 0:
+            self.encoder = integrate_twist(self.encoder, *self._encoder_twist(), dt)
+        if now >= self.until - 1e-9:
+            self.twist, self.until = STOP, math.inf
+        force = self.updates == 0 or self.world.commands() != self._written
+        settled = self._apply(dt, force)
+        self.updates += 1
+        # Targets at their goal: the plugin's own rate is enough for timeouts and odometry.
+        self._observe_at(self.plugin_rate if settled else self.rate)
+
+    def _write(self, targets: dict[str, float], mode: str) -> None:
+        """Writes joint targets through the world's joint command API (clipped to the joints'
+        limits), and remembers the world's commands so a reset is noticed."""
+        if targets:
+            self.world.command_joints(self.entity, targets, mode=mode, clip=True)
+        self._written = dict(self.world.commands())
+
+    def joint_speed(self, joint: str) -> float:
+        """A joint's speed [rad/s] now (world lock held); 0 for a joint the model lacks."""
+        m, d = self.world.model, self.world.data
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.entity}/{joint}")
+        return float(d.qvel[m.jnt_dofadr[j]]) if j >= 0 else 0.0
+
+    def joint_position(self, joint: str) -> float:
+        """A hinge joint's angle [rad] now (world lock held); 0 for a joint the model lacks."""
+        m, d = self.world.model, self.world.data
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.entity}/{joint}")
+        return float(d.qpos[m.jnt_qposadr[j]]) if j >= 0 else 0.0
+
+    # ------------------------------------------------------------------ odometry
+    def odometry(self) -> dict[str, Any]:
+        """nav_msgs/Odometry's content: pose in the odom frame, twist in the base frame."""
+        with self.world.lock:
+            if self.plugin.odometry_source == "encoder":
+                v, w = self._encoder_twist()
+                pose = self.encoder
+                return self._message(
+                    [pose.x, pose.y, 0.0], [0.0, 0.0, pose.theta], [v, 0.0, 0.0], [0.0, 0.0, w]
+                )
+            return self._world_odometry()
+
+    def _world_odometry(self) -> dict[str, Any]:
+        pose = self.world.get_pose(self.entity)
+        ix = self.world.index_of(self.entity)
+        linear, angular = [0.0] * 3, [0.0] * 3
+        if ix.free_qpos >= 0:
+            d, dof = self.world.data, int(ix.dofs[0])
+            quat = d.qpos[ix.free_qpos + 3 : ix.free_qpos + 7]
+            rot = np.empty(9)
+            mujoco.mju_quat2Mat(rot, quat)
+            # free joint: linear velocity in the world frame, angular in the body frame
+            linear = (rot.reshape(3, 3).T @ d.qvel[dof : dof + 3]).tolist()
+            angular = d.qvel[dof + 3 : dof + 6].tolist()
+        return self._message(
+            [pose.x, pose.y, pose.z], [pose.roll, pose.pitch, pose.yaw], linear, angular
+        )
+
+    def _message(self, position: list, rpy: list, linear: list, angular: list) -> dict[str, Any]:
+        t = self.twist
+        return {
+            "entity": self.entity,
+            "plugin": self.plugin.name,
+            "family": self.plugin.family,
+            "time": float(self.world.data.time),
+            "source": self.plugin.odometry_source,
+            "odometry_frame": self.plugin.odometry_frame,
+            "robot_base_frame": self.plugin.robot_base_frame,
+            "pose": {"position": position, "rpy": rpy},
+            "twist": {"linear": linear, "angular": angular},
+            "command": {
+                "linear": t.linear,
+                "angular": t.angular,
+                "lateral": t.lateral,
+                "steering": t.steering,
+                "curvature": t.curvature,
+            },
+        }

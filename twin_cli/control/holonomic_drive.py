@@ -1,0 +1,81 @@
+"""A holonomic base run as a twin controller: gazebo_ros planar move and gz-sim MecanumDrive.
+
+Gazebo's planar move sets the model's planar velocity itself. The converter gave the root link
+three velocity servos in its own frame (`converters.gazebo.drive_motors`: x, y and yaw, computed
+by MuJoCo at every step); this controller ramps the command (vx, vy, ωz) into their `ctrl`
+(LINEAR_RAMP, ANGULAR_RAMP), waking the robot if it sleeps, and reports the world pose as
+odometry. A held command costs no writes, and the servos hold a zero twist between commands, as
+the plugin does.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import mujoco
+
+from converters.gazebo.drive_motors import planar_actuator
+from twin_cli.control.drive_base import DriveController
+from twin_cli.control.kinematics import ramp
+from twin_cli.world.sleeping import wake_actuated
+
+if TYPE_CHECKING:
+    from converters.gazebo.drive_records import HolonomicDrive
+
+
+LINEAR_RAMP = 3.0  # [m/s²] twin's ramp of a new command (the plugin sets it at once)
+ANGULAR_RAMP = 6.0  # [rad/s²]
+"""Gazebo's planar move sets the new velocity in one step. A servo asked for 0.3 m/s at once
+pushes the base with M·0.3/dt (2.4 kN for 8 kg) against its feet's friction, which kicks it off
+the ground (measured: a 7 cm hop); ramped at 3 m/s² it reaches 0.3 m/s in 0.1 s without leaving
+the ground. The ramp is applied per elapsed sim time, at MIN_RATE while it lasts."""
+
+
+class HolonomicController(DriveController):
+    """Drives an entity's base at (vx, vy, ωz) in its own frame."""
+
+    plugin: HolonomicDrive
+    current: tuple[float, float, float] = (0.0, 0.0, 0.0)  # written at the last update
+
+    def goals(self) -> tuple[float, float, float]:
+        """(vx [m/s], vy [m/s], ωz [rad/s]) within the plugin's limits."""
+        p, t = self.plugin, self.twist
+        top, spin = p.max_linear_velocity, p.max_angular_velocity
+        return (_clip(t.linear, top), _clip(t.lateral, top), _clip(t.angular, spin))
+
+    def _reset_targets(self) -> None:
+        self.current = (0.0, 0.0, 0.0)
+
+    def _apply(self, dt: float, force: bool) -> bool:
+        goals = self.goals()
+        limits = (LINEAR_RAMP, LINEAR_RAMP, ANGULAR_RAMP)
+        now = tuple(ramp(c, g, a, dt) for c, g, a in zip(self.current, goals, limits, strict=True))
+        m, d = self.world.model, self.world.data
+        name = self.plugin.name
+        ids = [
+            mujoco.mj_name2id(
+                m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{self.entity}/{planar_actuator(name, a)}"
+            )
+            for a in ("vx", "vy", "wz")
+        ]
+        if any(a < 0 for a in ids):
+            return True  # a hand-written model without the servos: nothing to drive
+        if force or now != self.current:
+            wake_actuated(m, d, ids)
+            for a, value in zip(ids, now, strict=True):
+                d.ctrl[a] = value
+            self.current = now  # type: ignore[assignment]
+        self._written = dict(self.world.commands())
+        return now == goals
+
+    def _encoder_twist(self) -> tuple[float, float]:
+        return self.goals()[0], self.goals()[2]
+
+    def command_reply(self) -> dict[str, Any]:
+        vx, vy, wz = self.goals()
+        return {"base_twist": {"x": vx, "y": vy, "yaw": wz}}
+
+
+def _clip(value: float, limit: float) -> float:
+    return value if math.isinf(limit) else max(-limit, min(limit, value))
