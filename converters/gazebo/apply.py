@@ -110,6 +110,8 @@ def _apply_surface(
         geom.condim = max(int(geom.condim), 4)
     geom.friction = np.array(friction)
     geom.priority = friction_priority(mu)
+    if mu <= 0.0:  # Gazebo's μ 0 is frictionless; a zero-width friction pyramid is singular
+        geom.condim = 1
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
     softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))

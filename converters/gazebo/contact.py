@@ -19,11 +19,12 @@ m·g/kp exactly (S = (1 - d)·kp/m, m the mass of the geom's body) and its behav
   - the correction rate h²·S stays at most MAX_CORRECTION_ERP per step, and at most ODE's own
     ERP: with ODE's ERP ≈ 1 and no `max_vel` cap, MuJoCo handed a 0.2 m drop back as a 65 mm
     bounce, and a resting box's normal force swung between 0 and 2·m·g;
-  - B = 4·√S (damping ratio 2, never above 1/h): overdamped like ODE's capped correction, so a
-    drop does not bounce (0.000 mm from 0.2 m, against 13.8 mm at the former ratio 0.5);
+  - B = 4·√S (damping ratio 2, = 1/h) at the correction cap, 2·√S (critical) below it:
+    overdamped like ODE's capped correction, so a drop does not bounce (0.000 mm from 0.2 m,
+    against 13.8 mm at the former ratio 0.5);
   - d = SOFT_IMPEDANCE, or higher when the correction cap binds (d = 1 - m·S/kp, at most
     HARD_IMPEDANCE): friction rows share d, and a body on a slope below its friction angle
-    creeps as (1 - d)/B (3.1 mm in 10 s on a 34° slope at d 0.95; 0.006 mm at 0.9999).
+    creeps as (1 - d)/B (3.1 mm in 10 s on a 34° slope at d 0.95; 0.06 mm at 0.999).
 A contact through the centre of mass (a ball) reproduces kp exactly; a cube resting on a face
 has m/4 at each corner (kp/4 each), as before.
 """
@@ -74,10 +75,16 @@ SOFT_IMPEDANCE = 0.9
 """Impedance d of a contact whose kp is soft enough to be reproduced below the correction cap;
 MuJoCo's friction rows share it, and (1 - d) sets how fast a body creeps under a tangential
 load it should hold."""
-HARD_IMPEDANCE = 0.9999
-"""MuJoCo's largest impedance (mjMAXIMP): a rigid surface (SDF's default kp 1e12)."""
+HARD_IMPEDANCE = 0.999
+"""Impedance of a rigid surface (SDF's default kp 1e12). MuJoCo allows up to 0.9999, but there a
+two-wheeled test base on frictionless casters leapt 0.4 m off the ground at rest (its contact
+rows nearly unregularised); at 0.999 it rests, and a body creeps 0.06 mm in 10 s on a slope
+6° short of its friction angle."""
 DAMPING_RATIO = 2.0
-"""B = 2·DAMPING_RATIO·√S: overdamped, as ODE's capped correction never pushes back fast."""
+"""B = 2·DAMPING_RATIO·√S on a surface at the correction cap (= 1/h there): overdamped, as ODE's
+capped correction never pushes back fast. A softer surface is critically damped (ratio 1): it
+does not bounce either, and settles at m·g/kp in about 4/√S (overdamped, a 5.5 kg crate on
+kp 1e3 had not sunk to it after the 1 s a check waits)."""
 SOLIMP_WIDTH = 0.001
 """solimp width [m]; irrelevant when d0 = d1, kept at MuJoCo's default."""
 DEFAULT_LIMIT_ERP = 0.2
@@ -151,14 +158,15 @@ def contact_softness(
     limit = min(max_contact_stiffness(timestep), max(erp, 1e-9) / timestep**2)
     d = SOFT_IMPEDANCE
     stiffness = (1.0 - d) * kp / mass
-    clamped = False
-    if stiffness > limit:
+    clamped, hard = False, stiffness >= limit
+    if hard:
         stiffness = limit
         d = 1.0 - mass * stiffness / kp
         clamped = d > HARD_IMPEDANCE
         d = min(d, HARD_IMPEDANCE)
     stiffness = max(stiffness, 1e-9)
-    damping = min(max(2.0 * DAMPING_RATIO * math.sqrt(stiffness), kd / mass), 1.0 / timestep)
+    ratio = DAMPING_RATIO if hard else 1.0
+    damping = min(max(2.0 * ratio * math.sqrt(stiffness), kd / mass), 1.0 / timestep)
     zeta_gazebo = kd / (2.0 * math.sqrt(kp * mass)) if kp > 0 else math.inf
     return ContactSoftness(
         solref=(-stiffness, -damping),

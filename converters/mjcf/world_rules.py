@@ -17,7 +17,11 @@ import math
 import mujoco
 import numpy as np
 
-from converters.gazebo.contact import add_gazebo_ground, friction_priority
+from converters.gazebo.contact import (
+    add_gazebo_ground,
+    friction_priority,
+    max_contact_stiffness,
+)
 from converters.mjcf.world_options import WorldOptions, apply_world_options
 
 # Gazebo's empty.world sun: directional, from above, casting shadows.
@@ -73,13 +77,14 @@ def min_friction_priorities(spec: mujoco.MjSpec) -> None:
 
 
 def capped_solrefs(solref: np.ndarray, timestep: float) -> tuple[np.ndarray, np.ndarray]:
-    """Direct solrefs (n, 2) capped at S ≤ 1/(2h)², keeping the damping ratio B/(2√S).
+    """Direct solrefs (n, 2) capped at the stiffest S a contact gets at step h
+    (`max_contact_stiffness`), keeping the damping ratio B/(2√S).
 
     Returns:
         The capped solrefs and a mask of the rows that were capped.
     """
     solref = np.asarray(solref, dtype=float).reshape(-1, 2)
-    limit = 1.0 / (2.0 * timestep) ** 2
+    limit = max_contact_stiffness(timestep)
     stiffness = -solref[:, 0]
     over = (solref[:, 0] < 0) & (stiffness > limit)
     capped = solref.copy()

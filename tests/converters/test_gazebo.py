@@ -15,7 +15,7 @@ from converters.gazebo.apply import DAMPING_FACTOR_PREFIX
 from converters.gazebo.blocks import parse_gazebo
 from converters.gazebo.contact import (
     CONTACT_MU_MAX,
-    IMPEDANCE,
+    SOFT_IMPEDANCE,
     friction_priority,
     max_contact_stiffness,
 )
@@ -79,7 +79,7 @@ def _ref(reference: str, body: str) -> str:
 
 
 def _stiffness(mass: float, kp: float) -> float:
-    return (1 - IMPEDANCE) * kp / mass
+    return (1 - SOFT_IMPEDANCE) * kp / mass
 
 
 # (row id, <gazebo> XML, check(done, model)); each check names the quantity it asserts.
@@ -114,7 +114,7 @@ TAG_TABLE = [
         _ref("arm", "<kp>1e4</kp><kd>50</kd>"),
         lambda d, m: (
             _geom(d, m, "arm").solref[0] == pytest.approx(-_stiffness(0.6, 1e4))
-            and _geom(d, m, "arm").solimp[0] == pytest.approx(IMPEDANCE)
+            and _geom(d, m, "arm").solimp[0] == pytest.approx(SOFT_IMPEDANCE)
         ),
     ),
     (

@@ -8,6 +8,8 @@ import mujoco
 import numpy as np
 import pytest
 
+from converters.gazebo.contact import SOFT_IMPEDANCE
+
 from converters import convert
 from converters.errors import ConversionError, PackageNotFoundError, SDFError
 from converters.gazebo.contact import friction_priority
@@ -96,7 +98,7 @@ def test_surface_friction_and_contact_follow_gazebo_rules(tmp_path: Path) -> Non
     assert tagged.priority[0] == friction_priority(0.4), "min-μ priority"
     assert plain.friction[0] == pytest.approx(1.0) and plain.priority[0] == friction_priority(1.0)
     stiffness = -tagged.solref[0]
-    assert stiffness == pytest.approx(0.05 * 1e5 / 2.0, rel=1e-9), "S = (1-d)·kp/m [1/s²]"
+    assert stiffness == pytest.approx((1 - SOFT_IMPEDANCE) * 1e5 / 2.0, rel=1e-9), "S [1/s²]"
 
 
 def test_model_include_resolves_through_model_config_and_overrides(tmp_path, monkeypatch):

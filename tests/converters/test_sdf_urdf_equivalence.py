@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from converters.gazebo.contact import SOFT_IMPEDANCE
+
 from converters import convert
 
 INERTIA = "ixx='0.02' iyy='0.03' izz='0.04' ixy='0.001' ixz='-0.002' iyz='0.0015'"
@@ -151,4 +153,4 @@ def test_gazebo_values_reach_the_arm(models) -> None:
     _, sdf = models
     arm = sdf.geom("arm_collision_0")
     assert arm.friction[0] == pytest.approx(0.4), "μ from <surface>"
-    assert -arm.solref[0] == pytest.approx(0.05 * 1e5 / 0.8, rel=1e-9), "S = (1-d)·kp/m"
+    assert -arm.solref[0] == pytest.approx((1 - SOFT_IMPEDANCE) * 1e5 / 0.8, rel=1e-9), "S"

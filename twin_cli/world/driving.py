@@ -160,7 +160,7 @@ def _set_command(
     dof = int(state.model.jnt_dofadr[j])
     here = float(state.data.qpos[state.model.jnt_qposadr[j]])
     hold = float(load[dof]) if start is not None and mode == "position" else 0.0
-    step = abs(value - here)
+    step = abs(value - here) if mode == "position" else abs(value)
     slope = 0.0
     if start is not None and mode == "position" and step > 1e-9:
         slope = (hold - float(start[dof])) / (value - here)

@@ -220,7 +220,8 @@ def servo_rule(
 
     Args:
         mode: the command's mode. limits: the motor's record. effort: effort limit [N m or N].
-        inertia: reflected inertia [kg m² or kg]. timestep: [s].
+        inertia: reflected inertia [kg m² or kg]. timestep: [s]. step: |target − q| of a
+        position command, |target| of a velocity command.
         reference: the motor tracks a reference in its activation (`twin_cli.world.servos`);
             otherwise the older rules below (a hand-written model's own actuators).
         carried: the inertia the joint carries through its contacts (`carried_inertia`).

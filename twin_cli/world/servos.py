@@ -60,6 +60,14 @@ the carried inertia is right, less when it is overestimated; the integral then s
 about 4·INTEGRAL_MARGIN·I_c/kv."""
 SPEED_MARGIN = 0.95  # ramp speed of a position move, as a fraction of the velocity limit
 OVERSHOOT = 0.05  # most a position servo's speed may pass its ramp's while it catches up
+LEAK_S = 0.5
+"""[s] how fast a stopped servo forgets an integral it is paying back. An integral also stores
+the lag of a speed change the damping could not follow (a light wheel dragged on by its
+robot while it brakes) and pays it back later: a turtlebot stopped after a drive turned its
+wheels back for a minute (1.1-1.7 mrad of yaw in 60 s). So while a servo commanded to 0 moves
+towards its reference (|q̇| > LEAK_SPEED, the sign of r − q), the integral decays; a load that
+pushes the joint away from its reference, or holds it still, keeps it."""
+LEAK_SPEED = 1e-5  # [rad/s or m/s]
 WINDUP_RATE = 100.0  # [Hz] of sim time at which a velocity servo's reference is kept near q
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
 _NONE = mujoco.mjtDyn.mjDYN_NONE
@@ -109,8 +117,7 @@ def gains(
             or m/s] (inf: a hold, or the start of a trajectory). step: |target − q| [rad or m].
 
     kv = I/h, the most damping a clamped step tolerates: an inner velocity loop that reaches
-    the speed kp·(r − q)/kv asks of it in a few steps. A velocity servo's kp (its integral
-    gain) is critically damped on INTEGRAL_MARGIN·I_c. A position servo's time constant
+    the speed kp·(r − q)/kv asks of it in a few steps. A velocity servo's kp (its integral gain) is critically damped on INTEGRAL_MARGIN·I_c. A position servo's time constant
     τ = kv/kp is at least 4·I_c/kv (critically damped), and otherwise as short as the ramp allows:
     at most step/speed, so that the speed asked never passes the ramp's (a legacy of the servo
     without ramp, which needs no acceleration), and at most speed/(2·ε·a), so that the lag a
@@ -229,20 +236,26 @@ def limit_windup(
     """Clamps each velocity servo's integral e = r − q so that kv·(v* − q̇) + kp·e stays within
     ±effort, and lets it grow only towards the side with room left: while the damping term alone
     saturates the joint (spinning up, stalled), the integral does not grow, so the joint reaches
-    its speed, or leaves a stall, without a catch-up burst.
+    its speed, or leaves a stall, without a catch-up burst; a stopped servo forgets a lag it
+    pays back (LEAK_S).
 
     Args:
         servos: (actuator id, its velocity command) with kp > 0.
     """
+    keep = math.exp(-1.0 / (WINDUP_RATE * LEAK_S))
     for a, cmd in servos:
         joint = int(model.actuator_trnid[a, 0])
         q = float(data.qpos[model.jnt_qposadr[joint]])
-        damping = cmd.kv * (cmd.target - float(data.qvel[model.jnt_dofadr[joint]]))
+        speed = float(data.qvel[model.jnt_dofadr[joint]])
+        damping = cmd.kv * (cmd.target - speed)
         effort = cmd.effort if math.isfinite(cmd.effort) else math.inf
         low = min(0.0, (-effort - damping) / cmd.kp)
         high = max(0.0, (effort - damping) / cmd.kp)
         address = int(model.actuator_actadr[a])
-        data.act[address] = q + float(np.clip(data.act[address] - q, low, high))
+        error = float(np.clip(data.act[address] - q, low, high))
+        if cmd.target == 0.0 and abs(speed) > LEAK_SPEED and error * speed > 0.0:
+            error *= keep  # paying back a stored lag (LEAK_S)
+        data.act[address] = q + error
 
 
 def follow(

@@ -172,7 +172,9 @@ def test_a_plugins_wheel_refuses_other_modes_without_suggesting_a_tag(tmp_path):
     with pytest.raises(ModeNotOfferedError) as caught:
         world.command_joints("bot", {"lj": 0.1}, mode="effort")
     message = str(caught.value)
-    assert "its diff_drive plugin offers only velocity; use --mode velocity" in message, message
+    assert (
+        "its gazebo_ros_diff_drive plugin offers only velocity; use --mode velocity" in message
+    ), message
     assert "declare" not in message, message
 
 

@@ -89,13 +89,9 @@ def test_turtlebot3_ends_within_5_percent_of_the_unicycle(driven: dict) -> None:
     assert heading <= POSE_TOLERANCE * turned, f"heading {heading:.4f} rad off of {turned:.3f}"
 
 
-@pytest.mark.xfail(
-    reason="wheel velocity servos sag under load (kv capped at I/h): the inner wheel turns at "
-    "4.798 rad/s for 4.848; measured 2.02 % of the path in position, 1.0 % of the turn in "
-    "heading; to re-check once the servos hold their targets"
-)
 def test_turtlebot3_ends_within_2_percent_of_the_unicycle(driven: dict) -> None:
-    """The bound every drive family is held to (test_drive_families.py)."""
+    """The bound every drive family is held to (test_drive_families.py). Measured 1.65 % of the
+    path (its wheels' μ 0.1 lets them slip a little at the plugin's 1 m/s² ramps)."""
     plugin, start = driven["plugin"], driven["start"]
     (x, y, th), path = _unicycle(
         plugin.wheel_separation, plugin.max_wheel_acceleration, (start.x, start.y, start.yaw)

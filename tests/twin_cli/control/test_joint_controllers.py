@@ -71,6 +71,6 @@ def test_joint_position_controller_reaches_its_angle_with_the_plugins_gains(rig:
 def test_a_joint_controllers_joint_offers_only_its_mode(
     rig: World, joint: str, mode: str, offered: str
 ) -> None:
-    with pytest.raises(InvalidRequestError, match=f"offer only {offered}") as caught:
+    with pytest.raises(InvalidRequestError, match=f"offers only {offered}") as caught:
         rig.command_joints("rig", {joint: 1.0}, mode=mode)
     assert f"--mode {offered}" in str(caught.value), "the message names the fix"

@@ -15,6 +15,7 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import pytest
 import validate_robots as robots
 
 from twin_cli.validate.checks.base import Status
@@ -90,24 +91,16 @@ def test_lidar_on_a_missing_link_fails_sensor_links_listing_the_links(tmp_path):
     assert [r.status for r in run.results] == [Status.PASS, Status.PASS], run.results
 
 
-def test_imu_on_ringing_contacts_fails_its_noise_and_the_kp_the_hint_names_fixes_it(tmp_path):
-    """A box on Gazebo's rigid default contact rings from step to step at rest; its IMU declares
-    1e-4 m/s², so the reading's spread sqrt(jitter² + σ²) is thousands of σ (factor 3)."""
-    run = validate(robots.write(tmp_path, robots.imu_box(), "ringing.urdf"), only=["sensor_imu"])
-    (outcome,) = run.results
-    assert outcome.status is Status.FAIL, outcome.measured
-    noise = [h for h in outcome.hints if "declared noise" in h]
-    assert noise and "IMU 'imu' on link 'base'" in noise[0], outcome.hints
-    spread = float(re.search(r"spreads ([0-9.e+-]+) m/s²", noise[0]).group(1))
-    assert spread > 3 * robots.IMU_NOISE, f"spread {spread} m/s² within 3 σ"
-    kp = float(re.search(r"'base' <kp> ≤ ([0-9.e+]+) N/m", noise[0]).group(1))
-    softened = robots.write(tmp_path, robots.imu_box(kp=kp), "quiet.urdf")
-    quiet = validate(softened, only=["sensor_imu"])
-    (outcome,) = quiet.results
+@pytest.mark.parametrize("kp", [None, 1e6])
+def test_an_imu_resting_on_gazebos_contacts_reads_its_declared_noise(tmp_path, kp):
+    """A box on Gazebo's rigid default contact (kp 1e12), or on kp 1e6 with kd 1, rests without
+    ringing, as in Gazebo: its IMU, declaring 1e-4 m/s², spreads within 20 % of that (the
+    contacts used to ring at the rigid default: thousands of σ)."""
+    path = robots.write(tmp_path, robots.imu_box(kp=kp), "resting.urdf")
+    (outcome,) = validate(path, only=["sensor_imu"]).results
     assert outcome.status is Status.PASS, (outcome.measured, outcome.hints)
-    # Without jitter the reading spreads exactly its declared noise: ratio 1.
     ratio = float(re.search(r"noise ([0-9.e+-]+)× declared", outcome.measured).group(1))
-    assert math.isclose(ratio, 1.0, rel_tol=1e-3), f"spread over declared noise {ratio}"
+    assert ratio <= 1.2, f"spread over declared noise {ratio}"
 
 
 def test_arm_folded_onto_itself_fails_initial_overlap_unless_started_apart(tmp_path):

@@ -96,7 +96,7 @@ def test_robots_without_sensors_skip_the_sensor_checks_with_a_reason() -> None:
 
 
 def test_imu_check_fails_when_the_robot_is_not_at_rest(tmp_path: Path) -> None:
-    # The same robot pushed with 60 N through the settled half rocks (~0.17 rad/s measured):
+    # The same robot pushed with 200 N through the settled half slides (friction holds 24 N):
     # the IMU is not at rest, and the check fails saying so.
     # (at = 0.5505 s, mid-step: ScenarioRun.run misses an action at an exact multiple of the
     # step once sim time has accumulated rounding; a bug of sim.py reported to the lead.)
@@ -105,7 +105,7 @@ def test_imu_check_fails_when_the_robot_is_not_at_rest(tmp_path: Path) -> None:
     text = (Path(scenarios.__file__).parent / "sensor_imu.toml").read_text()
     shaken.write_text(
         text.replace('name = "sensor_imu"', 'name = "shaken"')
-        + '\n[[actions]]\nkind = "push"\nat = 0.5505\nduration = 0.3\nforce = [60.0, 0.0, 0.0]\n'
+        + '\n[[actions]]\nkind = "push"\nat = 0.5505\nduration = 0.3\nforce = [200.0, 0.0, 0.0]\n'
     )
     run = validate(path, scenarios=[str(shaken)], only=["sensor_imu"])
     (outcome,) = run.results

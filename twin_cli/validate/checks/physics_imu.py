@@ -35,7 +35,6 @@ if TYPE_CHECKING:
     from twin_cli.sensors.imu import ImuSensor
 
 QUANTITIES = (("specific force", "m/s²", slice(0, 3)), ("angular velocity", "rad/s", slice(3, 6)))
-RING_MARGIN = 10.0  # a contact stiffer than 1/RING_MARGIN of the step's bound may ring at rest
 
 
 @dataclass(frozen=True)
@@ -120,37 +119,7 @@ def _mean_hints(f: ImuFigures, th: dict[str, float]) -> list[str]:
     return []
 
 
-def ringing_links(run: ScenarioRun) -> dict[str, float]:
-    """Links touching the ground whose contact is within RING_MARGIN of the stiffest a step
-    resolves, each with the Gazebo <kp> [N/m] that puts it RING_MARGIN below that bound.
-
-    A contact at that bound rings from step to step at rest: a 2 kg box on Gazebo's default
-    kp (clamped to the bound) reads 5.1 m/s² of white spread in z, on kp 2.5e6 N/m (a quarter of
-    the bound) 2.8 m/s², on kp 1e6 N/m (a tenth) 2e-13 m/s².
-    """
-    from converters.gazebo.contact import IMPEDANCE, max_contact_stiffness
-
-    model = run.world.model
-    bound = max_contact_stiffness(float(model.opt.timestep))
-    out = {}
-    for geom, _ in run.ground_contacts():
-        stiffness = -float(model.geom_solref[geom][0])  # direct solref: −S [1/s²]
-        body = int(model.geom_bodyid[geom])
-        if stiffness * RING_MARGIN >= bound:
-            link = model.body(body).name.removeprefix(f"{run.entity}/")
-            kp = bound / RING_MARGIN * float(model.body_mass[body]) / (1.0 - IMPEDANCE)
-            out[link] = min(out.get(link, kp), kp)
-    return out
-
-
-def _damping_fix(ringing: dict[str, float]) -> str:
-    if not ringing:
-        return "damp what shakes (the <kd> of the links that touch, or the hold's gains)"
-    kps = ", ".join(f"'{link}' <kp> ≤ {kp:.2g} N/m" for link, kp in sorted(ringing.items()))
-    return f"soften the contacts that ring at rest ({kps} in their <gazebo> blocks)"
-
-
-def _noise_hints(f: ImuFigures, factor: float, ringing: dict[str, float]) -> list[str]:
+def _noise_hints(f: ImuFigures, factor: float) -> list[str]:
     """The quantities whose spread at rest exceeds `factor` × the declared noise."""
     hints, ratios = [], f.noise_ratios()
     for quantity, unit, axes in QUANTITIES:
@@ -163,8 +132,9 @@ def _noise_hints(f: ImuFigures, factor: float, ringing: dict[str, float]) -> lis
             f"IMU '{f.name}' on link '{f.link}': at rest its {quantity} ({axis}) spreads "
             f"{total:.3g} {unit}, {ratios[worst]:.3g}× its declared noise "
             f"{f.declared[worst]:.3g} {unit} (> {factor:g}×): the robot itself shakes it by "
-            f"{f.jitter[worst]:.3g} {unit}; {_damping_fix(ringing)}, or declare the noise "
-            "the sensor really has (<noise><stddev>)"
+            f"{f.jitter[worst]:.3g} {unit}; damp what shakes (the <kd> of the links that "
+            "touch, or the hold's gains), or declare the noise the sensor really has "
+            "(<noise><stddev>)"
         )
     return hints
 
@@ -183,8 +153,7 @@ def check_sensor_imu(
     dt = float(run.world.model.opt.timestep)
     figures = [_figures(s, tables[s.spec.name], dt) for s in sensors]
     factor = th["max_noise_factor"]
-    ringing = ringing_links(run)
-    hints = [h for f in figures for h in _mean_hints(f, th) + _noise_hints(f, factor, ringing)]
+    hints = [h for f in figures for h in _mean_hints(f, th) + _noise_hints(f, factor)]
     worst = max(f.bias for f in figures)
     ratios = {f.name: float(np.nanmax(f.noise_ratios(), initial=0.0)) for f in figures}
     noise = f"noise {max(ratios.values()):.3g}× declared" if any(ratios.values()) else "no noise"
