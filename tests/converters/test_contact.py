@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from converters.gazebo.contact import (
+    DAMPING_RATIO,
     DEFAULT_LIMIT_ERP,
     GROUND_MU,
-    LIMIT_SOLIMP,
-    DAMPING_RATIO,
     HARD_IMPEDANCE,
+    LIMIT_SOLIMP,
     PRIORITY_PER_DECADE,
     add_gazebo_ground,
     contact_softness,

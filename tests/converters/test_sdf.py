@@ -8,11 +8,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters.gazebo.contact import SOFT_IMPEDANCE
-
 from converters import convert
 from converters.errors import ConversionError, PackageNotFoundError, SDFError
-from converters.gazebo.contact import friction_priority
+from converters.gazebo.contact import SOFT_IMPEDANCE, friction_priority
 from converters.gazebo.materials import gazebo_rgba
 from converters.sdf import read_sdf_world
 

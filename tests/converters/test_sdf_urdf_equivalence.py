@@ -10,9 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from converters.gazebo.contact import SOFT_IMPEDANCE
-
 from converters import convert
+from converters.gazebo.contact import SOFT_IMPEDANCE
 
 INERTIA = "ixx='0.02' iyy='0.03' izz='0.04' ixy='0.001' ixz='-0.002' iyz='0.0015'"
 URDF = f"""<robot name="twin_arm">

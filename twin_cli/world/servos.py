@@ -117,14 +117,15 @@ def gains(
             or m/s] (inf: a hold, or the start of a trajectory). step: |target − q| [rad or m].
 
     kv = I/h, the most damping a clamped step tolerates: an inner velocity loop that reaches
-    the speed kp·(r − q)/kv asks of it in a few steps. A velocity servo's kp (its integral gain) is critically damped on INTEGRAL_MARGIN·I_c. A position servo's time constant
-    τ = kv/kp is at least 4·I_c/kv (critically damped), and otherwise as short as the ramp allows:
-    at most step/speed, so that the speed asked never passes the ramp's (a legacy of the servo
-    without ramp, which needs no acceleration), and at most speed/(2·ε·a), so that the lag a
-    joint of acceleration a = effort/I_c builds while it speeds up adds at most ε = OVERSHOOT of
-    speed (a UR5e shoulder, 150 N m on 1.7 kg m², went to 2.2 times its limit with τ = 4 ms).
-    A hold gets the stiffest servo: critically damped on I itself, so a trajectory is tracked
-    tightly (its damping ratio on the carried inertia, at most HELD_RATIO·I, stays ≥ 0.58).
+    the speed kp·(r − q)/kv asks of it in a few steps. A velocity servo's kp (its integral gain)
+    is critically damped on INTEGRAL_MARGIN·I_c. A position servo's time constant τ = kv/kp is
+    at least 4·I_c/kv (critically damped), and otherwise as short as the ramp allows: at most
+    step/speed, so that the speed asked never passes the ramp's, and at most
+    speed/(2·ε·a), so that the lag a joint of acceleration a = effort/I_c builds while it
+    speeds up adds at most ε = OVERSHOOT of speed (a UR5e shoulder, 150 N m on 1.7 kg m², went
+    to 2.2 times its limit with τ = 4 ms). A hold gets the stiffest servo: critically damped
+    on I itself, so a trajectory is tracked tightly (its damping ratio on the carried inertia,
+    at most HELD_RATIO·I, stays ≥ 0.58).
     """
     own, carried = inertia
     carried = max(carried, own)
