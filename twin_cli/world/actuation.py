@@ -1,11 +1,13 @@
 """Joint commands (position, velocity, effort), timed pushes and Gazebo dampingFactor.
 
 Joint commands reuse the entity's motor actuator (one per actuated joint, `ctrlrange` = ±effort,
-converter contract). Effort mode keeps it a motor. Position and velocity modes turn it into a PD
-servo *inside MuJoCo* by rewriting its gain and bias (force = kp·(target − q) − kv·q̇, clipped to
-±effort through `forcerange`), so the PD runs in C at every step with no Python in the hot path,
-and `implicitfast` integrates the kv term implicitly. Commands are rewritten into each new model
-after a recompile, since compiling restores the spec's motor.
+converter contract). Effort mode keeps it a motor. Position and velocity modes turn it into a
+servo *inside MuJoCo* by rewriting its gain, bias, force range and dynamics: a spawned robot's
+motor tracks a reference in its activation (`twin_cli.world.servos`: ramps, PI), a hand-written
+model's own actuator a PD on ctrl (force = kp·(target − q) − kv·q̇). Either way it runs in C at
+every step with no Python in the hot path, and `implicitfast` integrates the kv term implicitly.
+Commands are rewritten into each new model after a recompile, since compiling restores the
+spec's motor.
 
 A multicopter rotor's joint actuator (converters.gazebo.multicopter) also sets, per command, its
 thrust and drag actuators (`<actuator>:thrust`, `:drag_x`, `:drag_y`) and the motor lag.

@@ -108,23 +108,10 @@ def command_joints(
         }
         dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
         rolling = dofs if mode == "velocity" else dofs[:0]
-        change = [
-            c[4] - _speed_before(state, c[0], int(d)) for c, d in zip(checked, dofs, strict=True)
-        ]
-        loads = joint_control.posture_loads(
-            state.model, state.data, positions, dofs, rolling, np.array(change)
-        )
+        loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
         fixed = ix.free_qpos < 0
         start = joint_control.posture_loads(state.model, state.data, {})[1] if fixed else None
         return [_set_command(state, c, loads, start) for c in checked]
-
-
-def _speed_before(state: WorldState, key: str, dof: int) -> float:
-    """The speed a velocity command changes from: the last one's target, else the joint's."""
-    previous = state.commands.get(key)
-    if previous is not None and previous.mode == "velocity":
-        return previous.target
-    return float(state.data.qvel[dof])
 
 
 def _checked(
@@ -156,9 +143,10 @@ def _set_command(
     posture (`start`: the loads where the entity is now; None for a free-base entity), from the
     start posture's to the target's as the joint moves."""
     key, a, j, mode, value, effort, limits = checked
-    inertia, load, carried, impulse = loads
+    inertia, load, carried = loads
     dof = int(state.model.jnt_dofadr[j])
     here = float(state.data.qpos[state.model.jnt_qposadr[j]])
+    qvel = float(state.data.qvel[dof])
     hold = float(load[dof]) if start is not None and mode == "position" else 0.0
     step = abs(value - here) if mode == "position" else abs(value)
     slope = 0.0
@@ -185,7 +173,10 @@ def _set_command(
         key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
     )
     if reference:
-        lead = float(impulse[dof]) / kv if mode == "velocity" and kv > 0 else 0.0
+        lead = 0.0
+        if mode == "velocity" and kv > 0:
+            before = previous.target if previous and previous.mode == mode else qvel
+            lead = float(carried[dof]) * (value - before) / kv
         servos.start(state.model, state.data, a, cmd, previous.mode if previous else "", lead)
     control.apply_command(state.model, state.data, a, cmd)
     state.commands[key] = cmd

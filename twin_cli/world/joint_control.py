@@ -2,16 +2,17 @@
 that turns a command into servo gains.
 
 The converter writes every motor's record into one `control` text (converters.mjcf.control_data);
-a motor without one (hand-written MJCF) offers every mode with no velocity limit. The gain rule
+a motor without one (hand-written MJCF) offers every mode with no velocity limit. The gain rules
 (documented in docs/control.md):
 
-- position: kp from the tag's `pos_kp`, else from the joint's reflected inertia
-  I = 1/(M⁻¹)ᵢᵢ: kp = I·min((MAX_OMEGA_DT/dt)², v/(dt·|Δ|)) for a step of Δ, v = SPEED_MARGIN·
-  v_max; kv from `pos_kd`, else max(2·√(kp·I), kp·|Δ|/v): an overdamped PD from rest never moves
-  faster than kp·|Δ|/kv = v, and kv ≤ I/dt keeps one saturated step from jumping past it. A
-  fixed-base entity's servo also feeds forward the gravity load of the target posture.
-- velocity: kv from `vel_kp`, else full effort at 5 % of the velocity limit; with an effort
-  limit, at most I/h (`_velocity_gain`).
+- a robot's motor, which carries a servo reference (`twin_cli.world.servos`): kv = I/h on the
+  reflected inertia I = 1/(M⁻¹)ᵢᵢ, kp critically damped on the inertia the joint carries
+  (`posture_loads`), or the tag's PID; see `servos.gains`.
+- a hand-written model's own actuator (no reference): position kp = I·min((MAX_OMEGA_DT/dt)²,
+  v/(dt·|Δ|)) for a step of Δ, v = SPEED_MARGIN·v_max, kv = max(2·√(kp·I), kp·|Δ|/v) (an
+  overdamped PD from rest never moves faster than v); velocity kv from `vel_kp`, else full
+  effort at 5 % of the velocity limit, at most I/h with an effort limit (`_velocity_gain`).
+- a fixed-base entity's position servo also feeds forward the static load of the posture.
 - effort: Gazebo's velocity rule (see twin_cli.world.actuation.apply_command).
 """
 
@@ -93,12 +94,10 @@ def posture_loads(
     targets: dict[int, float],
     dofs: np.ndarray | None = None,
     rolling: np.ndarray | None = None,
-    change: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Reflected inertia [kg m² or kg] and static load [N m or N] of every dof, and the inertia
     each dof of `dofs` carries: with every other joint held by its servo, and for the dofs of
-    `rolling` (velocity commands: wheels, tracks) through their contacts too; and the impulse
-    [N m s or N s] that changes the speeds of `rolling` together by `change` (`speed_impulses`).
+    `rolling` (velocity commands: wheels, tracks) through their contacts too.
 
     Computed at rest in the posture with the position `targets` (qpos address → value) written
     over the current one, on a scratch copy so the world's data (and warm start) stays untouched.
@@ -124,13 +123,12 @@ def posture_loads(
     carried = own.copy()
     if dofs is not None and len(dofs):  # every other joint held by its servo, up to a bound
         carried[dofs] = np.minimum(np.diag(full)[dofs], HELD_RATIO * own[dofs])
-    impulse = np.zeros(model.nv)
     if rolling is not None and len(rolling):
         through = carried_inertia(model, scratch, inverse, np.asarray(rolling))
+        if len(rolling) > 1:  # wheels commanded together share their robot
+            through = np.minimum(through, shared_inertia(model, scratch, inverse, rolling))
         carried[rolling] = np.maximum(carried[rolling], through)
-        if change is not None:
-            impulse[rolling] = speed_impulses(model, scratch, inverse, np.asarray(rolling), change)
-    return own, load, carried, impulse
+    return own, load, carried
 
 
 HELD_RATIO = 3.0
@@ -148,24 +146,21 @@ CARRIED_CONSTRAINTS = (
 MAX_CARRIED_RATIO = 1e4  # a joint its contacts lock completely counts as carrying this much
 
 
-def speed_impulses(
-    model: mujoco.MjModel,
-    scratch: mujoco.MjData,
-    inverse: np.ndarray,
-    dofs: np.ndarray,
-    change: np.ndarray,
+def shared_inertia(
+    model: mujoco.MjModel, scratch: mujoco.MjData, inverse: np.ndarray, dofs: np.ndarray
 ) -> np.ndarray:
-    """The impulses at `dofs` that change their speeds together by `change`, the contacts that
-    move with them held rigid and everything else free: (M_c⁻¹ restricted to dofs)⁺·Δv. Two
-    wheels driven together share their robot; a mode the contacts lock (four wheels turning
-    unequally) counts as needing none."""
-    jac = _constraint_rows(model, scratch)
-    rows = jac[(np.abs(jac[:, dofs]) > 0).any(axis=1)] if len(jac) else jac
+    """The inertia each of `dofs` carries when they all speed up together: the impulses
+    (M_c⁻¹ restricted to dofs)⁺·1, with the contacts that move with any of them held rigid. Four
+    wheels driven alike each carry a quarter of their cart, not all of it, as one wheel would;
+    a dof whose share comes out non-positive keeps infinity (`carried_inertia` decides)."""
+    active = _constraint_rows(model, scratch)
+    rows = active[(np.abs(active[:, dofs]) > 0).any(axis=1)] if len(active) else active
     reduced = inverse[np.ix_(dofs, dofs)]
     if len(rows):
         mjt = inverse @ rows.T
         reduced = reduced - mjt[dofs] @ np.linalg.pinv(rows @ mjt, rcond=1e-10) @ mjt[dofs].T
-    return np.linalg.pinv(reduced, rcond=1e-8) @ np.asarray(change, dtype=float)
+    share = np.linalg.pinv(reduced, rcond=1e-8) @ np.ones(len(dofs))
+    return np.where(share > 0, share, np.inf)
 
 
 def _constraint_rows(model: mujoco.MjModel, scratch: mujoco.MjData) -> np.ndarray:

@@ -26,11 +26,12 @@ QUAT_TOL = 1e-9
 
 @pytest.fixture(scope="module")
 def falling(tmp_path_factory) -> tuple[Path, dict[float, dict], dict[float, list], dict]:
-    """2 s of the humanoid falling from 1 m, sampled at 100 Hz; the world's own link poses and
+    """2 s of the humanoid falling from 1 m, tilted (so its frame is turned while it moves),
+    sampled at 100 Hz; the world's own link poses and
     joint states at each sample time, read through World's API as `twin links/joints` do, and
     the free joint's velocity (world-frame linear, body-frame angular: MuJoCo's qvel)."""
     world = World()
-    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0))
+    world.spawn(HUMANOID, name="h", pose=Pose(z=1.0, roll=0.3, pitch=0.2))
     path = tmp_path_factory.mktemp("rec") / "fall.mcap"
     recording = BagRecording(world, path, rate=RATE).start()  # encoded in another process
     links, joints = {0.0: world.link_poses("h")}, {0.0: world.joint_states("h")}
