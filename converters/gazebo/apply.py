@@ -132,13 +132,16 @@ def _report_softness(
     )
     if softness.clamped:
         report.approximated(
-            subject, figures + "; stiffer than a 0.001 s step resolves: clamped", tag="kp"
+            subject,
+            figures + "; stiffer than MuJoCo's rigid contact reproduces: clamped (sinks microns)",
+            tag="kp",
         )
     elif softness.damping_ratio > softness.damping_ratio_gazebo * 1.001:
         report.approximated(
             subject,
             figures + f"; damping ratio {softness.damping_ratio_gazebo:.3g} raised to "
-            f"{softness.damping_ratio:.3g} so static friction holds",
+            f"{softness.damping_ratio:.3g}: ODE's velocity-level contact neither rings nor "
+            "bounces (docs/contacts.md)",
             tag="kd",
         )
     else:
