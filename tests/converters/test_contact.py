@@ -139,11 +139,11 @@ def test_a_dropped_ball_lands_without_a_bounce(kp, kd):
     _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.3, 1.0, 1.0, soft)
     model = spec.compile()
     data = mujoco.MjData(model)
-    heights, landed = [], False
+    heights, rising = [], False
     for _ in range(1500):
         mujoco.mj_step(model, data)
-        landed = landed or data.ncon > 0
-        if landed:
+        rising = rising or (data.ncon > 0 and data.qvel[2] >= 0.0)  # stopped by the ground
+        if rising:
             heights.append(data.qpos[2])
     rest = 0.1 - soft.sinkage
     assert max(heights) - rest <= 0.01**2 / (2 * G), f"bounced {max(heights) - rest:.2e} m"
@@ -186,6 +186,23 @@ def test_a_box_on_a_slope_below_its_friction_angle_does_not_creep():
     start = data.qpos[0]
     mujoco.mj_step(model, data, nstep=10000)
     assert abs(data.qpos[0] - start) < 1e-4, f"crept {data.qpos[0] - start:.2e} m in 10 s"
+
+
+def test_a_frictionless_surface_gets_a_frictionless_contact(tmp_path):
+    """Gazebo's μ 0 (a caster): condim 1 in MuJoCo, whose friction pyramid of zero width left a
+    two-wheeled base leaping off the ground."""
+    from converters import convert
+
+    urdf = tmp_path / "caster.urdf"
+    urdf.write_text(
+        '<robot name="c"><link name="ball"><inertial><mass value="1"/><inertia ixx="1e-3" '
+        'iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
+        '<sphere radius="0.05"/></geometry></collision></link><gazebo reference="ball">'
+        "<mu1>0</mu1><mu2>0</mu2></gazebo></robot>"
+    )
+    spec, _ = convert(urdf)
+    (geom,) = [g for g in spec.geoms if g.contype]
+    assert geom.condim == 1 and geom.friction[0] == 0.0
 
 
 def test_stiffer_than_timestep_is_clamped_and_sinks_as_reported():

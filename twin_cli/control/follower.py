@@ -156,17 +156,34 @@ class TrajectoryFollower:
         wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
         self._last = (positions, speeds)
 
-    def _record_last(self) -> None:
-        positions, speeds = self._last
-        pairs = zip(positions.tolist(), speeds.tolist(), strict=True)
-        self.world.record_targets(dict(zip(self.keys, pairs, strict=True)))
+    def _halt(self) -> dict[str, tuple[float, float]]:
+        """Stops the servos it still holds where their references are now: a reference that
+        ramps (ctrl) would otherwise run on with nothing updating it. Returns their targets
+        (actuator → (position, feedforward 0)) for the world's command records."""
+        from twin_cli.world import servos
+
+        world, (positions, _) = self.world, self._last
+        commands = world.commands()
+        targets = {}
+        for i, (key, held) in enumerate(zip(self.keys, self._held, strict=True)):
+            if commands.get(key) is not held or self._model is not world.model:
+                continue  # claimed by another command, or a recompile renumbered the servos
+            a = int(self._ids[i])
+            target = float(positions[i])
+            if servos.has_reference(world.model, a):
+                target = float(world.data.act[world.model.actuator_actadr[a]])
+            world.data.ctrl[a] = 0.0 if servos.has_reference(world.model, a) else target
+            world.model.actuator_biasprm[a, 0] = self._hold[i]
+            targets[key] = (target, 0.0)
+        return targets
 
     def stop(self) -> None:
-        """Stops updating; the joints keep their last target."""
+        """Stops updating; the joints it still holds stay at their last reference."""
         self.report.active = False
         self.world.remove_observer(self.handle)
         if self._last is not None:
-            self._record_last()
+            held = dict(zip(self.keys, self._held, strict=True))
+            self.world.record_targets(self._halt(), held=held)
 
 
 def _check_points(world: World, entity: str, trajectory: Trajectory) -> None:

@@ -2,12 +2,13 @@
 
 Joint commands reuse the entity's motor actuator (one per actuated joint, `ctrlrange` = ±effort,
 converter contract). Effort mode keeps it a motor. Position and velocity modes turn it into a
-servo *inside MuJoCo* by rewriting its gain, bias, force range and dynamics: a spawned robot's
-motor tracks a reference in its activation (`twin_cli.world.servos`: ramps, PI), a hand-written
-model's own actuator a PD on ctrl (force = kp·(target − q) − kv·q̇). Either way it runs in C at
-every step with no Python in the hot path, and `implicitfast` integrates the kv term implicitly.
-Commands are rewritten into each new model after a recompile, since compiling restores the
-spec's motor.
+servo *inside MuJoCo* by rewriting its gain, bias, force range and dynamics: a plain motor
+(every converted robot's, and an MJCF `<motor>`) tracks a reference in its activation
+(`twin_cli.world.servos`: ramps, PI); an actuator with its own bias or dynamics (an MJCF
+`<position>`, a rotor's lag) a PD on ctrl (force = kp·(target − q) − kv·q̇). Either way it
+runs in C at every step with no Python in the hot path, and `implicitfast` integrates the kv
+term implicitly. Commands are rewritten into each new model after a recompile, since compiling
+restores the spec's motor.
 
 A multicopter rotor's joint actuator (converters.gazebo.multicopter) also sets, per command, its
 thrust and drag actuators (`<actuator>:thrust`, `:drag_x`, `:drag_y`) and the motor lag.

@@ -4,7 +4,7 @@ The converter writes kp/kd as direct solrefs (`-S -B`) capped for Gazebo's 1 ms 
 refsafe bound (time constant ≥ 2 steps) guards only positive solrefs, so a world with a longer
 step (an SDF world's `max_step_size`, `twin physics --step`) would integrate those contacts
 unstably: a box dropped at a 2 ms step on a kp = 1e12 ground bounced back to 95 % of its
-height. Each compiled model is therefore capped at S ≤ 1/(2h)², keeping the damping ratio, and
+height. Each compiled model is therefore capped at S ≤ 1/(16·h²), keeping the damping ratio, and
 given inverse weights that do not depend on where its robots spawned. The rules live in
 converters, so the `scene.xml` that `twin convert` writes is finished by the same code.
 """

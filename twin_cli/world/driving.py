@@ -151,7 +151,10 @@ def _set_command(
     step = abs(value - here) if mode == "position" else abs(value)
     slope = 0.0
     if start is not None and mode == "position" and step > 1e-9:
-        slope = (hold - float(start[dof])) / (value - here)
+        now = float(start[dof])
+        if math.isfinite(effort):  # the loads the servo can give, at both ends of the move
+            hold, now = (min(max(v, -effort), effort) for v in (hold, now))
+        slope = (hold - now) / (value - here)
     reference = servos.has_reference(state.model, a)
     kp, kv, rule = joint_control.servo_rule(
         mode,
@@ -202,22 +205,35 @@ def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tupl
 
 
 def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """Writes every joint command into a (re)compiled model, by actuator name."""
+    """Writes every joint command into a (re)compiled model, by actuator name, and starts the
+    servo observer for them (a loaded or restored world has none yet)."""
+    watched = False
     for actuator, cmd in state.commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
         if a >= 0:
             control.apply_command(model, data, a, cmd)
+            watched |= cmd.mode != "effort" and servos.has_reference(model, a)
+    if watched:
+        servo_watch.watch(state)
 
 
-def record_targets(state: WorldState, targets: Mapping[str, tuple[float, float]]) -> None:
+def record_targets(
+    state: WorldState,
+    targets: Mapping[str, tuple[float, float]],
+    held: Mapping[str, control.JointCommand] | None = None,
+) -> None:
     """Records where a controller left position servos (actuator → target, feedforward), so
-    `twin joints` and a save show them; commands that no longer exist, or were switched to
-    another mode since (whose targets are not positions), are skipped."""
+    `twin joints` and a save show them. Skipped: commands that no longer exist, were switched
+    to another mode since (whose targets are not positions), or, given `held` (the command
+    objects the controller claimed), were replaced since, by a new command or controller."""
     with state.lock:
         for key, (target, feedforward) in targets.items():
             cmd = state.commands.get(key)
-            if cmd is not None and cmd.mode == "position":
-                state.commands[key] = replace(cmd, target=target, feedforward=feedforward)
+            if cmd is None or cmd.mode != "position":
+                continue
+            if held is not None and cmd is not held.get(key):
+                continue
+            state.commands[key] = replace(cmd, target=target, feedforward=feedforward)
 
 
 def _check_command(joint: str, mode: str, value: float) -> None:

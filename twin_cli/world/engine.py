@@ -243,10 +243,15 @@ class World:
         with self.lock:
             return driving.joint_commands(self._state, name)
 
-    def record_targets(self, targets: Mapping[str, tuple[float, float]]) -> None:
+    def record_targets(
+        self,
+        targets: Mapping[str, tuple[float, float]],
+        held: Mapping[str, JointCommand] | None = None,
+    ) -> None:
         """Records where a controller left position servos: actuator name → (target [rad or
-        m], feedforward velocity); commands that no longer exist are skipped."""
-        driving.record_targets(self._state, targets)
+        m], feedforward velocity); commands that no longer exist, or that replaced the ones
+        the controller `held`, are skipped."""
+        driving.record_targets(self._state, targets, held)
 
     # ----------------------------------------------------------------- running
     @property

@@ -5,10 +5,10 @@ The converter writes every motor's record into one `control` text (converters.mj
 a motor without one (hand-written MJCF) offers every mode with no velocity limit. The gain rules
 (documented in docs/control.md):
 
-- a robot's motor, which carries a servo reference (`twin_cli.world.servos`): kv = I/h on the
+- a plain motor, which carries a servo reference (`twin_cli.world.servos`): kv = I/h on the
   reflected inertia I = 1/(M⁻¹)ᵢᵢ, kp critically damped on the inertia the joint carries
   (`posture_loads`), or the tag's PID; see `servos.gains`.
-- a hand-written model's own actuator (no reference): position kp = I·min((MAX_OMEGA_DT/dt)²,
+- an actuator with its own bias or dynamics (no reference): position kp = I·min((MAX_OMEGA_DT/dt)²,
   v/(dt·|Δ|)) for a step of Δ, v = SPEED_MARGIN·v_max, kv = max(2·√(kp·I), kp·|Δ|/v) (an
   overdamped PD from rest never moves faster than v); velocity kv from `vel_kp`, else full
   effort at 5 % of the velocity limit, at most I/h with an effort limit (`_velocity_gain`).
@@ -218,7 +218,7 @@ def servo_rule(
         inertia: reflected inertia [kg m² or kg]. timestep: [s]. step: |target − q| of a
         position command, |target| of a velocity command.
         reference: the motor tracks a reference in its activation (`twin_cli.world.servos`);
-            otherwise the older rules below (a hand-written model's own actuators).
+            otherwise the older rules below (actuators with their own bias or dynamics).
         carried: the inertia the joint carries through its contacts (`carried_inertia`).
     """
     pid = limits.pid.get(mode)

@@ -94,7 +94,12 @@ def _compiles_to_model(state: WorldState, spec: mujoco.MjSpec) -> bool:
         candidate = spec.compile()
     except (ValueError, RuntimeError):
         return False
-    reapply_commands(state, candidate, mujoco.MjData(candidate))
+    data = mujoco.MjData(candidate)
+    if candidate.na == state.model.na:
+        data.act[:] = state.data.act  # position servos size their ramps from their reference
+    reapply_commands(state, candidate, data)
+    if candidate.nu == state.model.nu:  # a ramp's range is where it started: command state
+        candidate.actuator_actrange[:] = state.model.actuator_actrange
     cap_contact_stiffness(candidate)
     allow_actuated(candidate)
     return model_bytes(candidate) == model_bytes(state.model)

@@ -99,6 +99,7 @@ def load(path: str | os.PathLike) -> World:
     doc = _read(Path(path))
     world = _new_world(path, doc)
     entities = [_respawn(path, world, item.model_dump()) for item in doc.entities]
+    layout, state = _servo_references(world, dict(doc.layout), np.array(doc.state, dtype=float))
     snapshot = WorldSnapshot(
         doc.name,
         world.settings,
@@ -108,8 +109,8 @@ def load(path: str | os.PathLike) -> World:
         tuple(entities),
         tuple(JointCommand(**c.model_dump()) for c in doc.commands),
         tuple(Push(p.body, tuple(p.wrench), p.end_step) for p in doc.pushes),
-        dict(doc.layout),
-        np.array(doc.state, dtype=float),
+        layout,
+        state,
     )
     try:
         world.restore(snapshot)
@@ -118,6 +119,26 @@ def load(path: str | os.PathLike) -> World:
             path, str(exc), "restore the robot files as they were when saved, or spawn afresh"
         ) from exc
     return world
+
+
+def _servo_references(
+    world: World, layout: dict[str, int], state: np.ndarray
+) -> tuple[dict[str, int], np.ndarray]:
+    """A file saved before robots' motors carried a servo reference (no activations, `na` 0)
+    gets them where MuJoCo's state keeps activations (after time, qpos and qvel), each at its
+    joint's saved position: its commands go on from where the joints were. Other files pass
+    unchanged."""
+    model = world.model
+    rest = {k: v for k, v in layout.items() if k != "na"}
+    if layout.get("na") != 0 or model.na == 0 or rest != {k: int(getattr(model, k)) for k in rest}:
+        return layout, state
+    references = np.zeros(model.na)
+    for a in range(model.nu):
+        if model.actuator_actadr[a] >= 0 and model.actuator_trntype[a] == 0:  # joint transmission
+            joint = int(model.actuator_trnid[a, 0])
+            references[model.actuator_actadr[a]] = state[1 + int(model.jnt_qposadr[joint])]
+    at = 1 + model.nq + model.nv
+    return {**layout, "na": int(model.na)}, np.insert(state, at, references)
 
 
 def _new_world(path: str | os.PathLike, doc: SaveDocument) -> World:
@@ -183,4 +204,6 @@ def _respawn(path: str | os.PathLike, world: World, item: dict[str, Any]) -> Ent
         raise WorldFileError(path, problem, "restore its source file, or spawn afresh") from exc
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world.entity(item["name"])
+    if spawn_state.act.size == 0 and entity.spawn_state.act.size:  # saved before servo refs
+        spawn_state = replace(spawn_state, act=np.zeros(entity.spawn_state.act.size))
     return replace(entity, source=item["source"], request=request, spawn_state=spawn_state)

@@ -69,6 +69,7 @@ towards its reference (|q̇| > LEAK_SPEED, the sign of r − q), the integral de
 pushes the joint away from its reference, or holds it still, keeps it."""
 LEAK_SPEED = 1e-5  # [rad/s or m/s]
 WINDUP_RATE = 100.0  # [Hz] of sim time at which a velocity servo's reference is kept near q
+MARK_SLOT, MARK = 9, 1.0  # dynprm entry that marks a servo reference (integrators ignore dynprm)
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
 _NONE = mujoco.mjtDyn.mjDYN_NONE
 _AFFINE = mujoco.mjtBias.mjBIAS_AFFINE
@@ -92,13 +93,12 @@ def give_reference(spec: mujoco.MjSpec) -> None:
         )
         if plain:
             actuator.dyntype = _INTEGRATOR
+            actuator.dynprm[MARK_SLOT] = MARK  # not an MJCF <intvelocity>: ours to rewrite
 
 
 def has_reference(model: mujoco.MjModel, a: int) -> bool:
     """Whether actuator `a` carries the reference activation `give_reference` adds."""
-    return int(model.actuator_actnum[a]) == 1 and (
-        int(model.actuator_dyntype[a]) in (int(_INTEGRATOR), int(_NONE))
-    )
+    return int(model.actuator_actnum[a]) == 1 and model.actuator_dynprm[a, MARK_SLOT] == MARK
 
 
 def gains(
