@@ -1,0 +1,121 @@
+"""Spawns with the viewer page open, in headless chromium on a real world server: the page takes
+each new model as pieces keyed by content (`twin_cli.view.piece_routes`).
+
+One page, one test: a turtlebot3 (meshes: 2.9 MiB of mesh arrays, 16 MiB of bundle with their
+BVHs) spawned with the page open shows within `APPEAR_S`; a second turtlebot3 shows within
+`APPEAR_S` too, and the page receives no byte of mesh data for it. Bytes are counted twice: by
+Chromium (the bodies of the responses the page receives, from its network events) and by the
+page's own record of the pieces it fetched.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+from corpus_registry import CORPUS, needs_corpus, package_paths
+from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing
+
+pytestmark = [
+    pytest.mark.skipif(bool(chromium_missing()), reason=chromium_missing() or ""),
+    needs_corpus,
+]
+
+WORLD = "pieces"
+ROBOT = "turtlebot3_burger"
+APPEAR_S = 2.0  # [s] from the spawn's reply to the new model drawn on the page
+FIRST_LOAD_S = 120.0  # [s] the page's first load: WASM and WebGL in SwiftShader, ~12 s
+TWIN_TIMEOUT_S = 120.0  # [s] a spawn converts the xacro and its meshes on a loaded machine
+# Structure the second spawn changes: bodies, joints, names, their trees in the BVH arrays
+# (measured: 0.37 MiB of a 16 MiB bundle); the mesh arrays are 2.9 MiB.
+MAX_SECOND_BYTES = 1024 * 1024  # [bytes]
+
+
+def twin(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", WORLD],
+        capture_output=True,
+        text=True,
+        timeout=TWIN_TIMEOUT_S,
+        env=os.environ.copy(),
+    )
+
+
+def spawn_turtlebot(name: str, x: float) -> float:
+    """Spawns a turtlebot3 at (x, 0); returns the wall time [s since the epoch] of the reply."""
+    robot = CORPUS[ROBOT]
+    root = package_paths(robot)
+    entry = root[robot["entry"].split("/")[0]].parent / robot["entry"]
+    packages = [f"--package={n}={p}" for n, p in root.items()]
+    spawned = twin("spawn", str(entry), *packages, "--name", name, "-x", str(x))
+    assert spawned.returncode == 0, spawned.stderr
+    return time.time()
+
+
+def loads(tab) -> list[dict]:
+    return tab.evaluate("window.twinPieces ? window.twinPieces.loads : []")
+
+
+def wait_shown(tab, after: float, timeout: float) -> dict:
+    """The first model load the page drew after `after` [s since the epoch]."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        drawn = [x for x in loads(tab) if x["shown"] and x["parsed"] / 1e3 > after]
+        if drawn:
+            return drawn[0]
+        time.sleep(0.02)
+    pytest.fail(f"no model drawn on the page within {timeout:.0f} s (loads: {loads(tab)})")
+
+
+@pytest.fixture
+def page(tmp_path_factory, serve_world):
+    from playwright.sync_api import sync_playwright
+
+    root = tmp_path_factory.mktemp("pieces")
+    with serve_world(root, WORLD):
+        url = twin("view").stdout.strip()
+        assert url.startswith("http://localhost:"), url
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            tab = browser.new_page(viewport={"width": 640, "height": 480})
+            received: list[tuple[str, int]] = []  # (URL, body bytes) as Chromium got them
+            tab.on("requestfinished", lambda r: received.append((r.url, _body_bytes(r))))
+            tab.goto(url)
+            wait_shown(tab, 0.0, FIRST_LOAD_S)
+            yield tab, received
+            browser.close()
+
+
+def _body_bytes(request) -> int:
+    return int(request.sizes()["responseBodySize"])
+
+
+def test_spawns_show_in_2_s_and_a_second_robot_sends_no_mesh_bytes(page):
+    tab, received = page
+    first_at = spawn_turtlebot("tb1", 0.0)
+    first = wait_shown(tab, first_at - 1.0, FIRST_LOAD_S)
+    first_s = first["shown"] / 1e3 - first_at
+    record = tab.evaluate("window.twinPieces")
+    assert record["assetBytes"] > 2 * 2**20, f"first turtlebot: {record['assetBytes']} mesh bytes"
+
+    before, asset_before, seen = record["bytes"], record["assetBytes"], len(received)
+    second_at = spawn_turtlebot("tb2", 1.0)
+    second = wait_shown(tab, second_at - 1.0, 30.0)
+    second_s = second["shown"] / 1e3 - second_at
+    record = tab.evaluate("window.twinPieces")
+    pieces = sum(n for url, n in received[seen:] if "/twin/pieces" in url)
+    print(
+        f"first turtlebot shown {first_s:.2f} s after its spawn, second {second_s:.2f} s; "
+        f"second: {pieces} bytes of pieces (Chromium), {record['bytes'] - before} (page)"
+    )
+    assert record["assetBytes"] == asset_before, (
+        f"second turtlebot: {record['assetBytes'] - asset_before} mesh bytes sent again"
+    )
+    assert pieces == record["bytes"] - before, "Chromium and the page disagree on bytes"
+    assert pieces < MAX_SECOND_BYTES, f"second turtlebot: {pieces} bytes, > {MAX_SECOND_BYTES}"
+    assert not any("/model" in url for url, _ in received), "the whole model was downloaded"
+    assert first_s < APPEAR_S, f"first turtlebot shown {first_s:.2f} s after its spawn"
+    assert second_s < APPEAR_S, f"second turtlebot shown {second_s:.2f} s after its spawn"
