@@ -21,7 +21,7 @@
   }
 
   worker.onmessage = (event) => {
-    const { crc, model, error } = event.data;
+    const { crc, model, error, published } = event.data;
     if (error) {
       console.warn("[twin] pieces failed:", error);
       settle(crc, null);
@@ -37,6 +37,27 @@
     );
     cacheModel(model.crc, model.bytes);
     settle(model.crc, model.bytes);
+    if (published) showPublished(model.crc);
+  };
+
+  // The server's newest model shows as soon as the worker has it, not when the state stream
+  // names it: the page reads that stream once a frame, and a frame in SwiftShader can take a
+  // second. State payloads still in flight for the model before then name a superseded model:
+  // MuJoCo's page would load it again (the robot would vanish for a moment), so those reloads
+  // are skipped; its payloads, sized for the other model, are dropped by the page meanwhile.
+  let newest = 0;
+  const superseded = new Set();
+  function showPublished(crc) {
+    if (newest && newest !== crc) superseded.add(newest);
+    superseded.delete(crc);
+    newest = crc;
+    if (currentModelCrc && currentModelCrc !== crc) reloadModel(crc);
+  }
+  const mujocoReload = reloadModel;
+  // eslint-disable-next-line no-global-assign
+  reloadModel = function (crc) {
+    if (superseded.has((crc || 0) >>> 0)) return Promise.resolve();
+    return mujocoReload(crc);
   };
 
   const mujocoDownload = downloadModel;
@@ -56,9 +77,14 @@
   // eslint-disable-next-line no-global-assign
   loadModelBytes = function (bytes) {
     const crc = mujocoLoad(bytes);
-    const load = { crc: crc, parsed: Date.now(), shown: null };
+    // shown: the next animation frame began; presented: the one after it began, by which the
+    // page's render loop has drawn the new model (its frame with new meshes runs in between).
+    const load = { crc: crc, parsed: Date.now(), shown: null, presented: null };
     record.loads.push(load);
-    requestAnimationFrame(() => requestAnimationFrame(() => (load.shown = Date.now())));
+    requestAnimationFrame(() => {
+      load.shown = Date.now();
+      requestAnimationFrame(() => (load.presented = Date.now()));
+    });
     return crc;
   };
 })();

@@ -6,7 +6,7 @@
 const BATCH_BYTES = 4 * 1024 * 1024; // per request
 const BATCH_KEYS = 256; // the server's limit
 const PARALLEL = 4;
-const POLL_MS = 100;
+const POLL_MS = 50;
 let pieces = new Map(); // key -> Uint8Array: the pieces of the last model assembled
 const inflight = new Map(); // crc32 (0: the current one) -> Promise of the bundle
 let lastCrc = -1;
@@ -74,13 +74,13 @@ async function assemble(crc) {
   return { crc: manifest.crc32, bytes: bytes, stats: stats };
 }
 
-function deliver(crc) {
+function deliver(crc, published) {
   let job = inflight.get(crc);
   if (!job) {
     job = assemble(crc).then(
       (model) => {
         // A copy: the worker keeps its pieces as views of its own bytes.
-        postMessage({ crc: crc, model: model });
+        postMessage({ crc: crc, model: model, published: published });
         return model;
       },
       (error) => postMessage({ crc: crc, error: String(error) }),
@@ -99,7 +99,7 @@ async function watch() {
         const crc = Number(await resp.text()) >>> 0;
         if (crc && crc !== lastCrc) {
           lastCrc = crc;
-          await deliver(crc);
+          await deliver(crc, true);
         }
       }
     } catch (e) {
@@ -109,5 +109,5 @@ async function watch() {
   }
 }
 
-onmessage = (event) => deliver(event.data.want >>> 0);
+onmessage = (event) => deliver(event.data.want >>> 0, false);
 watch();
