@@ -2,9 +2,10 @@
 each new model as pieces keyed by content (`twin_cli.view.piece_routes`).
 
 One page, one test: a turtlebot3 (meshes: 2.9 MiB of mesh arrays, 16 MiB of bundle with their
-BVHs) spawned with the page open is in the page's renderer within `APPEAR_S`, and drawn within
-that plus what the browser's own frames cost (`DRAW_FRAMES`); so is a second turtlebot3, and
-the page receives no byte of mesh data for it. Bytes are counted twice: by
+BVHs) spawned with the page open is in the page's renderer within `APPEAR_S` plus one of the
+page's frames (its main thread takes the bundle between two), and drawn within `APPEAR_S` plus
+what the browser's own frames cost (`DRAW_FRAMES`); so is a second turtlebot3, and the page
+receives no byte of mesh data for it. Bytes are counted twice: by
 Chromium (the bodies of the responses the page receives, from its network events) and by the
 page's own record of the pieces it fetched.
 """
@@ -27,7 +28,7 @@ pytestmark = [
 
 WORLD = "pieces"
 ROBOT = "turtlebot3_burger"
-APPEAR_S = 2.0  # [s] from the spawn's reply to the new model in the page's renderer
+APPEAR_S = 2.0  # [s] from the spawn's reply to the new model in the page (plus its frames)
 # Frames (as long as the page's frames before the spawns) the browser may take to draw a new
 # model on top of APPEAR_S: 0 when its frames are quick (measured 1.41 s to drawn, with frames
 # 107 ms apart), ~1-2 s on a loaded machine where frames are 400-600 ms apart.
@@ -150,8 +151,10 @@ def test_spawns_show_in_2_s_and_a_second_robot_sends_no_mesh_bytes(page):
         ("first", first, first_at, first_s),
         ("second", second, second_at, second_s),
     ):
+        # The page's main thread takes the bundle between two frames: up to one frame's wait.
         parsed_s = load["parsed"] / 1e3 - at
-        assert parsed_s < APPEAR_S, f"{name} turtlebot in the page {parsed_s:.2f} s after; {times}"
+        budget = APPEAR_S + frame / 1e3
+        assert parsed_s < budget, f"{name} turtlebot in the page {parsed_s:.2f} s after; {times}"
         # Drawing the new model is the browser's own cost: on a loaded machine SwiftShader's
         # frames slow down, and the frame that uploads the new meshes takes several of them.
         budget = APPEAR_S + DRAW_FRAMES * frame / 1e3
