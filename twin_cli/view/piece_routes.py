@@ -44,7 +44,6 @@ class PieceStore:
             collections.OrderedDict()
         )
         self._pieces: dict[str, memoryview] = {}
-        self.sent_bytes = 0  # [bytes] of piece responses, for the log and the figures
 
     def publish(self, bundle: bytes, crc32: int, model: Any) -> Manifest:
         """Cuts `bundle` (the model MuJoCo now serves, with its crc32) into pieces."""
@@ -76,9 +75,7 @@ class PieceStore:
             parts = [self._pieces.get(k) for k in keys]
         if any(p is None for p in parts):
             return None
-        body = b"".join(p for p in parts if p is not None)
-        self.sent_bytes += len(body)
-        return body
+        return b"".join(p for p in parts if p is not None)
 
 
 class PieceRoutes:

@@ -67,7 +67,7 @@ def array_ranges(bundle: bytes, model: Any) -> list[tuple[int, int, bool]]:
     array is found by its bytes (MJB's layout is MuJoCo's own); one found nowhere, or a slice
     overlapping another, is left to the content cuts, which costs reuse, never correctness."""
     found: list[tuple[int, int, bool]] = []
-    for name, items in _items(model).items():
+    for name, items in (_items(model) if model is not None else {}).items():
         array = getattr(model, name, None)
         if not isinstance(array, np.ndarray) or array.nbytes < ASSET_MIN_BYTES:
             continue

@@ -123,7 +123,7 @@ def _body_bytes(request) -> int:
     return int(request.sizes()["responseBodySize"])
 
 
-def test_spawns_show_in_2_s_and_a_second_robot_sends_no_mesh_bytes(page):
+def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(page):
     tab, received = page
     frame = frame_ms(tab)
     first_at = spawn_turtlebot("tb1", 0.0)
@@ -159,3 +159,15 @@ def test_spawns_show_in_2_s_and_a_second_robot_sends_no_mesh_bytes(page):
         # frames slow down, and the frame that uploads the new meshes takes several of them.
         budget = APPEAR_S + DRAW_FRAMES * frame / 1e3
         assert drawn_s < budget, f"{name} turtlebot drawn {drawn_s:.2f} s after; {times}"
+
+    # A delete: the page holds every mesh the smaller model has.
+    record = tab.evaluate("window.twinPieces")
+    asset_before, loaded = record["assetBytes"], len(loads(tab))
+    deleted = twin("delete", "tb2")
+    assert deleted.returncode == 0, deleted.stderr
+    deadline = time.monotonic() + 30.0
+    while not [x for x in loads(tab)[loaded:] if x["crc"] != second["crc"] and x["presented"]]:
+        assert time.monotonic() < deadline, f"the delete did not show (loads: {loads(tab)})"
+        time.sleep(0.05)
+    sent = tab.evaluate("window.twinPieces.assetBytes") - asset_before
+    assert sent == 0, f"delete of tb2: {sent} mesh bytes sent"
