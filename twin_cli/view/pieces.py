@@ -67,13 +67,17 @@ def array_ranges(bundle: bytes, model: Any) -> list[tuple[int, int, bool]]:
     array is found by its bytes (MJB's layout is MuJoCo's own); one found nowhere, or a slice
     overlapping another, is left to the content cuts, which costs reuse, never correctness."""
     found: list[tuple[int, int, bool]] = []
+    cursor = 0  # the arrays are searched in MJB's order, each from where the last one ended
     for name, items in (_items(model) if model is not None else {}).items():
         array = getattr(model, name, None)
         if not isinstance(array, np.ndarray) or array.nbytes < ASSET_MIN_BYTES:
             continue
-        start = bundle.find(array.tobytes())
+        data = array.tobytes()
+        start = cursor if bundle.startswith(data, cursor) else bundle.find(data, cursor)
+        start = start if start >= 0 else bundle.find(data)  # another order: the whole bundle
         if start < 0:
             continue
+        cursor = start + array.nbytes
         row = array.nbytes // max(1, len(array))
         asset = name.startswith(ASSET_PREFIXES)
         found += [(start + a * row, start + (a + n) * row, asset) for a, n in items if n > 0]
@@ -84,7 +88,8 @@ def array_ranges(bundle: bytes, model: Any) -> list[tuple[int, int, bool]]:
     return ranges
 
 
-# Per-item arrays and the (address, count) fields that say where each mesh's rows are.
+# Per-item arrays and the (address, count) fields that say where each mesh's rows are, in the
+# order MJB stores them (a face array equal to the one before is then found where it is).
 MESH_ROWS = {
     "mesh_vert": ("mesh_vertadr", "mesh_vertnum"),
     "mesh_normal": ("mesh_normaladr", "mesh_normalnum"),
@@ -95,20 +100,23 @@ MESH_ROWS = {
     "mesh_polymapadr": ("mesh_vertadr", "mesh_vertnum"),
     "mesh_polymapnum": ("mesh_vertadr", "mesh_vertnum"),
 }
-BVH_ARRAYS = ("bvh_aabb", "bvh_child", "bvh_nodeid", "bvh_depth")
+BVH_ARRAYS = ("bvh_depth", "bvh_child", "bvh_nodeid", "bvh_aabb")
 
 
 def _items(model: Any) -> dict[str, list[tuple[int, int]]]:
-    """(first row, rows) of each mesh, texture, and body's and mesh's BVH, per array: an item
-    is the same bytes wherever the items added before it pushed it."""
-    items = {
-        name: _rows(getattr(model, adr), getattr(model, num))
-        for name, (adr, num) in MESH_ROWS.items()
-    }
+    """(first row, rows) of each mesh, texture, and body's and mesh's BVH, per array, in the
+    order MJB stores the arrays: an item is the same bytes wherever the items added before it
+    pushed it."""
     trees = _rows(model.body_bvhadr, model.body_bvhnum) + _rows(
         model.mesh_bvhadr, model.mesh_bvhnum
     )
-    items.update({name: trees for name in BVH_ARRAYS})
+    items = {name: trees for name in BVH_ARRAYS}
+    items.update(
+        {
+            name: _rows(getattr(model, adr), getattr(model, num))
+            for name, (adr, num) in MESH_ROWS.items()
+        }
+    )
     sizes = model.tex_height * model.tex_width * model.tex_nchannel
     items["tex_data"] = _rows(model.tex_adr, sizes)
     return items
