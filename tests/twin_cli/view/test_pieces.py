@@ -60,7 +60,8 @@ def test_pieces_put_back_the_bundle_and_are_named_by_the_hash_of_their_bytes(tmp
 @needs_corpus
 def test_a_second_robot_of_the_same_description_adds_no_mesh_piece():
     """Two turtlebot3 in a world: every mesh piece of the second model is one of the first's,
-    and what is new (bodies, joints, names, their BVH trees) is under 1 MiB of the 16 MiB."""
+    and what is new (bodies, joints, names, their BVH trees) is under 256 KiB of the 16 MiB
+    (measured: 26 KiB)."""
     from twin_cli.spawn_request import SpawnRequest
     from twin_cli.world.engine import World
 
@@ -73,12 +74,12 @@ def test_a_second_robot_of_the_same_description_adds_no_mesh_piece():
     _, first = manifest_of(world.model)
     world.spawn(request, name="tb2")
     bundle, second = manifest_of(world.model)
-    assert first.asset_bytes > 2 * 2**20, f"the turtlebot's meshes: {first.asset_bytes} bytes"
+    assert first.asset_bytes > 4 * 2**20, f"the turtlebot's meshes: {first.asset_bytes} bytes"
     had = {p.key for p in first.pieces}
     new = [p for p in second.pieces if p.key not in had]
     assert not [p for p in new if p.asset], "mesh pieces new in the second model"
     new_bytes = sum(p.size for p in new)
-    assert new_bytes < 2**20, f"second turtlebot: {new_bytes} new bytes of {len(bundle)}"
+    assert new_bytes < 256 * 1024, f"second turtlebot: {new_bytes} new bytes of {len(bundle)}"
 
 
 def twin(*args: str) -> subprocess.CompletedProcess:
