@@ -84,7 +84,8 @@ def _viewer_class(host: str, token: str | None, store: PieceStore) -> type:
             super()._start_server()
             # Only the current bundle is kept: the page never goes back to an old one by crc,
             # and MuJoCo's page would otherwise download every earlier model in the background.
-            self._web_server.model_cache_bytes = 0
+            if self._web_server is not None:
+                self._web_server.model_cache_bytes = 0
             self._publish()
 
         @messages.handler(priority=messages.Priority.INTERNAL)
@@ -94,8 +95,11 @@ def _viewer_class(host: str, token: str | None, store: PieceStore) -> type:
             self._publish()
 
         def _publish(self) -> None:
+            server = self._web_server
+            if server is None or not server.mjb_data:
+                return  # stopped, or MuJoCo found no page files to serve
             started = time.perf_counter()
-            manifest = store.publish(self._web_server.mjb_data, self._model_crc32, self.model)
+            manifest = store.publish(server.mjb_data, self._model_crc32, self.model)
             log.info(
                 "viewer: model %d, %.1f MiB in %d pieces (%.0f ms)",
                 manifest.crc32,
