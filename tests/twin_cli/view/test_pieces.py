@@ -10,6 +10,7 @@ import os
 import random
 import subprocess
 import sys
+import time
 import urllib.error
 import urllib.request
 import zlib
@@ -114,3 +115,26 @@ def test_the_viewer_port_serves_the_model_as_pieces_that_put_back_its_bundle(tmp
         with pytest.raises(urllib.error.HTTPError) as gone:
             get(url + "twin/pieces?keys=" + "0" * 32)
         assert gone.value.code == 404
+
+        # A load replaces the world: the viewer serves its model as pieces too.
+        saved = tmp_path / "world.twin"
+        assert twin("save", str(saved)).returncode == 0
+        assert twin("delete", "mesh_robot").returncode == 0
+        assert wait_for_model(url, manifest["crc32"], differ=True)
+        loaded = twin("load", str(saved))
+        assert loaded.returncode == 0, loaded.stderr
+        assert wait_for_model(url, manifest["crc32"], differ=False), "the load did not show"
+
+
+def wait_for_model(url: str, crc32: int, *, differ: bool, timeout: float = 30.0) -> bool:
+    """Waits until the viewer serves, as pieces that put back /model, a model whose crc32 is
+    (`differ`: is not) `crc32`."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        manifest = json.loads(get(url + "twin/manifest"))
+        if (manifest["crc32"] != crc32) == differ:
+            keys = ",".join(row[0] for row in manifest["pieces"])
+            body = get(url + "twin/pieces?keys=" + keys)
+            return zlib.crc32(body) == manifest["crc32"]
+        time.sleep(0.1)
+    return False
