@@ -113,6 +113,10 @@ def _cookies(header: str) -> dict[str, str]:
 # sockets registered here get the checks, so any other viewer in the process is left as it was.
 _GUARDS: weakref.WeakKeyDictionary[socket.socket, ViewGuard] = weakref.WeakKeyDictionary()
 _ARMED: weakref.WeakSet[socket.socket] = weakref.WeakSet()  # the sockets served behind a guard
+# Twin's own routes on a guarded socket, tried before MuJoCo's (behind the same guard).
+_ROUTES: weakref.WeakKeyDictionary[
+    socket.socket, Callable[[ProcessRequest | None], ProcessRequest]
+] = weakref.WeakKeyDictionary()
 
 
 def armed(sock: socket.socket) -> bool:
@@ -121,11 +125,18 @@ def armed(sock: socket.socket) -> bool:
     return sock in _ARMED
 
 
-def protect(sock: socket.socket, guard: ViewGuard) -> None:
-    """Puts `guard` in front of the viewer server that will listen on `sock`."""
+def protect(
+    sock: socket.socket,
+    guard: ViewGuard,
+    routes: Callable[[ProcessRequest | None], ProcessRequest] | None = None,
+) -> None:
+    """Puts `guard` in front of the viewer server that will listen on `sock`, and behind it
+    `routes` (wraps MuJoCo's `process_request` with twin's own paths), if given."""
     from mujoco.studio.web import web_server
 
     _GUARDS[sock] = guard
+    if routes is not None:
+        _ROUTES[sock] = routes
     if not getattr(web_server.serve, "twin_guarded", False):
         web_server.serve = _guarded_serve(web_server.serve)
 
@@ -135,7 +146,9 @@ def _guarded_serve(original: Callable[..., Any]) -> Callable[..., Any]:
         sock = kwargs.get("sock")
         guard = _GUARDS.get(sock) if sock is not None else None
         if guard is not None and sock is not None:
-            kwargs["process_request"] = guard.wrap(kwargs.get("process_request"))
+            inner = kwargs.get("process_request")
+            routes = _ROUTES.get(sock)
+            kwargs["process_request"] = guard.wrap(routes(inner) if routes else inner)
             _ARMED.add(sock)
         return original(handler, *args, **kwargs)
 

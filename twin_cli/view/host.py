@@ -28,6 +28,7 @@ from mujoco.studio import messages
 
 from twin_cli.view.bridge import WorldBridge
 from twin_cli.view.guard import ViewGuard, armed, protect
+from twin_cli.view.piece_routes import PieceRoutes, PieceStore
 
 log = logging.getLogger("twin.view")
 
@@ -57,9 +58,10 @@ class ViewAddress:
         return not ipaddress.ip_address(self.host).is_loopback
 
 
-def _viewer_class(host: str, token: str | None) -> type:
+def _viewer_class(host: str, token: str | None, store: PieceStore) -> type:
     """`WebViewer` bound to `host` instead of the "::" (all interfaces) it hard-codes, its
-    server behind twin's Host, Origin and token checks (`twin_cli.view.guard`).
+    server behind twin's Host, Origin and token checks (`twin_cli.view.guard`), each model it
+    serves also cut into `store`'s pieces (`twin_cli.view.piece_routes`).
 
     `WebViewer.__init__` assigns `self._host = "::"` and binds right after; a class property
     whose setter ignores that assignment makes it bind `host` (MuJoCo 4.0.0 has no option).
@@ -77,13 +79,34 @@ def _viewer_class(host: str, token: str | None) -> type:
 
         def _start_server(self) -> None:
             """Registers the guard for the bound socket before MuJoCo's server starts on it."""
-            protect(self._http_sock, ViewGuard(host, self._http_port, token))
+            guard = ViewGuard(host, self._http_port, token)
+            protect(self._http_sock, guard, PieceRoutes(store).wrap)
             super()._start_server()
+            # Only the current bundle is kept: the page never goes back to an old one by crc,
+            # and MuJoCo's page would otherwise download every earlier model in the background.
+            if self._web_server is not None:
+                self._web_server.model_cache_bytes = 0
+            self._publish()
 
         @messages.handler(priority=messages.Priority.INTERNAL)
         def _on_post_model(self, event: messages.PostModelEvent) -> None:
-            """Serves the new model; the page swaps it in place (MuJoCo's prints a line)."""
+            """Serves the new model as pieces; the page swaps it in place (MuJoCo's prints)."""
             self._update_model()
+            self._publish()
+
+        def _publish(self) -> None:
+            server = self._web_server
+            if server is None or not server.mjb_data:
+                return  # stopped, or MuJoCo found no page files to serve
+            started = time.perf_counter()
+            manifest = store.publish(server.mjb_data, self._model_crc32, self.model)
+            log.info(
+                "viewer: model %d, %.1f MiB in %d pieces (%.0f ms)",
+                manifest.crc32,
+                manifest.size / 2**20,
+                len(manifest.pieces),
+                (time.perf_counter() - started) * 1e3,
+            )
 
     return BoundWebViewer
 
@@ -122,6 +145,7 @@ class WebHost:
         self._host, self._port, self._period = host, port, 1.0 / rate
         self._token = token
         self._bridge = WorldBridge(current_world())
+        self.pieces = PieceStore()
         self._handle: Any = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -138,7 +162,7 @@ class WebHost:
         from mujoco.studio import launch_thread, viewer_protocol
 
         bound: queue.Queue[Any] = queue.Queue()
-        viewer_class = _viewer_class(self._host, self._token)
+        viewer_class = _viewer_class(self._host, self._token, self.pieces)
         config = viewer_protocol.ViewerConfig(gfx="web", http_port=self._port, title="twin")
 
         def run(endpoint: Any) -> None:

@@ -1,0 +1,90 @@
+// twin: the page takes each model from twin's worker (pieces_worker.js), which fetches only the
+// pieces keyed by content that the page lacks (a second robot of the same description: no mesh
+// bytes) off the main thread. Loaded after MuJoCo's page script, it puts each bundle the
+// worker posts into that script's model cache (a cache hit loads at once when the state stream
+// names the model), replaces its downloadModel (a global function) to ask the worker, and
+// wraps loadModelBytes to record when each model showed. If the worker fails, MuJoCo's own
+// download runs.
+(() => {
+  const WORKER_WAIT_MS = 30000; // then MuJoCo's whole download
+  // What the page received and when models showed; read by tests and in the console.
+  const record = { bytes: 0, assetBytes: 0, received: [], loads: [] };
+  window.twinPieces = record;
+  const waiting = new Map(); // crc32 (0: the current model) -> [resolve]
+  const worker = new Worker("twin/pieces_worker.js");
+
+  function settle(crc, bytes) {
+    for (const key of [crc, 0]) {
+      for (const resolve of waiting.get(key) || []) resolve(bytes);
+      waiting.delete(key);
+    }
+  }
+
+  worker.onmessage = (event) => {
+    const { crc, model, error, published } = event.data;
+    if (error) {
+      console.warn("[twin] pieces failed:", error);
+      settle(crc, null);
+      return;
+    }
+    const s = model.stats;
+    record.bytes += s.bytes;
+    record.assetBytes += s.assetBytes;
+    record.received.push({ crc: model.crc, at: Date.now(), ...s });
+    console.log(
+      "[twin] model " + model.crc + ": " + s.pieces + " of " + s.of + " pieces, " + s.bytes +
+        " bytes (" + s.assetBytes + " of meshes and textures) in " + s.ms.toFixed(0) + " ms",
+    );
+    cacheModel(model.crc, model.bytes);
+    settle(model.crc, model.bytes);
+    if (published) showPublished(model.crc);
+  };
+
+  // The server's newest model shows as soon as the worker has it, not when the state stream
+  // names it: the page reads that stream once a frame, and a frame in SwiftShader can take a
+  // second. State payloads still in flight for the model before then name a superseded model:
+  // MuJoCo's page would load it again (the robot would vanish for a moment), so those reloads
+  // are skipped; its payloads, sized for the other model, are dropped by the page meanwhile.
+  let newest = 0;
+  const superseded = new Set();
+  function showPublished(crc) {
+    if (newest && newest !== crc) superseded.add(newest);
+    superseded.delete(crc);
+    newest = crc;
+    if (currentModelCrc && currentModelCrc !== crc) reloadModel(crc);
+  }
+  const mujocoReload = reloadModel;
+  // eslint-disable-next-line no-global-assign
+  reloadModel = function (crc) {
+    if (superseded.has((crc || 0) >>> 0)) return Promise.resolve();
+    return mujocoReload(crc);
+  };
+
+  const mujocoDownload = downloadModel;
+  // eslint-disable-next-line no-global-assign
+  downloadModel = function (crc, report) {
+    // A twin world never returns to an earlier model by its crc32: no background prefetch.
+    if (!report) return Promise.resolve(null);
+    const asked = new Promise((resolve) => {
+      waiting.set(crc, [...(waiting.get(crc) || []), resolve]);
+      worker.postMessage({ want: crc });
+      setTimeout(() => resolve(null), WORKER_WAIT_MS);
+    });
+    return asked.then((bytes) => bytes || mujocoDownload(crc, report));
+  };
+
+  const mujocoLoad = loadModelBytes;
+  // eslint-disable-next-line no-global-assign
+  loadModelBytes = function (bytes) {
+    const crc = mujocoLoad(bytes);
+    // shown: the next animation frame began; presented: the one after it began, by which the
+    // page's render loop has drawn the new model (its frame with new meshes runs in between).
+    const load = { crc: crc, parsed: Date.now(), shown: null, presented: null };
+    record.loads.push(load);
+    requestAnimationFrame(() => {
+      load.shown = Date.now();
+      requestAnimationFrame(() => (load.presented = Date.now()));
+    });
+    return crc;
+  };
+})();
