@@ -1,0 +1,221 @@
+"""A ROS 2 peer that shares no code with twin: run as its own process by the tests.
+
+Its DDS types are written here from the official `.msg` definitions (rosgraph_msgs/Clock,
+tf2_msgs/TFMessage, sensor_msgs/JointState, nav_msgs/Odometry, std_msgs/String,
+geometry_msgs/Twist), named as rosidl names them; it joins the domain over loopback only
+(interface 127.0.0.1, multicast off, peer 127.0.0.1), decodes every sample's CDR bytes with
+rosbags (an independent reader) and prints one JSON document on stdout.
+
+Usage: python ros_peer.py listen SECONDS ENTITY | python ros_peer.py drive ENTITY VX WZ SECONDS
+"""
+
+# No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
+
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass
+
+from cyclonedds.domain import Domain, DomainParticipant
+from cyclonedds.idl import IdlStruct, types
+from cyclonedds.pub import DataWriter
+from cyclonedds.qos import Policy, Qos
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from rosbags.typesys import Stores, get_typestore
+
+CONFIG = (
+    '<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
+    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+    "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32"
+    '</MaxAutoParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery>'
+    "</Domain></CycloneDDS>"
+)
+
+
+@dataclass
+class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+
+@dataclass
+class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Time
+    frame_id: str
+
+
+@dataclass
+class Clock(IdlStruct, typename="rosgraph_msgs::msg::dds_::Clock_"):
+    clock: Time
+
+
+@dataclass
+class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+
+@dataclass
+class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+
+@dataclass
+class Quaternion(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+    w: types.float64
+
+
+@dataclass
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3
+    rotation: Quaternion
+
+
+@dataclass
+class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header
+    child_frame_id: str
+    transform: Transform
+
+
+@dataclass
+class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    transforms: types.sequence[TransformStamped]
+
+
+@dataclass
+class JointState(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
+    header: Header
+    name: types.sequence[str]
+    position: types.sequence[types.float64]
+    velocity: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+
+
+@dataclass
+class Pose(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
+    position: Point
+    orientation: Quaternion
+
+
+@dataclass
+class PoseWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
+    pose: Pose
+    covariance: types.array[types.float64, 36]
+
+
+@dataclass
+class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    linear: Vector3
+    angular: Vector3
+
+
+@dataclass
+class TwistWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
+    twist: Twist
+    covariance: types.array[types.float64, 36]
+
+
+@dataclass
+class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
+    header: Header
+    child_frame_id: str
+    pose: PoseWithCovariance
+    twist: TwistWithCovariance
+
+
+@dataclass
+class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+
+
+def qos(latched: bool = False) -> Qos:
+    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last 1."""
+    if latched:
+        return Qos(
+            Policy.Reliability.Reliable(0),
+            Policy.Durability.TransientLocal,
+            Policy.History.KeepLast(1),
+            Policy.DataRepresentation(use_cdrv0_representation=True),
+        )
+    return Qos(
+        Policy.Reliability.Reliable(0),
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(10),
+        Policy.DataRepresentation(use_cdrv0_representation=True),
+    )
+
+
+def participant() -> DomainParticipant:
+    domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0"))
+    participant.domain = Domain(domain_id, CONFIG)  # kept alive with the participant
+    return DomainParticipant(domain_id)
+
+
+def listen(seconds: float, entity: str) -> dict:
+    """Every message of the world's topics for `seconds` of wall time, decoded by rosbags."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    dp = participant()
+    wanted = {
+        "/clock": (Clock, "rosgraph_msgs/msg/Clock", False),
+        "/tf": (TFMessage, "tf2_msgs/msg/TFMessage", False),
+        "/tf_static": (TFMessage, "tf2_msgs/msg/TFMessage", True),
+        f"/{entity}/joint_states": (JointState, "sensor_msgs/msg/JointState", False),
+        f"/{entity}/odom": (Odometry, "nav_msgs/msg/Odometry", False),
+        f"/{entity}/robot_description": (String, "std_msgs/msg/String", True),
+    }
+    readers = {}
+    for name, (idl, _, latched) in wanted.items():
+        topic = Topic(dp, "rt" + name, idl, qos=qos(latched))
+        readers[name] = DataReader(dp, topic, qos=qos(latched))
+    out: dict[str, list] = {name: [] for name in wanted}
+    types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        for name, reader in readers.items():
+            for sample in reader.take(64):
+                cdr = sample.serialize(use_version_2=False)  # the bytes, as received
+                message = store.deserialize_cdr(cdr, wanted[name][1])
+                out[name].append([time.monotonic(), to_plain(message)])
+        time.sleep(0.01)
+    return {"messages": out, "types": types_seen}
+
+
+def drive(entity: str, vx: float, wz: float, seconds: float) -> dict:
+    """Publishes a Twist on /<entity>/cmd_vel every 0.1 s for `seconds`."""
+    dp = participant()
+    topic = Topic(dp, f"rt/{entity}/cmd_vel", Twist, qos=qos())
+    writer = DataWriter(dp, topic, qos=qos())
+    end, sent = time.monotonic() + seconds, 0
+    while time.monotonic() < end:
+        writer.write(Twist(Vector3(vx, 0.0, 0.0), Vector3(0.0, 0.0, wz)))
+        sent += 1
+        time.sleep(0.1)
+    matched = len(writer.get_matched_subscriptions())
+    return {"sent": sent, "matched": matched}
+
+
+def to_plain(value):
+    if hasattr(value, "__dataclass_fields__"):
+        return {k: to_plain(getattr(value, k)) for k in value.__dataclass_fields__ if k[0] != "_"}
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, list | tuple):
+        return [to_plain(v) for v in value]
+    return value
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "listen":
+        result = listen(float(sys.argv[2]), sys.argv[3])
+    else:
+        result = drive(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]))
+    json.dump(result, sys.stdout)
