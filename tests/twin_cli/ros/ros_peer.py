@@ -17,6 +17,8 @@ import sys
 import time
 from dataclasses import dataclass
 
+from cyclonedds._clayer import ddspy_take
+from cyclonedds.core import InstanceState, SampleState, ViewState
 from cyclonedds.domain import Domain, DomainParticipant
 from cyclonedds.idl import IdlStruct, types
 from cyclonedds.pub import DataWriter
@@ -179,11 +181,15 @@ def listen(seconds: float, entity: str) -> dict:
     out: dict[str, list] = {name: [] for name in wanted}
     types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
     end = time.monotonic() + seconds
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
     while time.monotonic() < end:
         for name, reader in readers.items():
-            for sample in reader.take(64):
-                cdr = sample.serialize(use_version_2=False)  # the bytes, as received
-                message = store.deserialize_cdr(cdr, wanted[name][1])
+            idl, type_name, _ = wanted[name]
+            for cdr, info in ddspy_take(reader._ref, mask, 64):  # the bytes as received
+                if not info.valid_data:
+                    continue
+                message = store.deserialize_cdr(cdr, type_name)
+                idl.deserialize(cdr)  # the IDL type written here reads them too
                 out[name].append([time.monotonic(), to_plain(message)])
         time.sleep(0.01)
     return {"messages": out, "types": types_seen}

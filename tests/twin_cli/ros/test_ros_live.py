@@ -1,0 +1,214 @@
+"""`twin serve --ros` seen and driven from another process over loopback DDS, as a ROS 2 node
+would: a real server, and a peer (`ros_peer.py`) that shares no code with twin, types its
+topics from the official `.msg` definitions and decodes the received bytes with rosbags.
+
+Each test module runs in a domain of its own (ROS_DOMAIN_ID), so parallel runs never meet; the
+Cyclone configuration on both sides is loopback only, so nothing leaves the machine.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import drive_models as dm
+import numpy as np
+import pytest
+
+pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
+
+WORLD = "ros_live"
+PEER = Path(__file__).with_name("ros_peer.py")
+DOMAIN_ID = str(100 + os.getpid() % 100)  # one domain per test process
+STATE_PERIOD = 0.01  # [s] of sim time between /clock, /tf and joint_states messages (100 Hz)
+POSE_TOL = 1e-9  # [m, rad] tf composed against `twin model`: the same numbers, two routes
+DIFF = (
+    '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>wheel_left_joint'
+    "</left_joint><right_joint>wheel_right_joint</right_joint><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><odometry_frame>odom"
+    "</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
+)
+
+
+def _env(runtime: Path) -> dict[str, str]:
+    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime), "ROS_DOMAIN_ID": DOMAIN_ID}
+    for name in ("TWIN_WORLD", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS"):
+        env.pop(name, None)
+    return env
+
+
+def _twin(runtime: Path, *args: str) -> str:
+    proc = subprocess.run(
+        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD],
+        env=_env(runtime), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
+    return proc.stdout
+
+
+def _peer(runtime: Path, *args: str) -> dict:
+    proc = subprocess.run(
+        [sys.executable, str(PEER), *args],
+        env=_env(runtime), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, f"ros_peer {' '.join(args)}: {proc.stderr[-2000:]}"
+    return json.loads(proc.stdout)
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory, serve_world):
+    """A world served with --ros (running in real time) and two diff-drive bases on the ground."""
+    root = tmp_path_factory.mktemp("ros_live")
+    path = root / "base.urdf"
+    path.write_text(dm.two_wheel_base(DIFF))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("ROS_DOMAIN_ID", DOMAIN_ID)
+        patch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
+        with serve_world(root, WORLD, "--ros") as (_, proc):
+            for name, y in (("bot", 0.0), ("twin_bot", 2.0)):
+                _twin(root, "spawn", str(path), "--name", name, "-y", str(y), "--on-ground")
+            yield root, proc
+
+
+def test_clock_advances_in_sim_time_at_the_stated_rate(served) -> None:
+    root, _ = served
+    got = _peer(root, "listen", "2", "bot")
+    clocks = [
+        m["clock"]["sec"] + m["clock"]["nanosec"] * 1e-9 for _, m in got["messages"]["/clock"]
+    ]
+    assert len(clocks) >= 50, f"/clock: {len(clocks)} messages in 2 s of wall time"
+    steps = np.diff(clocks) / STATE_PERIOD
+    assert np.all(steps > 0.5), f"/clock went back or repeated: steps {steps.min()} periods"
+    assert np.allclose(steps, np.round(steps), atol=1e-6), "/clock off its 100 Hz grid"
+    assert np.median(steps) == pytest.approx(1.0), "/clock: most messages 10 ms of sim time apart"
+    assert got["types"]["/clock"] == "rosgraph_msgs::msg::dds_::Clock_"
+
+
+def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
+    root, _ = served
+    _twin(root, "pause")
+    try:
+        got = _peer(root, "listen", "1.5", "bot")  # a paused world is republished every 0.5 s
+        model = json.loads(_twin(root, "model", "bot", "--json"))
+        joints = json.loads(_twin(root, "joints", "bot", "--json"))
+    finally:
+        _twin(root, "resume")
+    messages = got["messages"]
+    assert messages["/tf"] and messages["/bot/joint_states"], "no /tf or joint_states received"
+    edges = {}
+    for key in ("/tf_static", "/tf"):  # late joiner: /tf_static arrives transient-local
+        for transform in messages[key][-1][1]["transforms"]:
+            edges[transform["child_frame_id"]] = transform
+    for frame in model["frames"]:
+        position, quat = _world_pose(frame["name"], edges)
+        expected = frame["pose"]
+        for axis, value in zip("xyz", position, strict=True):
+            assert value == pytest.approx(expected[axis], abs=POSE_TOL), f"{frame['name']} {axis}"
+        assert _same_rotation(quat, expected["quat"]), f"{frame['name']} rotation"
+    state = messages["/bot/joint_states"][-1][1]
+    for joint in joints:
+        i = state["name"].index(joint["name"])
+        for field in ("position", "velocity", "effort"):
+            assert state[field][i] == pytest.approx(joint[field], abs=1e-12), (joint["name"], field)
+    assert messages["/bot/robot_description"], "robot_description not sent to a late joiner"
+    assert messages["/bot/odom"][-1][1]["child_frame_id"] == "bot/base_link"
+
+
+def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
+    """bot gets (0.2 m/s, 0.5 rad/s) over DDS, twin_bot the same from `twin drive`, in one
+    paused world stepped 2 s: their paths agree to 1e-6 (measured: 1e-13), and follow the
+    unicycle's arc (0.337, 0.184) m, 1 rad within 10 % (measured: 0.336, 0.177 m, 0.98 rad)."""
+    root, _ = served
+    _twin(root, "pause")
+    start = {n: json.loads(_twin(root, "pose", n, "--json")) for n in ("bot", "twin_bot")}
+    sent = _peer(root, "drive", "bot", "0.2", "0.5", "0.6")
+    assert sent["matched"] == 1, "the twin's cmd_vel reader did not match the peer's writer"
+    status = json.loads(_twin(root, "ros", "status", "--json"))
+    assert status["commands"] >= 1 and "/bot/cmd_vel" in status["cmd_vel"], status
+    _twin(root, "drive", "twin_bot", "--linear", "0.2", "--angular", "0.5")
+    _twin(root, "step", "2000")
+    end = {n: json.loads(_twin(root, "pose", n, "--json")) for n in ("bot", "twin_bot")}
+    _twin(root, "resume")
+    moved = {n: _moved(start[n], end[n]) for n in end}
+    for got, same in zip(moved["bot"], moved["twin_bot"], strict=True):
+        assert got == pytest.approx(same, abs=1e-6), f"cmd_vel {moved['bot']} vs drive {same}"
+    x, y, yaw = moved["bot"]
+    arc = (0.2 / 0.5 * math.sin(1.0), 0.2 / 0.5 * (1 - math.cos(1.0)))  # 2 s at 0.5 rad/s
+    assert yaw == pytest.approx(1.0, rel=0.1), f"heading turned {yaw} rad, unicycle 1.0"
+    assert math.hypot(x - arc[0], y - arc[1]) < 0.1 * 0.4, f"({x}, {y}) vs unicycle {arc}"
+
+
+def test_the_server_binds_no_address_but_loopback(served) -> None:
+    """Every UDP socket of the server is on 127.0.0.1 or unbound to an address (Cyclone's
+    receive sockets), none is connected anywhere, and multicast is not joined."""
+    _, proc = served
+    inodes = {
+        m.group(1)
+        for fd in Path(f"/proc/{proc.pid}/fd").iterdir()
+        if (m := re.match(r"socket:\[(\d+)\]", os.readlink(fd)))
+    }
+    seen = []
+    for table in ("udp", "udp6"):
+        for line in Path(f"/proc/{proc.pid}/net/{table}").read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[9] in inodes:
+                seen.append((_address(fields[1]), _address(fields[2])))
+    assert seen, "the server has no UDP socket: is the bridge running?"
+    for local, remote in seen:
+        assert local[0] in ("127.0.0.1", "0.0.0.0"), f"socket bound to {local}"
+        assert remote[0] in ("0.0.0.0", "127.0.0.1"), f"socket connected to {remote}"
+
+
+def _address(text: str) -> tuple[str, int]:
+    """A /proc/net/udp address (hex, little-endian IPv4; IPv6 shown as its hex)."""
+    host, port = text.split(":")
+    if len(host) == 8:
+        host = ".".join(str(int(host[i : i + 2], 16)) for i in (6, 4, 2, 0))
+    return host, int(port, 16)
+
+
+def _world_pose(frame: str, edges: dict) -> tuple[np.ndarray, np.ndarray]:
+    """`frame`'s world position and quaternion (x, y, z, w), composed along tf's parents."""
+    position, quat = np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])
+    while frame in edges:
+        t = edges[frame]["transform"]
+        p = np.array([t["translation"][k] for k in "xyz"])
+        q = np.array([t["rotation"][k] for k in "xyzw"])
+        position, quat = p + _rotate(q, position), _multiply(q, quat)
+        frame = edges[frame]["header"]["frame_id"]
+    assert frame == "world", f"tf chain ends at {frame}, not world"
+    return position, quat
+
+
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    (ax, ay, az, aw), (bx, by, bz, bw) = a, b
+    return np.array([
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ])  # fmt: skip
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return _multiply(_multiply(q, np.array([*v, 0.0])), q * np.array([-1, -1, -1, 1]))[:3]
+
+
+def _same_rotation(a: np.ndarray, b: list) -> bool:
+    return abs(abs(float(np.dot(a, np.array(b)))) - 1.0) < POSE_TOL
+
+
+def _moved(start: dict, end: dict) -> tuple[float, float, float]:
+    """Displacement in the start's heading frame [m] and the heading turned [rad]."""
+    dx, dy, yaw = end["x"] - start["x"], end["y"] - start["y"], start["yaw"]
+    turned = math.remainder(end["yaw"] - yaw, math.tau)
+    return (
+        dx * math.cos(yaw) + dy * math.sin(yaw),
+        -dx * math.sin(yaw) + dy * math.cos(yaw),
+        turned,
+    )
