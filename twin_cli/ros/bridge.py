@@ -85,8 +85,15 @@ class RosService:
         self._lock = threading.Lock()
         self.bridge: RosBridge | None = None
 
-    def start(self, world: World, *, interface: str | None = None) -> dict[str, Any]:
-        """Joins the ROS 2 graph in the scope ROS's variables and `interface` ask.
+    def start(
+        self,
+        world: World,
+        *,
+        interface: str | None = None,
+        environment: dict[str, str] | None = None,
+    ) -> dict[str, Any]:
+        """Joins the ROS 2 graph in the scope ROS's variables and `interface` ask (the variables
+        of `environment`, the client's, else this process's).
 
         Raises:
             InvalidRequestError: a bridge runs already, or a ROS_* variable cannot be read.
@@ -99,7 +106,8 @@ class RosService:
                     f"already publishing ({self.bridge.scope.describe()})",
                     "stop it first with `twin ros stop`",
                 )
-            self.bridge = RosBridge(world, scope_from(interface=interface)).start()
+            scope = scope_from(environment, interface)
+            self.bridge = RosBridge(world, scope).start()
             return self.bridge.status()
 
     def status(self) -> dict[str, Any]:

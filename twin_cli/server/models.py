@@ -190,6 +190,8 @@ class RosBody(Body):
     """`twin ros start`: join the ROS 2 graph; loopback only unless an interface is given."""
 
     interface: Annotated[str, Field(min_length=1, max_length=64)] | None = None
+    # the client's ROS_DOMAIN_ID and discovery variables (None: the server's own)
+    environment: dict[Annotated[str, Field(pattern=r"^ROS_[A-Z_]+$")], str] | None = None
 
 
 class SpawnBatchBody(SpawnBody):

@@ -30,7 +30,8 @@ def ros_service(state: Any) -> Any:
 @router.post("/ros", status_code=201)
 def start_ros(body: RosBody, request: Request, world: WorldDep) -> dict:
     """Publish the world's topics on the ROS 2 graph and take its cmd_vel (`twin ros start`)."""
-    status = ros_service(request.app.state).start(world, interface=body.interface)
+    service = ros_service(request.app.state)
+    status = service.start(world, interface=body.interface, environment=body.environment)
     log.info("ROS 2 bridge started: %s", status["scope"])
     return status
 

@@ -212,3 +212,29 @@ def _moved(start: dict, end: dict) -> tuple[float, float, float]:
         -dx * math.sin(yaw) + dy * math.cos(yaw),
         turned,
     )
+
+
+def test_ros_start_and_stop_on_a_running_world_and_their_errors(served) -> None:
+    """`twin ros start` twice, or with a ROS_DOMAIN_ID out of range, says what and how (exit 2,
+    no traceback); `twin ros stop` leaves the graph and `start` joins it again (the shell's
+    domain), and the peer sees the world again."""
+    root, _ = served
+    again = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "ros", "start", "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert again.returncode == 2 and "twin ros stop" in again.stderr, again.stderr
+    assert "Traceback" not in again.stderr
+    stopped = json.loads(_twin(root, "ros", "stop", "--json"))
+    assert stopped["local_only"] is True and stopped["domain_id"] == int(DOMAIN_ID)
+    bad = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "ros", "start", "--world", WORLD],
+        env={**_env(root), "ROS_DOMAIN_ID": "999"}, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert bad.returncode == 2, bad.stderr
+    assert "ROS_DOMAIN_ID=999" in bad.stderr and "0-232" in bad.stderr, bad.stderr
+    assert "Traceback" not in bad.stderr
+    started = json.loads(_twin(root, "ros", "start", "--json"))
+    assert started["domain_id"] == int(DOMAIN_ID) and started["local_only"] is True
+    got = _peer(root, "listen", "1", "bot")
+    assert got["messages"]["/clock"], "no /clock after twin ros stop and start"

@@ -1,12 +1,14 @@
 """`twin ros start|stop|status`: a running world on the live ROS 2 graph (over DDS).
 
 Client-side (no mujoco, numpy or cyclonedds here): the server runs the DDS participant
-(`twin_cli.ros`); this side only asks. The scope is the server's: its ROS_DOMAIN_ID and
-discovery variables, loopback only unless `--interface` is given.
+(`twin_cli.ros`); this side only asks. The scope is the ROS_DOMAIN_ID and
+discovery variables as this shell has them (sent with the request), loopback only unless
+`--interface` is given.
 """
 
 from __future__ import annotations
 
+import os
 from typing import Annotated, Any
 
 import typer
@@ -14,6 +16,12 @@ import typer
 from twin_cli.cli.options import JsonOpt, WorldOpt
 from twin_cli.cli.output import Output
 
+SCOPE_VARIABLES = (
+    "ROS_DOMAIN_ID",
+    "ROS_AUTOMATIC_DISCOVERY_RANGE",
+    "ROS_STATIC_PEERS",
+    "ROS_LOCALHOST_ONLY",
+)
 app = typer.Typer(
     help="Publish a running world's topics on the ROS 2 graph and take its cmd_vel "
     "(`twin ros start`); `twin ros stop` leaves the graph.",
@@ -30,7 +38,9 @@ def start(
     json: JsonOpt = False,
 ) -> None:
     """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out, cmd_vel in."""
-    body = {} if interface is None else {"interface": interface}
+    body: dict[str, Any] = {"environment": ros_environment()}
+    if interface is not None:
+        body["interface"] = interface
     _show(_ask(world, "POST", body), json, "publishing")
 
 
@@ -42,6 +52,11 @@ def stop(world: WorldOpt = "default", json: JsonOpt = False) -> None:
 def status(world: WorldOpt = "default", json: JsonOpt = False) -> None:
     """What the bridge publishes, where, and the commands it took."""
     _show(_ask(world, "GET"), json, "publishing")
+
+
+def ros_environment() -> dict[str, str]:
+    """This shell's ROS 2 scope variables: the bridge joins the graph this shell's nodes see."""
+    return {k: v for k, v in os.environ.items() if k in SCOPE_VARIABLES}
 
 
 def _ask(world: str, method: str, body: dict | None = None) -> dict[str, Any]:
