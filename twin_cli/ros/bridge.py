@@ -7,7 +7,10 @@ recorder's code and the participant publishes their CDR bytes. So the live topic
 names and stamps are those of a recording, sensors included, `/tf_static` and
 `robot_description` are sent when an entity comes or goes, and a paused world's state is sent
 again every half second. The worker keeps only the newest sample while it is busy, so the loop
-never waits for DDS. `CommandListener` takes `cmd_vel` the other way.
+never waits for DDS, and takes at most WALL_SPEEDUP × RATE samples per wall second: a world up
+to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
+echo`), so building messages never takes the interpreter from the loop in proportion to its
+speed. `CommandListener` takes `cmd_vel` the other way.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import threading
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.live.budget import WALL_SPEEDUP
 from twin_cli.live.catalogue import STATE_RATE
 from twin_cli.record.recorder import Recording
 from twin_cli.ros.commands import CommandListener
@@ -39,8 +43,9 @@ class RosBridge:
         self.participant = Participant(scope)
         try:
             self.recording = Recording(
-                world, [self.participant], rate=rate, latest_only=True, frame_prefix=frame_prefix
-            )
+                world, [self.participant], rate=rate, latest_only=True,
+                frame_prefix=frame_prefix, max_wall_rate=WALL_SPEEDUP * rate,
+            )  # fmt: skip
         except BaseException:
             self.participant.close()
             raise
