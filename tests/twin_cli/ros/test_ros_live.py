@@ -238,3 +238,16 @@ def test_ros_start_and_stop_on_a_running_world_and_their_errors(served) -> None:
     assert started["domain_id"] == int(DOMAIN_ID) and started["local_only"] is True
     got = _peer(root, "listen", "1", "bot")
     assert got["messages"]["/clock"], "no /clock after twin ros stop and start"
+
+
+def test_twin_ros_imports_no_physics_and_no_dds(served) -> None:
+    """`twin ros` only asks the server: the client loads neither mujoco, numpy nor cyclonedds."""
+    root, _ = served
+    proc = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "twin_cli", "ros", "status", "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-500:]
+    names = set(re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s*([\w.]+)", proc.stderr, re.M))
+    heavy = {n.split(".")[0] for n in names} & {"mujoco", "numpy", "cyclonedds", "rosbags"}
+    assert not heavy, f"twin ros status imported {heavy}"
