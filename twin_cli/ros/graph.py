@@ -110,13 +110,15 @@ def _member(node: int, detail: Any) -> Any:
     from cyclonedds.idl import types
 
     if node == 1:
-        return _base(detail[0])
+        name, bound = detail
+        return types.bounded_str[bound] if name == "string" and bound else _base(name)
     if node == 2:
         return idl_type(detail)
     (inner_node, inner), length = detail
     if node == 3:
         return types.array[_member(inner_node, inner), length]
-    return types.sequence[_member(inner_node, inner)]
+    inner_type = _member(inner_node, inner)  # bounded sequences keep their bound (type match)
+    return types.sequence[inner_type, length] if length else types.sequence[inner_type]
 
 
 def _base(name: str) -> Any:

@@ -1,6 +1,7 @@
 """The twin's DDS participant: writers of the world's topics, readers of the commands it takes.
 
-One Cyclone DDS domain and participant per bridge, configured by `scope.cyclone_config` alone.
+One Cyclone DDS domain and participant per bridge, configured by `scope.cyclone_config` alone;
+the participant announces one node, `/twin`, with its readers and writers (`node`).
 Writers send the CDR bytes rosbags encoded (a recording's very bytes) through a topic typed by
 `graph.idl_type`, so subscribers see the types rmw_cyclonedds_cpp announces; readers hand back
 the cyclonedds objects of those same types.
@@ -18,7 +19,8 @@ from typing import Any
 
 from twin_cli.errors import RequestError
 from twin_cli.record.topics import Message, Topic
-from twin_cli.ros.graph import Qos, dds_qos, dds_topic, idl_type, qos_of
+from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
+from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, discovery_info
 from twin_cli.ros.scope import Scope, cyclone_config
 
 log = logging.getLogger("twin.ros")
@@ -67,6 +69,8 @@ class Participant:
         self._writers: dict[str, tuple[Any, type]] = {}
         self._readers: list[Any] = []
         self._closed = False
+        with self._lock:
+            self._info_writer = self._open_info_writer()
 
     # ------------------------------------------------------------ a recording sink
     def set_topics(self, topics: list[Topic]) -> None:
@@ -78,6 +82,7 @@ class Participant:
             for name, topic in wanted.items():
                 if name not in self._writers and not self._closed:
                     self._writers[name] = self._open_writer(topic)
+            self._announce()
 
     def write(self, message: Message) -> None:
         """Publishes `message`'s CDR bytes (encoded now: its object is refilled after)."""
@@ -95,6 +100,7 @@ class Participant:
                 return
             self._closed = True
             entities = [w for w, _ in self._writers.values()] + self._readers
+            entities.append(self._info_writer[0])
             entities += [*self._topics.values(), self._participant, self._domain]
             self._writers.clear()
             self._readers.clear()
@@ -112,6 +118,7 @@ class Participant:
                 self._participant, self._topic(name, type_name), qos=dds_qos(qos, type_name)
             )
             self._readers.append(reader)
+            self._announce()
         return reader
 
     def drop_reader(self, reader: Any) -> None:
@@ -119,6 +126,7 @@ class Participant:
             if reader in self._readers:
                 self._readers.remove(reader)
                 _delete(reader)
+                self._announce()
 
     # ------------------------------------------------------------ inside (lock held)
     def _open_writer(self, topic: Topic) -> tuple[Any, type]:
@@ -130,6 +138,26 @@ class Participant:
             qos=dds_qos(qos_of(topic), topic.type),
         )
         return writer, _encoded_type(topic.type)
+
+    def _open_info_writer(self) -> tuple[Any, type]:
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.topic import Topic as DdsTopic
+
+        topic = DdsTopic(self._participant, DISCOVERY_TOPIC, idl_type(INFO))
+        self._topics[(DISCOVERY_TOPIC, INFO)] = topic
+        return DataWriter(self._participant, topic, qos=dds_qos(LATCHED_QOS, INFO)), _encoded_type(
+            INFO
+        )
+
+    def _announce(self) -> None:
+        """Publishes the node's readers and writers on `ros_discovery_info` (`ros2 node`)."""
+        if self._closed:
+            return
+        writers = [w.get_guid().bytes for w, _ in self._writers.values()]
+        readers = [r.get_guid().bytes for r in self._readers]
+        data = discovery_info(self._participant.get_guid().bytes, readers, writers)
+        writer, sample_type = self._info_writer
+        writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
 
     def _topic(self, name: str, type_name: str) -> Any:
         from cyclonedds.topic import Topic as DdsTopic

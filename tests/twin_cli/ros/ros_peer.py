@@ -6,6 +6,9 @@ geometry_msgs/Twist), named as rosidl names them; it joins the domain over loopb
 (interface 127.0.0.1, multicast off, peer 127.0.0.1), decodes every sample's CDR bytes with
 rosbags (an independent reader) and prints one JSON document on stdout.
 
+It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo), where
+`ros2 node list` finds node names.
+
 Usage: python ros_peer.py listen SECONDS ENTITY | python ros_peer.py drive ENTITY VX WZ SECONDS
 """
 
@@ -139,6 +142,27 @@ class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
     data: str
 
 
+@dataclass
+class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
+    data: types.array[types.uint8, 16]
+
+
+@dataclass
+class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):
+    node_namespace: types.bounded_str[256]
+    node_name: types.bounded_str[256]
+    reader_gid_seq: types.sequence[Gid]
+    writer_gid_seq: types.sequence[Gid]
+
+
+@dataclass
+class ParticipantEntitiesInfo(
+    IdlStruct, typename="rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"
+):
+    gid: Gid
+    node_entities_info_seq: types.sequence[NodeEntitiesInfo]
+
+
 def qos(latched: bool = False) -> Qos:
     """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last 1."""
     if latched:
@@ -178,6 +202,11 @@ def listen(seconds: float, entity: str) -> dict:
     for name, (idl, _, latched) in wanted.items():
         topic = Topic(dp, "rt" + name, idl, qos=qos(latched))
         readers[name] = DataReader(dp, topic, qos=qos(latched))
+    # the rmw's own topic (no rt/): which nodes a participant holds
+    info = "rmw_dds_common/msg/ParticipantEntitiesInfo"
+    wanted["ros_discovery_info"] = (ParticipantEntitiesInfo, info, True)
+    topic = Topic(dp, "ros_discovery_info", ParticipantEntitiesInfo, qos=qos(True))
+    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True))
     out: dict[str, list] = {name: [] for name in wanted}
     types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
     end = time.monotonic() + seconds

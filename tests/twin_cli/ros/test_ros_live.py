@@ -119,6 +119,20 @@ def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
     assert messages["/bot/odom"][-1][1]["child_frame_id"] == "bot/base_link"
 
 
+def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
+    """ros_discovery_info (transient local) names node /twin, with a writer per published
+    topic and a reader per cmd_vel type of each drive."""
+    root, _ = served
+    got = _peer(root, "listen", "1", "bot")
+    infos = [m for _, m in got["messages"]["ros_discovery_info"]]
+    nodes = [n for info in infos for n in info["node_entities_info_seq"]]
+    twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
+    assert twin, f"no /twin node announced: {nodes}"
+    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot"
+    assert len(twin[-1]["reader_gid_seq"]) == 4, "readers: Twist and TwistStamped per bot"
+    assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
+
+
 def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
     """bot gets (0.2 m/s, 0.5 rad/s) over DDS, twin_bot the same from `twin drive`, in one
     paused world stepped 2 s: their paths agree to 1e-6 (measured: 1e-13), and follow the
