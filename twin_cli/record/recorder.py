@@ -213,7 +213,9 @@ class Recording(Follows):
     def _capture_sensors(self, rate: float | None = None) -> None:
         if self._done.is_set():
             return
-        if self._latest_only and self._busy and not self._pacing:  # a busy live view skips them
+        # a live view already behind skips them: a sample waits while another is built (a
+        # sample queued just now does not count: sensor ticks fall on state ticks, 10 Hz on 100)
+        if self._latest_only and self._newest is not None and not self._pacing:
             return
         if self._wall_period and rate is not None:  # max_wall_rate thins sensors alike
             now = time.monotonic()

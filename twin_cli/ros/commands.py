@@ -84,16 +84,24 @@ class CommandListener:
         waited = 0.0
         while not self._stopping.wait(POLL_S):
             waited += POLL_S
-            if waited >= FOLLOW_S:
-                waited = 0.0
-                self._follow()
-            for entity, readers in list(self._readers.items()):
-                newest = None
-                for reader in readers:
-                    taken = reader.take(16)
-                    newest = taken[-1] if taken else newest
-                if newest is not None:
-                    self._act(entity, newest)
+            try:
+                if waited >= FOLLOW_S:
+                    waited = 0.0
+                    self._follow()
+                self._take_all()
+            except Exception:  # one bad look must not end the listener: the world goes on
+                log.exception("cmd_vel listener")
+
+    def _take_all(self) -> None:
+        """Acts on the newest command of each entity (a writer that left sends an invalid
+        sample, which carries no data)."""
+        for entity, readers in list(self._readers.items()):
+            newest = None
+            for reader in readers:
+                valid = [s for s in reader.take(16) if hasattr(s, "__idl__")]
+                newest = valid[-1] if valid else newest
+            if newest is not None:
+                self._act(entity, newest)
 
     def _follow(self) -> None:
         """Opens readers for new drive entities and drops those of deleted ones."""

@@ -9,7 +9,8 @@ rosbags (an independent reader) and prints one JSON document on stdout.
 It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo), where
 `ros2 node list` finds node names.
 
-Usage: python ros_peer.py listen SECONDS ENTITY | python ros_peer.py drive ENTITY VX WZ SECONDS
+Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
+    drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS
 """
 
 # No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
@@ -143,6 +144,26 @@ class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
 
 
 @dataclass
+class TwistStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TwistStamped_"):
+    header: Header
+    twist: Twist
+
+
+@dataclass
+class LaserScan(IdlStruct, typename="sensor_msgs::msg::dds_::LaserScan_"):
+    header: Header
+    angle_min: types.float32
+    angle_max: types.float32
+    angle_increment: types.float32
+    time_increment: types.float32
+    scan_time: types.float32
+    range_min: types.float32
+    range_max: types.float32
+    ranges: types.sequence[types.float32]
+    intensities: types.sequence[types.float32]
+
+
+@dataclass
 class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
     data: types.array[types.uint8, 16]
 
@@ -224,18 +245,42 @@ def listen(seconds: float, entity: str) -> dict:
     return {"messages": out, "types": types_seen}
 
 
-def drive(entity: str, vx: float, wz: float, seconds: float) -> dict:
-    """Publishes a Twist on /<entity>/cmd_vel every 0.1 s for `seconds`."""
+def drive(entity: str, vx: float, wz: float, seconds: float, stamped: bool = False) -> dict:
+    """Publishes a Twist (or TwistStamped) on /<entity>/cmd_vel every 0.1 s for `seconds`."""
     dp = participant()
-    topic = Topic(dp, f"rt/{entity}/cmd_vel", Twist, qos=qos())
+    kind = TwistStamped if stamped else Twist
+    topic = Topic(dp, f"rt/{entity}/cmd_vel", kind, qos=qos())
     writer = DataWriter(dp, topic, qos=qos())
     end, sent = time.monotonic() + seconds, 0
     while time.monotonic() < end:
-        writer.write(Twist(Vector3(vx, 0.0, 0.0), Vector3(0.0, 0.0, wz)))
+        twist = Twist(Vector3(vx, 0.0, 0.0), Vector3(0.0, 0.0, wz))
+        writer.write(TwistStamped(Header(Time(0, 0), ""), twist) if stamped else twist)
         sent += 1
         time.sleep(0.1)
     matched = len(writer.get_matched_subscriptions())
     return {"sent": sent, "matched": matched}
+
+
+def scan(seconds: float, topic: str) -> dict:
+    """LaserScans on `topic` for `seconds`, read best effort (keep last 5) as a ROS sensor
+    subscriber reads them; decoded by rosbags."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    dp = participant()
+    sensor_qos = Qos(
+        Policy.Reliability.BestEffort,
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(5),
+        Policy.DataRepresentation(use_cdrv0_representation=True),
+    )
+    reader = DataReader(dp, Topic(dp, "rt" + topic, LaserScan, qos=sensor_qos), qos=sensor_qos)
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    out, end = [], time.monotonic() + seconds
+    while time.monotonic() < end:
+        for cdr, info in ddspy_take(reader._ref, mask, 16):
+            if info.valid_data:
+                out.append(to_plain(store.deserialize_cdr(cdr, "sensor_msgs/msg/LaserScan")))
+        time.sleep(0.01)
+    return {"scans": out}
 
 
 def to_plain(value):
@@ -251,6 +296,10 @@ def to_plain(value):
 if __name__ == "__main__":
     if sys.argv[1] == "listen":
         result = listen(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "scan":
+        result = scan(float(sys.argv[2]), sys.argv[3])
     else:
-        result = drive(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]))
+        stamped = sys.argv[1] == "drive_stamped"
+        args = float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
+        result = drive(sys.argv[2], *args, stamped=stamped)
     json.dump(result, sys.stdout)

@@ -19,6 +19,7 @@ from pathlib import Path
 import drive_models as dm
 import numpy as np
 import pytest
+from sensor_models import lidar_post
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
 
@@ -72,6 +73,9 @@ def served(tmp_path_factory, serve_world):
         with serve_world(root, WORLD, "--ros") as (_, proc):
             for name, y in (("bot", 0.0), ("twin_bot", 2.0)):
                 _twin(root, "spawn", str(path), "--name", name, "-y", str(y), "--on-ground")
+            post = root / "post.urdf"
+            post.write_text(lidar_post(rate=10.0))
+            _twin(root, "spawn", str(post), "--name", "post", "-x", "3", "-y", "-2")
             yield root, proc
 
 
@@ -155,6 +159,36 @@ def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
     arc = (0.2 / 0.5 * math.sin(1.0), 0.2 / 0.5 * (1 - math.cos(1.0)))  # 2 s at 0.5 rad/s
     assert yaw == pytest.approx(1.0, rel=0.1), f"heading turned {yaw} rad, unicycle 1.0"
     assert math.hypot(x - arc[0], y - arc[1]) < 0.1 * 0.4, f"({x}, {y}) vs unicycle {arc}"
+
+
+def test_a_twist_stamped_on_cmd_vel_drives_the_base_too(served) -> None:
+    """TwistStamped (Jazzy's controllers, Nav2) on the same topic: 0.1 m/s straight replaces the
+    turning command of the test before; over 1 s the base goes ~0.1 m and barely turns."""
+    root, _ = served
+    _twin(root, "pause")
+    before = json.loads(_twin(root, "ros", "status", "--json"))["commands"]
+    start = json.loads(_twin(root, "pose", "bot", "--json"))
+    sent = _peer(root, "drive_stamped", "bot", "0.1", "0.0", "0.6")
+    assert sent["matched"] == 1, "the twin's TwistStamped reader did not match"
+    assert json.loads(_twin(root, "ros", "status", "--json"))["commands"] > before
+    _twin(root, "step", "1000")
+    end = json.loads(_twin(root, "pose", "bot", "--json"))
+    _twin(root, "resume")
+    forward, _, turned = _moved(start, end)
+    assert 0.05 < forward < 0.15, f"went {forward} m in 1 s at 0.1 m/s"
+    assert abs(turned) < 0.1, f"turned {turned} rad (the former command turns 0.5 rad/s)"
+
+
+def test_a_lidar_is_published_best_effort_at_its_rate(served) -> None:
+    """`/post/scan` (sensor_msgs/LaserScan) comes to a best-effort subscriber, in the sensor's
+    frame, ~10 a second (10 Hz of sim time in real time)."""
+    root, _ = served
+    scans = _peer(root, "scan", "1.5", "/post/scan")["scans"]
+    assert len(scans) >= 5, f"{len(scans)} scans in 1.5 s"
+    assert scans[-1]["header"]["frame_id"] == "post/scan"
+    assert len(scans[-1]["ranges"]) == 181
+    stamps = [s["header"]["stamp"]["sec"] + s["header"]["stamp"]["nanosec"] * 1e-9 for s in scans]
+    assert np.allclose(np.diff(stamps) / 0.1, np.round(np.diff(stamps) / 0.1), atol=1e-6)
 
 
 def test_the_server_binds_no_address_but_loopback(served) -> None:
