@@ -14,6 +14,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import drive_models as dm
@@ -299,3 +300,24 @@ def test_twin_ros_imports_no_physics_and_no_dds(served) -> None:
     names = set(re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s*([\w.]+)", proc.stderr, re.M))
     heavy = {n.split(".")[0] for n in names} & {"mujoco", "numpy", "cyclonedds", "rosbags"}
     assert not heavy, f"twin ros status imported {heavy}"
+
+
+def test_the_bridge_follows_deletes_and_loads(served) -> None:
+    """A deleted base's cmd_vel reader goes; `twin load` moves the bridge to the loaded world
+    (the reply says so) and the peer receives its clock and robots again."""
+    root, _ = served
+    _twin(root, "delete", "twin_bot")
+    deadline = time.monotonic() + 10.0
+    while "/twin_bot/cmd_vel" in json.loads(_twin(root, "ros", "status", "--json"))["cmd_vel"]:
+        assert time.monotonic() < deadline, "twin_bot's cmd_vel reader outlived its entity"
+        time.sleep(0.2)
+    saved = root / "saved.json"
+    _twin(root, "save", str(saved))
+    proc = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "load", str(saved), "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    got = _peer(root, "listen", "1", "bot")["messages"]
+    assert got["/clock"] and got["/bot/joint_states"], "nothing after twin load"
+    assert json.loads(_twin(root, "ros", "status", "--json"))["cmd_vel"] == ["/bot/cmd_vel"]
