@@ -10,7 +10,7 @@ again every half second. The worker keeps only the newest sample while it is bus
 never waits for DDS, and takes at most WALL_SPEEDUP × RATE samples per wall second: a world up
 to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
 echo`), so building messages never takes the interpreter from the loop in proportion to its
-speed. `CommandListener` takes `cmd_vel` the other way.
+speed. `CommandListener` takes `cmd_vel` and forward controller commands the other way.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ class RosBridge:
             "rate": self.recording.rate,
             "samples": recording.samples,
             "error": recording.error,
-            "cmd_vel": self.commands.topics,
+            "inputs": self.commands.topics,
             "commands": self.commands.commands,
         }
 

@@ -1,24 +1,31 @@
-"""What a ROS 2 stack sends the twin: `cmd_vel` for each drive, acted on as `twin drive` acts.
+"""What a ROS 2 stack sends the twin: `cmd_vel` for each drive, and ros2_control's forward
+command controllers, acted on through the calls `twin drive` and `twin command` make.
 
-Each entity with a drive plugin gets readers on `/<entity>/cmd_vel` for geometry_msgs/Twist (as
-gazebo_ros' drive plugins subscribe) and TwistStamped (as Jazzy's controllers and Nav2 publish
-with stamped commands); both types may share the topic. A thread of the bridge's own polls the
-readers every POLL_S, follows spawns and deletes, and hands the newest command of each entity to
-`twin_cli.control.drive` with no duration: like the plugins, a base keeps its last command until
-the next one. A command the drive refuses (a sideways speed for a diff drive) is logged once per
-entity and kind, and the listener goes on.
+- Each entity with a drive plugin gets readers on `/<entity>/cmd_vel` for geometry_msgs/Twist
+  (as gazebo_ros' drive plugins subscribe) and TwistStamped (as Jazzy's controllers and Nav2
+  publish with stamped commands); both types may share the topic. The newest command goes to
+  `twin_cli.control.drive` with no duration: like the plugins, a base keeps its last command.
+- Each entity whose joints offer a command mode (position, velocity, effort) gets
+  `/<entity>/forward_<mode>_controller/commands` (std_msgs/Float64MultiArray, the controller
+  names of ros2_control's demos), whose `data` holds one target per such joint in the order
+  `twin joints` lists them; it goes to `World.command_joints` (all or none).
+
+A thread of the bridge's own polls the readers every POLL_S and follows spawns and deletes. A
+command that is refused (a sideways speed for a diff drive, a wrong number of targets) is
+logged once per entity and kind, and the listener goes on.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control import drive
 from twin_cli.control.drives import CONTROLLERS
-from twin_cli.errors import TwinError
-from twin_cli.ros.graph import DEFAULT_QOS, TWIST, TWIST_STAMPED
+from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST, TWIST_STAMPED
 
 if TYPE_CHECKING:
     from twin_cli.ros.participant import Participant
@@ -28,17 +35,39 @@ log = logging.getLogger("twin.ros")
 POLL_S = 0.02  # [s] wall between looks at the readers (a 50 Hz cmd_vel is taken as it comes)
 FOLLOW_S = 0.5  # [s] wall between looks at the world's entities (spawns, deletes)
 HOLONOMIC = "HolonomicDrive"
+MODES = ("position", "velocity", "effort")
 
 
-def drive_entities(world: World) -> dict[str, str]:
-    """Each entity with a drive plugin → the kind of its first drive (`control.drives`)."""
+@dataclass(frozen=True)
+class Input:
+    """One topic the twin reads: `mode` None for cmd_vel (`drive` the kind of drive), else a
+    forward command controller of that mode over `joints`."""
+
+    topic: str
+    type: str
+    mode: str | None = None
+    joints: tuple[str, ...] = ()
+    drive: str = ""
+
+
+def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
+    """Each entity's inputs now: cmd_vel for a drive, a forward controller per command mode."""
     with world.lock:
         out = {}
         for name in world.entity_names():
-            kinds = [type(p).__name__ for p in world.entity(name).plugins]
-            drives = [k for k in kinds if k in CONTROLLERS]
+            inputs = []
+            drives = [type(p).__name__ for p in world.entity(name).plugins]
+            drives = [k for k in drives if k in CONTROLLERS]
             if drives:
-                out[name] = drives[0]
+                topic = f"/{name}/cmd_vel"
+                inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
+            rows = world.joint_commands(name)
+            for mode in MODES:
+                joints = tuple(j for j, row in rows.items() if mode in row["modes"])
+                if joints:
+                    topic = f"/{name}/forward_{mode}_controller/commands"
+                    inputs.append(Input(topic, FLOAT64_ARRAY, mode, joints))
+            out[name] = tuple(inputs)
         return out
 
 
@@ -49,12 +78,12 @@ def twist_of(message: Any) -> tuple[float, float, float]:
 
 
 class CommandListener:
-    """Readers of every drive's `cmd_vel` in `participant`, acting on `world` (retargetable)."""
+    """Readers of every entity's inputs in `participant`, acting on `world` (retargetable)."""
 
     def __init__(self, world: World, participant: Participant) -> None:
         self._world, self._participant = world, participant
-        self._readers: dict[str, list[Any]] = {}
-        self._kinds: dict[str, str] = {}
+        self._inputs: dict[str, tuple[Input, ...]] = {}
+        self._readers: dict[str, list[tuple[Input, Any]]] = {}
         self._warned: set[tuple[str, str]] = set()
         self._stopping = threading.Event()
         self._thread = threading.Thread(target=self._run, name="twin-ros-commands", daemon=True)
@@ -62,8 +91,9 @@ class CommandListener:
 
     @property
     def topics(self) -> list[str]:
-        """The `cmd_vel` topics listened to now."""
-        return [f"/{entity}/cmd_vel" for entity in self._readers]
+        """Every topic read now, once each."""
+        names = [i.topic for readers in self._readers.values() for i, _ in readers]
+        return list(dict.fromkeys(names))
 
     def start(self) -> CommandListener:
         self._follow()
@@ -90,45 +120,56 @@ class CommandListener:
                     self._follow()
                 self._take_all()
             except Exception:  # one bad look must not end the listener: the world goes on
-                log.exception("cmd_vel listener")
+                log.exception("command listener")
 
     def _take_all(self) -> None:
-        """Acts on the newest command of each entity (a writer that left sends an invalid
+        """Acts on the newest message of each input (a writer that left sends an invalid
         sample, which carries no data)."""
         for entity, readers in list(self._readers.items()):
-            newest = None
-            for reader in readers:
+            for spec, reader in readers:
                 valid = [s for s in reader.take(16) if hasattr(s, "__idl__")]
-                newest = valid[-1] if valid else newest
-            if newest is not None:
-                self._act(entity, newest)
+                if valid:
+                    self._act(entity, spec, valid[-1])
 
     def _follow(self) -> None:
-        """Opens readers for new drive entities and drops those of deleted ones."""
+        """Opens readers for new or changed entities and drops those of deleted ones."""
         try:
-            kinds = drive_entities(self._world)
+            wanted = entity_inputs(self._world)
         except TwinError:  # the world went away under us: the next look will see
             return
-        for entity in [e for e in self._readers if e not in kinds]:
-            for reader in self._readers.pop(entity):
+        for entity in [e for e in self._readers if wanted.get(e) != self._inputs.get(e)]:
+            for _, reader in self._readers.pop(entity):
                 self._participant.drop_reader(reader)
-        for entity in kinds:
-            if entity not in self._readers:
-                topic = f"/{entity}/cmd_vel"
+        for entity, inputs in wanted.items():
+            if entity not in self._readers and inputs:
                 self._readers[entity] = [
-                    self._participant.reader(topic, kind, DEFAULT_QOS)
-                    for kind in (TWIST, TWIST_STAMPED)
+                    (i, self._participant.reader(i.topic, i.type, DEFAULT_QOS)) for i in inputs
                 ]
-        self._kinds = kinds
+        self._inputs = wanted
 
-    def _act(self, entity: str, message: Any) -> None:
-        linear, lateral, angular = twist_of(message)
-        holonomic = self._kinds.get(entity) == HOLONOMIC
+    def _act(self, entity: str, spec: Input, message: Any) -> None:
         try:
-            drive(self._world, entity, linear, angular, lateral=lateral if holonomic else 0.0)
+            if spec.mode is None:
+                linear, lateral, angular = twist_of(message)
+                lateral = lateral if spec.drive == HOLONOMIC else 0.0
+                drive(self._world, entity, linear, angular, lateral=lateral)
+            else:
+                self._command(entity, spec, [float(v) for v in message.data])
             self.commands += 1
         except TwinError as exc:
-            key = (entity, type(exc).__name__)
+            key = (entity, f"{spec.topic}:{type(exc).__name__}")
             if key not in self._warned:
                 self._warned.add(key)
-                log.warning("cmd_vel of [%s] not acted on: %s", entity, exc)
+                log.warning("%s not acted on: %s", spec.topic, exc)
+
+    def _command(self, entity: str, spec: Input, data: list[float]) -> None:
+        if len(data) != len(spec.joints):
+            raise InvalidRequestError(
+                spec.topic,
+                f"{len(data)} values for {len(spec.joints)} joints",
+                f"send one {spec.mode} target per joint, in this order: {', '.join(spec.joints)}",
+            )
+        assert spec.mode is not None
+        self._world.command_joints(
+            entity, dict(zip(spec.joints, data, strict=True)), mode=spec.mode
+        )

@@ -10,7 +10,8 @@ It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo
 `ros2 node list` finds node names.
 
 Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
-    drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS
+    drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
+    forward ENTITY MODE SECONDS VALUE...
 """
 
 # No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
@@ -164,6 +165,25 @@ class LaserScan(IdlStruct, typename="sensor_msgs::msg::dds_::LaserScan_"):
 
 
 @dataclass
+class MultiArrayDimension(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayDimension_"):
+    label: str
+    size: types.uint32
+    stride: types.uint32
+
+
+@dataclass
+class MultiArrayLayout(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayLayout_"):
+    dim: types.sequence[MultiArrayDimension]
+    data_offset: types.uint32
+
+
+@dataclass
+class Float64MultiArray(IdlStruct, typename="std_msgs::msg::dds_::Float64MultiArray_"):
+    layout: MultiArrayLayout
+    data: types.sequence[types.float64]
+
+
+@dataclass
 class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
     data: types.array[types.uint8, 16]
 
@@ -261,6 +281,19 @@ def drive(entity: str, vx: float, wz: float, seconds: float, stamped: bool = Fal
     return {"sent": sent, "matched": matched}
 
 
+def forward(entity: str, mode: str, seconds: float, values: list[float]) -> dict:
+    """Publishes `values` on /<entity>/forward_<mode>_controller/commands every 0.1 s."""
+    dp = participant()
+    name = f"rt/{entity}/forward_{mode}_controller/commands"
+    writer = DataWriter(dp, Topic(dp, name, Float64MultiArray, qos=qos()), qos=qos())
+    end, sent = time.monotonic() + seconds, 0
+    while time.monotonic() < end:
+        writer.write(Float64MultiArray(MultiArrayLayout([], 0), values))
+        sent += 1
+        time.sleep(0.1)
+    return {"sent": sent, "matched": len(writer.get_matched_subscriptions())}
+
+
 def scan(seconds: float, topic: str) -> dict:
     """LaserScans on `topic` for `seconds`, read best effort (keep last 5) as a ROS sensor
     subscriber reads them; decoded by rosbags."""
@@ -296,6 +329,9 @@ def to_plain(value):
 if __name__ == "__main__":
     if sys.argv[1] == "listen":
         result = listen(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "forward":
+        values = [float(v) for v in sys.argv[5:]]
+        result = forward(sys.argv[2], sys.argv[3], float(sys.argv[4]), values)
     elif sys.argv[1] == "scan":
         result = scan(float(sys.argv[2]), sys.argv[3])
     else:

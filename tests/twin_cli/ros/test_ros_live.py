@@ -20,6 +20,7 @@ from pathlib import Path
 import drive_models as dm
 import numpy as np
 import pytest
+from models import CONTROL_RIG
 from sensor_models import lidar_post
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
@@ -77,6 +78,9 @@ def served(tmp_path_factory, serve_world):
             post = root / "post.urdf"
             post.write_text(lidar_post(rate=10.0))
             _twin(root, "spawn", str(post), "--name", "post", "-x", "3", "-y", "-2")
+            rig = root / "rig.urdf"
+            rig.write_text(CONTROL_RIG)
+            _twin(root, "spawn", str(rig), "--name", "rig", "-x", "-3")
             yield root, proc
 
 
@@ -133,8 +137,9 @@ def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
     nodes = [n for info in infos for n in info["node_entities_info_seq"]]
     twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
     assert twin, f"no /twin node announced: {nodes}"
-    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot"
-    assert len(twin[-1]["reader_gid_seq"]) == 4, "readers: Twist and TwistStamped per bot"
+    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
+    readers = 2 * 3 + 3  # per bot: Twist, TwistStamped, forward velocity; rig: 3 modes
+    assert len(twin[-1]["reader_gid_seq"]) == readers, "a reader per input"
     assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
 
 
@@ -148,7 +153,7 @@ def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
     sent = _peer(root, "drive", "bot", "0.2", "0.5", "0.6")
     assert sent["matched"] == 1, "the twin's cmd_vel reader did not match the peer's writer"
     status = json.loads(_twin(root, "ros", "status", "--json"))
-    assert status["commands"] >= 1 and "/bot/cmd_vel" in status["cmd_vel"], status
+    assert status["commands"] >= 1 and "/bot/cmd_vel" in status["inputs"], status
     _twin(root, "drive", "twin_bot", "--linear", "0.2", "--angular", "0.5")
     _twin(root, "step", "2000")
     end = {n: json.loads(_twin(root, "pose", n, "--json")) for n in ("bot", "twin_bot")}
@@ -190,6 +195,19 @@ def test_a_lidar_is_published_best_effort_at_its_rate(served) -> None:
     assert len(scans[-1]["ranges"]) == 181
     stamps = [s["header"]["stamp"]["sec"] + s["header"]["stamp"]["nanosec"] * 1e-9 for s in scans]
     assert np.allclose(np.diff(stamps) / 0.1, np.round(np.diff(stamps) / 0.1), atol=1e-6)
+
+
+def test_forward_controller_commands_set_the_joint_targets(served) -> None:
+    """Float64MultiArray on /rig/forward_<mode>_controller/commands: one target per joint
+    offering that mode, in `twin joints` order; `twin joints` then shows them held."""
+    root, _ = served
+    sent = _peer(root, "forward", "rig", "velocity", "0.6", "1.5")
+    assert sent["matched"] == 1, "the twin's forward command reader did not match"
+    sent = _peer(root, "forward", "rig", "position", "0.6", "0.2")
+    assert sent["matched"] == 1
+    held = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
+    assert (held["spin"]["mode"], held["spin"]["target"]) == ("velocity", 1.5), held["spin"]
+    assert (held["slide"]["mode"], held["slide"]["target"]) == ("position", 0.2), held["slide"]
 
 
 def test_the_server_binds_no_address_but_loopback(served) -> None:
@@ -308,7 +326,7 @@ def test_the_bridge_follows_deletes_and_loads(served) -> None:
     root, _ = served
     _twin(root, "delete", "twin_bot")
     deadline = time.monotonic() + 10.0
-    while "/twin_bot/cmd_vel" in json.loads(_twin(root, "ros", "status", "--json"))["cmd_vel"]:
+    while "/twin_bot/cmd_vel" in json.loads(_twin(root, "ros", "status", "--json"))["inputs"]:
         assert time.monotonic() < deadline, "twin_bot's cmd_vel reader outlived its entity"
         time.sleep(0.2)
     saved = root / "saved.json"
@@ -320,4 +338,5 @@ def test_the_bridge_follows_deletes_and_loads(served) -> None:
     assert proc.returncode == 0, proc.stderr
     got = _peer(root, "listen", "1", "bot")["messages"]
     assert got["/clock"] and got["/bot/joint_states"], "nothing after twin load"
-    assert json.loads(_twin(root, "ros", "status", "--json"))["cmd_vel"] == ["/bot/cmd_vel"]
+    inputs = json.loads(_twin(root, "ros", "status", "--json"))["inputs"]
+    assert "/bot/cmd_vel" in inputs and not [i for i in inputs if "twin_bot" in i], inputs

@@ -37,7 +37,8 @@ def start(
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
-    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out, cmd_vel in."""
+    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel and
+    forward controller commands in."""
     body: dict[str, Any] = {"environment": ros_environment()}
     if interface is not None:
         body["interface"] = interface
@@ -72,8 +73,8 @@ def _show(reply: dict[str, Any], json: bool, verb: str) -> None:
         out.data(reply)
         return
     out.line(f"{verb}: {reply['scope']}, {reply['samples']} samples at {reply['rate']:g} Hz")
-    if reply["cmd_vel"]:
-        out.line(f"cmd_vel: {', '.join(reply['cmd_vel'])} ({reply['commands']} commands taken)")
+    if reply["inputs"]:
+        out.line(f"reading: {', '.join(reply['inputs'])} ({reply['commands']} commands taken)")
 
 
 def register(parent: typer.Typer) -> None:
