@@ -24,6 +24,8 @@ from models import CONTROL_RIG
 from sensor_models import lidar_post
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
+# One worker runs the module: its server and peers share one domain, of this process's own.
+pytestmark = pytest.mark.xdist_group("ros_live")
 
 WORLD = "ros_live"
 PEER = Path(__file__).with_name("ros_peer.py")
