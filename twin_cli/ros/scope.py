@@ -60,7 +60,12 @@ class Scope:
 
     def describe(self) -> str:
         """One line for the server's log and the start reply."""
-        where = "loopback only (nothing leaves this machine)" if self.local_only else self.range
+        if self.local_only:
+            where = "loopback only (nothing leaves this machine)"
+        elif self.interface is not None:
+            where = f"interface {self.interface}" + (", multicast" if self.multicast else "")
+        else:
+            where = f"{self.range}: Cyclone's interface choice, multicast"
         return f"ROS 2 domain {self.domain_id}, {where}"
 
 

@@ -80,3 +80,10 @@ def test_a_bad_setting_names_itself_and_the_fix(env, interface, names) -> None:
         scope_from(env, interface)
     for name in names:
         assert name in str(caught.value), str(caught.value)
+
+
+def test_the_description_says_where_the_participant_reaches() -> None:
+    assert "nothing leaves this machine" in scope_from({}).describe()
+    assert "interface eth0, multicast" in scope_from({}, "eth0").describe()
+    wide = scope_from({"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "ROS_DOMAIN_ID": "3"})
+    assert wide.describe() == "ROS 2 domain 3, SUBNET: Cyclone's interface choice, multicast"
