@@ -9,6 +9,8 @@ command controllers, acted on through the calls `twin drive` and `twin command` 
   `/<entity>/forward_<mode>_controller/commands` (std_msgs/Float64MultiArray, the controller
   names of ros2_control's demos), whose `data` holds one target per such joint in the order
   `twin joints` lists them; it goes to `World.command_joints` (all or none).
+- With position joints, `/<entity>/joint_trajectory_controller/joint_trajectory`
+  (trajectory_msgs/JointTrajectory) goes to `follow_trajectory`, as `twin trajectory` does.
 
 A thread of the bridge's own polls the readers every POLL_S and follows spawns and deletes. A
 command that is refused (a sideways speed for a diff drive, a wrong number of targets) is
@@ -22,10 +24,13 @@ import threading
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from twin_cli.control import drive
+from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST, TWIST_STAMPED
+
+JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
+TRAJECTORY = "trajectory"  # an Input's mode: joint_trajectory_controller's topic
 
 if TYPE_CHECKING:
     from twin_cli.ros.participant import Participant
@@ -67,6 +72,9 @@ def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
                 if joints:
                     topic = f"/{name}/forward_{mode}_controller/commands"
                     inputs.append(Input(topic, FLOAT64_ARRAY, mode, joints))
+                if joints and mode == "position":
+                    topic = f"/{name}/joint_trajectory_controller/joint_trajectory"
+                    inputs.append(Input(topic, JOINT_TRAJECTORY, TRAJECTORY, joints))
             out[name] = tuple(inputs)
         return out
 
@@ -75,6 +83,24 @@ def twist_of(message: Any) -> tuple[float, float, float]:
     """Forward [m/s], sideways [m/s] and yaw rate [rad/s] of a Twist or TwistStamped object."""
     twist = getattr(message, "twist", message)
     return float(twist.linear.x), float(twist.linear.y), float(twist.angular.z)
+
+
+def trajectory_doc(message: Any) -> dict[str, Any]:
+    """A JointTrajectory object as the dict `twin trajectory` sends (empty vectors left out)."""
+
+    def vector(values: Any) -> list[float] | None:
+        return [float(v) for v in values] or None
+
+    points = [
+        {
+            "positions": vector(p.positions),
+            "velocities": vector(p.velocities),
+            "accelerations": vector(p.accelerations),
+            "time_from_start": {"sec": p.time_from_start.sec, "nanosec": p.time_from_start.nanosec},
+        }
+        for p in message.points
+    ]
+    return {"joint_names": list(message.joint_names), "points": points}
 
 
 class CommandListener:
@@ -153,6 +179,10 @@ class CommandListener:
                 linear, lateral, angular = twist_of(message)
                 lateral = lateral if spec.drive == HOLONOMIC else 0.0
                 drive(self._world, entity, linear, angular, lateral=lateral)
+            elif spec.mode == TRAJECTORY:
+                follow_trajectory(
+                    self._world, entity, trajectory_from_dict(trajectory_doc(message))
+                )
             else:
                 self._command(entity, spec, [float(v) for v in message.data])
             self.commands += 1

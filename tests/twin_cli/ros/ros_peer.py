@@ -11,7 +11,7 @@ It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo
 
 Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
-    forward ENTITY MODE SECONDS VALUE...
+    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT
 """
 
 # No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
@@ -184,6 +184,28 @@ class Float64MultiArray(IdlStruct, typename="std_msgs::msg::dds_::Float64MultiAr
 
 
 @dataclass
+class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+
+@dataclass
+class JointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectoryPoint_"):
+    positions: types.sequence[types.float64]
+    velocities: types.sequence[types.float64]
+    accelerations: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+    time_from_start: Duration
+
+
+@dataclass
+class JointTrajectory(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectory_"):
+    header: Header
+    joint_names: types.sequence[str]
+    points: types.sequence[JointTrajectoryPoint]
+
+
+@dataclass
 class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
     data: types.array[types.uint8, 16]
 
@@ -294,6 +316,22 @@ def forward(entity: str, mode: str, seconds: float, values: list[float]) -> dict
     return {"sent": sent, "matched": len(writer.get_matched_subscriptions())}
 
 
+def trajectory(entity: str, joint: str, position: float, at: float) -> dict:
+    """Publishes one JointTrajectory (`joint` to `position` [rad or m] at `at` [s]) once it
+    is matched, as a MoveIt or rqt_joint_trajectory_controller would."""
+    dp = participant()
+    name = f"rt/{entity}/joint_trajectory_controller/joint_trajectory"
+    writer = DataWriter(dp, Topic(dp, name, JointTrajectory, qos=qos()), qos=qos())
+    deadline = time.monotonic() + 10.0
+    while not writer.get_matched_subscriptions() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    sec, nanosec = int(at), int(round((at - int(at)) * 1e9))
+    point = JointTrajectoryPoint([position], [], [], [], Duration(sec, nanosec))
+    writer.write(JointTrajectory(Header(Time(0, 0), ""), [joint], [point]))
+    time.sleep(0.5)  # reliable delivery before the process leaves
+    return {"matched": len(writer.get_matched_subscriptions())}
+
+
 def scan(seconds: float, topic: str) -> dict:
     """LaserScans on `topic` for `seconds`, read best effort (keep last 5) as a ROS sensor
     subscriber reads them; decoded by rosbags."""
@@ -332,6 +370,9 @@ if __name__ == "__main__":
     elif sys.argv[1] == "forward":
         values = [float(v) for v in sys.argv[5:]]
         result = forward(sys.argv[2], sys.argv[3], float(sys.argv[4]), values)
+    elif sys.argv[1] == "trajectory":
+        args = sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
+        result = trajectory(*args)
     elif sys.argv[1] == "scan":
         result = scan(float(sys.argv[2]), sys.argv[3])
     else:

@@ -140,7 +140,7 @@ def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
     twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
     assert twin, f"no /twin node announced: {nodes}"
     assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
-    readers = 2 * 3 + 3  # per bot: Twist, TwistStamped, forward velocity; rig: 3 modes
+    readers = 2 * 3 + 4  # per bot: Twist, TwistStamped, forward velocity; rig: 3 + trajectory
     assert len(twin[-1]["reader_gid_seq"]) == readers, "a reader per input"
     assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
 
@@ -210,6 +210,23 @@ def test_forward_controller_commands_set_the_joint_targets(served) -> None:
     held = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
     assert (held["spin"]["mode"], held["spin"]["target"]) == ("velocity", 1.5), held["spin"]
     assert (held["slide"]["mode"], held["slide"]["target"]) == ("position", 0.2), held["slide"]
+
+
+def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
+    """trajectory_msgs/JointTrajectory on /rig/joint_trajectory_controller/joint_trajectory
+    (slide to 0.1 m in 0.5 s) is followed as `twin trajectory` follows one: the joint gets
+    there (5 mm: the servo's tracking) within 3 s of wall time."""
+    root, _ = served
+    sent = _peer(root, "trajectory", "rig", "slide", "0.1", "0.5")
+    assert sent["matched"] == 1, "the twin's JointTrajectory reader did not match"
+    deadline, position = time.monotonic() + 3.0, None
+    while time.monotonic() < deadline:
+        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
+        position = joints["slide"]["position"]
+        if abs(position - 0.1) < 0.005:
+            break
+        time.sleep(0.2)
+    assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
 
 
 def test_the_server_binds_no_address_but_loopback(served) -> None:
