@@ -10,7 +10,9 @@ CYCLONEDDS_URI), so what the twin opens is decided here alone.
 - `ROS_AUTOMATIC_DISCOVERY_RANGE` (Jazzy): LOCALHOST (twin's default), SUBNET (Cyclone's own
   interface choice and multicast, as a plain ROS 2 node), OFF (no peers: nothing discovered,
   nothing sent), SYSTEM_DEFAULT (same as SUBNET here).
-- `ROS_STATIC_PEERS` (Jazzy, `;`-separated addresses): extra unicast peers, in any range but OFF.
+- `ROS_STATIC_PEERS` (Jazzy, `;`-separated addresses): extra unicast peers, in any range but OFF;
+  with LOCALHOST, discovery and data go to them by unicast only (no multicast), on the interface
+  Cyclone chooses (a loopback interface could not reach them).
 - `ROS_LOCALHOST_ONLY=1` (Humble): LOCALHOST; `0` does not widen on its own.
 - `--ros-interface ADDRESS`: that interface instead of loopback, multicast as Cyclone's default.
 """
@@ -62,6 +64,8 @@ class Scope:
         """One line for the server's log and the start reply."""
         if self.local_only:
             where = "loopback only (nothing leaves this machine)"
+        elif not self.multicast:
+            where = f"loopback and unicast to {', '.join(self.peers[1:])}"
         elif self.interface is not None:
             where = f"interface {self.interface}" + (", multicast" if self.multicast else "")
         else:
@@ -94,6 +98,9 @@ def scope_from(env: Mapping[str, str] | None = None, interface: str | None = Non
         return Scope(domain, wanted, None, True, peers)
     if wanted == "OFF":
         return Scope(domain, wanted, LOOPBACK, False, ())
+    remote = [p for p in peers if not ipaddress.ip_address(p).is_loopback]
+    if remote:  # asked for by name: unicast to them (Cyclone's interface choice), no multicast
+        return Scope(domain, "LOCALHOST", None, False, (LOOPBACK, *peers))
     return Scope(domain, "LOCALHOST", LOOPBACK, False, (LOOPBACK, *peers))
 
 

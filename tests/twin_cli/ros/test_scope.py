@@ -55,9 +55,12 @@ def test_off_has_no_peers_and_an_interface_is_named_as_given() -> None:
     assert general.find("Interfaces/NetworkInterface").get("name") == "eth0"
 
 
-def test_static_peers_join_loopback() -> None:
+def test_static_peers_join_loopback_by_unicast_only() -> None:
     scope = scope_from({"ROS_STATIC_PEERS": "10.0.0.7; 10.0.0.8"})
     assert scope.peers == (LOOPBACK, "10.0.0.7", "10.0.0.8") and not scope.local_only
+    assert (scope.interface, scope.multicast) == (None, False), "loopback could not reach them"
+    assert "unicast to 10.0.0.7, 10.0.0.8" in scope.describe()
+    assert scope_from({"ROS_STATIC_PEERS": "127.0.0.2"}).local_only
 
 
 def test_domain_id_is_read_from_ros_domain_id() -> None:
