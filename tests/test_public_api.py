@@ -21,6 +21,7 @@ PACKAGES = [
     "twin_cli.cli",
     "twin_cli.live",
     "twin_cli.record",
+    "twin_cli.ros",
     "twin_cli.sensors",
     "twin_cli.control",
     "twin_cli.server",

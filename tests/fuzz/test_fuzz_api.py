@@ -3,10 +3,11 @@
 Properties, for every operation: no 5xx; the status code is one the schema documents; the body
 matches the schema of that status; afterwards the world still steps. `make test` runs a few
 derandomised cases per operation; `make fuzz` many more (TWIN_FUZZ_EXAMPLES).
-Operations that write files or open listeners (/save, /record, /foxglove, /view, /snapshot) are
-fuzzed with every path confined to the server's temporary directory (the fuzzed name is kept,
-its '/' replaced) and every host set to 127.0.0.1: as root on the test machine they could
-otherwise write anywhere or listen on every interface. /shutdown is called last, once, and
+Operations that write files or open listeners (/save, /record, /foxglove, /view, /snapshot,
+/ros) are fuzzed with every path confined to the server's temporary directory (the fuzzed name
+is kept, its '/' replaced), every host set to 127.0.0.1 and the ROS 2 bridge's interface and
+variables left out (loopback only): as root on the test machine they could otherwise write
+anywhere, listen on every interface or send to the network. /shutdown is called last, once, and
 must end the server cleanly. `/step` counts are capped at 1,000 and snapshot sizes at 640 px so
 one case cannot hold the world for minutes (both legitimate, slow requests), and an echo stream
 at one message.
@@ -30,7 +31,7 @@ from twin_cli.server import runtime  # noqa: E402
 from twin_cli.server.client import Client  # noqa: E402
 
 EXAMPLES = int(os.environ.get("TWIN_FUZZ_API_EXAMPLES", 5))  # per operation
-CONFINED = ("/save", "/record", "/foxglove", "/view", "/snapshot")
+CONFINED = ("/save", "/record", "/foxglove", "/view", "/snapshot", "/ros")
 MAX_STEPS = 1000
 MAX_PIXELS = 640  # [px] per snapshot side
 
@@ -138,6 +139,9 @@ def _confine(body: dict, root) -> None:  # noqa: ANN001
         body["path"] = str(root / "confined" / name)
     if "host" in body:
         body["host"] = "127.0.0.1"
+    # the ROS 2 bridge stays on loopback: no interface, none of ROS's widening variables
+    body.pop("interface", None)
+    body.pop("environment", None)
     for side in ("width", "height"):
         if isinstance(body.get(side), int):
             body[side] = min(body[side], MAX_PIXELS)

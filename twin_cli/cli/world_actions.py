@@ -278,7 +278,7 @@ def load(*, file: Path | None, world: str, last: bool = False) -> None:
     with connect_world(world, start=True, serve_args=(path,), announce=announce) as c:
         reply = None if any("started world" in line for line in started) else c.load(path)
     sys.stderr.write(f"twin: world [{world}] loaded from {path}\n")
-    for consumer in ("recording", "foxglove"):  # a running recording follows, or says it stopped
+    for consumer in ("recording", "foxglove", "ros"):  # they follow, or say they stopped
         if isinstance(reply, dict) and consumer in reply:
             sys.stderr.write(f"twin: {consumer} {reply[consumer]}\n")
 

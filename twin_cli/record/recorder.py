@@ -11,6 +11,7 @@ import logging
 import math
 import queue
 import threading
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
@@ -92,6 +93,7 @@ class Recording(Follows):
         duration: float | None = None,
         latest_only: bool = False,
         frame_prefix: str | None = None,
+        max_wall_rate: float | None = None,
     ) -> None:
         """Args:
         world: a `twin_cli.world.World` (stepping or not).
@@ -104,6 +106,10 @@ class Recording(Follows):
             slows the loop, never falls behind, always ends on the latest state).
         frame_prefix: tf frame prefix template (`{entity}` is the entity's name; None:
             `TWIN_FRAME_PREFIX`, else `{entity}/`; "": none).
+        max_wall_rate: with `latest_only`, at most this many samples per wall second (the
+            newest is taken each time): a world far faster than real time is thinned, so
+            building its messages does not take the interpreter from the loop in proportion to
+            its speed.
 
         Raises:
             EntityNotFoundError, InvalidRequestError: unknown entity, bad rate or duration.
@@ -118,6 +124,11 @@ class Recording(Follows):
         self._sinks = list(sinks)
         self._duration = duration
         self._latest_only = latest_only
+        self._wall_period = 1.0 / max_wall_rate if latest_only and max_wall_rate else 0.0
+        self._next_slot = 0.0  # [s] monotonic: when the worker may take its next sample
+        self._suspended = False  # set_sampling(False)
+        self._pacing = False  # the worker waits out a wall period (max_wall_rate)
+        self._sensor_slots: dict[float, float] = {}  # sensor rate → next wall time it may capture
         self._queue: queue.SimpleQueue[Sample | list | None] = queue.SimpleQueue()
         self._handle: int | None = None
         self._slot_lock = threading.Lock()  # latest_only: worker busy flag and newest sample
@@ -149,6 +160,19 @@ class Recording(Follows):
                 self._handle = self._world.add_observer(self._capture, self.rate)
         self._follow_sensors(self._world)
         return self
+
+    def set_sampling(self, on: bool) -> None:
+        """Suspends or resumes sampling, keeping the worker and the sinks open (benchmarks that
+        alternate the loop with and without sampling, as `BagRecording.set_sampling`)."""
+        with self._world.lock:
+            if self._done.is_set() or (self._handle is not None) == on:
+                return
+            self._suspended = not on  # no heartbeat either
+            if on:
+                self._handle = self._world.add_observer(self._capture, self.rate)
+            else:
+                self._world.remove_observer(self._handle)
+                self._handle = None
 
     def capture_now(self) -> None:
         """Takes one sample now (for callers that step the world themselves)."""
@@ -189,8 +213,16 @@ class Recording(Follows):
     def _capture_sensors(self, rate: float | None = None) -> None:
         if self._done.is_set():
             return
-        if not (self._latest_only and self._busy):  # a busy live view skips them
-            self._pump.capture(self._feed, rate)  # copies; the pump's thread builds them
+        # a live view already behind skips them: a sample waits while another is built (a
+        # sample queued just now does not count: sensor ticks fall on state ticks, 10 Hz on 100)
+        if self._latest_only and self._newest is not None and not self._pacing:
+            return
+        if self._wall_period and rate is not None:  # max_wall_rate thins sensors alike
+            now = time.monotonic()
+            if now < self._sensor_slots.get(rate, 0.0):
+                return
+            self._sensor_slots[rate] = now + self._wall_period * self.rate / rate
+        self._pump.capture(self._feed, rate)  # copies; the pump's thread builds them
 
     def _finish_sampling(self) -> None:
         if self._done.is_set():
@@ -214,6 +246,7 @@ class Recording(Follows):
                     continue
                 while sample is not None:
                     layout = self._publish(sample, layout, publisher)
+                    self._pace()
                     sample = self._next_newest()
             self._pump.close()  # its last readings, then those still queued
             while not self._queue.empty():
@@ -259,7 +292,21 @@ class Recording(Follows):
                 return self._queue.get(timeout=HEARTBEAT_S)
             except queue.Empty:
                 with self._world.lock:
-                    self._capture()
+                    if not self._suspended:
+                        self._capture()
+
+    def _pace(self) -> None:
+        """max_wall_rate: waits out the rest of this sample's wall period (still busy, so the
+        stepping thread only replaces the newest sample meanwhile)."""
+        if not self._wall_period:
+            return
+        now = time.monotonic()
+        self._next_slot = max(self._next_slot, now - self._wall_period)
+        self._next_slot += self._wall_period
+        if self._next_slot > now:
+            self._pacing = True  # waiting, not building: sensor captures go on
+            self._done.wait(self._next_slot - now)
+            self._pacing = False
 
     def _next_newest(self) -> Sample | None:
         """latest_only: the newest sample kept while busy, or None (and the worker is idle)."""

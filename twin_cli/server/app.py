@@ -18,6 +18,7 @@ from twin_cli.server import (
     consumer_routes,
     control_routes,
     live_routes,
+    ros_routes,
     sensor_routes,
     view_routes,
 )
@@ -234,6 +235,8 @@ def load(body: PathBody, request: Request) -> dict:
     log.info("loaded world from %s", body.path)
     consumers = getattr(request.app.state, "consumers", None)  # recording, Foxglove stream
     followed = consumers.follow(new_world) if consumers is not None else {}
+    ros = getattr(request.app.state, "ros", None)  # the ROS 2 bridge
+    followed.update(ros.follow(new_world) if ros is not None else {})
     return {"loaded": body.path, "entities": [e.name for e in new_world.entities()], **followed}
 
 
@@ -270,6 +273,7 @@ def create_app(
         sensor_routes.router,
         control_routes.router,
         live_routes.router,
+        ros_routes.router,
         view_routes.router,
     ):
         app.include_router(routes, responses=ERROR_RESPONSES)

@@ -186,6 +186,14 @@ class FoxgloveBody(Body):
     rate: Annotated[Finite, Field(gt=0, le=1000)] = 30.0
 
 
+class RosBody(Body):
+    """`twin ros start`: join the ROS 2 graph; loopback only unless an interface is given."""
+
+    interface: Annotated[str, Field(min_length=1, max_length=64)] | None = None
+    # the client's ROS_DOMAIN_ID and discovery variables (None: the server's own)
+    environment: dict[Annotated[str, Field(pattern=r"^ROS_[A-Z_]+$")], str] | None = None
+
+
 class SpawnBatchBody(SpawnBody):
     """Spawn one description at many poses in one request and one recompile (all or nothing):
     entities `names`, else `name_0`, `name_1`, … (`name` defaults to the robot's own name)."""

@@ -39,6 +39,8 @@ class ServeOptions:
         background: started by a client that holds the world's start lock.
         record: a rosbag2 MCAP file to record into from the start (100 Hz), or None.
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
+        ros: publish on the ROS 2 graph over DDS from the start (`twin_cli.ros`).
+        ros_interface: the network interface the ROS 2 participant uses (None: loopback).
         autosave: seconds between autosaves to `<world>.autosave.json`; 0 turns it off.
         view: serve MuJoCo's web viewer on 127.0.0.1 from the start.
         package_paths: package or model name → directory for an SDF world's `model://` and
@@ -57,6 +59,8 @@ class ServeOptions:
     autosave: float = DEFAULT_INTERVAL_S
     view: bool = False
     package_paths: dict[str, str] | None = None
+    ros: bool = False
+    ros_interface: str | None = None
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -256,6 +260,7 @@ def serve(opts: ServeOptions) -> None:
             # already ending: a second SIGTERM (twin stop's) must not cut the cleanup short
             signal.signal(signal.SIGTERM, signal.SIG_IGN)
             _close_views(app)
+            _close_ros(app)
             consumers.close()
             saver.close()
             app.state.holder.world.stop()
@@ -288,10 +293,27 @@ def _start_consumers(app: Any, world: Any, opts: ServeOptions) -> Any:
         if opts.foxglove is not None:
             url = consumers.stream(world, port=opts.foxglove)["url"]
             sys.stderr.write(f"twin: Foxglove stream on {url}\n")
+        if opts.ros or opts.ros_interface is not None:
+            _start_ros(app, world, opts.ros_interface)
     except BaseException:
+        _close_ros(app)
         consumers.close()
         raise
     return consumers
+
+
+def _start_ros(app: Any, world: Any, interface: str | None) -> None:
+    """`--ros`: the world on the ROS 2 graph; its scope on stderr."""
+    from twin_cli.server.ros_routes import ros_service
+
+    status = ros_service(app.state).start(world, interface=interface)
+    sys.stderr.write(f"twin: on the ROS 2 graph: {status['scope']}\n")
+
+
+def _close_ros(app: Any) -> None:
+    service = getattr(app.state, "ros", None)
+    if service is not None:
+        service.close()
 
 
 def _listen(paths: runtime.WorldPaths, tcp: tuple[str, int] | None, token: str | None) -> list:

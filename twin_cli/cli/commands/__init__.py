@@ -15,6 +15,7 @@ MODULES = (
     "record",
     "sensors",
     "topics",
+    "ros",
     "model",
     "validate",
     "control",

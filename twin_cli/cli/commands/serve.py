@@ -51,6 +51,16 @@ def serve(
         bool, typer.Option("--view", help="Serve MuJoCo's web viewer on 127.0.0.1 too.")
     ] = False,
     package: PackageOpt = None,
+    ros: Annotated[
+        bool,
+        typer.Option(
+            "--ros", help="Publish on the ROS 2 graph over DDS (loopback only; ROS_DOMAIN_ID)."
+        ),
+    ] = False,
+    ros_interface: Annotated[
+        str | None,
+        typer.Option(help="With --ros: use this interface (address or name), not loopback."),
+    ] = None,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it.
 
@@ -76,6 +86,8 @@ def serve(
         view=view,
         autosave=0.0 if no_autosave else autosave,
         package_paths=packages or None,
+        ros=ros,
+        ros_interface=ros_interface,
     )
     run_server(opts)
 

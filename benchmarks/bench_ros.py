@@ -1,0 +1,145 @@
+"""ROS 2 bridge figures in one run: what publishing the world on DDS costs the stepping loop.
+
+A humanoid with an IMU (100 Hz) and a 360-ray lidar (10 Hz) on its IMU link, published at 100 Hz
+of sim time (/clock, /tf, joint_states, odom; the sensors at their rates) over loopback DDS in a
+domain of its own, with a subscriber in another process taking the state topics (the peer of the
+tests: it decodes every message with rosbags, as a ROS node on this machine would cost).
+
+- `ros_vs_plain`: the unthrottled loop's throughput with the bridge's sampling over without,
+  alternating every WINDOW steps on one world and one running bridge (benchmarks/paired.py;
+  `Recording.set_sampling`). Unthrottled, the world runs ~15x real time, so the bridge takes
+  WALL_SPEEDUP × RATE samples per wall second of it (the rest are thinned). Target ≥ 0.95.
+- `realtime`: the real-time factor over 10 s at 1 kHz with the bridge publishing. Target 1.00.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from benchmarks.paired import interleaved_ratio
+from twin_cli.live.budget import WALL_SPEEDUP
+from twin_cli.ros import RosBridge, scope_from
+from twin_cli.world import Pose, World, WorldSettings
+
+ROBOTS = Path(__file__).parents[1] / "scenarios" / "robots"
+PEER = Path(__file__).parents[1] / "tests" / "twin_cli" / "ros" / "ros_peer.py"
+DOMAIN_ID = "231"  # a domain of the benchmark's own
+RATE = 100.0  # [Hz] of sim time
+WINDOW = 2000  # [steps] per arm
+ROLL = 1000  # [steps] sampled, untimed, before a sampled arm: the worker in its steady state
+PAIRS = 60
+REALTIME_SECONDS = 10.0  # [s]
+TARGETS = {"ros_vs_plain": 0.95, "realtime_factor": (0.99, 1.01)}
+SENSORS = """
+  <gazebo reference="imu_link"><sensor type="imu" name="imu"><always_on>true</always_on>
+    <update_rate>100</update_rate><topic>imu</topic></sensor></gazebo>
+  <gazebo reference="imu_link"><sensor type="ray" name="lidar"><update_rate>10</update_rate>
+    <ray><scan><horizontal><samples>360</samples><resolution>1</resolution>
+    <min_angle>-3.14159</min_angle><max_angle>3.14159</max_angle></horizontal></scan>
+    <range><min>0.12</min><max>10</max><resolution>0.015</resolution></range></ray>
+    <topic>scan</topic></sensor></gazebo>
+</robot>"""
+
+
+def _humanoid_with_sensors(tmp: Path) -> Path:
+    """The scenario humanoid with an IMU and a lidar added (its macros copied beside it)."""
+    shutil.copy(ROBOTS / "humanoid_macros.xacro", tmp / "humanoid_macros.xacro")
+    text = (ROBOTS / "humanoid.urdf.xacro").read_text()
+    head, _, _ = text.rpartition("</robot>")
+    path = tmp / "humanoid_sensors.urdf.xacro"
+    path.write_text(head + SENSORS)
+    return path
+
+
+def _world(robot: Path, rate: float = 0.0) -> World:
+    world = World(WorldSettings(rate=rate))
+    world.spawn(robot, name="h", pose=Pose(z=1.0))
+    world.step(2000)  # settled on the ground: the same contacts in every window
+    return world
+
+
+def throughput(robot: Path) -> dict:
+    """The loop's throughput with the bridge's sampling over without (see module docstring)."""
+    world = _world(robot)
+    bridge = RosBridge(world, scope_from({"ROS_DOMAIN_ID": DOMAIN_ID})).start()
+    bridge.commands.stop()  # no command comes: its thread only polls
+    recording = bridge.recording
+
+    def plain() -> None:
+        world.step(WINDOW)
+
+    def prepare() -> None:  # the worker in its steady state when the sampled window starts
+        recording.set_sampling(True)
+        world.step(ROLL)
+
+    def sampled() -> None:
+        world.step(WINDOW)
+
+    def settle() -> None:  # the worker's last sample built, then the loop hot again, untimed
+        recording.set_sampling(False)
+        time.sleep(2.0 / (WALL_SPEEDUP * RATE))
+        world.step(ROLL)  # a plain arm that followed a sleep ran ~30 % slower (a cold core)
+
+    with _subscriber():
+        time.sleep(2.0)  # discovery done before timing
+        recording.set_sampling(False)
+        before = recording.status().samples
+        paired = {"pairs": PAIRS, "prepare": prepare, "settle": settle}
+        wall = interleaved_ratio(plain, sampled, **paired)
+        cpu = interleaved_ratio(plain, sampled, clock=time.thread_time, **paired)
+    status = bridge.stop()
+    return {
+        "ros_vs_plain": wall,
+        "ros_vs_plain_loop_cpu": cpu,
+        "published_samples": status["samples"] - before,
+    }
+
+
+def realtime(robot: Path) -> dict:
+    """Real-time factor over REALTIME_SECONDS at 1 kHz with the bridge publishing."""
+    world = _world(robot, rate=1000.0)
+    bridge = RosBridge(world, scope_from({"ROS_DOMAIN_ID": DOMAIN_ID})).start()
+    with _subscriber():
+        world.start()
+        time.sleep(REALTIME_SECONDS)
+        stats, figures = world.stats(), world.loop_figures()
+        world.stop()
+    status = bridge.stop()
+    return {
+        "factor": stats.factor,
+        "sim_over_wall": stats.sim_time / stats.real_time,
+        "dropped_steps": figures.dropped,
+        "published_samples": status["samples"],
+    }
+
+
+class _subscriber:  # noqa: N801 - a context manager used as `with _subscriber():`
+    """The tests' ROS peer in another process, taking the state topics of `h`."""
+
+    def __enter__(self) -> None:
+        env = {**os.environ, "ROS_DOMAIN_ID": DOMAIN_ID}
+        self._proc = subprocess.Popen(
+            [sys.executable, str(PEER), "listen", "600", "h"],
+            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+
+    def __exit__(self, *_: object) -> None:
+        self._proc.terminate()
+        self._proc.wait(timeout=10)
+
+
+def run() -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        robot = _humanoid_with_sensors(Path(tmp))
+        return {
+            "load_average": os.getloadavg()[0],
+            "throughput": throughput(robot),
+            "realtime": realtime(robot),
+            "targets": TARGETS,
+        }

@@ -1,0 +1,382 @@
+"""A ROS 2 peer that shares no code with twin: run as its own process by the tests.
+
+Its DDS types are written here from the official `.msg` definitions (rosgraph_msgs/Clock,
+tf2_msgs/TFMessage, sensor_msgs/JointState, nav_msgs/Odometry, std_msgs/String,
+geometry_msgs/Twist), named as rosidl names them; it joins the domain over loopback only
+(interface 127.0.0.1, multicast off, peer 127.0.0.1), decodes every sample's CDR bytes with
+rosbags (an independent reader) and prints one JSON document on stdout.
+
+It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo), where
+`ros2 node list` finds node names.
+
+Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
+    drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
+    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT
+"""
+
+# No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
+
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass
+
+from cyclonedds._clayer import ddspy_take
+from cyclonedds.core import InstanceState, SampleState, ViewState
+from cyclonedds.domain import Domain, DomainParticipant
+from cyclonedds.idl import IdlStruct, types
+from cyclonedds.pub import DataWriter
+from cyclonedds.qos import Policy, Qos
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from rosbags.typesys import Stores, get_typestore
+
+CONFIG = (
+    '<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
+    "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
+    "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32"
+    '</MaxAutoParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery>'
+    "</Domain></CycloneDDS>"
+)
+
+
+@dataclass
+class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+
+@dataclass
+class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Time
+    frame_id: str
+
+
+@dataclass
+class Clock(IdlStruct, typename="rosgraph_msgs::msg::dds_::Clock_"):
+    clock: Time
+
+
+@dataclass
+class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+
+@dataclass
+class Point(IdlStruct, typename="geometry_msgs::msg::dds_::Point_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+
+
+@dataclass
+class Quaternion(IdlStruct, typename="geometry_msgs::msg::dds_::Quaternion_"):
+    x: types.float64
+    y: types.float64
+    z: types.float64
+    w: types.float64
+
+
+@dataclass
+class Transform(IdlStruct, typename="geometry_msgs::msg::dds_::Transform_"):
+    translation: Vector3
+    rotation: Quaternion
+
+
+@dataclass
+class TransformStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TransformStamped_"):
+    header: Header
+    child_frame_id: str
+    transform: Transform
+
+
+@dataclass
+class TFMessage(IdlStruct, typename="tf2_msgs::msg::dds_::TFMessage_"):
+    transforms: types.sequence[TransformStamped]
+
+
+@dataclass
+class JointState(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
+    header: Header
+    name: types.sequence[str]
+    position: types.sequence[types.float64]
+    velocity: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+
+
+@dataclass
+class Pose(IdlStruct, typename="geometry_msgs::msg::dds_::Pose_"):
+    position: Point
+    orientation: Quaternion
+
+
+@dataclass
+class PoseWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
+    pose: Pose
+    covariance: types.array[types.float64, 36]
+
+
+@dataclass
+class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    linear: Vector3
+    angular: Vector3
+
+
+@dataclass
+class TwistWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
+    twist: Twist
+    covariance: types.array[types.float64, 36]
+
+
+@dataclass
+class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
+    header: Header
+    child_frame_id: str
+    pose: PoseWithCovariance
+    twist: TwistWithCovariance
+
+
+@dataclass
+class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+
+
+@dataclass
+class TwistStamped(IdlStruct, typename="geometry_msgs::msg::dds_::TwistStamped_"):
+    header: Header
+    twist: Twist
+
+
+@dataclass
+class LaserScan(IdlStruct, typename="sensor_msgs::msg::dds_::LaserScan_"):
+    header: Header
+    angle_min: types.float32
+    angle_max: types.float32
+    angle_increment: types.float32
+    time_increment: types.float32
+    scan_time: types.float32
+    range_min: types.float32
+    range_max: types.float32
+    ranges: types.sequence[types.float32]
+    intensities: types.sequence[types.float32]
+
+
+@dataclass
+class MultiArrayDimension(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayDimension_"):
+    label: str
+    size: types.uint32
+    stride: types.uint32
+
+
+@dataclass
+class MultiArrayLayout(IdlStruct, typename="std_msgs::msg::dds_::MultiArrayLayout_"):
+    dim: types.sequence[MultiArrayDimension]
+    data_offset: types.uint32
+
+
+@dataclass
+class Float64MultiArray(IdlStruct, typename="std_msgs::msg::dds_::Float64MultiArray_"):
+    layout: MultiArrayLayout
+    data: types.sequence[types.float64]
+
+
+@dataclass
+class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
+    sec: types.int32
+    nanosec: types.uint32
+
+
+@dataclass
+class JointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectoryPoint_"):
+    positions: types.sequence[types.float64]
+    velocities: types.sequence[types.float64]
+    accelerations: types.sequence[types.float64]
+    effort: types.sequence[types.float64]
+    time_from_start: Duration
+
+
+@dataclass
+class JointTrajectory(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectory_"):
+    header: Header
+    joint_names: types.sequence[str]
+    points: types.sequence[JointTrajectoryPoint]
+
+
+@dataclass
+class Gid(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
+    data: types.array[types.uint8, 16]
+
+
+@dataclass
+class NodeEntitiesInfo(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):
+    node_namespace: types.bounded_str[256]
+    node_name: types.bounded_str[256]
+    reader_gid_seq: types.sequence[Gid]
+    writer_gid_seq: types.sequence[Gid]
+
+
+@dataclass
+class ParticipantEntitiesInfo(
+    IdlStruct, typename="rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"
+):
+    gid: Gid
+    node_entities_info_seq: types.sequence[NodeEntitiesInfo]
+
+
+def qos(latched: bool = False) -> Qos:
+    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last 1."""
+    if latched:
+        return Qos(
+            Policy.Reliability.Reliable(0),
+            Policy.Durability.TransientLocal,
+            Policy.History.KeepLast(1),
+            Policy.DataRepresentation(use_cdrv0_representation=True),
+        )
+    return Qos(
+        Policy.Reliability.Reliable(0),
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(10),
+        Policy.DataRepresentation(use_cdrv0_representation=True),
+    )
+
+
+def participant() -> DomainParticipant:
+    domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0"))
+    participant.domain = Domain(domain_id, CONFIG)  # kept alive with the participant
+    return DomainParticipant(domain_id)
+
+
+def listen(seconds: float, entity: str) -> dict:
+    """Every message of the world's topics for `seconds` of wall time, decoded by rosbags."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    dp = participant()
+    wanted = {
+        "/clock": (Clock, "rosgraph_msgs/msg/Clock", False),
+        "/tf": (TFMessage, "tf2_msgs/msg/TFMessage", False),
+        "/tf_static": (TFMessage, "tf2_msgs/msg/TFMessage", True),
+        f"/{entity}/joint_states": (JointState, "sensor_msgs/msg/JointState", False),
+        f"/{entity}/odom": (Odometry, "nav_msgs/msg/Odometry", False),
+        f"/{entity}/robot_description": (String, "std_msgs/msg/String", True),
+    }
+    readers = {}
+    for name, (idl, _, latched) in wanted.items():
+        topic = Topic(dp, "rt" + name, idl, qos=qos(latched))
+        readers[name] = DataReader(dp, topic, qos=qos(latched))
+    # the rmw's own topic (no rt/): which nodes a participant holds
+    info = "rmw_dds_common/msg/ParticipantEntitiesInfo"
+    wanted["ros_discovery_info"] = (ParticipantEntitiesInfo, info, True)
+    topic = Topic(dp, "ros_discovery_info", ParticipantEntitiesInfo, qos=qos(True))
+    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True))
+    out: dict[str, list] = {name: [] for name in wanted}
+    types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
+    end = time.monotonic() + seconds
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    while time.monotonic() < end:
+        for name, reader in readers.items():
+            idl, type_name, _ = wanted[name]
+            for cdr, info in ddspy_take(reader._ref, mask, 64):  # the bytes as received
+                if not info.valid_data:
+                    continue
+                message = store.deserialize_cdr(cdr, type_name)
+                idl.deserialize(cdr)  # the IDL type written here reads them too
+                out[name].append([time.monotonic(), to_plain(message)])
+        time.sleep(0.01)
+    return {"messages": out, "types": types_seen}
+
+
+def drive(entity: str, vx: float, wz: float, seconds: float, stamped: bool = False) -> dict:
+    """Publishes a Twist (or TwistStamped) on /<entity>/cmd_vel every 0.1 s for `seconds`."""
+    dp = participant()
+    kind = TwistStamped if stamped else Twist
+    topic = Topic(dp, f"rt/{entity}/cmd_vel", kind, qos=qos())
+    writer = DataWriter(dp, topic, qos=qos())
+    end, sent = time.monotonic() + seconds, 0
+    while time.monotonic() < end:
+        twist = Twist(Vector3(vx, 0.0, 0.0), Vector3(0.0, 0.0, wz))
+        writer.write(TwistStamped(Header(Time(0, 0), ""), twist) if stamped else twist)
+        sent += 1
+        time.sleep(0.1)
+    matched = len(writer.get_matched_subscriptions())
+    return {"sent": sent, "matched": matched}
+
+
+def forward(entity: str, mode: str, seconds: float, values: list[float]) -> dict:
+    """Publishes `values` on /<entity>/forward_<mode>_controller/commands every 0.1 s."""
+    dp = participant()
+    name = f"rt/{entity}/forward_{mode}_controller/commands"
+    writer = DataWriter(dp, Topic(dp, name, Float64MultiArray, qos=qos()), qos=qos())
+    end, sent = time.monotonic() + seconds, 0
+    while time.monotonic() < end:
+        writer.write(Float64MultiArray(MultiArrayLayout([], 0), values))
+        sent += 1
+        time.sleep(0.1)
+    return {"sent": sent, "matched": len(writer.get_matched_subscriptions())}
+
+
+def trajectory(entity: str, joint: str, position: float, at: float) -> dict:
+    """Publishes one JointTrajectory (`joint` to `position` [rad or m] at `at` [s]) once it
+    is matched, as a MoveIt or rqt_joint_trajectory_controller would."""
+    dp = participant()
+    name = f"rt/{entity}/joint_trajectory_controller/joint_trajectory"
+    writer = DataWriter(dp, Topic(dp, name, JointTrajectory, qos=qos()), qos=qos())
+    deadline = time.monotonic() + 10.0
+    while not writer.get_matched_subscriptions() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    sec, nanosec = int(at), int(round((at - int(at)) * 1e9))
+    point = JointTrajectoryPoint([position], [], [], [], Duration(sec, nanosec))
+    writer.write(JointTrajectory(Header(Time(0, 0), ""), [joint], [point]))
+    time.sleep(0.5)  # reliable delivery before the process leaves
+    return {"matched": len(writer.get_matched_subscriptions())}
+
+
+def scan(seconds: float, topic: str) -> dict:
+    """LaserScans on `topic` for `seconds`, read best effort (keep last 5) as a ROS sensor
+    subscriber reads them; decoded by rosbags."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    dp = participant()
+    sensor_qos = Qos(
+        Policy.Reliability.BestEffort,
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(5),
+        Policy.DataRepresentation(use_cdrv0_representation=True),
+    )
+    reader = DataReader(dp, Topic(dp, "rt" + topic, LaserScan, qos=sensor_qos), qos=sensor_qos)
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    out, end = [], time.monotonic() + seconds
+    while time.monotonic() < end:
+        for cdr, info in ddspy_take(reader._ref, mask, 16):
+            if info.valid_data:
+                out.append(to_plain(store.deserialize_cdr(cdr, "sensor_msgs/msg/LaserScan")))
+        time.sleep(0.01)
+    return {"scans": out}
+
+
+def to_plain(value):
+    if hasattr(value, "__dataclass_fields__"):
+        return {k: to_plain(getattr(value, k)) for k in value.__dataclass_fields__ if k[0] != "_"}
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, list | tuple):
+        return [to_plain(v) for v in value]
+    return value
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "listen":
+        result = listen(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "forward":
+        values = [float(v) for v in sys.argv[5:]]
+        result = forward(sys.argv[2], sys.argv[3], float(sys.argv[4]), values)
+    elif sys.argv[1] == "trajectory":
+        args = sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
+        result = trajectory(*args)
+    elif sys.argv[1] == "scan":
+        result = scan(float(sys.argv[2]), sys.argv[3])
+    else:
+        stamped = sys.argv[1] == "drive_stamped"
+        args = float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
+        result = drive(sys.argv[2], *args, stamped=stamped)
+    json.dump(result, sys.stdout)

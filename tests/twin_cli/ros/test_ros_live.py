@@ -1,0 +1,361 @@
+"""`twin serve --ros` seen and driven from another process over loopback DDS, as a ROS 2 node
+would: a real server, and a peer (`ros_peer.py`) that shares no code with twin, types its
+topics from the official `.msg` definitions and decodes the received bytes with rosbags.
+
+Each test module runs in a domain of its own (ROS_DOMAIN_ID), so parallel runs never meet; the
+Cyclone configuration on both sides is loopback only, so nothing leaves the machine.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import drive_models as dm
+import numpy as np
+import pytest
+from models import CONTROL_RIG
+from sensor_models import lidar_post
+
+pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
+# One worker runs the module: its server and peers share one domain, of this process's own.
+pytestmark = pytest.mark.xdist_group("ros_live")
+
+WORLD = "ros_live"
+PEER = Path(__file__).with_name("ros_peer.py")
+DOMAIN_ID = str(100 + os.getpid() % 100)  # one domain per test process
+STATE_PERIOD = 0.01  # [s] of sim time between /clock, /tf and joint_states messages (100 Hz)
+POSE_TOL = 1e-9  # [m, rad] tf composed against `twin model`: the same numbers, two routes
+DIFF = (
+    '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>wheel_left_joint'
+    "</left_joint><right_joint>wheel_right_joint</right_joint><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><odometry_frame>odom"
+    "</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
+)
+
+
+def _env(runtime: Path) -> dict[str, str]:
+    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime), "ROS_DOMAIN_ID": DOMAIN_ID}
+    for name in ("TWIN_WORLD", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS"):
+        env.pop(name, None)
+    return env
+
+
+def _twin(runtime: Path, *args: str) -> str:
+    proc = subprocess.run(
+        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD],
+        env=_env(runtime), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
+    return proc.stdout
+
+
+def _peer(runtime: Path, *args: str) -> dict:
+    proc = subprocess.run(
+        [sys.executable, str(PEER), *args],
+        env=_env(runtime), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, f"ros_peer {' '.join(args)}: {proc.stderr[-2000:]}"
+    return json.loads(proc.stdout)
+
+
+@pytest.fixture(scope="module")
+def served(tmp_path_factory, serve_world):
+    """A world served with --ros (running in real time) and two diff-drive bases on the ground."""
+    root = tmp_path_factory.mktemp("ros_live")
+    path = root / "base.urdf"
+    path.write_text(dm.two_wheel_base(DIFF))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("ROS_DOMAIN_ID", DOMAIN_ID)
+        patch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
+        with serve_world(root, WORLD, "--ros") as (_, proc):
+            for name, y in (("bot", 0.0), ("twin_bot", 2.0)):
+                _twin(root, "spawn", str(path), "--name", name, "-y", str(y), "--on-ground")
+            post = root / "post.urdf"
+            post.write_text(lidar_post(rate=10.0))
+            _twin(root, "spawn", str(post), "--name", "post", "-x", "3", "-y", "-2")
+            rig = root / "rig.urdf"
+            rig.write_text(CONTROL_RIG)
+            _twin(root, "spawn", str(rig), "--name", "rig", "-x", "-3")
+            yield root, proc
+
+
+def test_clock_advances_in_sim_time_at_the_stated_rate(served) -> None:
+    root, _ = served
+    got = _peer(root, "listen", "2", "bot")
+    clocks = [
+        m["clock"]["sec"] + m["clock"]["nanosec"] * 1e-9 for _, m in got["messages"]["/clock"]
+    ]
+    assert len(clocks) >= 50, f"/clock: {len(clocks)} messages in 2 s of wall time"
+    steps = np.diff(clocks) / STATE_PERIOD
+    assert np.all(steps > 0.5), f"/clock went back or repeated: steps {steps.min()} periods"
+    assert np.allclose(steps, np.round(steps), atol=1e-6), "/clock off its 100 Hz grid"
+    assert np.median(steps) == pytest.approx(1.0), "/clock: most messages 10 ms of sim time apart"
+    assert got["types"]["/clock"] == "rosgraph_msgs::msg::dds_::Clock_"
+
+
+def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
+    root, _ = served
+    _twin(root, "pause")
+    try:
+        got = _peer(root, "listen", "1.5", "bot")  # a paused world is republished every 0.5 s
+        model = json.loads(_twin(root, "model", "bot", "--json"))
+        joints = json.loads(_twin(root, "joints", "bot", "--json"))
+    finally:
+        _twin(root, "resume")
+    messages = got["messages"]
+    assert messages["/tf"] and messages["/bot/joint_states"], "no /tf or joint_states received"
+    edges = {}
+    for key in ("/tf_static", "/tf"):  # late joiner: /tf_static arrives transient-local
+        for transform in messages[key][-1][1]["transforms"]:
+            edges[transform["child_frame_id"]] = transform
+    for frame in model["frames"]:
+        position, quat = _world_pose(frame["name"], edges)
+        expected = frame["pose"]
+        for axis, value in zip("xyz", position, strict=True):
+            assert value == pytest.approx(expected[axis], abs=POSE_TOL), f"{frame['name']} {axis}"
+        assert _same_rotation(quat, expected["quat"]), f"{frame['name']} rotation"
+    state = messages["/bot/joint_states"][-1][1]
+    for joint in joints:
+        i = state["name"].index(joint["name"])
+        for field in ("position", "velocity", "effort"):
+            assert state[field][i] == pytest.approx(joint[field], abs=1e-12), (joint["name"], field)
+    assert messages["/bot/robot_description"], "robot_description not sent to a late joiner"
+    assert messages["/bot/odom"][-1][1]["child_frame_id"] == "bot/base_link"
+
+
+def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
+    """ros_discovery_info (transient local) names node /twin, with a writer per published
+    topic and a reader per cmd_vel type of each drive."""
+    root, _ = served
+    got = _peer(root, "listen", "1", "bot")
+    infos = [m for _, m in got["messages"]["ros_discovery_info"]]
+    nodes = [n for info in infos for n in info["node_entities_info_seq"]]
+    twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
+    assert twin, f"no /twin node announced: {nodes}"
+    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
+    readers = 2 * 3 + 4  # per bot: Twist, TwistStamped, forward velocity; rig: 3 + trajectory
+    assert len(twin[-1]["reader_gid_seq"]) == readers, "a reader per input"
+    assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
+
+
+def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
+    """bot gets (0.2 m/s, 0.5 rad/s) over DDS, twin_bot the same from `twin drive`, in one
+    paused world stepped 2 s: their paths agree to 1e-6 (measured: 1e-13), and follow the
+    unicycle's arc (0.337, 0.184) m, 1 rad within 10 % (measured: 0.336, 0.177 m, 0.98 rad)."""
+    root, _ = served
+    _twin(root, "pause")
+    start = {n: json.loads(_twin(root, "pose", n, "--json")) for n in ("bot", "twin_bot")}
+    sent = _peer(root, "drive", "bot", "0.2", "0.5", "0.6")
+    assert sent["matched"] == 1, "the twin's cmd_vel reader did not match the peer's writer"
+    status = json.loads(_twin(root, "ros", "status", "--json"))
+    assert status["commands"] >= 1 and "/bot/cmd_vel" in status["inputs"], status
+    _twin(root, "drive", "twin_bot", "--linear", "0.2", "--angular", "0.5")
+    _twin(root, "step", "2000")
+    end = {n: json.loads(_twin(root, "pose", n, "--json")) for n in ("bot", "twin_bot")}
+    _twin(root, "resume")
+    moved = {n: _moved(start[n], end[n]) for n in end}
+    for got, same in zip(moved["bot"], moved["twin_bot"], strict=True):
+        assert got == pytest.approx(same, abs=1e-6), f"cmd_vel {moved['bot']} vs drive {same}"
+    x, y, yaw = moved["bot"]
+    arc = (0.2 / 0.5 * math.sin(1.0), 0.2 / 0.5 * (1 - math.cos(1.0)))  # 2 s at 0.5 rad/s
+    assert yaw == pytest.approx(1.0, rel=0.1), f"heading turned {yaw} rad, unicycle 1.0"
+    assert math.hypot(x - arc[0], y - arc[1]) < 0.1 * 0.4, f"({x}, {y}) vs unicycle {arc}"
+
+
+def test_a_twist_stamped_on_cmd_vel_drives_the_base_too(served) -> None:
+    """TwistStamped (Jazzy's controllers, Nav2) on the same topic: 0.1 m/s straight replaces the
+    turning command of the test before; over 1 s the base goes ~0.1 m and barely turns."""
+    root, _ = served
+    _twin(root, "pause")
+    before = json.loads(_twin(root, "ros", "status", "--json"))["commands"]
+    start = json.loads(_twin(root, "pose", "bot", "--json"))
+    sent = _peer(root, "drive_stamped", "bot", "0.1", "0.0", "0.6")
+    assert sent["matched"] == 1, "the twin's TwistStamped reader did not match"
+    assert json.loads(_twin(root, "ros", "status", "--json"))["commands"] > before
+    _twin(root, "step", "1000")
+    end = json.loads(_twin(root, "pose", "bot", "--json"))
+    _twin(root, "resume")
+    forward, _, turned = _moved(start, end)
+    assert 0.05 < forward < 0.15, f"went {forward} m in 1 s at 0.1 m/s"
+    assert abs(turned) < 0.1, f"turned {turned} rad (the former command turns 0.5 rad/s)"
+
+
+def test_a_lidar_is_published_best_effort_at_its_rate(served) -> None:
+    """`/post/scan` (sensor_msgs/LaserScan) comes to a best-effort subscriber, in the sensor's
+    frame, ~10 a second (10 Hz of sim time in real time)."""
+    root, _ = served
+    scans = _peer(root, "scan", "1.5", "/post/scan")["scans"]
+    assert len(scans) >= 5, f"{len(scans)} scans in 1.5 s"
+    assert scans[-1]["header"]["frame_id"] == "post/scan"
+    assert len(scans[-1]["ranges"]) == 181
+    stamps = [s["header"]["stamp"]["sec"] + s["header"]["stamp"]["nanosec"] * 1e-9 for s in scans]
+    assert np.allclose(np.diff(stamps) / 0.1, np.round(np.diff(stamps) / 0.1), atol=1e-6)
+
+
+def test_forward_controller_commands_set_the_joint_targets(served) -> None:
+    """Float64MultiArray on /rig/forward_<mode>_controller/commands: one target per joint
+    offering that mode, in `twin joints` order; `twin joints` then shows them held."""
+    root, _ = served
+    sent = _peer(root, "forward", "rig", "velocity", "0.6", "1.5")
+    assert sent["matched"] == 1, "the twin's forward command reader did not match"
+    sent = _peer(root, "forward", "rig", "position", "0.6", "0.2")
+    assert sent["matched"] == 1
+    held = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
+    assert (held["spin"]["mode"], held["spin"]["target"]) == ("velocity", 1.5), held["spin"]
+    assert (held["slide"]["mode"], held["slide"]["target"]) == ("position", 0.2), held["slide"]
+
+
+def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
+    """trajectory_msgs/JointTrajectory on /rig/joint_trajectory_controller/joint_trajectory
+    (slide to 0.1 m in 0.5 s) is followed as `twin trajectory` follows one: the joint gets
+    there (5 mm: the servo's tracking) within 3 s of wall time."""
+    root, _ = served
+    sent = _peer(root, "trajectory", "rig", "slide", "0.1", "0.5")
+    assert sent["matched"] == 1, "the twin's JointTrajectory reader did not match"
+    deadline, position = time.monotonic() + 3.0, None
+    while time.monotonic() < deadline:
+        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
+        position = joints["slide"]["position"]
+        if abs(position - 0.1) < 0.005:
+            break
+        time.sleep(0.2)
+    assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
+
+
+def test_the_server_binds_no_address_but_loopback(served) -> None:
+    """Every UDP socket of the server is on 127.0.0.1 or unbound to an address (Cyclone's
+    receive sockets), none is connected anywhere, and multicast is not joined."""
+    _, proc = served
+    inodes = {
+        m.group(1)
+        for fd in Path(f"/proc/{proc.pid}/fd").iterdir()
+        if (m := re.match(r"socket:\[(\d+)\]", os.readlink(fd)))
+    }
+    seen = []
+    for table in ("udp", "udp6"):
+        for line in Path(f"/proc/{proc.pid}/net/{table}").read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[9] in inodes:
+                seen.append((_address(fields[1]), _address(fields[2])))
+    assert seen, "the server has no UDP socket: is the bridge running?"
+    for local, remote in seen:
+        assert local[0] in ("127.0.0.1", "0.0.0.0"), f"socket bound to {local}"
+        assert remote[0] in ("0.0.0.0", "127.0.0.1"), f"socket connected to {remote}"
+
+
+def _address(text: str) -> tuple[str, int]:
+    """A /proc/net/udp address (hex, little-endian IPv4; IPv6 shown as its hex)."""
+    host, port = text.split(":")
+    if len(host) == 8:
+        host = ".".join(str(int(host[i : i + 2], 16)) for i in (6, 4, 2, 0))
+    return host, int(port, 16)
+
+
+def _world_pose(frame: str, edges: dict) -> tuple[np.ndarray, np.ndarray]:
+    """`frame`'s world position and quaternion (x, y, z, w), composed along tf's parents."""
+    position, quat = np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])
+    while frame in edges:
+        t = edges[frame]["transform"]
+        p = np.array([t["translation"][k] for k in "xyz"])
+        q = np.array([t["rotation"][k] for k in "xyzw"])
+        position, quat = p + _rotate(q, position), _multiply(q, quat)
+        frame = edges[frame]["header"]["frame_id"]
+    assert frame == "world", f"tf chain ends at {frame}, not world"
+    return position, quat
+
+
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    (ax, ay, az, aw), (bx, by, bz, bw) = a, b
+    return np.array([
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ])  # fmt: skip
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return _multiply(_multiply(q, np.array([*v, 0.0])), q * np.array([-1, -1, -1, 1]))[:3]
+
+
+def _same_rotation(a: np.ndarray, b: list) -> bool:
+    return abs(abs(float(np.dot(a, np.array(b)))) - 1.0) < POSE_TOL
+
+
+def _moved(start: dict, end: dict) -> tuple[float, float, float]:
+    """Displacement in the start's heading frame [m] and the heading turned [rad]."""
+    dx, dy, yaw = end["x"] - start["x"], end["y"] - start["y"], start["yaw"]
+    turned = math.remainder(end["yaw"] - yaw, math.tau)
+    return (
+        dx * math.cos(yaw) + dy * math.sin(yaw),
+        -dx * math.sin(yaw) + dy * math.cos(yaw),
+        turned,
+    )
+
+
+def test_ros_start_and_stop_on_a_running_world_and_their_errors(served) -> None:
+    """`twin ros start` twice, or with a ROS_DOMAIN_ID out of range, says what and how (exit 2,
+    no traceback); `twin ros stop` leaves the graph and `start` joins it again (the shell's
+    domain), and the peer sees the world again."""
+    root, _ = served
+    again = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "ros", "start", "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert again.returncode == 2 and "twin ros stop" in again.stderr, again.stderr
+    assert "Traceback" not in again.stderr
+    stopped = json.loads(_twin(root, "ros", "stop", "--json"))
+    assert stopped["local_only"] is True and stopped["domain_id"] == int(DOMAIN_ID)
+    bad = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "ros", "start", "--world", WORLD],
+        env={**_env(root), "ROS_DOMAIN_ID": "999"}, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert bad.returncode == 2, bad.stderr
+    assert "ROS_DOMAIN_ID=999" in bad.stderr and "0-232" in bad.stderr, bad.stderr
+    assert "Traceback" not in bad.stderr
+    started = json.loads(_twin(root, "ros", "start", "--json"))
+    assert started["domain_id"] == int(DOMAIN_ID) and started["local_only"] is True
+    got = _peer(root, "listen", "1", "bot")
+    assert got["messages"]["/clock"], "no /clock after twin ros stop and start"
+
+
+def test_twin_ros_imports_no_physics_and_no_dds(served) -> None:
+    """`twin ros` only asks the server: the client loads neither mujoco, numpy nor cyclonedds."""
+    root, _ = served
+    proc = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "twin_cli", "ros", "status", "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-500:]
+    names = set(re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s*([\w.]+)", proc.stderr, re.M))
+    heavy = {n.split(".")[0] for n in names} & {"mujoco", "numpy", "cyclonedds", "rosbags"}
+    assert not heavy, f"twin ros status imported {heavy}"
+
+
+def test_the_bridge_follows_deletes_and_loads(served) -> None:
+    """A deleted base's cmd_vel reader goes; `twin load` moves the bridge to the loaded world
+    (the reply says so) and the peer receives its clock and robots again."""
+    root, _ = served
+    _twin(root, "delete", "twin_bot")
+    deadline = time.monotonic() + 10.0
+    while "/twin_bot/cmd_vel" in json.loads(_twin(root, "ros", "status", "--json"))["inputs"]:
+        assert time.monotonic() < deadline, "twin_bot's cmd_vel reader outlived its entity"
+        time.sleep(0.2)
+    saved = root / "saved.json"
+    _twin(root, "save", str(saved))
+    proc = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "load", str(saved), "--world", WORLD],
+        env=_env(root), capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    got = _peer(root, "listen", "1", "bot")["messages"]
+    assert got["/clock"] and got["/bot/joint_states"], "nothing after twin load"
+    inputs = json.loads(_twin(root, "ros", "status", "--json"))["inputs"]
+    assert "/bot/cmd_vel" in inputs and not [i for i in inputs if "twin_bot" in i], inputs

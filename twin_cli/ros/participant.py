@@ -1,0 +1,177 @@
+"""The twin's DDS participant: writers of the world's topics, readers of the commands it takes.
+
+One Cyclone DDS domain and participant per bridge, configured by `scope.cyclone_config` alone;
+the participant announces one node, `/twin`, with its readers and writers (`node`).
+Writers send the CDR bytes rosbags encoded (a recording's very bytes) through a topic typed by
+`graph.idl_type`, so subscribers see the types rmw_cyclonedds_cpp announces; readers hand back
+the cyclonedds objects of those same types.
+
+As a recording sink (`set_topics`, `write`, `close`) it runs in the recording's worker thread;
+readers are polled by the command thread. Cyclone's entities are thread safe.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from functools import cache
+from typing import Any
+
+from twin_cli.errors import RequestError
+from twin_cli.record.topics import Message, Topic
+from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
+from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, discovery_info
+from twin_cli.ros.scope import Scope, cyclone_config
+
+log = logging.getLogger("twin.ros")
+
+
+@cache
+def _encoded_type(name: str) -> type:
+    """A sample class of message type `name` that carries its CDR bytes as they are: cyclonedds'
+    writer asks a sample to `serialize` itself, and these hand back rosbags' encoding."""
+    base = idl_type(name)
+
+    def __init__(self: Any, cdr: bytes) -> None:
+        self.cdr = cdr
+
+    def serialize(self: Any, use_version_2: bool | None = None, **_: Any) -> bytes:
+        return self.cdr
+
+    return type(base.__name__ + "Cdr", (base,), {"__init__": __init__, "serialize": serialize})
+
+
+class Participant:
+    """A DDS participant in `scope`'s domain, with a writer per topic set by `set_topics`."""
+
+    def __init__(self, scope: Scope) -> None:
+        """Raises: RequestError: Cyclone DDS refused the configuration (e.g. no such
+        interface) or is not installed."""
+        try:
+            from cyclonedds.domain import Domain, DomainParticipant
+        except ImportError as exc:
+            raise RequestError(
+                "ROS 2 bridge", f"cyclonedds cannot be imported ({exc})",
+                "install it: pip install cyclonedds==11.0.1",
+            ) from exc  # fmt: skip
+        self.scope = scope
+        self._lock = threading.Lock()
+        try:
+            self._domain = Domain(scope.domain_id, cyclone_config(scope))
+            self._participant = DomainParticipant(scope.domain_id)
+        except Exception as exc:  # cyclonedds raises DDSException with Cyclone's return code
+            raise RequestError(
+                f"ROS 2 participant ({scope.describe()})",
+                f"Cyclone DDS cannot start ({exc})",
+                "check --ros-interface and the ROS_* variables; see the server log",
+            ) from exc
+        self._topics: dict[tuple[str, str], Any] = {}
+        self._writers: dict[str, tuple[Any, type]] = {}
+        self._readers: list[Any] = []
+        self._closed = False
+        with self._lock:
+            self._info_writer = self._open_info_writer()
+
+    # ------------------------------------------------------------ a recording sink
+    def set_topics(self, topics: list[Topic]) -> None:
+        """Opens a writer for each new topic and closes those of topics that are gone."""
+        wanted = {t.name: t for t in topics}
+        with self._lock:
+            for name in [n for n in self._writers if n not in wanted]:
+                _delete(self._writers.pop(name)[0])
+            for name, topic in wanted.items():
+                if name not in self._writers and not self._closed:
+                    self._writers[name] = self._open_writer(topic)
+            self._announce()
+
+    def write(self, message: Message) -> None:
+        """Publishes `message`'s CDR bytes (encoded now: its object is refilled after)."""
+        entry = self._writers.get(message.topic)
+        if entry is None:
+            return
+        writer, sample_type = entry
+        data = message.cdr()
+        writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
+
+    def close(self) -> None:
+        """Deletes every writer, reader and topic, then the participant and its domain."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            entities = [w for w, _ in self._writers.values()] + self._readers
+            entities.append(self._info_writer[0])
+            entities += [*self._topics.values(), self._participant, self._domain]
+            self._writers.clear()
+            self._readers.clear()
+        for entity in entities:
+            _delete(entity)
+
+    # ------------------------------------------------------------ readers
+    def reader(self, name: str, type_name: str, qos: Qos) -> Any:
+        """A DataReader of ROS topic `name` with message type `type_name`; its `take` returns
+        cyclonedds objects of `graph.idl_type(type_name)`."""
+        from cyclonedds.sub import DataReader
+
+        with self._lock:
+            reader = DataReader(
+                self._participant, self._topic(name, type_name), qos=dds_qos(qos, type_name)
+            )
+            self._readers.append(reader)
+            self._announce()
+        return reader
+
+    def drop_reader(self, reader: Any) -> None:
+        with self._lock:
+            if reader in self._readers:
+                self._readers.remove(reader)
+                _delete(reader)
+                self._announce()
+
+    # ------------------------------------------------------------ inside (lock held)
+    def _open_writer(self, topic: Topic) -> tuple[Any, type]:
+        from cyclonedds.pub import DataWriter
+
+        writer = DataWriter(
+            self._participant,
+            self._topic(topic.name, topic.type),
+            qos=dds_qos(qos_of(topic), topic.type),
+        )
+        return writer, _encoded_type(topic.type)
+
+    def _open_info_writer(self) -> tuple[Any, type]:
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.topic import Topic as DdsTopic
+
+        topic = DdsTopic(self._participant, DISCOVERY_TOPIC, idl_type(INFO))
+        self._topics[(DISCOVERY_TOPIC, INFO)] = topic
+        return DataWriter(self._participant, topic, qos=dds_qos(LATCHED_QOS, INFO)), _encoded_type(
+            INFO
+        )
+
+    def _announce(self) -> None:
+        """Publishes the node's readers and writers on `ros_discovery_info` (`ros2 node`)."""
+        if self._closed:
+            return
+        writers = [w.get_guid().bytes for w, _ in self._writers.values()]
+        readers = [r.get_guid().bytes for r in self._readers]
+        data = discovery_info(self._participant.get_guid().bytes, readers, writers)
+        writer, sample_type = self._info_writer
+        writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
+
+    def _topic(self, name: str, type_name: str) -> Any:
+        from cyclonedds.topic import Topic as DdsTopic
+
+        key = (name, type_name)
+        if key not in self._topics:
+            self._topics[key] = DdsTopic(self._participant, dds_topic(name), idl_type(type_name))
+        return self._topics[key]
+
+
+def _delete(entity: Any) -> None:
+    """Deletes a cyclonedds entity now: the binding keeps every entity in a class-wide table
+    until its `__del__`, so dropping the reference alone would keep it on the network."""
+    try:
+        entity.__del__()
+    except Exception:  # already gone with its parent
+        log.debug("deleting %r failed", entity, exc_info=True)
