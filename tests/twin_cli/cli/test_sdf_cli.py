@@ -4,34 +4,23 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from cli_world import twin_in, twin_ok
 from sdf_models import LESSON_BOX, WORLD
 
 WORLD_NAME = "sdf_cli"
 
 
 def _twin(runtime: Path, *args: str, stdin: str | None = None) -> subprocess.CompletedProcess:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime)}
-    env.pop("TWIN_WORLD", None)
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD_NAME],
-        env=env,
-        input=stdin,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return twin_in(runtime, WORLD_NAME, *args, stdin=stdin)
 
 
 def _ok(runtime: Path, *args: str, stdin: str | None = None) -> str:
-    proc = _twin(runtime, *args, stdin=stdin)
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, WORLD_NAME, *args, stdin=stdin)
 
 
 @pytest.fixture(scope="module")

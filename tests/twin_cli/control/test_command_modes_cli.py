@@ -4,12 +4,11 @@ server holding a robot whose joints declare several command interfaces in both t
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from cli_world import twin_in, twin_ok
 from interface_models import SEVERAL_INTERFACES
 from models import write_urdf
 
@@ -17,21 +16,11 @@ WORLD_NAME = "modes_cli"
 
 
 def _twin(runtime: Path, *args: str) -> subprocess.CompletedProcess:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime)}
-    env.pop("TWIN_WORLD", None)
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD_NAME],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return twin_in(runtime, WORLD_NAME, *args)
 
 
 def _ok(runtime: Path, *args: str) -> str:
-    proc = _twin(runtime, *args)
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, WORLD_NAME, *args)
 
 
 def _joints(runtime: Path) -> dict[str, dict]:

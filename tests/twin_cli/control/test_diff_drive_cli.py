@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from cli_world import twin_in, twin_ok
 from corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus
 
 WORLD_NAME = "drive_cli"
@@ -20,21 +19,11 @@ pytestmark = needs_corpus
 
 
 def _twin(runtime: Path, *args: str) -> subprocess.CompletedProcess:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime)}
-    env.pop("TWIN_WORLD", None)
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD_NAME],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return twin_in(runtime, WORLD_NAME, *args)
 
 
 def _ok(runtime: Path, *args: str) -> str:
-    proc = _twin(runtime, *args)
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, WORLD_NAME, *args)
 
 
 @pytest.fixture(scope="module")

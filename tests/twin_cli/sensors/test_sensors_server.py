@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from cli_world import twin_in
 from models import write_urdf
 from sensor_models import imu_box, lidar_post
 
@@ -20,15 +19,7 @@ WALL_SDF = """<sdf version="1.7"><model name="wall"><static>true</static>
 
 
 def _twin(runtime: Path, *args: str) -> subprocess.CompletedProcess:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime)}
-    env.pop("TWIN_WORLD", None)
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD_NAME],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    return twin_in(runtime, WORLD_NAME, *args)
 
 
 @pytest.fixture(scope="module")
