@@ -43,10 +43,12 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 
 def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
     """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
+    from converters.mjcf.export_servos import export_servos
     from converters.mjcf.world_rules import finish_robot_spec
 
     copy = spec.copy()
     finish_robot_spec(copy)  # priorities and solrefs as a world attaches the robot
+    export_servos(copy)  # what the robot's tags command by position or velocity, as servos
     copy.modelfiledir = str(assets_dir.parent)  # to_xml compiles: let it find the new files
     for mesh in copy.meshes:
         if len(mesh.uservert) == 0:

@@ -40,12 +40,15 @@ reads a few numbers at WINDUP_RATE.
 
 from __future__ import annotations
 
+import json
 import math
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
+from converters.control_text import CONTROL_TEXT
+from converters.mjcf.export_servos import EXPORTED
 from twin_cli.world import sleeping
 
 if TYPE_CHECKING:
@@ -94,6 +97,29 @@ def give_reference(spec: mujoco.MjSpec) -> None:
         if plain:
             actuator.dyntype = _INTEGRATOR
             actuator.dynprm[MARK_SLOT] = MARK  # not an MJCF <intvelocity>: ours to rewrite
+
+
+def restore_exported_motors(spec: mujoco.MjSpec) -> None:
+    """Turns the servos an exported file carries for MuJoCo users back into the torque motors
+    they replaced (`converters.mjcf.export_servos`), so a World commands a robot spawned from
+    `twin convert`'s file exactly as it commands the robot's source."""
+    text = spec.text(CONTROL_TEXT)
+    if text is None:
+        return
+    records = json.loads(text.data)
+    restored = False
+    for actuator in spec.actuators:
+        motor = records.get(actuator.target, {}).pop(EXPORTED, None)
+        if motor is None:
+            continue
+        actuator.set_to_motor()
+        actuator.ctrlrange = np.array(motor["ctrlrange"], dtype=float)
+        actuator.ctrllimited = mujoco.mjtLimited(motor["ctrllimited"])
+        actuator.forcerange = np.array(motor["forcerange"], dtype=float)
+        actuator.forcelimited = mujoco.mjtLimited(motor["forcelimited"])
+        restored = True
+    if restored:
+        text.data = json.dumps(records)
 
 
 def has_reference(model: mujoco.MjModel, a: int) -> bool:

@@ -1,0 +1,168 @@
+"""The exported robot's joints that its tags command by position or velocity get servos.
+
+In a twin World a motor is one actuator whose law follows the command's mode
+(`twin_cli.world.servos`). A MuJoCo user of the exported file has only `ctrl`. Where the robot's
+own tags (ros2_control interfaces, transmissions, a drive plugin) command a joint by position or
+by velocity, that user expects what Gazebo's controller does: a servo bounded by the effort limit.
+A raw torque within ±effort means nothing there and breaks the model: 10 N m on a turtlebot3
+wheel (2e-5 kg m²) spins it past 1e5 rad/s within a second of random `ctrl`, and MuJoCo diverges.
+
+So each such joint is written as MuJoCo's own position or velocity actuator:
+  - `ctrl` is the target (position within the joint's range, velocity within its limit), the
+    force stays within ±effort (`forcerange`), as Menagerie's models do;
+  - kv = I/h on the joint's reflected inertia I at the home posture (the most damping an
+    explicit step tolerates, reached in one step like Gazebo's joint motor), and a position
+    servo's kp = kv²/(4I), critically damped on I;
+  - the `home` keyframe's ctrl holds the home posture.
+Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
+torque motor. The control record keeps the motor each servo replaced (`EXPORTED`), so a World
+that spawns the file restores it and commands it as it commands the robot's source.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from converters.control_text import CONTROL_TEXT
+from converters.mjcf.world_options import TIMESTEP_S
+
+if TYPE_CHECKING:
+    import mujoco
+
+EXPORTED = "exported_motor"  # record key: the torque motor a servo replaced in the file
+UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag commands
+SERVO_MODES = ("position", "velocity")
+HOME_KEY = "home"
+
+
+def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> None:
+    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc)."""
+    text = spec.text(CONTROL_TEXT)
+    if text is None:
+        return
+    records = json.loads(text.data)
+    chosen = [
+        (i, a, records[a.target]) for i, a in enumerate(spec.actuators) if _servoed(a, records)
+    ]
+    if not chosen:
+        return
+    inertia, home = _home_inertia(spec)
+    key = _home_key(spec)
+    ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
+    if key is not None and len(ctrl) != len(spec.actuators):
+        ctrl = np.zeros(len(spec.actuators))
+    for i, actuator, record in chosen:
+        joint = actuator.target
+        record[EXPORTED] = {
+            "ctrlrange": [float(v) for v in actuator.ctrlrange],
+            "ctrllimited": int(actuator.ctrllimited),
+            "forcerange": [float(v) for v in actuator.forcerange],
+            "forcelimited": int(actuator.forcelimited),
+        }
+        _to_servo(spec, actuator, record, inertia[joint], timestep)
+        if key is not None and record["modes"][0] == "position":
+            ctrl[i] = home[joint]
+    if key is not None:
+        key.ctrl = ctrl
+    text.data = json.dumps(records)
+
+
+def _servoed(actuator: mujoco.MjsActuator, records: dict) -> bool:
+    import mujoco
+
+    record = records.get(actuator.target)
+    return (
+        record is not None
+        and actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT
+        and float(actuator.gear[0]) == 1.0
+        and actuator.dyntype == mujoco.mjtDyn.mjDYN_NONE
+        and actuator.biastype == mujoco.mjtBias.mjBIAS_NONE
+        and record.get("source") not in UNTAGGED_SOURCES
+        and bool(record.get("modes"))
+        and record["modes"][0] in SERVO_MODES
+    )
+
+
+def _to_servo(
+    spec: mujoco.MjSpec,
+    actuator: mujoco.MjsActuator,
+    record: dict,
+    inertia: float,
+    timestep: float,
+) -> None:
+    """One motor (gear 1) → MuJoCo's position or velocity actuator, its effort as the bound."""
+    import mujoco
+
+    kv = inertia / timestep
+    if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.forcerange = np.asarray(actuator.ctrlrange, dtype=float)
+    low, high = _target_range(spec, actuator.target, record)
+    actuator.ctrllimited = (
+        mujoco.mjtLimited.mjLIMITED_TRUE if np.isfinite(high) else mujoco.mjtLimited.mjLIMITED_FALSE
+    )
+    actuator.ctrlrange = np.array([low, high]) if np.isfinite(high) else np.zeros(2)
+    if record["modes"][0] == "position":
+        effort = float(actuator.forcerange[1]) if actuator.forcelimited else np.inf
+        kp = _position_gain(inertia, kv, effort, record.get("velocity_limit"), high - low)
+        actuator.set_to_position(kp=kp, kv=kv)
+    else:
+        actuator.set_to_velocity(kv=kv)
+
+
+def _position_gain(
+    inertia: float, kv: float, effort: float, speed: float | None, span: float
+) -> float:
+    """kp critically damped on the joint's inertia, and at most (effort + kv·v_max)/span.
+
+    While the force is at its bound, kp·e − kv·q̇ > effort, so q̇ < (kp·span − effort)/kv: the
+    bound keeps a saturated move at or below the velocity limit. Without it a UR5e wrist
+    (1.3e-4 kg m², ±28 N m) crossed its 2π range at 2900 rad/s and MuJoCo diverged.
+    """
+    kp = kv * kv / (4.0 * inertia)
+    if speed is None or not np.isfinite(speed) or not np.isfinite(effort):
+        return kp
+    span = span if np.isfinite(span) else 2.0 * np.pi  # a continuous joint: one turn
+    return min(kp, (effort + kv * speed) / span)
+
+
+def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[float, float]:
+    """A position servo's targets: the joint's range; a velocity servo's: ±its velocity limit."""
+    import mujoco
+
+    if record["modes"][0] == "position":
+        joint = spec.joint(joint_name)
+        if joint is not None and joint.limited == mujoco.mjtLimited.mjLIMITED_TRUE:
+            return float(joint.range[0]), float(joint.range[1])
+        return -np.inf, np.inf
+    limit = record.get("velocity_limit")
+    if limit is not None and np.isfinite(limit) and limit > 0:
+        return -float(limit), float(limit)
+    return -np.inf, np.inf
+
+
+def _home_inertia(spec: mujoco.MjSpec) -> tuple[dict[str, float], dict[str, float]]:
+    """Each joint's reflected inertia (mass-matrix diagonal) and position at the home posture."""
+    import mujoco
+
+    model = spec.copy().compile()
+    data = mujoco.MjData(model)
+    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, HOME_KEY)
+    if key >= 0:
+        data.qpos[:] = model.key_qpos[key]
+    mujoco.mj_forward(model, data)
+    full = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
+    inertia, home = {}, {}
+    for j in range(model.njnt):
+        dof, adr = model.jnt_dofadr[j], model.jnt_qposadr[j]
+        inertia[model.joint(j).name] = float(full[dof, dof])
+        home[model.joint(j).name] = float(data.qpos[adr])
+    return inertia, home
+
+
+def _home_key(spec: mujoco.MjSpec) -> mujoco.MjsKey | None:
+    return next((k for k in spec.keys if k.name == HOME_KEY), None)
