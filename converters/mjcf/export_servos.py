@@ -56,6 +56,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> None:
         ctrl = np.zeros(len(spec.actuators))
     for i, actuator, record in chosen:
         joint = actuator.target
+        if not inertia.get(joint, 0.0) > 0.0:
+            continue  # nothing to tune a servo on: the torque motor stays
         record[EXPORTED] = {
             "ctrlrange": [float(v) for v in actuator.ctrlrange],
             "ctrllimited": int(actuator.ctrllimited),
