@@ -11,9 +11,7 @@ from __future__ import annotations
 R = 0.05  # wheel radius [m]
 TRACK = 0.30  # left-right wheel spacing [m]
 WHEEL_BASE = 0.40  # fixed axle to steered axle [m]
-WIDTH = (
-    0.004  # wheel width [m]: MuJoCo puts a contact at each rim edge, wider wheels scrub in turns
-)
+WIDTH = 0.004  # wheel width [m] (the drive tests also run 3 cm wheels)
 
 
 def _inertial(mass: float, i: float, xyz: str = "0 0 0") -> str:

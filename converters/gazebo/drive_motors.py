@@ -39,6 +39,7 @@ from converters.gazebo.drive_records import (
     TricycleDrive,
 )
 from converters.gazebo.multicopter import Rotor, add_rotors
+from converters.gazebo.wheel_contact import centre_wheel_contacts
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -82,7 +83,8 @@ def add_drive_motors(
 ) -> None:
     """Motors for every drive's joints (unless they have one), planar servos for holonomic
     bases, each multicopter rotor its actuators (`converters.gazebo.multicopter.add_rotors`),
-    and a report line for each approximation a drive makes.
+    wheels that touch the ground on their mid-plane (`converters.gazebo.wheel_contact`), and a
+    report line for each approximation a drive makes.
 
     Raises:
         PluginJointError: a joint the plugin names is not a joint of the model.
@@ -90,6 +92,7 @@ def add_drive_motors(
     import mujoco
 
     add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
+    centre_wheel_contacts(spec, tuple(p for p in plugins if not isinstance(p, Rotor)), report)
     driven = {a.target for a in spec.actuators}
     for record in plugins:
         if isinstance(record, Rotor):
