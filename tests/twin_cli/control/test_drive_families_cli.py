@@ -136,3 +136,26 @@ def test_the_fix_named_for_a_base_without_a_drive_works(served: Path) -> None:
         _ok(served, "command", "cart", "wheel_right_joint=0.5", "--mode", "effort", "--json")
     )
     assert any("passive in Gazebo" in n for n in reply["notes"]), reply
+
+
+def test_no_server_exits_2_naming_a_start_that_works(tmp_path: Path, serve_world) -> None:
+    """With no world served, `twin drive` and `twin odom` exit 2 with gz's line and the command
+    that starts one; that command, run as printed, serves a world the drive then reaches."""
+    world = "no_server_yet"
+    for args in (("drive", "kobuki", "--linear", "0.2"), ("odom", "kobuki"), ("topics",)):
+        proc = twin_in(tmp_path, world, *args)
+        assert proc.returncode == 2, f"twin {args}: exit {proc.returncode} {proc.stderr}"
+        assert proc.stderr.startswith("An instance of twin is not running."), proc.stderr
+        assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    found = re.search(r"`twin (serve[^`]*)`", proc.stderr)
+    assert found, proc.stderr
+    command = shlex.split(found.group(1))
+    assert command[:3] == ["serve", "--world", world], command
+    with serve_world(tmp_path, world, *command[3:]):
+        path = tmp_path / "kobuki.urdf"
+        path.write_text(dm.two_wheel_base(KOBUKI))
+        twin_ok(tmp_path, world, "spawn", str(path), "--name", "kobuki", "--on-ground")
+        twin_ok(tmp_path, world, "drive", "kobuki", "--linear", "0.2", "-d", "0.5")
+        twin_ok(tmp_path, world, "step", "700")
+        pose = json.loads(twin_ok(tmp_path, world, "pose", "kobuki", "--json"))
+    assert pose["x"] > 0.05, f"the base drove {pose['x']:.3f} m on the started world"
