@@ -8,6 +8,7 @@ its servos. The report lists them tag by tag, so a user sees exactly what did no
 
 from __future__ import annotations
 
+from converters.gazebo import trajectory_controller
 from converters.gazebo.plugin_params import Params
 
 ROS_TOPICS = ("ros", "publish", "topic", "covariance", "broadcast", "namespace", "legacy")
@@ -144,6 +145,7 @@ USED: dict[str, set[str]] = {
         "d_gain",
         "cmd_max",
     },
+    "gz-sim-joint-trajectory-controller-system": trajectory_controller.USED,
 }
 
 APPROXIMATED: dict[str, tuple[str, ...]] = {
@@ -173,6 +175,7 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
         "the planar velocity through three velocity servos at the centre of mass, a new command "
         "ramped at 3 m/s² and 6 rad/s² (the plugin sets the velocity in one step)",
     ),
+    "gz-sim-joint-trajectory-controller-system": trajectory_controller.APPROXIMATED,
 }
 
 

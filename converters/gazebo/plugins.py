@@ -49,7 +49,9 @@ SYSTEM_NAMES = {
     "MecanumDrive": "gz-sim-mecanum-drive-system",
     "JointController": "gz-sim-joint-controller-system",
     "JointPositionController": "gz-sim-joint-position-controller-system",
+    "JointTrajectoryController": "gz-sim-joint-trajectory-controller-system",
 }
+TRAJECTORY_KEY = "gz-sim-joint-trajectory-controller-system"
 # Systems twin does not run, with what running them would need (one report line each).
 NEEDS = {
     "gz-sim-lift-drag-system": "LiftDrag: not run; needs lift and drag along the blade's "
@@ -63,8 +65,6 @@ NEEDS = {
     "site actuator, like the multicopter rotors",
     "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs tracks (a surface "
     "velocity along each track's belt), which MuJoCo contacts cannot move",
-    "gz-sim-joint-trajectory-controller-system": "JointTrajectoryController: not run as such; "
-    "send the trajectory with `twin trajectory` (joint_trajectory_controller's spline)",
 }
 RUN = {
     "command_interfaces": "enables the robot's <ros2_control>/<transmission> command interfaces",
@@ -72,6 +72,8 @@ RUN = {
     "command ENTITY ROTOR_JOINT=ω --mode velocity`, ω in rad/s)",
     "drive": "run by twin as a drive controller in sim time (`twin drive`, `twin odom`)",
     "joint_drive": "run by twin: its joints take `twin command ENTITY JOINT=VALUE --mode {mode}`",
+    "trajectory_drive": "run by twin: its joints follow `twin trajectory ENTITY FILE` with the "
+    "plugin's gains",
     "vendor_drive": "read as a differential drive (`twin drive`, `twin odom`): its tags "
     "approximated one by one below",
 }
@@ -87,14 +89,16 @@ def drive_key(blob: Blob) -> str | None:
 
 
 def plugin_kind(blob: Blob) -> str:
-    """ "drive", "joint_drive", "vendor_drive", "command_interfaces", "multicopter", a NEEDS
-    key or "not_run"."""
+    """ "drive", "joint_drive", "trajectory_drive", "vendor_drive", "command_interfaces",
+    "multicopter", a NEEDS key or "not_run"."""
     filename = (blob.kind or "").rsplit("/", 1)[-1]
     if filename in CONTROL_FILES:
         return "command_interfaces"
     if is_motor_model(blob):
         return "multicopter"
     key = drive_key(blob)
+    if key == TRAJECTORY_KEY:
+        return "trajectory_drive"
     if key is not None:
         return "joint_drive" if "joint" in key else "drive"
     system = plugin_key(blob)
@@ -130,7 +134,7 @@ def read_plugins(
     out: list[DriveRecord | Rotor] = []
     for blob in blobs:
         kind = plugin_kind(blob)
-        if kind in ("drive", "joint_drive"):
+        if kind in ("drive", "joint_drive", "trajectory_drive"):
             key = drive_key(blob) or ""
             params = Params.of(blob, source)
             if geometry is not None:
