@@ -63,8 +63,10 @@ NEEDS = {
     "displaced volume (MuJoCo's `density` option gives it only for a fully submerged world)",
     "gz-sim-thruster-system": "Thruster: not run; needs a propeller thrust ρ·Kt·D⁴·ω|ω| as a "
     "site actuator, like the multicopter rotors",
-    "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs tracks (a surface "
-    "velocity along each track's belt), which MuJoCo contacts cannot move",
+    "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs each track's belt speed "
+    "from the body twist and steering_efficiency, moved as its geoms' contact surface "
+    "(MuJoCo's geom surfacevel), and turns that skid (MuJoCo's sliding contacts lift a "
+    "skid-steered base: docs/plugins.md)",
 }
 RUN = {
     "command_interfaces": "enables the robot's <ros2_control>/<transmission> command interfaces",
@@ -162,7 +164,9 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
             given = f"; parameters: {shown(params)}" if params else ""
             report.ignored("model", f"<plugin> {label}: not run by twin{given}", tag="plugin")
         elif kind in NEEDS:
-            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}", tag="plugin")
+            params = Params.of(blob, "").given() if blob.xml else {}
+            given = f"; parameters: {shown(params)}" if params else ""
+            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}{given}", tag="plugin")
         elif kind == "multicopter" and missing_names(blob):
             report.ignored("model", f"<plugin> {label}: {missing_names(blob)}", tag="plugin")
         elif kind == "vendor_drive":
