@@ -32,6 +32,13 @@ KOBUKI = (
     "wheel_right_joint</wheel_right_joint_name><wheel_separation>0.3</wheel_separation>"
     "<wheel_diameter>0.1</wheel_diameter></plugin>"
 )
+JTC = (
+    '<plugin filename="gz-sim-joint-trajectory-controller-system" '
+    'name="gz::sim::systems::JointTrajectoryController"><joint_name>shoulder</joint_name>'
+    "<joint_name>elbow</joint_name><position_p_gain>200</position_p_gain><position_p_gain>100"
+    "</position_p_gain><position_d_gain>12</position_d_gain><position_d_gain>4"
+    "</position_d_gain></plugin>"
+)
 BOX = '<sdf version="1.6"><model name="box"><link name="l"><collision name="c"><geometry><box>'
 BOX += "<size>0.2 0.2 0.2</size></box></geometry></collision></link></model></sdf>"
 
@@ -47,7 +54,7 @@ def _ok(runtime: Path, *args: str) -> str:
 @pytest.fixture(scope="module")
 def served(tmp_path_factory, serve_world):
     """A paused world with an Ackermann car, a vendor diff-drive base, a base whose wheels no
-    plugin drives, and a box."""
+    plugin drives, an arm a JointTrajectoryController drives, and a box."""
     root = tmp_path_factory.mktemp("drive_families_cli")
     robots = {
         "car": dm.ackermann_car(ACKERMANN),
@@ -60,6 +67,8 @@ def served(tmp_path_factory, serve_world):
             path.write_text(text)
             _ok(root, "spawn", str(path), "--name", name, "-y", str(2.0 * i), "--on-ground")
         _ok(root, "spawn", "--xml", BOX, "--name", "box", "-x", "3", "-z", "0.1")
+        (root / "arm.urdf").write_text(dm.arm_urdf(JTC))
+        _ok(root, "spawn", str(root / "arm.urdf"), "--name", "arm", "-x", "-3")
         _ok(root, "step", "300")
         yield root
 
@@ -159,3 +168,17 @@ def test_no_server_exits_2_naming_a_start_that_works(tmp_path: Path, serve_world
         twin_ok(tmp_path, world, "step", "700")
         pose = json.loads(twin_ok(tmp_path, world, "pose", "kobuki", "--json"))
     assert pose["x"] > 0.05, f"the base drove {pose['x']:.3f} m on the started world"
+
+
+def test_the_fix_named_for_an_arm_without_a_drive_moves_it(served: Path) -> None:
+    """A JointTrajectoryController's joints take positions only: `twin drive arm` names
+    `twin command arm shoulder=0.5 --mode position`, which, run as printed, moves the joint."""
+    proc = _twin(served, "drive", "arm", "--linear", "0.2")
+    assert proc.returncode == 2 and "twin trajectory arm FILE" in proc.stderr, proc.stderr
+    found = re.search(r"twin (command arm \S+=\S+ --mode position)", proc.stderr)
+    assert found, proc.stderr
+    _ok(served, *shlex.split(found.group(1)))
+    _ok(served, "step", "1500")
+    joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "arm", "--json"))}
+    angle = joints["shoulder"]["position"]
+    assert angle == pytest.approx(0.5, abs=0.01), f"shoulder at {angle:.4f} rad (commanded 0.5)"

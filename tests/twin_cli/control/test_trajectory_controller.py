@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import drive_models as dm
 import pytest
 
 from converters.pipeline import convert_full
@@ -33,41 +34,6 @@ JTC = (
     "<velocity_i_gain>0.5</velocity_i_gain>{topic}</plugin>"
 )
 NAMED = "<joint_name>shoulder</joint_name><joint_name>elbow</joint_name>"
-INERTIAL = (
-    '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
-    'iyz="0"/></inertial>'
-)
-
-
-def arm_urdf(plugin: str) -> str:
-    """A base fixed to the world, `shoulder` and `elbow` about z, 0.3 m apart."""
-    return f"""<robot name="arm"><link name="world"/><link name="base">{INERTIAL}</link>
-      <link name="upper">{INERTIAL}</link><link name="fore">{INERTIAL}</link>
-      <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
-      <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
-        <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="100" velocity="3"/></joint>
-      <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
-        <origin xyz="0.3 0 0"/><axis xyz="0 0 1"/>
-        <limit lower="-2" upper="2" effort="100" velocity="3"/></joint>
-      <gazebo>{plugin}</gazebo></robot>"""
-
-
-def arm_sdf(plugin: str) -> str:
-    """`arm_urdf` as an SDF model fixed to the world, the plugin inside the model."""
-    link = (
-        '<link name="{n}"><pose>{x} 0 0 0 0 0</pose><inertial><mass>1</mass><inertia><ixx>0.01'
-        "</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>"
-    )
-    joint = (
-        '<joint name="{n}" type="revolute"><parent>{p}</parent><child>{c}</child><axis><xyz>0 0 1'
-        "</xyz><limit><lower>-2</lower><upper>2</upper><effort>100</effort><velocity>3</velocity>"
-        "</limit></axis></joint>"
-    )
-    parts = [link.format(n=n, x=x) for n, x in (("base", 0), ("upper", 0), ("fore", 0.3))]
-    parts += ['<joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>']
-    parts += [joint.format(n="shoulder", p="base", c="upper")]
-    parts += [joint.format(n="elbow", p="upper", c="fore")]
-    return f'<sdf version="1.8"><model name="arm">{"".join(parts)}{plugin}</model></sdf>'
 
 
 def _record(tmp_path: Path, text: str, suffix: str):  # noqa: ANN202
@@ -81,8 +47,8 @@ def _record(tmp_path: Path, text: str, suffix: str):  # noqa: ANN202
 @pytest.mark.parametrize(
     ("robot", "suffix", "joints", "topic"),
     [
-        (arm_urdf, "urdf", NAMED, ""),
-        (arm_sdf, "sdf", "", "<topic>/arm/trajectory</topic>"),  # every 1-axis joint, in order
+        (dm.arm_urdf, "urdf", NAMED, ""),
+        (dm.arm_sdf, "sdf", "", "<topic>/arm/trajectory</topic>"),  # every 1-axis joint, in order
     ],
 )
 def test_its_per_joint_tags_are_read_in_the_joints_order(
@@ -107,7 +73,7 @@ def test_the_arm_starts_at_its_initial_positions_and_follows_a_trajectory(
     tmp_path: Path,
 ) -> None:
     path = tmp_path / "arm.urdf"
-    path.write_text(arm_urdf(JTC.format(joints=NAMED, topic="")))
+    path.write_text(dm.arm_urdf(JTC.format(joints=NAMED, topic="")))
     world = World()
     world.spawn(SpawnRequest(str(path)), name="arm")
     start = {s.name: s.position for s in world.joint_states("arm")}
@@ -129,7 +95,7 @@ def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
 
     plugin = JTC.format(joints="<joint_name>wrist</joint_name>", topic="")
     path = tmp_path / "arm.urdf"
-    path.write_text(arm_urdf(plugin))
+    path.write_text(dm.arm_urdf(plugin))
     with pytest.raises(PluginJointError, match="wrist") as caught:
         convert_full(path)
     assert "shoulder" in str(caught.value), "the message lists the model's joints"
