@@ -148,14 +148,17 @@ def test_the_fix_named_for_a_base_without_a_drive_works(served: Path) -> None:
 
 
 def test_no_server_exits_2_naming_a_start_that_works(tmp_path: Path, serve_world) -> None:
-    """With no world served, `twin drive` and `twin odom` exit 2 with gz's line and the command
-    that starts one; that command, run as printed, serves a world the drive then reaches."""
+    """With no world served, `twin drive`, `twin odom`, `twin topics` and `twin logs` exit 2
+    naming the command that starts one; that command, run as printed, serves a world the drive
+    then reaches."""
     world = "no_server_yet"
     for args in (("drive", "kobuki", "--linear", "0.2"), ("odom", "kobuki"), ("topics",)):
         proc = twin_in(tmp_path, world, *args)
         assert proc.returncode == 2, f"twin {args}: exit {proc.returncode} {proc.stderr}"
         assert proc.stderr.startswith("An instance of twin is not running."), proc.stderr
         assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    logs = twin_in(tmp_path, world, "logs")
+    assert logs.returncode == 2 and f"`twin serve --world {world}`" in logs.stderr, logs.stderr
     found = re.search(r"`twin (serve[^`]*)`", proc.stderr)
     assert found, proc.stderr
     command = shlex.split(found.group(1))
