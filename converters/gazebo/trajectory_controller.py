@@ -49,7 +49,8 @@ USED = {
 APPROXIMATED = (
     "joints as position servos with kp = position_p_gain and kv = position_d_gain + "
     "velocity_p_gain, following twin trajectory's spline instead of stepping its targets from "
-    "point to point; they start at initial_position instead of being driven there from 0",
+    "point to point; they start at initial_position instead of being driven there from 0, and "
+    "hold it once commanded (twin trajectory, twin command), not from the first step",
 )
 
 
