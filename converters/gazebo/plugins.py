@@ -65,8 +65,8 @@ NEEDS = {
     "site actuator, like the multicopter rotors",
     "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs each track's belt speed "
     "from the body twist and steering_efficiency, moved as its geoms' contact surface "
-    "(MuJoCo's geom surfacevel), and turns that skid (MuJoCo's sliding contacts lift a "
-    "skid-steered base: docs/plugins.md)",
+    "(MuJoCo's geom surfacevel), and turns that skid, which MuJoCo's sliding contacts do not "
+    "reproduce (they lift a skid-steered base)",
 }
 RUN = {
     "command_interfaces": "enables the robot's <ros2_control>/<transmission> command interfaces",
@@ -160,13 +160,11 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         kind = plugin_kind(blob)
         label = " ".join(x for x in (blob.name and f"'{blob.name}'", blob.kind) if x)
         if kind == "not_run":
-            params = Params.of(blob, "").given() if blob.xml else {}
-            given = f"; parameters: {shown(params)}" if params else ""
-            report.ignored("model", f"<plugin> {label}: not run by twin{given}", tag="plugin")
+            report.ignored(
+                "model", f"<plugin> {label}: not run by twin{_given(blob)}", tag="plugin"
+            )
         elif kind in NEEDS:
-            params = Params.of(blob, "").given() if blob.xml else {}
-            given = f"; parameters: {shown(params)}" if params else ""
-            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}{given}", tag="plugin")
+            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}{_given(blob)}", tag="plugin")
         elif kind == "multicopter" and missing_names(blob):
             report.ignored("model", f"<plugin> {label}: {missing_names(blob)}", tag="plugin")
         elif kind == "vendor_drive":
@@ -174,3 +172,9 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         else:
             mode = "position" if "position" in (drive_key(blob) or "") else "velocity"
             report.mapped("model", f"<plugin> {label}: {RUN[kind].format(mode=mode)}", tag="plugin")
+
+
+def _given(blob: Blob) -> str:
+    """`; parameters: tag=value, ...` of a plugin twin does not run (empty without any)."""
+    params = Params.of(blob, "").given() if blob.xml else {}
+    return f"; parameters: {shown(params)}" if params else ""
