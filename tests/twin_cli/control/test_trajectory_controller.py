@@ -99,3 +99,16 @@ def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
     with pytest.raises(PluginJointError, match="wrist") as caught:
         convert_full(path)
     assert "shoulder" in str(caught.value), "the message lists the model's joints"
+
+
+def test_a_gain_that_is_not_a_number_is_refused_naming_its_tag(tmp_path: Path) -> None:
+    from converters.errors import GazeboTagError
+
+    plugin = JTC.format(joints=NAMED, topic="").replace(
+        "<position_p_gain>100</position_p_gain>", "<position_p_gain>stiff</position_p_gain>"
+    )
+    path = tmp_path / "arm.urdf"
+    path.write_text(dm.arm_urdf(plugin))
+    with pytest.raises(GazeboTagError, match="position_p_gain") as caught:
+        convert_full(path)
+    assert "'stiff'" in str(caught.value) and "a number" in str(caught.value)
