@@ -1,6 +1,7 @@
 """Mobile bases the drive tests write: one per kinematic family, URDF and SDF, with the plugin
-given as XML. Every base's root link origin is the kinematic model's reference point (the fixed
-axle's midpoint), so its world pose is what the model predicts.
+given as XML (and a two-joint arm for joint trajectory controllers). Every base's root link
+origin is the kinematic model's reference point (the fixed axle's midpoint), so its world pose
+is what the model predicts.
 
 Geometry [m, kg]: wheels of radius R on continuous joints about their y axis (a positive speed
 rolls forward), a chassis box above them; steering joints turn about z (positive: left).
@@ -11,9 +12,7 @@ from __future__ import annotations
 R = 0.05  # wheel radius [m]
 TRACK = 0.30  # left-right wheel spacing [m]
 WHEEL_BASE = 0.40  # fixed axle to steered axle [m]
-WIDTH = (
-    0.004  # wheel width [m]: MuJoCo puts a contact at each rim edge, wider wheels scrub in turns
-)
+WIDTH = 0.004  # wheel width [m] (the drive tests also run 3 cm wheels)
 
 
 def _inertial(mass: float, i: float, xyz: str = "0 0 0") -> str:
@@ -193,3 +192,40 @@ def sdf_ackermann(plugin: str) -> str:
         parts.append(_sdf_wheel(f"front_{side}", f"{side}_knuckle", "0 0 0"))
     body = "".join(parts)
     return f'<sdf version="1.8"><model name="car">{body}{plugin}</model></sdf>'
+
+
+ARM_INERTIAL = (
+    '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
+    'iyz="0"/></inertial>'
+)
+
+
+def arm_urdf(plugin: str) -> str:
+    """A base fixed to the world, `shoulder` and `elbow` about z, 0.3 m apart."""
+    return f"""<robot name="arm"><link name="world"/><link name="base">{ARM_INERTIAL}</link>
+      <link name="upper">{ARM_INERTIAL}</link><link name="fore">{ARM_INERTIAL}</link>
+      <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+      <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+        <axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="100" velocity="3"/></joint>
+      <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
+        <origin xyz="0.3 0 0"/><axis xyz="0 0 1"/>
+        <limit lower="-2" upper="2" effort="100" velocity="3"/></joint>
+      <gazebo>{plugin}</gazebo></robot>"""
+
+
+def arm_sdf(plugin: str) -> str:
+    """`arm_urdf` as an SDF model fixed to the world, the plugin inside the model."""
+    link = (
+        '<link name="{n}"><pose>{x} 0 0 0 0 0</pose><inertial><mass>1</mass><inertia><ixx>0.01'
+        "</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>"
+    )
+    joint = (
+        '<joint name="{n}" type="revolute"><parent>{p}</parent><child>{c}</child><axis><xyz>0 0 1'
+        "</xyz><limit><lower>-2</lower><upper>2</upper><effort>100</effort><velocity>3</velocity>"
+        "</limit></axis></joint>"
+    )
+    parts = [link.format(n=n, x=x) for n, x in (("base", 0), ("upper", 0), ("fore", 0.3))]
+    parts += ['<joint name="fix" type="fixed"><parent>world</parent><child>base</child></joint>']
+    parts += [joint.format(n="shoulder", p="base", c="upper")]
+    parts += [joint.format(n="elbow", p="upper", c="fore")]
+    return f'<sdf version="1.8"><model name="arm">{"".join(parts)}{plugin}</model></sdf>'

@@ -8,16 +8,31 @@ class TwinError(Exception):
 
 
 class NotRunningError(TwinError):
-    """No world server answers for this world name."""
+    """No world server answers for this world name.
 
-    # gz's readiness-probe wording and exit code 1: scripts grep the first line.
-    exit_code = 1
+    The message starts with gz's readiness-probe line (scripts grep it) and names how to start
+    a server for that world; like every failed client command it exits 2.
+    """
+
+    exit_code = 2
     MESSAGE = "An instance of twin is not running."
 
     def __init__(self, world: str, detail: str = "") -> None:
-        super().__init__(f"{self.MESSAGE}\n{detail}" if detail else self.MESSAGE)
+        first = f"{self.MESSAGE} {start_fix(world)}"
+        super().__init__(f"{first}\n{detail}" if detail else first)
         self.world = world
         self.detail = detail
+
+
+def start_fix(world: str) -> str:
+    """How to start a server for `world` (the default world needs no --world)."""
+    import shlex
+
+    flag = "" if world == "default" else f" --world {shlex.quote(world)}"
+    return (
+        f"Start one with `twin serve{flag}` (in the foreground) or `twin spawn FILE{flag}` "
+        "(in the background)."
+    )
 
 
 class EntityNotFoundError(TwinError):

@@ -3,9 +3,10 @@ and a holonomic base gets a planar velocity servo on its root link.
 
 Gazebo's drive plugins command their joints directly (a joint velocity with `fmax`, a force, a
 position) whatever `<transmission>` or `<ros2_control>` says, so their joints need a motor even
-without those tags. A joint that already has one keeps it (its tags decide its modes); a new one
-offers only the mode the plugin uses, bounded by the plugin's torque (unbounded when the plugin
-sets velocities directly, as gz-sim's systems do).
+without those tags. A joint that already has one keeps it (its tags decide its modes; a gz-sim
+joint controller's PID replaces the gains of a motor no tag configured); a new one offers only the
+mode the plugin uses, bounded by the plugin's torque (unbounded when the plugin sets velocities
+directly, as gz-sim's systems do).
 
 Planar move (and MecanumDrive, whose rollers MuJoCo cannot model) drives the base's planar twist.
 Gazebo's planar move overwrites the model's velocity every step; twin gives the root link three
@@ -22,13 +23,14 @@ implicitly by implicitfast, so the twist is reached within a few steps and a fri
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from converters.control_text import set_control_record
+from converters.control_text import CONTROL_TEXT, set_control_record
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     AckermannDrive,
@@ -36,9 +38,12 @@ from converters.gazebo.drive_records import (
     DriveRecord,
     HolonomicDrive,
     JointDrive,
+    TrajectoryDrive,
     TricycleDrive,
 )
 from converters.gazebo.multicopter import Rotor, add_rotors
+from converters.gazebo.trajectory_controller import start_at_initial_positions
+from converters.gazebo.wheel_contact import centre_wheel_contacts
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -74,6 +79,9 @@ def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
         ]
     if isinstance(record, JointDrive):
         return [(j, record.mode, record.max_force, record.pid) for j in record.joints]
+    if isinstance(record, TrajectoryDrive):
+        rows = zip(record.joints, record.max_forces, record.pids, strict=True)
+        return [(j, "position", bound, pid) for j, bound, pid in rows]
     return []
 
 
@@ -82,7 +90,8 @@ def add_drive_motors(
 ) -> None:
     """Motors for every drive's joints (unless they have one), planar servos for holonomic
     bases, each multicopter rotor its actuators (`converters.gazebo.multicopter.add_rotors`),
-    and a report line for each approximation a drive makes.
+    wheels that touch the ground on their mid-plane (`converters.gazebo.wheel_contact`), and a
+    report line for each approximation a drive makes.
 
     Raises:
         PluginJointError: a joint the plugin names is not a joint of the model.
@@ -90,6 +99,7 @@ def add_drive_motors(
     import mujoco
 
     add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
+    centre_wheel_contacts(spec, tuple(p for p in plugins if not isinstance(p, Rotor)), report)
     driven = {a.target for a in spec.actuators}
     for record in plugins:
         if isinstance(record, Rotor):
@@ -103,10 +113,22 @@ def add_drive_motors(
                 _motor(spec, joint, effort)
                 set_control_record(spec, joint, _record(record, mode, pid))
                 driven.add(joint)
+            elif pid and _untagged(spec, joint):
+                set_control_record(spec, joint, _record(record, mode, pid))
         if isinstance(record, HolonomicDrive):
             _planar_servos(spec, record)
+        if isinstance(record, TrajectoryDrive):
+            start_at_initial_positions(spec, record)
         for note in record.notes:
             report.approximated("model", f"<plugin> '{record.name}': {note}", tag="plugin")
+
+
+def _untagged(spec: mujoco.MjSpec, joint: str) -> bool:
+    """Whether `joint`'s motor is the builder's default (no control tag): a gz-sim joint
+    controller's own PID then decides its gains, as the system drives the joint's force."""
+    text = spec.text(CONTROL_TEXT)
+    records = json.loads(text.data) if text is not None else {}
+    return records.get(joint, {}).get("source") == "default"
 
 
 def _motor(spec: mujoco.MjSpec, joint: str, effort: float) -> None:

@@ -8,6 +8,7 @@ its servos. The report lists them tag by tag, so a user sees exactly what did no
 
 from __future__ import annotations
 
+from converters.gazebo import trajectory_controller
 from converters.gazebo.plugin_params import Params
 
 ROS_TOPICS = ("ros", "publish", "topic", "covariance", "broadcast", "namespace", "legacy")
@@ -144,12 +145,15 @@ USED: dict[str, set[str]] = {
         "d_gain",
         "cmd_max",
     },
+    "gz-sim-joint-trajectory-controller-system": trajectory_controller.USED,
 }
 
 APPROXIMATED: dict[str, tuple[str, ...]] = {
     "gazebo_ros_skid_steer_drive": (
         "four wheels driven as the two sides of a diff drive, as the plugin does; in a turn they "
-        "slip sideways, so the base turns slower than the unicycle model (as in Gazebo)",
+        "slide sideways, and the base turns much slower than the unicycle model (a test base: "
+        "0.15 rad/s for 0.5; Coulomb friction predicts 0.43): MuJoCo's sliding contacts lift "
+        "the wheels",
     ),
     "gz-sim-diff-drive-system": (
         "max_linear_acceleration applied at the wheel rims; wheels as velocity servos without a "
@@ -173,6 +177,7 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
         "the planar velocity through three velocity servos at the centre of mass, a new command "
         "ramped at 3 m/s² and 6 rad/s² (the plugin sets the velocity in one step)",
     ),
+    "gz-sim-joint-trajectory-controller-system": trajectory_controller.APPROXIMATED,
 }
 
 

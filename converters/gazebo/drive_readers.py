@@ -29,6 +29,7 @@ from converters.gazebo.drive_records import (
     TricycleDrive,
 )
 from converters.gazebo.plugin_params import Params
+from converters.gazebo.trajectory_controller import read_joint_trajectory_controller
 from converters.gazebo.wheel_geometry import WheelGeometry
 
 
@@ -307,4 +308,5 @@ READERS: dict[str, Reader] = {
     "gz-sim-mecanum-drive-system": read_gz_mecanum,
     "gz-sim-joint-controller-system": read_joint_controller,
     "gz-sim-joint-position-controller-system": read_joint_position_controller,
+    "gz-sim-joint-trajectory-controller-system": read_joint_trajectory_controller,
 }

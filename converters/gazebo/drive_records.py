@@ -8,6 +8,7 @@ own parameter names and defaults.
 - `TricycleDrive`: gazebo_ros tricycle drive (a steered, driven front wheel; bicycle kinematics).
 - `HolonomicDrive`: gazebo_ros planar move and gz-sim MecanumDrive (the base's planar twist).
 - `JointDrive`: gz-sim JointController (a velocity on joints) and JointPositionController.
+- `TrajectoryDrive`: gz-sim JointTrajectoryController (per-joint PIDs, a trajectory topic).
 
 Units are SI: [m], [m/s], [m/s²], [rad], [N m], [Hz]; `math.inf` is "no limit".
 """
@@ -224,5 +225,36 @@ class JointDrive(_Record):
         return self.joints
 
 
+@dataclass(frozen=True)
+class TrajectoryDrive(_Record):
+    """gz-sim's JointTrajectoryController: a position PID and a velocity PID on each joint,
+    summed into the joint's force, that step through the trajectories sent on its topic.
+
+    Attributes:
+        joints: the joints it controls, in order (every 1-axis joint when none is named);
+        initial_positions: [rad or m] per joint, what the PIDs hold before any trajectory;
+        pids: per joint (p, i, d) for twin's position servo: the position PID's p, no i (not
+        used), its d plus the velocity PID's p (both act on the joint's speed), or None when
+        they are 0 (gz-sim applies no force; twin's own gains); max_forces [N m or N] per
+        joint (inf: none); topic, progress_topic: where gz-sim takes trajectories and reports
+        progress.
+    """
+
+    name: str
+    where: str
+    joints: tuple[str, ...]
+    initial_positions: tuple[float, ...]
+    pids: tuple[tuple[float, float, float] | None, ...]
+    max_forces: tuple[float, ...]
+    topic: str
+    progress_topic: str
+    family: str = "gz_joint_trajectory_controller"
+    notes: tuple[str, ...] = ()
+
+    def wheel_joints(self) -> tuple[str, ...]:
+        """The joints it commands."""
+        return self.joints
+
+
 BaseDrive = DiffDrive | AckermannDrive | TricycleDrive | HolonomicDrive
-DriveRecord = BaseDrive | JointDrive
+DriveRecord = BaseDrive | JointDrive | TrajectoryDrive

@@ -58,18 +58,29 @@ class Params:
         """
         for tag in tags:
             el = self.root.find(tag)
-            if el is None:
-                continue
-            text = (el.text or "").strip()
-            try:
-                value = float(text)
-            except ValueError as exc:
-                raise GazeboTagError(self.source, "", f"plugin/{tag}", text, "a number") from exc
-            if not math.isfinite(value) or (value < 0 and not signed):
-                expected = "a finite number" if signed else "a finite number >= 0"
-                raise GazeboTagError(self.source, "", f"plugin/{tag}", text, expected)
-            return value
+            if el is not None:
+                return self._number(tag, (el.text or "").strip(), signed)
         return default
+
+    def _number(self, tag: str, text: str, signed: bool) -> float:
+        try:
+            value = float(text)
+        except ValueError as exc:
+            raise GazeboTagError(self.source, "", f"plugin/{tag}", text, "a number") from exc
+        if not math.isfinite(value) or (value < 0 and not signed):
+            expected = "a finite number" if signed else "a finite number >= 0"
+            raise GazeboTagError(self.source, "", f"plugin/{tag}", text, expected)
+        return value
+
+    def numbers(self, tag: str, *, signed: bool = False) -> tuple[float, ...]:
+        """Every value of a repeatable `tag`, in order (gz-sim's per-joint parameters).
+
+        Raises:
+            GazeboTagError: a value is not a finite number (>= 0 unless `signed`).
+        """
+        return tuple(
+            self._number(tag, (el.text or "").strip(), signed) for el in self.root.findall(tag)
+        )
 
     def flag(self, default: bool, *tags: str) -> bool:
         """The first given value of `tags` as a boolean (true/false/1/0).

@@ -49,7 +49,9 @@ SYSTEM_NAMES = {
     "MecanumDrive": "gz-sim-mecanum-drive-system",
     "JointController": "gz-sim-joint-controller-system",
     "JointPositionController": "gz-sim-joint-position-controller-system",
+    "JointTrajectoryController": "gz-sim-joint-trajectory-controller-system",
 }
+TRAJECTORY_KEY = "gz-sim-joint-trajectory-controller-system"
 # Systems twin does not run, with what running them would need (one report line each).
 NEEDS = {
     "gz-sim-lift-drag-system": "LiftDrag: not run; needs lift and drag along the blade's "
@@ -61,10 +63,10 @@ NEEDS = {
     "displaced volume (MuJoCo's `density` option gives it only for a fully submerged world)",
     "gz-sim-thruster-system": "Thruster: not run; needs a propeller thrust ρ·Kt·D⁴·ω|ω| as a "
     "site actuator, like the multicopter rotors",
-    "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs tracks (a surface "
-    "velocity along each track's belt), which MuJoCo contacts cannot move",
-    "gz-sim-joint-trajectory-controller-system": "JointTrajectoryController: not run as such; "
-    "send the trajectory with `twin trajectory` (joint_trajectory_controller's spline)",
+    "gz-sim-tracked-vehicle-system": "TrackedVehicle: not run; needs each track's belt speed "
+    "from the body twist and steering_efficiency, moved as its geoms' contact surface "
+    "(MuJoCo's geom surfacevel), and turns that skid, which MuJoCo's sliding contacts do not "
+    "reproduce (they lift a skid-steered base)",
 }
 RUN = {
     "command_interfaces": "enables the robot's <ros2_control>/<transmission> command interfaces",
@@ -72,6 +74,8 @@ RUN = {
     "command ENTITY ROTOR_JOINT=ω --mode velocity`, ω in rad/s)",
     "drive": "run by twin as a drive controller in sim time (`twin drive`, `twin odom`)",
     "joint_drive": "run by twin: its joints take `twin command ENTITY JOINT=VALUE --mode {mode}`",
+    "trajectory_drive": "run by twin: its joints follow `twin trajectory ENTITY FILE` with the "
+    "plugin's gains",
     "vendor_drive": "read as a differential drive (`twin drive`, `twin odom`): its tags "
     "approximated one by one below",
 }
@@ -87,14 +91,16 @@ def drive_key(blob: Blob) -> str | None:
 
 
 def plugin_kind(blob: Blob) -> str:
-    """ "drive", "joint_drive", "vendor_drive", "command_interfaces", "multicopter", a NEEDS
-    key or "not_run"."""
+    """ "drive", "joint_drive", "trajectory_drive", "vendor_drive", "command_interfaces",
+    "multicopter", a NEEDS key or "not_run"."""
     filename = (blob.kind or "").rsplit("/", 1)[-1]
     if filename in CONTROL_FILES:
         return "command_interfaces"
     if is_motor_model(blob):
         return "multicopter"
     key = drive_key(blob)
+    if key == TRAJECTORY_KEY:
+        return "trajectory_drive"
     if key is not None:
         return "joint_drive" if "joint" in key else "drive"
     system = plugin_key(blob)
@@ -130,7 +136,7 @@ def read_plugins(
     out: list[DriveRecord | Rotor] = []
     for blob in blobs:
         kind = plugin_kind(blob)
-        if kind in ("drive", "joint_drive"):
+        if kind in ("drive", "joint_drive", "trajectory_drive"):
             key = drive_key(blob) or ""
             params = Params.of(blob, source)
             if geometry is not None:
@@ -154,11 +160,11 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         kind = plugin_kind(blob)
         label = " ".join(x for x in (blob.name and f"'{blob.name}'", blob.kind) if x)
         if kind == "not_run":
-            params = Params.of(blob, "").given() if blob.xml else {}
-            given = f"; parameters: {shown(params)}" if params else ""
-            report.ignored("model", f"<plugin> {label}: not run by twin{given}", tag="plugin")
+            report.ignored(
+                "model", f"<plugin> {label}: not run by twin{_given(blob)}", tag="plugin"
+            )
         elif kind in NEEDS:
-            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}", tag="plugin")
+            report.ignored("model", f"<plugin> {label}: {NEEDS[kind]}{_given(blob)}", tag="plugin")
         elif kind == "multicopter" and missing_names(blob):
             report.ignored("model", f"<plugin> {label}: {missing_names(blob)}", tag="plugin")
         elif kind == "vendor_drive":
@@ -166,3 +172,9 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         else:
             mode = "position" if "position" in (drive_key(blob) or "") else "velocity"
             report.mapped("model", f"<plugin> {label}: {RUN[kind].format(mode=mode)}", tag="plugin")
+
+
+def _given(blob: Blob) -> str:
+    """`; parameters: tag=value, ...` of a plugin twin does not run (empty without any)."""
+    params = Params.of(blob, "").given() if blob.xml else {}
+    return f"; parameters: {shown(params)}" if params else ""

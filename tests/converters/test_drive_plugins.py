@@ -367,3 +367,18 @@ def test_a_known_drives_approximations_and_unused_tags_are_reported_tag_by_tag(
         ("ros", "twin publishes no ROS topics"),
     ):
         assert any(f"<{tag}>" in n and says in n for n in notes), f"<{tag}>: {says}"
+
+
+def test_a_tracked_vehicle_is_reported_not_run_with_each_of_its_tags(tmp_path: Path) -> None:
+    plugin = (
+        '<plugin filename="gz-sim-tracked-vehicle-system" name="gz::sim::systems::TrackedVehicle">'
+        "<left_track><link>left_track</link></left_track><right_track><link>right_track</link>"
+        "</right_track><tracks_separation>0.4</tracks_separation><steering_efficiency>0.5"
+        "</steering_efficiency></plugin>"
+    )
+    done = _convert(tmp_path, dm.two_wheel_base(plugin), "urdf")
+    (line,) = [e for e in done.report.entries if e.tag == "plugin" and "TrackedVehicle" in e.detail]
+    assert line.outcome.name == "IGNORED" and "not run" in line.detail, line.detail
+    for tag in ("left_track=<...>", "right_track=<...>", "tracks_separation=0.4"):
+        assert tag in line.detail, f"{tag} missing from {line.detail}"
+    assert "steering_efficiency=0.5" in line.detail and not done.plugins, "no drive runs"

@@ -138,7 +138,7 @@ def _fail(exc: Exception, debug: bool) -> NoReturn:
         _click_error(exc)
     if debug:
         raise exc
-    if isinstance(exc, NotRunningError):  # gz's readiness-probe line as it is, exit code 1
+    if isinstance(exc, NotRunningError):  # gz's readiness-probe line as it starts, exit code 2
         sys.stderr.write(f"{exc}\n")
         sys.exit(exc.exit_code)
     if _known(exc):

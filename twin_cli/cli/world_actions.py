@@ -7,7 +7,8 @@ the fast path (`fast.py`). Imports stay client-side: no mujoco, numpy, fastapi o
 Raises:
     BadOption: a value that does not parse (the error boundary, `app.main`, prints it as a usage
         error, exit 2).
-    SystemExit(1): no world runs, for the commands that must not start one (gz's wording).
+    SystemExit(2): no world runs, for the commands that must not start one (gz's wording and
+        how to start one).
 """
 
 from __future__ import annotations
@@ -302,6 +303,11 @@ def logs(*, lines: int | None, world: str) -> None:
 
     paths = runtime.world_paths(world)
     if not paths.log.exists():
-        sys.stderr.write(f"twin: no log for world [{world}] in {paths.directory}\n")
-        raise SystemExit(1)
+        from twin_cli.errors import start_fix
+
+        sys.stderr.write(
+            f"twin: no log for world [{world}] in {paths.directory}: no server has run for it. "
+            f"{start_fix(world)}\n"
+        )
+        raise SystemExit(2)
     sys.stdout.write(runtime.log_tail(paths, lines))

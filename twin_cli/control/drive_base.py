@@ -82,6 +82,12 @@ class DriveController:
         """(v [m/s], ω [rad/s]) the encoder wheels measure now."""
         raise NotImplementedError
 
+    def _encoder_motion(self, dt: float) -> tuple[float, float]:
+        """(distance [m], heading change [rad]) the encoders measured over the last `dt` [s]:
+        the speeds now times dt, as gazebo_ros' plugins integrate them."""
+        v, w = self._encoder_twist()
+        return v * dt, w * dt
+
     def command_reply(self) -> dict[str, Any]:
         """What the command became (wheel and steering goals), for the drive reply."""
         return {}
@@ -133,7 +139,7 @@ class DriveController:
             return
         dt, self.last_time = now - self.last_time, now
         if self.plugin.odometry_source == "encoder" and dt > 0:
-            self.encoder = integrate_twist(self.encoder, *self._encoder_twist(), dt)
+            self.encoder = integrate_twist(self.encoder, *self._encoder_motion(dt), 1.0)
         if now >= self.until - 1e-9:
             self.twist, self.until = STOP, math.inf
         force = self.updates == 0 or self.world.commands() != self._written

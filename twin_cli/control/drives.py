@@ -141,10 +141,16 @@ def _no_drive(world: World, entity: str) -> InvalidRequestError:
     """The error for an entity without a drive; its fix names only what works for it."""
     rows = world.joint_commands(entity)
     wheels = [j for j, row in rows.items() if "velocity" in row["modes"]]
+    held = [j for j, row in rows.items() if "position" in row["modes"]]
     if wheels:
         fix = (
             f"drive its joints one by one, e.g. twin command {entity} {wheels[0]}=2 --mode "
             "velocity (rad/s), or give it a drive <plugin>"
+        )
+    elif held:  # joints a gz-sim position or trajectory controller owns
+        fix = (
+            f"move its joints, e.g. twin command {entity} {held[0]}=0.5 --mode position (rad "
+            f"or m), or send a trajectory with twin trajectory {entity} FILE"
         )
     else:
         fix = "give it a drive <plugin> (in its URDF's <gazebo> or its SDF <model>); it has no "
@@ -185,5 +191,5 @@ def _check_options(entity: str, cls: type[DriveController], record: Any, twist: 
 def _check_finite(what: str, value: float, unit: str) -> None:
     if not isinstance(value, (int, float)) or not math.isfinite(value):
         raise InvalidRequestError(
-            f"drive {what} velocity", f"{value!r} is not a finite number", f"give {unit}"
+            f"drive {what} velocity", f"{value!r} is not a finite number", f"give one in {unit}"
         )

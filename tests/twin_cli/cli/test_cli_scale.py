@@ -61,7 +61,7 @@ def test_a_bad_name_in_names_is_refused_before_any_world_starts(twin):
                check=False)  # fmt: skip
     assert bad.returncode == 2 and "a/b" in bad.stderr and "Traceback" not in bad.stderr
     listed = twin("list", check=False)  # gz's line: no world was started for the refusal
-    assert listed.returncode == 1 and "not running" in listed.stderr, listed.stderr
+    assert listed.returncode == 2 and "not running" in listed.stderr, listed.stderr
 
 
 def test_video_and_record_with_a_sweep_are_refused_not_ignored(tmp_path):

@@ -17,6 +17,10 @@ import scenarios
 GZ_LINE = re.compile(
     r"^Factor\[\d+\.\d\d\] SimTime\[\d+\.\d\d\] RealTime\[\d+\.\d\d\] Paused\[[TF]\]$"
 )
+NOT_RUNNING = (  # gz's readiness-probe line, then how to start a server
+    "An instance of twin is not running. Start one with `twin serve` (in the foreground) or "
+    "`twin spawn FILE` (in the background)."
+)
 MOON, EARTH = 1.62, 9.81  # [m/s^2], the presets
 DT, STEPS = 0.001, 300  # [s], steps of free fall measured through `twin pose`
 BOX_URDF = block(size=0.2, name="box")  # 1 kg, 0.2 m cube
@@ -102,8 +106,8 @@ def test_used_by_flow_on_the_bundled_humanoid(twin):
     twin("stop")
     assert "stopped" in twin("logs", "-n", "3").stdout, "server log should end with the stop"
     probe = twin("stats", "-d", "0", check=False)
-    assert probe.returncode == 1, f"stats with no world: exit {probe.returncode}"
-    assert probe.stderr.strip() == "An instance of twin is not running.", probe.stderr
+    assert probe.returncode == 2, f"stats with no world: exit {probe.returncode}"
+    assert probe.stderr.strip() == NOT_RUNNING, probe.stderr
 
 
 def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
@@ -122,8 +126,8 @@ def test_sigkilled_server_is_replaced_on_next_spawn(twin, tmp_path):
     assert "already served" in twice.stderr and "twin stop" in twice.stderr, twice.stderr
     twin("stop")
     again = twin("stop", check=False)
-    assert again.returncode == 1, f"stop with no world: exit {again.returncode}"
-    assert again.stderr.strip() == "An instance of twin is not running.", again.stderr
+    assert again.returncode == 2, f"stop with no world: exit {again.returncode}"
+    assert again.stderr.strip() == NOT_RUNNING, again.stderr
 
 
 def test_concurrent_first_commands_start_exactly_one_server(twin):

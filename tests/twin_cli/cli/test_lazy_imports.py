@@ -64,7 +64,7 @@ def _client_commands(tmp_path) -> list[list[str]]:
 def test_stats_without_a_world_imports_nothing_heavy(tmp_path):
     env = {**os.environ, runtime.RUNTIME_ENV: str(tmp_path)}
     proc, modules = _imported(["stats", "-d", "0"], env)
-    assert proc.returncode == 1, proc.stderr[-500:]
+    assert proc.returncode == 2, proc.stderr[-500:]
     assert "An instance of twin is not running." in proc.stderr
     assert not modules & set(HEAVY), f"heavy imports: {sorted(modules & set(HEAVY))}"
 

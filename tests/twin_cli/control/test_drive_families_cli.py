@@ -32,6 +32,13 @@ KOBUKI = (
     "wheel_right_joint</wheel_right_joint_name><wheel_separation>0.3</wheel_separation>"
     "<wheel_diameter>0.1</wheel_diameter></plugin>"
 )
+JTC = (
+    '<plugin filename="gz-sim-joint-trajectory-controller-system" '
+    'name="gz::sim::systems::JointTrajectoryController"><joint_name>shoulder</joint_name>'
+    "<joint_name>elbow</joint_name><position_p_gain>200</position_p_gain><position_p_gain>100"
+    "</position_p_gain><position_d_gain>12</position_d_gain><position_d_gain>4"
+    "</position_d_gain></plugin>"
+)
 BOX = '<sdf version="1.6"><model name="box"><link name="l"><collision name="c"><geometry><box>'
 BOX += "<size>0.2 0.2 0.2</size></box></geometry></collision></link></model></sdf>"
 
@@ -47,7 +54,7 @@ def _ok(runtime: Path, *args: str) -> str:
 @pytest.fixture(scope="module")
 def served(tmp_path_factory, serve_world):
     """A paused world with an Ackermann car, a vendor diff-drive base, a base whose wheels no
-    plugin drives, and a box."""
+    plugin drives, an arm a JointTrajectoryController drives, and a box."""
     root = tmp_path_factory.mktemp("drive_families_cli")
     robots = {
         "car": dm.ackermann_car(ACKERMANN),
@@ -60,6 +67,8 @@ def served(tmp_path_factory, serve_world):
             path.write_text(text)
             _ok(root, "spawn", str(path), "--name", name, "-y", str(2.0 * i), "--on-ground")
         _ok(root, "spawn", "--xml", BOX, "--name", "box", "-x", "3", "-z", "0.1")
+        (root / "arm.urdf").write_text(dm.arm_urdf(JTC))
+        _ok(root, "spawn", str(root / "arm.urdf"), "--name", "arm", "-x", "-3")
         _ok(root, "step", "300")
         yield root
 
@@ -136,3 +145,43 @@ def test_the_fix_named_for_a_base_without_a_drive_works(served: Path) -> None:
         _ok(served, "command", "cart", "wheel_right_joint=0.5", "--mode", "effort", "--json")
     )
     assert any("passive in Gazebo" in n for n in reply["notes"]), reply
+
+
+def test_no_server_exits_2_naming_a_start_that_works(tmp_path: Path, serve_world) -> None:
+    """With no world served, `twin drive`, `twin odom`, `twin topics` and `twin logs` exit 2
+    naming the command that starts one; that command, run as printed, serves a world the drive
+    then reaches."""
+    world = "no_server_yet"
+    for args in (("drive", "kobuki", "--linear", "0.2"), ("odom", "kobuki"), ("topics",)):
+        proc = twin_in(tmp_path, world, *args)
+        assert proc.returncode == 2, f"twin {args}: exit {proc.returncode} {proc.stderr}"
+        assert proc.stderr.startswith("An instance of twin is not running."), proc.stderr
+        assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    logs = twin_in(tmp_path, world, "logs")
+    assert logs.returncode == 2 and f"`twin serve --world {world}`" in logs.stderr, logs.stderr
+    found = re.search(r"`twin (serve[^`]*)`", proc.stderr)
+    assert found, proc.stderr
+    command = shlex.split(found.group(1))
+    assert command[:3] == ["serve", "--world", world], command
+    with serve_world(tmp_path, world, *command[3:]):
+        path = tmp_path / "kobuki.urdf"
+        path.write_text(dm.two_wheel_base(KOBUKI))
+        twin_ok(tmp_path, world, "spawn", str(path), "--name", "kobuki", "--on-ground")
+        twin_ok(tmp_path, world, "drive", "kobuki", "--linear", "0.2", "-d", "0.5")
+        twin_ok(tmp_path, world, "step", "700")
+        pose = json.loads(twin_ok(tmp_path, world, "pose", "kobuki", "--json"))
+    assert pose["x"] > 0.05, f"the base drove {pose['x']:.3f} m on the started world"
+
+
+def test_the_fix_named_for_an_arm_without_a_drive_moves_it(served: Path) -> None:
+    """A JointTrajectoryController's joints take positions only: `twin drive arm` names
+    `twin command arm shoulder=0.5 --mode position`, which, run as printed, moves the joint."""
+    proc = _twin(served, "drive", "arm", "--linear", "0.2")
+    assert proc.returncode == 2 and "twin trajectory arm FILE" in proc.stderr, proc.stderr
+    found = re.search(r"twin (command arm \S+=\S+ --mode position)", proc.stderr)
+    assert found, proc.stderr
+    _ok(served, *shlex.split(found.group(1)))
+    _ok(served, "step", "1500")
+    joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "arm", "--json"))}
+    angle = joints["shoulder"]["position"]
+    assert angle == pytest.approx(0.5, abs=0.01), f"shoulder at {angle:.4f} rad (commanded 0.5)"

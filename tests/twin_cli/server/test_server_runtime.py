@@ -133,7 +133,7 @@ def test_a_world_file_serve_refuses_ends_in_order_not_as_a_death(rtdir, tmp_path
     assert served.returncode == 2, served.stderr
     assert "missing.world: no such file" in served.stderr and "Traceback" not in served.stderr
     listed = twin("list")
-    assert listed.returncode == 1 and "not running" in listed.stderr, listed.stderr
+    assert listed.returncode == 2 and "not running" in listed.stderr, listed.stderr
     assert "died" not in listed.stderr and "SIGKILL" not in listed.stderr, listed.stderr
     logged = twin("logs")
     assert "not served: " in logged.stdout and "missing.world" in logged.stdout, logged.stdout

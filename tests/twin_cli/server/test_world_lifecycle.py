@@ -13,7 +13,11 @@ from pathlib import Path
 import pytest
 from models import block
 
-GZ_LINE = "An instance of twin is not running."
+NOT_RUNNING = "An instance of twin is not running."  # gz's readiness-probe line
+GZ_LINE = (  # ... then how to start a server
+    "An instance of twin is not running. Start one with `twin serve` (in the foreground) or "
+    "`twin spawn FILE` (in the background)."
+)
 AUTOSAVE_S = 0.3  # [s] the interval the tests ask for (TWIN_AUTOSAVE)
 
 
@@ -72,7 +76,7 @@ def test_commands_other_than_spawn_never_start_a_world(twin):
     )
     for args in commands:
         probe = twin(*args, check=False)
-        assert probe.returncode == 1, f"twin {args}: exit {probe.returncode} {probe.stderr}"
+        assert probe.returncode == 2, f"twin {args}: exit {probe.returncode} {probe.stderr}"
         assert probe.stderr.splitlines()[0] == GZ_LINE, f"twin {args}: {probe.stderr!r}"
     assert not (twin.dir / "default.pid").exists(), "a command other than spawn started a world"
 
@@ -80,7 +84,9 @@ def test_commands_other_than_spawn_never_start_a_world(twin):
 def test_typo_in_world_names_the_worlds_that_run(twin):
     twin("spawn", twin.box, "--name", "b", "-z", "1")
     probe = twin("gravity", "--world", "typo", check=False)
-    assert probe.returncode == 1 and probe.stderr.splitlines()[0] == GZ_LINE, probe.stderr
+    first = probe.stderr.splitlines()[0]
+    fix = "`twin serve --world typo` (in the foreground) or `twin spawn FILE --world typo`"
+    assert probe.returncode == 2 and first.startswith(NOT_RUNNING) and fix in first, first
     assert "running worlds: default" in probe.stderr, probe.stderr
     assert not (twin.dir / "typo.pid").exists(), "--world typo started a world"
 
@@ -98,7 +104,7 @@ def test_sigkilled_server_is_reported_and_load_last_restores_entities_and_poses(
     time.sleep(0.5)  # the supervisor reaps the server and writes its exit record
 
     probe = twin("list", check=False)
-    assert probe.returncode == 1, f"list after SIGKILL: exit {probe.returncode}"
+    assert probe.returncode == 2, f"list after SIGKILL: exit {probe.returncode}"
     first, *detail = probe.stderr.splitlines()
     assert first == GZ_LINE, probe.stderr
     text = "\n".join(detail)
@@ -125,10 +131,10 @@ def test_server_that_exits_with_an_error_is_reported_with_its_code(twin):
     os.kill(pid, signal.SIGUSR1)  # default action: the process ends by that signal
     time.sleep(0.5)
     probe = twin("stats", "-d", "0", check=False)
-    assert probe.returncode == 1 and f"pid {pid}" in probe.stderr, probe.stderr
+    assert probe.returncode == 2 and f"pid {pid}" in probe.stderr, probe.stderr
     assert "SIGUSR1" in probe.stderr, probe.stderr
     stop = twin("stop", check=False)  # acknowledges the death: reported, then forgotten
-    assert stop.returncode == 1 and "SIGUSR1" in stop.stderr, stop.stderr
+    assert stop.returncode == 2 and "SIGUSR1" in stop.stderr, stop.stderr
     assert twin("list", check=False).stderr.strip() == GZ_LINE
 
 

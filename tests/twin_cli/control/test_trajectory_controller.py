@@ -1,0 +1,114 @@
+"""gz-sim's JointTrajectoryController, in URDF `<gazebo>` and in SDF, read as gz-sim reads it and
+run through twin's trajectory follower.
+
+A fixed two-joint arm the test writes, both joints about the vertical (no gravity load), the
+plugin's per-joint tags repeated in the joints' order. Oracle: gz-sim's documented parameters
+(repeatable per-joint tags, defaults 0, topic `/model/<model>/joint_trajectory` and its
+`_progress`), the commanded angles, and the servo gains the mapping states: kp = position_p_gain,
+kv = position_d_gain + velocity_p_gain (chosen above critical damping on each joint's inertia,
+which twin's position servos keep as their least damping).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import drive_models as dm
+import pytest
+
+from converters.pipeline import convert_full
+from converters.report import Outcome
+from twin_cli.control import Trajectory, TrajectoryPoint, follow_trajectory
+from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import World
+
+JTC = (
+    '<plugin filename="gz-sim-joint-trajectory-controller-system" '
+    'name="gz::sim::systems::JointTrajectoryController">{joints}'
+    "<initial_position>0.3</initial_position><initial_position>-0.5</initial_position>"
+    "<position_p_gain>200</position_p_gain><position_p_gain>100</position_p_gain>"
+    "<position_d_gain>10</position_d_gain><position_d_gain>3</position_d_gain>"
+    "<velocity_p_gain>2</velocity_p_gain><velocity_p_gain>1</velocity_p_gain>"
+    "<position_cmd_min>-50</position_cmd_min><position_cmd_max>50</position_cmd_max>"
+    "<velocity_cmd_min>-10</velocity_cmd_min><velocity_cmd_max>10</velocity_cmd_max>"
+    "<velocity_i_gain>0.5</velocity_i_gain>{topic}</plugin>"
+)
+NAMED = "<joint_name>shoulder</joint_name><joint_name>elbow</joint_name>"
+
+
+def _record(tmp_path: Path, text: str, suffix: str):  # noqa: ANN202
+    path = tmp_path / f"arm.{suffix}"
+    path.write_text(text)
+    done = convert_full(path)
+    (record,) = done.plugins
+    return record, done.report
+
+
+@pytest.mark.parametrize(
+    ("robot", "suffix", "joints", "topic"),
+    [
+        (dm.arm_urdf, "urdf", NAMED, ""),
+        (dm.arm_sdf, "sdf", "", "<topic>/arm/trajectory</topic>"),  # every 1-axis joint, in order
+    ],
+)
+def test_its_per_joint_tags_are_read_in_the_joints_order(
+    tmp_path: Path, robot, suffix: str, joints: str, topic: str
+) -> None:
+    record, report = _record(tmp_path, robot(JTC.format(joints=joints, topic=topic)), suffix)
+    assert record.joints == ("shoulder", "elbow")
+    assert record.initial_positions == (0.3, -0.5)
+    assert record.pids == ((200.0, 0.0, 12.0), (100.0, 0.0, 4.0)), "kp; kv = d + velocity p"
+    # the first joint's output limits are given, the second's default to none (gz-sim's PID)
+    assert record.max_forces == (60.0, float("inf"))
+    expected = "/arm/trajectory" if topic else "/model/arm/joint_trajectory"
+    assert (record.topic, record.progress_topic) == (expected, expected + "_progress")
+    lines = [e.detail for e in report.entries if e.tag == "plugin"]
+    assert any("twin trajectory ENTITY FILE" in line for line in lines), lines
+    notes = [e.detail for e in report.of(Outcome.APPROXIMATED)]
+    assert any("<velocity_i_gain>: not used by twin" in n for n in notes), notes
+    assert any("kv = position_d_gain + velocity_p_gain" in n for n in notes), notes
+
+
+def test_the_arm_starts_at_its_initial_positions_and_follows_a_trajectory(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "arm.urdf"
+    path.write_text(dm.arm_urdf(JTC.format(joints=NAMED, topic="")))
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="arm")
+    start = {s.name: s.position for s in world.joint_states("arm")}
+    assert start == pytest.approx({"shoulder": 0.3, "elbow": -0.5}, abs=1e-9)
+    points = (TrajectoryPoint(1.0, (0.8, -1.0)),)
+    follow_trajectory(world, "arm", Trajectory(("shoulder", "elbow"), points))
+    world.step(2000)
+    end = {s.name: s.position for s in world.joint_states("arm")}
+    assert end == pytest.approx({"shoulder": 0.8, "elbow": -1.0}, abs=1e-3), "angles [rad]"
+    rows = world.joint_commands("arm")
+    gains = {j: (rows[j]["kp"], rows[j]["kv"]) for j in ("shoulder", "elbow")}
+    assert gains == {"shoulder": (200.0, 12.0), "elbow": (100.0, 4.0)}, "the plugin's gains"
+
+
+def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
+    tmp_path: Path,
+) -> None:
+    from converters.errors import PluginJointError
+
+    plugin = JTC.format(joints="<joint_name>wrist</joint_name>", topic="")
+    path = tmp_path / "arm.urdf"
+    path.write_text(dm.arm_urdf(plugin))
+    with pytest.raises(PluginJointError, match="wrist") as caught:
+        convert_full(path)
+    assert "shoulder" in str(caught.value), "the message lists the model's joints"
+
+
+def test_a_gain_that_is_not_a_number_is_refused_naming_its_tag(tmp_path: Path) -> None:
+    from converters.errors import GazeboTagError
+
+    plugin = JTC.format(joints=NAMED, topic="").replace(
+        "<position_p_gain>100</position_p_gain>", "<position_p_gain>stiff</position_p_gain>"
+    )
+    path = tmp_path / "arm.urdf"
+    path.write_text(dm.arm_urdf(plugin))
+    with pytest.raises(GazeboTagError, match="position_p_gain") as caught:
+        convert_full(path)
+    assert "'stiff'" in str(caught.value) and "a number" in str(caught.value)
