@@ -12,8 +12,10 @@ from converters.gazebo import trajectory_controller
 from converters.gazebo.plugin_params import Params
 
 ROS_TOPICS = ("ros", "publish", "topic", "covariance", "broadcast", "namespace", "legacy")
-"""Tags (by substring) that only publish or name ROS topics and TF: twin's odometry is `twin
-odom`, its topics a recording's."""
+"""Tags (by substring) that only publish or name ROS topics and TF: not the drive's to run.
+twin's odometry is `twin odom`; on a ROS graph `twin serve --ros` publishes it with tf, named
+from the plugin's namespace and remappings."""
+ROS_NOTE = "ROS output, not a drive parameter (twin odom; twin serve --ros publishes odom and tf)"
 
 USED: dict[str, set[str]] = {
     "gazebo_ros_diff_drive": {
@@ -190,7 +192,7 @@ def drive_notes(key: str, params: Params, initial: float = 0.0) -> tuple[str, ..
         if tag in used:
             continue
         if any(word in tag.lower() for word in ROS_TOPICS):
-            notes.append(f"<{tag}>: not used (twin publishes no ROS topics; see twin odom)")
+            notes.append(f"<{tag}>: {ROS_NOTE}")
         elif tag.startswith("initial_"):
             notes.append(f"<{tag}>{initial:g}: not applied at spawn; send it with twin command")
         else:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from converters.description.gazebo import Blob
-from converters.gazebo.drive_notes import ROS_TOPICS
+from converters.gazebo.drive_notes import ROS_NOTE, ROS_TOPICS
 from converters.gazebo.drive_records import DEFAULT_RATE, DEFAULT_TORQUE, DiffDrive
 from converters.gazebo.plugin_params import Params
 
@@ -81,7 +81,7 @@ def read_vendor_diff_drive(p: Params, blob: Blob) -> DiffDrive:
 
 def _unused(tag: str) -> str:
     if any(word in tag.lower() for word in ROS_TOPICS):
-        return f"<{tag}>: ignored (twin publishes no ROS topics; see twin odom)"
+        return f"<{tag}>: {ROS_NOTE}"
     return f"<{tag}>: ignored"
 
 

@@ -275,7 +275,7 @@ def test_vendor_plugin_is_reported_tag_by_tag(tmp_path: Path) -> None:
         ("wheel_diameter", "read as the wheel diameter"),
         ("torque", "read as the max wheel torque"),
         ("velocity_command_timeout", "ignored"),
-        ("publish_tf", "ignored"),
+        ("publish_tf", "twin serve --ros publishes odom and tf"),
     ):
         assert any(f"<{tag}>" in d and says in d for d in details), f"<{tag}>: {says}"
 
@@ -363,8 +363,8 @@ def test_a_known_drives_approximations_and_unused_tags_are_reported_tag_by_tag(
     for tag, says in (
         ("left_steering_pid_gain", "not used by twin"),
         ("steering_wheel_joint", "not used by twin"),
-        ("publish_odom", "twin publishes no ROS topics"),
-        ("ros", "twin publishes no ROS topics"),
+        ("publish_odom", "twin serve --ros publishes odom"),
+        ("ros", "twin serve --ros publishes odom"),
     ):
         assert any(f"<{tag}>" in n and says in n for n in notes), f"<{tag}>: {says}"
 
