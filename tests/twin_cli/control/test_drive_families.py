@@ -195,7 +195,7 @@ def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
 # A skid steer's turn misses the model: its wheels must slide sideways to turn, and on rigid
 # wheels and ground MuJoCo's contacts answer sustained sliding by lifting the base (measured: a
 # wheel off the ground in 87 % of steps, yaw rate 0.15 rad/s of the 0.5 commanded and of the
-# 0.43 that Coulomb friction predicts for this base; see docs/drives.md).
+# 0.43 that Coulomb friction predicts for this base; see docs/plugins.md).
 SAGS = {"gazebo_ros_skid_steer_drive"}
 
 
