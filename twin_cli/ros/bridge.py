@@ -74,6 +74,7 @@ class RosBridge:
             "domain_id": self.scope.domain_id,
             "range": self.scope.range,
             "local_only": self.scope.local_only,
+            "loopback_device": self.participant.on_loopback_device,
             "scope": self.scope.describe(),
             "rate": self.recording.rate,
             "samples": recording.samples,

@@ -22,6 +22,7 @@ from twin_cli.record.topics import Message, Topic
 from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
 from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, discovery_info
 from twin_cli.ros.scope import Scope, cyclone_config
+from twin_cli.ros.sockets import confine_to_loopback, open_sockets
 
 log = logging.getLogger("twin.ros")
 
@@ -56,8 +57,11 @@ class Participant:
             ) from exc  # fmt: skip
         self.scope = scope
         self._lock = threading.Lock()
+        before = open_sockets()
         try:
             self._domain = Domain(scope.domain_id, cyclone_config(scope))
+            # before the participant announces itself: nothing is sent off the device
+            self.on_loopback_device = scope.local_only and confine_to_loopback(before)
             self._participant = DomainParticipant(scope.domain_id)
         except Exception as exc:  # cyclonedds raises DDSException with Cyclone's return code
             raise RequestError(

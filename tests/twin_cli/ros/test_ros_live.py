@@ -12,6 +12,7 @@ import json
 import math
 import os
 import re
+import socket
 import subprocess
 import sys
 import time
@@ -22,6 +23,7 @@ import numpy as np
 import pytest
 from models import CONTROL_RIG
 from sensor_models import lidar_post
+from sock_diag import sockets_of
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
 # One worker runs the module: its server and peers share one domain, of this process's own.
@@ -230,32 +232,49 @@ def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
 
 
 def test_the_server_binds_no_address_but_loopback(served) -> None:
-    """Every UDP socket of the server is on 127.0.0.1 or unbound to an address (Cyclone's
-    receive sockets), none is connected anywhere, and multicast is not joined."""
+    """Every internet socket of the server is bound to 127.0.0.1, or to the loopback device
+    (Cyclone's receive sockets, which it binds to the wildcard address): none can receive from
+    or send to another host, and none is connected outside 127.0.0.1 (the kernel's sock_diag)."""
     _, proc = served
-    inodes = {
-        m.group(1)
-        for fd in Path(f"/proc/{proc.pid}/fd").iterdir()
-        if (m := re.match(r"socket:\[(\d+)\]", os.readlink(fd)))
-    }
-    seen = []
-    for table in ("udp", "udp6"):
-        for line in Path(f"/proc/{proc.pid}/net/{table}").read_text().splitlines()[1:]:
-            fields = line.split()
-            if fields[9] in inodes:
-                seen.append((_address(fields[1]), _address(fields[2])))
-    assert seen, "the server has no UDP socket: is the bridge running?"
-    for local, remote in seen:
-        assert local[0] in ("127.0.0.1", "0.0.0.0"), f"socket bound to {local}"
-        assert remote[0] in ("0.0.0.0", "127.0.0.1"), f"socket connected to {remote}"
+    found = sockets_of(proc.pid)
+    assert [s for s in found if s.protocol.startswith("udp")], "no UDP socket: is the bridge on?"
+    loopback = socket.if_nametoindex("lo")
+    for s in found:
+        on_loopback = s.local[0] == "127.0.0.1" or s.device == loopback
+        assert on_loopback, f"{s.protocol} socket bound to {s.local} on device {s.device}"
+        assert s.remote[0] in ("0.0.0.0", "127.0.0.1"), f"{s.protocol} socket to {s.remote}"
+    status = json.loads(_twin(served[0], "ros", "status", "--json"))
+    assert status["local_only"] and status["loopback_device"], status
 
 
-def _address(text: str) -> tuple[str, int]:
-    """A /proc/net/udp address (hex, little-endian IPv4; IPv6 shown as its hex)."""
-    host, port = text.split(":")
-    if len(host) == 8:
-        host = ".".join(str(int(host[i : i + 2], 16)) for i in (6, 4, 2, 0))
-    return host, int(port, 16)
+def test_a_widened_interface_leaves_the_sockets_unbound_from_loopback_and_still_meets(
+    served,
+) -> None:
+    """`twin ros start --interface 127.0.0.1` (an explicit interface: multicast on, here on
+    loopback, so nothing leaves the machine) is a widened setting: Cyclone's sockets keep the
+    wildcard address with no device, and the loopback peer still finds the world through the
+    static peer. `twin ros start` without it confines them again."""
+    root, proc = served
+    _twin(root, "ros", "stop")
+    env = {**_env(root), "ROS_STATIC_PEERS": "127.0.0.1"}
+    try:
+        started = subprocess.run(
+            [sys.executable, "-m", "twin_cli", "ros", "start", "--interface", "127.0.0.1",
+             "--json", "--world", WORLD],
+            env=env, capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert started.returncode == 0, started.stderr
+        status = json.loads(started.stdout)
+        assert not status["local_only"] and not status["loopback_device"], status
+        wildcard = [s for s in sockets_of(proc.pid) if s.local[0] == "0.0.0.0"]
+        assert wildcard and all(s.device == 0 for s in wildcard), wildcard
+        assert _peer(root, "listen", "1", "bot")["messages"]["/clock"], "no /clock (widened)"
+    finally:
+        _twin(root, "ros", "stop")
+        _twin(root, "ros", "start")
+    loopback = socket.if_nametoindex("lo")
+    wildcard = [s for s in sockets_of(proc.pid) if s.local[0] == "0.0.0.0"]
+    assert wildcard and all(s.device == loopback for s in wildcard), wildcard
 
 
 def _world_pose(frame: str, edges: dict) -> tuple[np.ndarray, np.ndarray]:
