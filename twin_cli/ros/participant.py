@@ -6,8 +6,9 @@ Writers send the CDR bytes rosbags encoded (a recording's very bytes) through a 
 `graph.idl_type`, so subscribers see the types rmw_cyclonedds_cpp announces; readers hand back
 the cyclonedds objects of those same types.
 
-As a recording sink (`set_topics`, `write`, `close`) it runs in the recording's worker thread;
-readers are polled by the command thread. Cyclone's entities are thread safe.
+As a recording sink (`set_topics`, `write`, `close`) it runs in the bridge's publisher process
+(node `/twin`); the server's own participant holds the readers (node `/twin_commands`), polled
+by the command thread. Cyclone's entities are thread safe.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from typing import Any
 from twin_cli.errors import RequestError
 from twin_cli.record.topics import Message, Topic
 from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
-from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, discovery_info
+from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, NODE_NAME, discovery_info
 from twin_cli.ros.scope import Scope, cyclone_config
 from twin_cli.ros.sockets import confine_to_loopback, open_sockets
 
@@ -43,9 +44,10 @@ def _encoded_type(name: str) -> type:
 
 
 class Participant:
-    """A DDS participant in `scope`'s domain, with a writer per topic set by `set_topics`."""
+    """A DDS participant in `scope`'s domain, with a writer per topic set by `set_topics`, and
+    one node, `node`."""
 
-    def __init__(self, scope: Scope) -> None:
+    def __init__(self, scope: Scope, node: str = NODE_NAME) -> None:
         """Raises: RequestError: Cyclone DDS refused the configuration (e.g. no such
         interface) or is not installed."""
         try:
@@ -56,6 +58,7 @@ class Participant:
                 "install it: pip install cyclonedds==11.0.1",
             ) from exc  # fmt: skip
         self.scope = scope
+        self.node = node
         self._lock = threading.Lock()
         before = open_sockets()
         try:
@@ -159,7 +162,7 @@ class Participant:
             return
         writers = [w.get_guid().bytes for w, _ in self._writers.values()]
         readers = [r.get_guid().bytes for r in self._readers]
-        data = discovery_info(self._participant.get_guid().bytes, readers, writers)
+        data = discovery_info(self._participant.get_guid().bytes, readers, writers, self.node)
         writer, sample_type = self._info_writer
         writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
 

@@ -226,13 +226,14 @@ class ParticipantEntitiesInfo(
     node_entities_info_seq: types.sequence[NodeEntitiesInfo]
 
 
-def qos(latched: bool = False) -> Qos:
-    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last 1."""
+def qos(latched: bool = False, depth: int = 1) -> Qos:
+    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last
+    `depth` (1 as ROS's publishers keep; the graph's readers keep 100: one per participant)."""
     if latched:
         return Qos(
             Policy.Reliability.Reliable(0),
             Policy.Durability.TransientLocal,
-            Policy.History.KeepLast(1),
+            Policy.History.KeepLast(depth),
             Policy.DataRepresentation(use_cdrv0_representation=True),
         )
     return Qos(
@@ -269,7 +270,7 @@ def listen(seconds: float, entity: str) -> dict:
     info = "rmw_dds_common/msg/ParticipantEntitiesInfo"
     wanted["ros_discovery_info"] = (ParticipantEntitiesInfo, info, True)
     topic = Topic(dp, "ros_discovery_info", ParticipantEntitiesInfo, qos=qos(True))
-    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True))
+    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True, depth=100))
     out: dict[str, list] = {name: [] for name in wanted}
     types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
     end = time.monotonic() + seconds

@@ -132,19 +132,25 @@ def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
     assert messages["/bot/odom"][-1][1]["child_frame_id"] == "bot/base_link"
 
 
-def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
-    """ros_discovery_info (transient local) names node /twin, with a writer per published
-    topic and a reader per cmd_vel type of each drive."""
+def test_the_nodes_are_announced_as_ros2_node_list_reads_them(served) -> None:
+    """ros_discovery_info (transient local) names node /twin with a writer per published topic
+    (the publisher process's participant) and /twin_commands with a reader per input (the
+    server's)."""
     root, _ = served
     got = _peer(root, "listen", "1", "bot")
     infos = [m for _, m in got["messages"]["ros_discovery_info"]]
-    nodes = [n for info in infos for n in info["node_entities_info_seq"]]
-    twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
-    assert twin, f"no /twin node announced: {nodes}"
-    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
+    nodes = {}
+    for info in infos:
+        for n in info["node_entities_info_seq"]:
+            nodes[(n["node_namespace"], n["node_name"])] = n
+    assert ("/", "twin") in nodes and ("/", "twin_commands") in nodes, f"nodes: {list(nodes)}"
+    twin, commands = nodes[("/", "twin")], nodes[("/", "twin_commands")]
+    assert len(twin["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
+    assert not twin["reader_gid_seq"], "the publisher reads nothing"
     readers = 2 * 3 + 4  # per bot: Twist, TwistStamped, forward velocity; rig: 3 + trajectory
-    assert len(twin[-1]["reader_gid_seq"]) == readers, "a reader per input"
-    assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
+    assert len(commands["reader_gid_seq"]) == readers, "a reader per input"
+    gids = twin["writer_gid_seq"] + commands["reader_gid_seq"]
+    assert all(len(g["data"]) == 16 for g in gids), "GIDs of 16 bytes"
 
 
 def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
@@ -231,13 +237,24 @@ def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
     assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
 
 
+def _server_sockets(pid: int) -> list:
+    """The sockets of the server and of its child processes (the bridge's publisher)."""
+    children = [
+        int(c) for task in Path(f"/proc/{pid}/task").iterdir()
+        for c in (task / "children").read_text().split()
+    ]  # fmt: skip
+    return [s for p in (pid, *children) for s in sockets_of(p)]
+
+
 def test_the_server_binds_no_address_but_loopback(served) -> None:
-    """Every internet socket of the server is bound to 127.0.0.1, or to the loopback device
-    (Cyclone's receive sockets, which it binds to the wildcard address): none can receive from
-    or send to another host, and none is connected outside 127.0.0.1 (the kernel's sock_diag)."""
+    """Every internet socket of the server and its publisher process is bound to 127.0.0.1, or
+    to the loopback device (Cyclone's receive sockets, which it binds to the wildcard address):
+    none can receive from or send to another host, and none is connected outside 127.0.0.1
+    (the kernel's sock_diag)."""
     _, proc = served
-    found = sockets_of(proc.pid)
-    assert [s for s in found if s.protocol.startswith("udp")], "no UDP socket: is the bridge on?"
+    found = _server_sockets(proc.pid)
+    udp = [s for s in found if s.protocol.startswith("udp")]
+    assert len(udp) >= 6, f"not two participants' sockets: is the bridge on? {udp}"
     loopback = socket.if_nametoindex("lo")
     for s in found:
         on_loopback = s.local[0] == "127.0.0.1" or s.device == loopback
@@ -266,14 +283,14 @@ def test_a_widened_interface_leaves_the_sockets_unbound_from_loopback_and_still_
         assert started.returncode == 0, started.stderr
         status = json.loads(started.stdout)
         assert not status["local_only"] and not status["loopback_device"], status
-        wildcard = [s for s in sockets_of(proc.pid) if s.local[0] == "0.0.0.0"]
+        wildcard = [s for s in _server_sockets(proc.pid) if s.local[0] == "0.0.0.0"]
         assert wildcard and all(s.device == 0 for s in wildcard), wildcard
         assert _peer(root, "listen", "1", "bot")["messages"]["/clock"], "no /clock (widened)"
     finally:
         _twin(root, "ros", "stop")
         _twin(root, "ros", "start")
     loopback = socket.if_nametoindex("lo")
-    wildcard = [s for s in sockets_of(proc.pid) if s.local[0] == "0.0.0.0"]
+    wildcard = [s for s in _server_sockets(proc.pid) if s.local[0] == "0.0.0.0"]
     assert wildcard and all(s.device == loopback for s in wildcard), wildcard
 
 

@@ -1,0 +1,143 @@
+"""The bridge's publisher process: samples from the ring → ROS messages → DDS writers.
+
+Runs in its own interpreter (`python -m twin_cli.ros.publisher`, started by `RosRecording`),
+as a bag recording's encoder does, so computing link poses, building messages, CDR-encoding
+them (rosbags) and writing them to DDS never hold the stepping loop's GIL. It is the encoder's
+loop (`record.encoder.run_encoder`) with a DDS participant as its sink, and it publishes only
+the newest sample, at most `max_wall_rate` a wall second: a world faster than that is thinned
+(the newest is taken each time), as a ROS node could not take more anyway. The process holds
+its own participant (node `/twin`, the world's writers) in the scope the server was given.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import asdict
+from typing import Any
+
+from twin_cli.record.encoder import Encoder, conn_pending, run_encoder, signals
+from twin_cli.record.topics import Message, Topic
+from twin_cli.ros.participant import Participant
+from twin_cli.ros.scope import Scope
+
+NICE = 5  # added niceness: below the loop, above a bag's encoder (live data is waited for)
+
+
+def command(fds: tuple[int, int], scope: Scope, max_wall_rate: float) -> list[str]:
+    """The publisher's arguments after `python -m twin_cli.ros.publisher`."""
+    return [*map(str, fds), json.dumps(asdict(scope)), repr(max_wall_rate)]
+
+
+def main(argv: list[str]) -> None:
+    """`python -m twin_cli.ros.publisher RING_FD PIPE_FD SCOPE_JSON MAX_WALL_RATE`."""
+    from multiprocessing.connection import Connection
+
+    from twin_cli.record import messages, ring
+
+    parent = os.getppid()
+    signals()
+    messages.typestore()  # rosbags' types, before the first sample
+    fields = json.loads(argv[2])
+    scope = Scope(**{**fields, "peers": tuple(fields["peers"])})
+    conn = Connection(int(argv[1]))
+    try:
+        participant = Participant(scope)
+    except Exception as exc:  # Cyclone refused the scope: the parent reads why
+        conn.send(("done", str(exc)))
+        return
+    os.nice(NICE)
+    buf, head, times = ring.views(ring.attach(int(argv[0])))
+    reader = ring.RingReader(buf, head)
+    encoder = LatestEncoder(DdsSink(participant), times, reader, parent, float(argv[3]))
+    run_encoder(encoder, conn, head)
+
+
+class DdsSink:
+    """The participant as a recording sink: a layout's topics replace the last layout's, sensor
+    topics stay once seen (a reading names only its own)."""
+
+    def __init__(self, participant: Participant) -> None:
+        self.participant = participant
+        self._layout: list[Topic] = []
+        self._sensors: dict[str, Topic] = {}
+
+    def set_topics(self, topics: list[Topic]) -> None:
+        self._layout = topics
+        self._announce()
+
+    def add_sensor_topics(self, topics: list[Topic]) -> None:
+        new = {t.name: t for t in topics if t.name not in self._sensors}
+        if new:
+            self._sensors.update(new)
+            self._announce()
+
+    def write(self, message: Message) -> None:
+        self.participant.write(message)
+
+    def close(self) -> None:
+        self.participant.close()
+
+    def _announce(self) -> None:
+        names = {t.name for t in self._layout}
+        extra = [t for name, t in self._sensors.items() if name not in names]
+        self.participant.set_topics(self._layout + extra)
+
+
+class LatestEncoder(Encoder):
+    """Publishes the newest record, at most `max_wall_rate` per wall second."""
+
+    def __init__(
+        self, writer: DdsSink, times: Any, reader: Any, parent: int | None, max_wall_rate: float
+    ) -> None:
+        super().__init__(writer, times, reader, parent)
+        self.period = 1.0 / max_wall_rate  # [s] wall between published samples
+        self.idle_s = self.period
+        self._pending: tuple[int, Any] | None = None
+        self._next = 0.0  # [s] monotonic: when the next sample may go
+
+    def encode(self, epoch: int, records: Any) -> None:
+        """Keeps the newest record (copied: the ring reuses its memory); sends it when due."""
+        self._pending = (epoch, records[-1:].copy())
+        self._send_if_due()
+
+    def idle(self) -> None:
+        self._send_if_due()
+
+    def poll(self, conn: Any) -> dict | None:
+        """As the encoder's, and waits out the rest of the wall period first (a busy world's
+        records pile up in the ring meanwhile; only the newest is built)."""
+        wait = self._next - time.monotonic()
+        if wait > 0:
+            conn_pending(conn, wait)
+        return super().poll(conn)
+
+    def close(self, figures: dict) -> None:
+        if self._pending is not None:
+            super().encode(*self._pending)
+        self.writer.close()
+
+    def _take(self, message: tuple) -> None:
+        if message[0] != "readings":
+            super()._take(message)
+            return
+        from twin_cli.record.sensor_messages import sensor_message
+
+        self.writer.add_sensor_topics([topic for topic, _ in message[1]])
+        for topic, reading in message[1]:
+            self.writer.write(sensor_message(topic, reading))
+
+    def _send_if_due(self) -> None:
+        now = time.monotonic()
+        if self._pending is None or now < self._next:
+            return
+        super().encode(*self._pending)
+        self._pending = None
+        self._next = max(self._next, now - self.period) + self.period
+
+
+if __name__ == "__main__":
+    import sys
+
+    main(sys.argv[1:])
