@@ -9,8 +9,8 @@ sent when an entity comes or goes, and a paused world's state is sent again ever
 The publisher sends only the newest sample, at most WALL_SPEEDUP × RATE a wall second: a world
 up to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
 echo`), and none of this holds the loop's interpreter. `CommandListener` takes `cmd_vel` and
-the controllers' topics the other way, through the server's participant (node
-`/twin_commands`).
+the controllers' topics the other way, and `ServiceServer` answers gazebo_ros' entity services,
+through the server's participant (node `/twin_commands`).
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from twin_cli.ros.live_recording import RosRecording
 from twin_cli.ros.node import COMMANDS_NODE_NAME
 from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope, scope_from
+from twin_cli.ros.services import ServiceServer
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
@@ -56,6 +57,7 @@ class RosBridge:
             self.participant.close()
             raise
         self.commands = CommandListener(world, self.participant)
+        self.services = ServiceServer(world, self.participant)
 
     def start(self) -> RosBridge:
         """Starts the publisher process and waits until it is on the graph.
@@ -71,17 +73,20 @@ class RosBridge:
                 "see the server log (`twin logs`)",
             )
         self.commands.start()
+        self.services.start()
         return self
 
     def retarget(self, world: World) -> None:
         """Follows the world the server loaded (its entities' topics and drives)."""
         self.recording.retarget(world)
         self.commands.retarget(world)
+        self.services.retarget(world)
 
     def stop(self) -> dict[str, Any]:
         """Stops listening and publishing; both participants leave the graph."""
         status = self.status()
         self.commands.stop()
+        self.services.stop()
         self.recording.stop(patience=STOP_PATIENCE_S)
         self.participant.close()
         return status
@@ -99,6 +104,8 @@ class RosBridge:
             "error": recording.error,
             "inputs": self.commands.topics,
             "commands": self.commands.commands,
+            "services": self.services.names,
+            "service_calls": self.services.calls,
         }
 
 

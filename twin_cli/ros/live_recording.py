@@ -4,7 +4,8 @@ The stepping thread's share per sample is a bag recording's (state copied into s
 a few µs); the publisher process (`publisher`) builds and publishes the messages. Two things a
 live view needs that a bag does not:
 - sensors are thinned as the samples are: at most `max_wall_rate` × rate / RATE captures of a
-  sensor per wall second, so ray casting in the server never grows with the world's speed;
+  sensor per wall second, and of an IMU's kept samples the newest as many, so ray casting and
+  building readings in the server never grow with the world's speed;
 - a world that does not step (paused) is sampled every HEARTBEAT_S, so a late subscriber sees
   it and a spawn on a paused world appears.
 """
@@ -56,6 +57,10 @@ class RosRecording(BagRecording):
     def _capture(self) -> None:
         self._last_capture = time.monotonic()
         super()._capture()
+
+    def _follow_sensors(self, world: World) -> None:
+        self._feed.wall_share = self.max_wall_rate / self.rate  # an IMU's kept samples too
+        super()._follow_sensors(world)
 
     def _capture_sensors(self, rate: float | None = None) -> None:
         if rate is not None:  # thinned alike: at most max_wall_rate × rate / self.rate a second

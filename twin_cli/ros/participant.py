@@ -20,6 +20,7 @@ from typing import Any
 
 from twin_cli.errors import RequestError
 from twin_cli.record.topics import Message, Topic
+from twin_cli.ros import graph
 from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
 from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, NODE_NAME, discovery_info
 from twin_cli.ros.scope import Scope, cyclone_config
@@ -75,6 +76,7 @@ class Participant:
         self._topics: dict[tuple[str, str], Any] = {}
         self._writers: dict[str, tuple[Any, type]] = {}
         self._readers: list[Any] = []
+        self._service_writers: list[Any] = []
         self._closed = False
         with self._lock:
             self._info_writer = self._open_info_writer()
@@ -107,10 +109,12 @@ class Participant:
                 return
             self._closed = True
             entities = [w for w, _ in self._writers.values()] + self._readers
+            entities += self._service_writers
             entities.append(self._info_writer[0])
             entities += [*self._topics.values(), self._participant, self._domain]
             self._writers.clear()
             self._readers.clear()
+            self._service_writers.clear()
         for entity in entities:
             _delete(entity)
 
@@ -127,6 +131,29 @@ class Participant:
             self._readers.append(reader)
             self._announce()
         return reader
+
+    def service(self, name: str, service_type: str) -> tuple[Any, Any]:
+        """A reader of service `name`'s requests and a writer of its replies (`service_types`:
+        DDS topics and types as rmw_cyclonedds_cpp maps them; QoS: services' default)."""
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.sub import DataReader
+
+        from twin_cli.ros import service_types as srv
+
+        qos = dds_qos(graph.DEFAULT_QOS, None)
+        with self._lock:
+            request = self._dds_topic(
+                srv.request_topic(name), srv.service_idl(service_type, srv.REQUEST)
+            )
+            reply = self._dds_topic(
+                srv.reply_topic(name), srv.service_idl(service_type, srv.RESPONSE)
+            )
+            reader = DataReader(self._participant, request, qos=qos)
+            writer = DataWriter(self._participant, reply, qos=qos)
+            self._readers.append(reader)
+            self._service_writers.append(writer)
+            self._announce()
+        return reader, writer
 
     def drop_reader(self, reader: Any) -> None:
         with self._lock:
@@ -161,17 +188,21 @@ class Participant:
         if self._closed:
             return
         writers = [w.get_guid().bytes for w, _ in self._writers.values()]
+        writers += [w.get_guid().bytes for w in self._service_writers]
         readers = [r.get_guid().bytes for r in self._readers]
         data = discovery_info(self._participant.get_guid().bytes, readers, writers, self.node)
         writer, sample_type = self._info_writer
         writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
 
     def _topic(self, name: str, type_name: str) -> Any:
+        return self._dds_topic(dds_topic(name), idl_type(type_name))
+
+    def _dds_topic(self, dds_name: str, idl: type) -> Any:
         from cyclonedds.topic import Topic as DdsTopic
 
-        key = (name, type_name)
+        key = (dds_name, idl.__name__)
         if key not in self._topics:
-            self._topics[key] = DdsTopic(self._participant, dds_topic(name), idl_type(type_name))
+            self._topics[key] = DdsTopic(self._participant, dds_name, idl)
         return self._topics[key]
 
 

@@ -9,15 +9,22 @@ rosbags (an independent reader) and prints one JSON document on stdout.
 It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo), where
 `ros2 node list` finds node names.
 
+It calls gazebo_ros' entity services as rmw_cyclonedds_cpp does: request and reply topics
+`rq/<service>Request` and `rr/<service>Reply`, types from the official gazebo_msgs `.srv`
+definitions with rmw's request header (`guid` uint64, `seq` int64) first; the reply's bytes are
+decoded by rosbags after the header.
+
 Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
-    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT
+    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT |
+    call SERVICE JSON_FIELDS
 """
 
 # No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
 
 import json
 import os
+import struct
 import sys
 import time
 from dataclasses import dataclass
@@ -30,7 +37,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.qos import Policy, Qos
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 CONFIG = (
     '<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
@@ -226,6 +233,75 @@ class ParticipantEntitiesInfo(
     node_entities_info_seq: types.sequence[NodeEntitiesInfo]
 
 
+# gazebo_msgs/srv: SpawnEntity, DeleteEntity, GetModelList (the official .srv fields)
+SERVICE_RESPONSES = {
+    "gazebo_msgs/srv/SpawnEntity_Response": "bool success\nstring status_message\n",
+    "gazebo_msgs/srv/DeleteEntity_Response": "bool success\nstring status_message\n",
+    "gazebo_msgs/srv/GetModelList_Response": (
+        "std_msgs/Header header\nstring[] model_names\nbool success\n"
+    ),
+}
+
+
+@dataclass
+class SpawnEntityRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::SpawnEntity_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    name: str
+    xml: str
+    robot_namespace: str
+    initial_pose: Pose
+    reference_frame: str
+
+
+@dataclass
+class SpawnEntityResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::SpawnEntity_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    success: bool
+    status_message: str
+
+
+@dataclass
+class DeleteEntityRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::DeleteEntity_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    name: str
+
+
+@dataclass
+class DeleteEntityResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::DeleteEntity_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    success: bool
+    status_message: str
+
+
+@dataclass
+class GetModelListRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::GetModelList_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    structure_needs_at_least_one_member: types.uint8 = 0
+
+
+@dataclass
+class GetModelListResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::GetModelList_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    header: Header
+    model_names: types.sequence[str]
+    success: bool
+
+
+SERVICES = {
+    "/spawn_entity": (SpawnEntityRequest, SpawnEntityResponse, "SpawnEntity"),
+    "/delete_entity": (DeleteEntityRequest, DeleteEntityResponse, "DeleteEntity"),
+    "/get_model_list": (GetModelListRequest, GetModelListResponse, "GetModelList"),
+}
+CLIENT_GUID = 0x5EED_0000_0000_0001  # this client's id in the request header
+SEQUENCE = 7
+
+
 def qos(latched: bool = False, depth: int = 1) -> Qos:
     """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last
     `depth` (1 as ROS's publishers keep; the graph's readers keep 100: one per participant)."""
@@ -355,6 +431,43 @@ def scan(seconds: float, topic: str) -> dict:
     return {"scans": out}
 
 
+def call(service: str, fields: dict) -> dict:
+    """One request to `service` once both topics are matched; the reply with this request's
+    header, decoded by rosbags from the bytes after the header."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    registered = {}  # rosbags files a parsed type under `.../msg/...`
+    for name, text in SERVICE_RESPONSES.items():
+        parsed = get_types_from_msg(text, name)
+        store.register(parsed)
+        registered[name] = next(iter(parsed))
+    request_type, reply_type, kind = SERVICES[service]
+    dp = participant()
+    name = service.lstrip("/")
+    writer = DataWriter(dp, Topic(dp, f"rq/{name}Request", request_type, qos=qos()), qos=qos())
+    reader = DataReader(dp, Topic(dp, f"rr/{name}Reply", reply_type, qos=qos()), qos=qos())
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and not (
+        writer.get_matched_subscriptions() and reader.get_matched_publications()
+    ):
+        time.sleep(0.05)
+    if "initial_pose" in fields:
+        p, q = fields["initial_pose"]["position"], fields["initial_pose"]["orientation"]
+        fields["initial_pose"] = Pose(Point(*p), Quaternion(*q))
+    writer.write(request_type(guid=CLIENT_GUID, seq=SEQUENCE, **fields))
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    while time.monotonic() < deadline + 30.0:
+        for cdr, info in ddspy_take(reader._ref, mask, 16):
+            if not info.valid_data:
+                continue
+            guid, seq = struct.unpack_from("<Qq", cdr, 4)
+            if (guid, seq) == (CLIENT_GUID, SEQUENCE):
+                name = registered[f"gazebo_msgs/srv/{kind}_Response"]
+                reply = store.deserialize_cdr(cdr[:4] + cdr[20:], name)
+                return {"reply": to_plain(reply), "header": [guid, seq]}
+        time.sleep(0.02)
+    return {"reply": None}
+
+
 def to_plain(value):
     if hasattr(value, "__dataclass_fields__"):
         return {k: to_plain(getattr(value, k)) for k in value.__dataclass_fields__ if k[0] != "_"}
@@ -376,6 +489,8 @@ if __name__ == "__main__":
         result = trajectory(*args)
     elif sys.argv[1] == "scan":
         result = scan(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "call":
+        result = call(sys.argv[2], json.loads(sys.argv[3]))
     else:
         stamped = sys.argv[1] == "drive_stamped"
         args = float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])

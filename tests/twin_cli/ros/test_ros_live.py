@@ -134,8 +134,8 @@ def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
 
 def test_the_nodes_are_announced_as_ros2_node_list_reads_them(served) -> None:
     """ros_discovery_info (transient local) names node /twin with a writer per published topic
-    (the publisher process's participant) and /twin_commands with a reader per input (the
-    server's)."""
+    (the publisher process's participant) and /twin_commands with a reader per input and the
+    entity services' readers and writers (the server's)."""
     root, _ = served
     got = _peer(root, "listen", "1", "bot")
     infos = [m for _, m in got["messages"]["ros_discovery_info"]]
@@ -147,8 +147,10 @@ def test_the_nodes_are_announced_as_ros2_node_list_reads_them(served) -> None:
     twin, commands = nodes[("/", "twin")], nodes[("/", "twin_commands")]
     assert len(twin["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
     assert not twin["reader_gid_seq"], "the publisher reads nothing"
-    readers = 2 * 3 + 4  # per bot: Twist, TwistStamped, forward velocity; rig: 3 + trajectory
+    readers = 2 * 3 + 4 + 3  # per bot: Twist, TwistStamped, forward velocity; rig: 3 +
+    # trajectory; a request reader per entity service
     assert len(commands["reader_gid_seq"]) == readers, "a reader per input"
+    assert len(commands["writer_gid_seq"]) == 3, "a reply writer per entity service"
     gids = twin["writer_gid_seq"] + commands["reader_gid_seq"]
     assert all(len(g["data"]) == 16 for g in gids), "GIDs of 16 bytes"
 
@@ -235,6 +237,54 @@ def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
             break
         time.sleep(0.2)
     assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
+
+
+def _names(root: Path) -> list[str]:
+    return [e["name"] for e in json.loads(_twin(root, "list", "--json"))]
+
+
+def test_gazebo_ros_entity_services_spawn_list_and_delete_as_the_cli_does(served) -> None:
+    """/spawn_entity, /get_model_list and /delete_entity called as an rmw_cyclonedds client
+    calls them (rmw's request header echoed in each reply): the spawned entity is where the
+    request put it (yaw 90 degrees, relative to the world, then to another entity); a refused
+    request (a taken name, an unknown reference frame, an unknown entity) says why and leaves
+    the world as it was."""
+    root, _ = served
+    listed = _peer(root, "call", "/get_model_list", "{}")
+    assert listed["header"] == [0x5EED_0000_0000_0001, 7], "reply without the request's header"
+    initial = _names(root)
+    assert listed["reply"]["success"] and listed["reply"]["model_names"] == initial
+    xml = dm.two_wheel_base("")
+    half = math.sqrt(0.5)
+    pose = {"position": [4.0, -4.0, 0.3], "orientation": [0.0, 0.0, half, half]}
+    request = {"name": "svc_bot", "xml": xml, "robot_namespace": "", "initial_pose": pose,
+               "reference_frame": "world"}  # fmt: skip
+    spawned = _peer(root, "call", "/spawn_entity", json.dumps(request))["reply"]
+    assert spawned["success"], spawned
+    at = json.loads(_twin(root, "pose", "svc_bot", "--json"))
+    assert (at["x"], at["y"]) == pytest.approx((4.0, -4.0), abs=0.02), f"spawned at {at}"
+    assert at["yaw"] == pytest.approx(math.pi / 2, abs=0.02), f"spawned with yaw {at['yaw']}"
+    before = _names(root)
+    again = _peer(root, "call", "/spawn_entity", json.dumps(request))["reply"]
+    assert not again["success"] and "svc_bot" in again["status_message"], again
+    unknown = {**request, "name": "svc_other", "reference_frame": "no_such_frame"}
+    refused = _peer(root, "call", "/spawn_entity", json.dumps(unknown))["reply"]
+    assert not refused["success"] and "no_such_frame" in refused["status_message"], refused
+    assert _names(root) == before, "a refused spawn changed the world"
+    ahead_1m = {"position": [1.0, 0.0, 0.0], "orientation": [0.0, 0.0, 0.0, 1.0]}
+    relative = {**request, "name": "svc_rel", "reference_frame": "svc_bot",
+                "initial_pose": ahead_1m}  # fmt: skip
+    base = json.loads(_twin(root, "pose", "svc_bot", "--json"))
+    assert _peer(root, "call", "/spawn_entity", json.dumps(relative))["reply"]["success"]
+    rel = json.loads(_twin(root, "pose", "svc_rel", "--json"))
+    ahead = (base["x"] + math.cos(base["yaw"]), base["y"] + math.sin(base["yaw"]))
+    assert (rel["x"], rel["y"]) == pytest.approx(ahead, abs=0.02), "1 m ahead of svc_bot"
+    for name in ("svc_rel", "svc_bot"):
+        deleted = _peer(root, "call", "/delete_entity", json.dumps({"name": name}))["reply"]
+        assert deleted["success"], deleted
+    assert _names(root) == initial, "the world after deleting what the services spawned"
+    gone = _peer(root, "call", "/delete_entity", json.dumps({"name": "svc_bot"}))["reply"]
+    assert not gone["success"] and "svc_bot" in gone["status_message"], gone
 
 
 def _server_sockets(pid: int) -> list:
