@@ -3,10 +3,10 @@
 Runs in its own interpreter (`python -m twin_cli.ros.publisher`, started by `RosRecording`),
 as a bag recording's encoder does, so computing link poses, building messages, CDR-encoding
 them (rosbags) and writing them to DDS never hold the stepping loop's GIL. It is the encoder's
-loop (`record.encoder.run_encoder`) with a DDS participant as its sink, and it publishes only
-the newest sample, at most `max_wall_rate` a wall second: a world faster than that is thinned
-(the newest is taken each time), as a ROS node could not take more anyway. The process holds
-its own participant (node `/twin`, the world's writers) in the scope the server was given.
+loop (`record.encoder.run_encoder`) with a DDS participant as its sink, and it publishes at
+most `max_wall_rate` samples a wall second: a world faster than that is thinned (the newest are
+taken each time), as a ROS node could not take more anyway; a slower one loses none. The
+process holds its own participant (node `/twin`, the world's writers) in the server's scope.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope
 
 NICE = 5  # added niceness: below the loop, above a bag's encoder (live data is waited for)
+BURST_S = 0.1  # [s] of max_wall_rate: records a late wake-up still publishes, not skips
 
 
 def command(fds: tuple[int, int], scope: Scope, max_wall_rate: float) -> list[str]:
@@ -86,31 +87,43 @@ class DdsSink:
 
 
 class LatestEncoder(Encoder):
-    """Publishes the newest record, at most `max_wall_rate` per wall second."""
+    """Publishes the records as they come, at most `max_wall_rate` per wall second (a token
+    bucket holding BURST_S of them): beyond that rate the newest are taken and the others
+    skipped, and a record that finds no token waits, replaced by any newer one."""
 
     def __init__(
         self, writer: DdsSink, times: Any, reader: Any, parent: int | None, max_wall_rate: float
     ) -> None:
         super().__init__(writer, times, reader, parent)
-        self.period = 1.0 / max_wall_rate  # [s] wall between published samples
-        self.idle_s = self.period
+        self.rate = max_wall_rate  # [1/s] wall
+        self.idle_s = 1.0 / max_wall_rate
+        self._burst = max(1.0, BURST_S * max_wall_rate)
+        self._tokens, self._filled = self._burst, time.monotonic()
         self._pending: tuple[int, Any] | None = None
-        self._next = 0.0  # [s] monotonic: when the next sample may go
 
     def encode(self, epoch: int, records: Any) -> None:
-        """Keeps the newest record (copied: the ring reuses its memory); sends it when due."""
-        self._pending = (epoch, records[-1:].copy())
-        self._send_if_due()
+        self._refill()
+        count = min(len(records), int(self._tokens))
+        if count:
+            self._pending = None
+            self._tokens -= count
+            super().encode(epoch, records[-count:])
+        else:  # copied: the ring reuses its memory
+            self._pending = (epoch, records[-1:].copy())
 
     def idle(self) -> None:
-        self._send_if_due()
+        self._refill()
+        if self._pending is not None and self._tokens >= 1.0:
+            self._tokens -= 1.0
+            pending, self._pending = self._pending, None
+            super().encode(*pending)
 
     def poll(self, conn: Any) -> dict | None:
-        """As the encoder's, and waits out the rest of the wall period first (a busy world's
-        records pile up in the ring meanwhile; only the newest is built)."""
-        wait = self._next - time.monotonic()
-        if wait > 0:
-            conn_pending(conn, wait)
+        """As the encoder's, after waiting for a token when none is left (a busy world's
+        records pile up in the ring meanwhile; only the newest are built)."""
+        self._refill()
+        if self._tokens < 1.0:
+            conn_pending(conn, (1.0 - self._tokens) / self.rate)
         return super().poll(conn)
 
     def close(self, figures: dict) -> None:
@@ -128,13 +141,10 @@ class LatestEncoder(Encoder):
         for topic, reading in message[1]:
             self.writer.write(sensor_message(topic, reading))
 
-    def _send_if_due(self) -> None:
+    def _refill(self) -> None:
         now = time.monotonic()
-        if self._pending is None or now < self._next:
-            return
-        super().encode(*self._pending)
-        self._pending = None
-        self._next = max(self._next, now - self.period) + self.period
+        self._tokens = min(self._burst, self._tokens + (now - self._filled) * self.rate)
+        self._filled = now
 
 
 if __name__ == "__main__":
