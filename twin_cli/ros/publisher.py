@@ -23,7 +23,7 @@ from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope
 
 NICE = 5  # added niceness: below the loop, above a bag's encoder (live data is waited for)
-BURST_S = 0.1  # [s] of max_wall_rate: records a late wake-up still publishes, not skips
+BURST_S = 0.05  # [s] of max_wall_rate: records a late wake-up still publishes, not skips
 
 
 def command(fds: tuple[int, int], scope: Scope, max_wall_rate: float) -> list[str]:

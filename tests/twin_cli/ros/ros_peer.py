@@ -14,6 +14,8 @@ It calls gazebo_ros' entity services as rmw_cyclonedds_cpp does: request and rep
 definitions with rmw's request header (`guid` uint64, `seq` int64) first; the reply's bytes are
 decoded by rosbags after the header.
 
+An ENTITY argument that starts with `/` is the whole topic (a name the robot's plugins gave).
+
 Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
     forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT |
@@ -364,11 +366,16 @@ def listen(seconds: float, entity: str) -> dict:
     return {"messages": out, "types": types_seen}
 
 
+def dds_name(entity: str, leaf: str) -> str:
+    """The DDS topic of `/<entity>/<leaf>`, or of `entity` itself when it is a topic (`/a/b`)."""
+    return "rt" + entity if entity.startswith("/") else f"rt/{entity}/{leaf}"
+
+
 def drive(entity: str, vx: float, wz: float, seconds: float, stamped: bool = False) -> dict:
     """Publishes a Twist (or TwistStamped) on /<entity>/cmd_vel every 0.1 s for `seconds`."""
     dp = participant()
     kind = TwistStamped if stamped else Twist
-    topic = Topic(dp, f"rt/{entity}/cmd_vel", kind, qos=qos())
+    topic = Topic(dp, dds_name(entity, "cmd_vel"), kind, qos=qos())
     writer = DataWriter(dp, topic, qos=qos())
     end, sent = time.monotonic() + seconds, 0
     while time.monotonic() < end:
@@ -397,7 +404,7 @@ def trajectory(entity: str, joint: str, position: float, at: float) -> dict:
     """Publishes one JointTrajectory (`joint` to `position` [rad or m] at `at` [s]) once it
     is matched, as a MoveIt or rqt_joint_trajectory_controller would."""
     dp = participant()
-    name = f"rt/{entity}/joint_trajectory_controller/joint_trajectory"
+    name = dds_name(entity, "joint_trajectory_controller/joint_trajectory")
     writer = DataWriter(dp, Topic(dp, name, JointTrajectory, qos=qos()), qos=qos())
     deadline = time.monotonic() + 10.0
     while not writer.get_matched_subscriptions() and time.monotonic() < deadline:

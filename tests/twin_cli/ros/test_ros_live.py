@@ -445,3 +445,75 @@ def test_the_bridge_follows_deletes_and_loads(served) -> None:
     assert got["/clock"] and got["/bot/joint_states"], "nothing after twin load"
     inputs = json.loads(_twin(root, "ros", "status", "--json"))["inputs"]
     assert "/bot/cmd_vel" in inputs and not [i for i in inputs if "twin_bot" in i], inputs
+
+
+NAMED_DIFF = DIFF.replace(
+    "</plugin>",
+    "<ros><namespace>/demo</namespace><remapping>cmd_vel:=cmd_demo</remapping></ros></plugin>",
+)
+CONTROLLERS_YAML = """controller_manager:
+  ros__parameters:
+    update_rate: 100
+    joint_state_broadcaster:
+      type: joint_state_broadcaster/JointStateBroadcaster
+    slide_controller:
+      type: joint_trajectory_controller/JointTrajectoryController
+    spin_speed:
+      type: velocity_controllers/JointGroupVelocityController
+slide_controller:
+  ros__parameters:
+    joints: [slide]
+    command_interfaces: [position]
+spin_speed:
+  ros__parameters:
+    joints: [spin]
+"""
+
+
+def test_inputs_take_the_names_the_robots_own_plugins_give(served) -> None:
+    """A diff drive's `<ros><namespace>/demo` and `<remapping>cmd_vel:=cmd_demo` make its
+    input /demo/cmd_demo; gazebo_ros2_control's `<parameters>` YAML (namespace /arm) replaces
+    the default controllers by its own: /arm/slide_controller/joint_trajectory and
+    /arm/spin_speed/commands. A Twist and a JointTrajectory sent there act."""
+    root, _ = served
+    base = root / "named_base.urdf"
+    base.write_text(dm.two_wheel_base(NAMED_DIFF))
+    _twin(root, "spawn", str(base), "--name", "named_bot", "-y", "-4", "--on-ground")
+    params = root / "controllers.yaml"
+    params.write_text(CONTROLLERS_YAML)
+    plugin = (
+        '<gazebo><plugin filename="libgazebo_ros2_control.so" name="gazebo_ros2_control">'
+        f"<ros><namespace>/arm</namespace></ros><parameters>{params}</parameters></plugin>"
+        "</gazebo></robot>"
+    )
+    rig = root / "named_rig.urdf"
+    rig.write_text(CONTROL_RIG.replace("</robot>", plugin))
+    _twin(root, "spawn", str(rig), "--name", "named_rig", "-x", "-6")
+    wanted = {
+        "/demo/cmd_demo",
+        "/arm/slide_controller/joint_trajectory",
+        "/arm/spin_speed/commands",
+    }
+    deadline = time.monotonic() + 10.0
+    while not wanted <= set(inputs := json.loads(_twin(root, "ros", "status", "--json"))["inputs"]):
+        assert time.monotonic() < deadline, f"inputs {inputs}, wanted {wanted}"
+        time.sleep(0.2)
+    kept = [i for i in inputs if i.startswith("/named_rig/") or i == "/named_bot/cmd_vel"]
+    assert not kept, f"default names kept beside the plugins' own: {kept}"
+    start = json.loads(_twin(root, "pose", "named_bot", "--json"))
+    assert _peer(root, "drive", "/demo/cmd_demo", "0.3", "0.0", "1.5")["matched"] == 1
+    end = json.loads(_twin(root, "pose", "named_bot", "--json"))
+    ahead, _, _ = _moved(start, end)
+    assert ahead > 0.1, f"named_bot moved {ahead} m on /demo/cmd_demo"
+    sent = _peer(
+        root, "trajectory", "/arm/slide_controller/joint_trajectory", "slide", "0.1", "0.5"
+    )
+    assert sent["matched"] == 1, "no reader on /arm/slide_controller/joint_trajectory"
+    deadline, position = time.monotonic() + 3.0, None
+    while time.monotonic() < deadline:
+        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "named_rig", "--json"))}
+        position = joints["slide"]["position"]
+        if abs(position - 0.1) < 0.005:
+            break
+        time.sleep(0.2)
+    assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
