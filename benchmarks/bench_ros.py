@@ -12,7 +12,9 @@ tests: it decodes every message with rosbags, as a ROS node on this machine woul
   `thread_vs_plain`: the same for the bridge's former design, measured in the same run: the
   messages built and published by a worker thread of the server (`Recording` with the
   participant as its sink) instead of the publisher process. `publisher_ms_per_sample`: the
-  publisher process's CPU per published sample (/proc).
+  publisher process's CPU per published sample (/proc); `server_threads_ms_per_sample`: the
+  CPU of the server's threads other than the stepping one (the interpreter's work beside the
+  loop: sensor readings, command polling, and in the former design the messages) per sample.
 - `realtime`: the real-time factor over 10 s at 1 kHz with the bridge publishing. Target 1.00.
 """
 
@@ -97,8 +99,11 @@ def throughput(robot: Path) -> dict:
         "ros_vs_plain_loop_cpu": now["cpu"],
         "published_samples": now["samples"],
         "publisher_ms_per_sample": 1e3 * cpu / max(1, now["samples"]),
+        "server_threads_ms_per_sample": 1e3 * now["others_s"] / max(1, now["samples"]),
         "thread_vs_plain": before["wall"],
         "thread_vs_plain_loop_cpu": before["cpu"],
+        "thread_published_samples": before["samples"],
+        "thread_server_threads_ms_per_sample": 1e3 * before["others_s"] / max(1, before["samples"]),
     }
 
 
@@ -123,10 +128,13 @@ def _paired(world: World, recording: Any) -> dict:
     recording.set_sampling(False)
     before = recording.status().samples
     paired = {"pairs": PAIRS, "prepare": prepare, "settle": settle}
+    process, loop = _cpu_s(os.getpid()), time.thread_time()
     wall = interleaved_ratio(plain, sampled, **paired)
     cpu = interleaved_ratio(plain, sampled, clock=time.thread_time, **paired)
     time.sleep(0.1)  # the last samples published
-    return {"wall": wall, "cpu": cpu, "samples": recording.status().samples - before}
+    others = _cpu_s(os.getpid()) - process - (time.thread_time() - loop)
+    samples = recording.status().samples - before
+    return {"wall": wall, "cpu": cpu, "samples": samples, "others_s": others}
 
 
 def _cpu_s(pid: int | None) -> float:

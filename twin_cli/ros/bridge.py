@@ -53,11 +53,11 @@ class RosBridge:
                 world, scope, rate=rate, max_wall_rate=WALL_SPEEDUP * rate,
                 frame_prefix=frame_prefix,
             )  # fmt: skip
+            self.commands = CommandListener(world, self.participant)
+            self.services = ServiceServer(world, self.participant)
         except BaseException:
             self.participant.close()
             raise
-        self.commands = CommandListener(world, self.participant)
-        self.services = ServiceServer(world, self.participant)
 
     def start(self) -> RosBridge:
         """Starts the publisher process and waits until it is on the graph.

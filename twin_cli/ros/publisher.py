@@ -35,11 +35,11 @@ def main(argv: list[str]) -> None:
     """`python -m twin_cli.ros.publisher RING_FD PIPE_FD SCOPE_JSON MAX_WALL_RATE`."""
     from multiprocessing.connection import Connection
 
-    from twin_cli.record import messages, ring
+    from twin_cli.record import layout, messages, recorder, ring, sensor_messages  # noqa: F401
 
     parent = os.getppid()
     signals()
-    messages.typestore()  # rosbags' types, before the first sample
+    messages.typestore()  # rosbags' types (and the imports above) before NICE: first samples
     fields = json.loads(argv[2])
     scope = Scope(**{**fields, "peers": tuple(fields["peers"])})
     conn = Connection(int(argv[1]))
