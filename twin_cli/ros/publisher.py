@@ -22,8 +22,7 @@ from twin_cli.record.topics import Message, Topic
 from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope
 
-NICE = 5  # added niceness: below the loop, above a bag's encoder (live data is waited for)
-BURST_S = 0.05  # [s] of max_wall_rate: records a late wake-up still publishes, not skips
+BURST_S = 0.1  # [s] of max_wall_rate: a real-time publisher may stall 0.2 s and lose no sample
 
 
 def command(fds: tuple[int, int], scope: Scope, max_wall_rate: float) -> list[str]:
@@ -39,7 +38,7 @@ def main(argv: list[str]) -> None:
 
     parent = os.getppid()
     signals()
-    messages.typestore()  # rosbags' types (and the imports above) before NICE: first samples
+    messages.typestore()  # rosbags' types (and the imports above) before the first sample
     fields = json.loads(argv[2])
     scope = Scope(**{**fields, "peers": tuple(fields["peers"])})
     conn = Connection(int(argv[1]))
@@ -48,7 +47,8 @@ def main(argv: list[str]) -> None:
     except Exception as exc:  # Cyclone refused the scope: the parent reads why
         conn.send(("done", str(exc)))
         return
-    os.nice(NICE)
+    # not niced, unlike a bag's encoder, whose ring keeps every sample until it gets the CPU:
+    # live samples are thinned, so a starved publisher would skip them
     buf, head, times = ring.views(ring.attach(int(argv[0])))
     reader = ring.RingReader(buf, head)
     encoder = LatestEncoder(DdsSink(participant), times, reader, parent, float(argv[3]))
