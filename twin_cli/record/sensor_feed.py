@@ -137,7 +137,8 @@ class SensorFeed:
 
     def _since(self, entity: str, name: str, now: float) -> float:
         """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
-        the clock went back) this very instant on."""
+        the clock went back) this very instant on; with `wall_share`, only the newest that the
+        wall time since the last look allows."""
         last = self._last.get((entity, name))
         if last is None or last > now:
             last = self._last[(entity, name)] = now - 1e-9
@@ -147,7 +148,8 @@ class SensorFeed:
         wall = time.monotonic()
         allowed = (wall - self._looked.get((entity, name), 0.0)) * self.wall_share * rate
         self._looked[(entity, name)] = wall
-        return max(last, now - max(1.0, allowed) / rate)
+        # the newest max(1, allowed): within that many periods and a half of now
+        return max(last, now - (max(1.0, allowed) + 0.5) / rate)
 
     def _drop(self, entity: str, name: str, error: Exception) -> None:
         if (entity, name) in self.dropped:
