@@ -14,7 +14,9 @@ tests: it decodes every message with rosbags, as a ROS node on this machine woul
   participant as its sink) instead of the publisher process. `publisher_ms_per_sample`: the
   publisher process's CPU per published sample (/proc); `server_threads_ms_per_sample`: the
   CPU of the server's threads other than the stepping one (the interpreter's work beside the
-  loop: sensor readings, command polling, and in the former design the messages) per sample.
+  loop: sensor readings, command polling, and in the former design the messages) per sample;
+  `subscriber_ms_per_sample`: the subscriber's (it decodes each message twice, with rosbags
+  and with its IDL types: a test's check, far more than a C++ node's cost).
 - `realtime`: the real-time factor over 10 s at 1 kHz with the bridge publishing. Target 1.00.
 """
 
@@ -80,19 +82,22 @@ def throughput(robot: Path) -> dict:
     bridge = RosBridge(world, scope_from({"ROS_DOMAIN_ID": DOMAIN_ID})).start()
     bridge.commands.stop()  # no command comes: its thread only polls
     bridge.services.stop()
-    with _subscriber():
+    with _subscriber() as peer:
         time.sleep(2.0)  # discovery done before timing
-        cpu_before = _cpu_s(bridge.recording.encoder_pid)
+        cpu_before, peer_before = _cpu_s(bridge.recording.encoder_pid), _cpu_s(peer)
         now = _paired(world, bridge.recording)
         cpu = _cpu_s(bridge.recording.encoder_pid) - cpu_before
+        peer_cpu = _cpu_s(peer) - peer_before
     bridge.stop()
     thread = Recording(
         world, [Participant(scope_from({"ROS_DOMAIN_ID": DOMAIN_ID}))], rate=RATE,
         latest_only=True, max_wall_rate=WALL_SPEEDUP * RATE,
     ).start()  # fmt: skip
-    with _subscriber():
+    with _subscriber() as peer:
         time.sleep(2.0)
+        peer_before = _cpu_s(peer)
         before = _paired(world, thread)
+        thread_peer_cpu = _cpu_s(peer) - peer_before
     thread.stop()
     return {
         "ros_vs_plain": now["wall"],
@@ -100,10 +105,12 @@ def throughput(robot: Path) -> dict:
         "published_samples": now["samples"],
         "publisher_ms_per_sample": 1e3 * cpu / max(1, now["samples"]),
         "server_threads_ms_per_sample": 1e3 * now["others_s"] / max(1, now["samples"]),
+        "subscriber_ms_per_sample": 1e3 * peer_cpu / max(1, now["samples"]),
         "thread_vs_plain": before["wall"],
         "thread_vs_plain_loop_cpu": before["cpu"],
         "thread_published_samples": before["samples"],
         "thread_server_threads_ms_per_sample": 1e3 * before["others_s"] / max(1, before["samples"]),
+        "thread_subscriber_ms_per_sample": 1e3 * thread_peer_cpu / max(1, before["samples"]),
     }
 
 
@@ -164,12 +171,13 @@ def realtime(robot: Path) -> dict:
 class _subscriber:  # noqa: N801 - a context manager used as `with _subscriber():`
     """The tests' ROS peer in another process, taking the state topics of `h`."""
 
-    def __enter__(self) -> None:
+    def __enter__(self) -> int:
         env = {**os.environ, "ROS_DOMAIN_ID": DOMAIN_ID}
         self._proc = subprocess.Popen(
             [sys.executable, str(PEER), "listen", "600", "h"],
             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         )  # fmt: skip
+        return self._proc.pid
 
     def __exit__(self, *_: object) -> None:
         self._proc.terminate()
