@@ -22,7 +22,8 @@ from twin_cli.record.topics import Message, Topic
 from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope
 
-BURST_S = 0.1  # [s] of max_wall_rate: a real-time publisher may stall 0.2 s and lose no sample
+BURST_S = 1.0  # [s]: a publisher stalled this long still sends every record of a world running
+# up to max_wall_rate's speed (tokens build up only while records wait in the ring)
 
 
 def command(fds: tuple[int, int], scope: Scope, max_wall_rate: float) -> list[str]:
@@ -88,8 +89,9 @@ class DdsSink:
 
 class LatestEncoder(Encoder):
     """Publishes the records as they come, at most `max_wall_rate` per wall second (a token
-    bucket holding BURST_S of them): beyond that rate the newest are taken and the others
-    skipped, and a record that finds no token waits, replaced by any newer one."""
+    bucket holding up to BURST_S of them while records wait, one while the ring is empty):
+    beyond that rate the newest are taken and the others skipped, and a record that finds no
+    token waits, replaced by any newer one."""
 
     def __init__(
         self, writer: DdsSink, times: Any, reader: Any, parent: int | None, max_wall_rate: float
@@ -112,11 +114,14 @@ class LatestEncoder(Encoder):
             self._pending = (epoch, records[-1:].copy())
 
     def idle(self) -> None:
+        """The ring is empty: the waiting record goes if due, and no burst is saved up (only a
+        publisher that fell behind, its records waiting in the ring, spends one)."""
         self._refill()
         if self._pending is not None and self._tokens >= 1.0:
             self._tokens -= 1.0
             pending, self._pending = self._pending, None
             super().encode(*pending)
+        self._tokens = min(self._tokens, 1.0)
 
     def poll(self, conn: Any) -> dict | None:
         """As the encoder's, after waiting for a token when none is left (a busy world's
