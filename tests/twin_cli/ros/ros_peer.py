@@ -16,7 +16,7 @@ decoded by rosbags after the header.
 
 An ENTITY argument that starts with `/` is the whole topic (a name the robot's plugins gave).
 
-Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
+Usage: python ros_peer.py listen SECONDS ENTITY | drain SECONDS ENTITY | scan SECONDS TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
     forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT |
     call SERVICE JSON_FIELDS
@@ -328,6 +328,25 @@ def participant() -> DomainParticipant:
     return DomainParticipant(domain_id)
 
 
+def drain(seconds: float, entity: str) -> dict:
+    """Takes the world's state topics for `seconds` as bytes, decoding none (a compiled node's
+    receiving, for benchmarks)."""
+    dp = participant()
+    names = ["/clock", "/tf", f"/{entity}/joint_states", f"/{entity}/odom"]
+    kinds = [Clock, TFMessage, JointState, Odometry]
+    readers = [
+        DataReader(dp, Topic(dp, "rt" + n, k, qos=qos()), qos=qos())
+        for n, k in zip(names, kinds, strict=True)
+    ]
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    taken, end = 0, time.monotonic() + seconds
+    while time.monotonic() < end:
+        for reader in readers:
+            taken += len(ddspy_take(reader._ref, mask, 64))
+        time.sleep(0.01)
+    return {"taken": taken}
+
+
 def listen(seconds: float, entity: str) -> dict:
     """Every message of the world's topics for `seconds` of wall time, decoded by rosbags."""
     store = get_typestore(Stores.ROS2_JAZZY)
@@ -488,6 +507,8 @@ def to_plain(value):
 if __name__ == "__main__":
     if sys.argv[1] == "listen":
         result = listen(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "drain":
+        result = drain(float(sys.argv[2]), sys.argv[3])
     elif sys.argv[1] == "forward":
         values = [float(v) for v in sys.argv[5:]]
         result = forward(sys.argv[2], sys.argv[3], float(sys.argv[4]), values)
