@@ -46,7 +46,7 @@ class BagRecording(Follows):
     def __init__(
         self,
         world: World,
-        path: str | Path,
+        path: str | Path | None,
         *,
         rate: float = 100.0,
         entities: Sequence[str] = (),
@@ -58,6 +58,7 @@ class BagRecording(Follows):
     ) -> None:
         """Args: as `Recording`, with the output file instead of sinks; `ring_bytes` [B] is the
         shared buffer between the loop and the encoder (when full, the loop waits for it).
+        `path` None: a subclass whose `_encoder_command` runs an encoder of its own.
 
         Raises:
             RequestError: the file exists or cannot be written.
@@ -69,8 +70,9 @@ class BagRecording(Follows):
         self._sampler = Sampler(world, entities, descriptions, frame_prefix)  # checks the names
         self._entities, self._descriptions = tuple(entities), descriptions
         self._frame_prefix = self._sampler.frame_prefix
-        open_output(path, overwrite=overwrite).close()  # the errors, here and now
-        self.path = Path(path).expanduser()
+        if path is not None:
+            open_output(path, overwrite=overwrite).close()  # the errors, here and now
+        self.path = None if path is None else Path(path).expanduser()
         self._world, self._duration = world, duration
         fd, self._memory = ring.allocate(ring_bytes // 8)
         data, self._header, self._span = ring.views(self._memory)
@@ -94,7 +96,7 @@ class BagRecording(Follows):
     def start(self) -> BagRecording:
         """Starts the encoder, takes the first sample now and follows the world's stepping."""
         fds = (self._ring_fd, self._child.fileno())
-        command = [sys.executable, "-m", "twin_cli.record.encoder", *map(str, fds), str(self.path)]
+        command = self._encoder_command(fds)
         self._process = subprocess.Popen(command, pass_fds=fds, stdin=subprocess.DEVNULL)
         os.close(self._ring_fd)
         self._child.close()
@@ -107,6 +109,10 @@ class BagRecording(Follows):
                 self._handle = self._world.add_observer(self._capture, self.rate)
         self._follow_sensors(self._world)
         return self
+
+    def _encoder_command(self, fds: tuple[int, int]) -> list[str]:
+        """The encoder process's command line, given the ring's and the pipe's descriptors."""
+        return [sys.executable, "-m", "twin_cli.record.encoder", *map(str, fds), str(self.path)]
 
     def capture_now(self) -> None:
         """Takes one sample now (for callers that step the world themselves)."""

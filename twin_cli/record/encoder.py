@@ -29,7 +29,7 @@ def main(argv: list[str]) -> None:
     from twin_cli.record import ring
 
     parent = os.getppid()
-    _signals()
+    signals()
     _warm_up()
     ring_fd, pipe_fd, path = int(argv[0]), int(argv[1]), argv[2]
     # Below the loop's priority: on a busy machine the loop keeps its CPU and the encoder works
@@ -47,8 +47,15 @@ def encode_main(memory: Any, conn: Any, path: str, parent: int | None = None) ->
     from twin_cli.record.recorder import BagSink
 
     buf, head, times = ring.views(memory)
-    reader = ring.RingReader(buf, head)
-    encoder = _Encoder(BagSink(path, overwrite=True), times, reader, parent)
+    encoder = Encoder(BagSink(path, overwrite=True), times, ring.RingReader(buf, head), parent)
+    run_encoder(encoder, conn, head)
+
+
+def run_encoder(encoder: Encoder, conn: Any, head: Any) -> None:
+    """The encoder's loop: records from the ring and messages from the pipe to `encoder`'s
+    sink until "stop" (or the parent's end), then the rest of the ring; "done" to the parent."""
+    from twin_cli.record import ring
+
     error, stop = None, None
     try:
         conn.send(("ready", None))
@@ -59,7 +66,7 @@ def encode_main(memory: Any, conn: Any, path: str, parent: int | None = None) ->
         while True:
             write = int(head[ring.WRITE])  # first: the layouts of these records are sent
             stop = encoder.poll(conn)  # layouts, sensor readings, stop
-            runs = reader.read(write, BATCH)
+            runs = encoder.reader.read(write, BATCH)
             for epoch, records in runs:
                 encoder.encode(epoch, records)
             head[ring.SAMPLES] = encoder.samples
@@ -67,8 +74,8 @@ def encode_main(memory: Any, conn: Any, path: str, parent: int | None = None) ->
                 continue  # (records written after `write` was read, before "stop")
             if stop is not None:  # never wait on the pipe after "stop": a parent that dies
                 break  # then leaves it readable (at its end) for ever
-            encoder.writer.writer.flush_if_due()  # idle: what is written reaches the file
-            conn_pending(conn, IDLE_S)  # the ring fills meanwhile; a message wakes it
+            encoder.idle()
+            conn_pending(conn, encoder.idle_s)  # the ring fills meanwhile; a message wakes it
     except Exception as exc:  # disk full...: report it to the parent
         error = f"{type(exc).__name__}: {exc}"
     finally:
@@ -86,7 +93,7 @@ def encode_main(memory: Any, conn: Any, path: str, parent: int | None = None) ->
 _TERMINATED: list[int] = []  # the signal that asked this process to end, once one did
 
 
-def _signals() -> None:
+def signals() -> None:
     """Ctrl-C reaches the whole foreground group: the server decides when the recording ends
     (it sends "stop"). SIGTERM (a group or a cgroup ended) finishes the file as a stop does."""
     import signal
@@ -104,8 +111,10 @@ def _warm_up() -> None:
     messages.typestore()
 
 
-class _Encoder:
-    """Turns records into messages with the layouts the parent sent."""
+class Encoder:
+    """Turns records into messages with the layouts the parent sent, for `writer` (a sink)."""
+
+    idle_s = IDLE_S  # [s] wait on the pipe when the ring is empty
 
     def __init__(self, writer: Any, times: Any, reader: Any, parent: int | None) -> None:
         from twin_cli.record.recorder import Publisher
@@ -164,6 +173,10 @@ class _Encoder:
                 self.times[0] = sent.times[0]
             self.times[1] = sent.times[-1]
             self.samples += len(sent)
+
+    def idle(self) -> None:
+        """The ring is empty: what is written reaches the file."""
+        self.writer.writer.flush_if_due()
 
     def close(self, figures: dict) -> None:
         self.writer.writer.custom_data = {k: str(v) for k, v in figures.items()}

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import time
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -69,6 +70,10 @@ class SensorFeed:
         self.dropped: dict[tuple[str, str], str] = {}  # (entity, sensor) → why
         self._kept: dict[str, set[str]] = {}  # entity → its sensors with a history
         self._last: dict[tuple[str, str], float] = {}  # (entity, sensor) → last sample [s]
+        # a live view's thinning: at most wall_share × rate kept samples of a sensor per wall
+        # second (the newest); None: every one (a bag)
+        self.wall_share: float | None = None
+        self._looked: dict[tuple[str, str], float] = {}  # (entity, sensor) → wall time [s]
 
     def rates(self) -> list[float]:
         """[Hz] of sim time to call `capture(rate)` at, one per distinct sensor rate, fastest
@@ -132,11 +137,19 @@ class SensorFeed:
 
     def _since(self, entity: str, name: str, now: float) -> float:
         """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
-        the clock went back) this very instant on."""
+        the clock went back) this very instant on; with `wall_share`, only the newest that the
+        wall time since the last look allows."""
         last = self._last.get((entity, name))
         if last is None or last > now:
             last = self._last[(entity, name)] = now - 1e-9
-        return last
+        if self.wall_share is None:
+            return last
+        rate = self._suites[entity].specs[name].update_rate or 1.0 / self._world.model.opt.timestep
+        wall = time.monotonic()
+        allowed = (wall - self._looked.get((entity, name), 0.0)) * self.wall_share * rate
+        self._looked[(entity, name)] = wall
+        # the newest max(1, allowed): within that many periods and a half of now
+        return max(last, now - (max(1.0, allowed) + 0.5) / rate)
 
     def _drop(self, entity: str, name: str, error: Exception) -> None:
         if (entity, name) in self.dropped:

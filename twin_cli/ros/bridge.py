@@ -1,16 +1,16 @@
 """The world on the live ROS 2 graph: its topics published over DDS, its drives commanded.
 
-A bridge is a live recording (`twin_cli.record.Recording`, the one that feeds the Foxglove
-stream) whose sink is the DDS participant: the stepping thread only copies a sample at RATE Hz
-of sim time (a world observer); the recording's worker builds the ROS messages with the
-recorder's code and the participant publishes their CDR bytes. So the live topics, types, frame
-names and stamps are those of a recording, sensors included, `/tf_static` and
-`robot_description` are sent when an entity comes or goes, and a paused world's state is sent
-again every half second. The worker keeps only the newest sample while it is busy, so the loop
-never waits for DDS, and takes at most WALL_SPEEDUP × RATE samples per wall second: a world up
-to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
-echo`), so building messages never takes the interpreter from the loop in proportion to its
-speed. `CommandListener` takes `cmd_vel` and forward controller commands the other way.
+A bridge samples the world as a bag recording does (`live_recording.RosRecording`): the
+stepping thread copies the state at RATE Hz of sim time into shared memory, and a publisher
+process (`publisher`) builds the ROS messages with the recorder's code and publishes their CDR
+bytes from a participant of its own (node `/twin`). So the live topics, types, frame names and
+stamps are those of a recording, sensors included; `/tf_static` and `robot_description` are
+sent when an entity comes or goes, and a paused world's state is sent again every half second.
+The publisher sends only the newest sample, at most WALL_SPEEDUP × RATE a wall second: a world
+up to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
+echo`), and none of this holds the loop's interpreter. `CommandListener` takes `cmd_vel` and
+the controllers' topics the other way, and `ServiceServer` answers gazebo_ros' entity services,
+through the server's participant (node `/twin_commands`).
 """
 
 from __future__ import annotations
@@ -18,18 +18,22 @@ from __future__ import annotations
 import threading
 from typing import TYPE_CHECKING, Any
 
-from twin_cli.errors import InvalidRequestError
+from twin_cli.errors import InvalidRequestError, RequestError
 from twin_cli.live.budget import WALL_SPEEDUP
 from twin_cli.live.catalogue import STATE_RATE
-from twin_cli.record.recorder import Recording
+from twin_cli.record import messages as ros_messages
 from twin_cli.ros.commands import CommandListener
+from twin_cli.ros.live_recording import RosRecording
+from twin_cli.ros.node import COMMANDS_NODE_NAME
 from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope, scope_from
+from twin_cli.ros.services import ServiceServer
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
 
 RATE = STATE_RATE  # [Hz] of sim time: /clock, /tf, joint_states and odom (Gazebo's default 100)
+STOP_PATIENCE_S = 10.0  # [s] for the publisher to leave the graph
 
 
 class RosBridge:
@@ -39,33 +43,52 @@ class RosBridge:
         self, world: World, scope: Scope, *, rate: float = RATE, frame_prefix: str | None = None
     ) -> None:
         """Raises: RequestError: Cyclone DDS cannot start in that scope."""
+        # rosbags' types (the node's announcement), built here rather than by the command
+        # thread beside a running loop: the build holds the interpreter for ~0.1 s
+        ros_messages.typestore()
         self.scope = scope
-        self.participant = Participant(scope)
+        self.participant = Participant(scope, COMMANDS_NODE_NAME)
         try:
-            self.recording = Recording(
-                world, [self.participant], rate=rate, latest_only=True,
-                frame_prefix=frame_prefix, max_wall_rate=WALL_SPEEDUP * rate,
+            self.recording = RosRecording(
+                world, scope, rate=rate, max_wall_rate=WALL_SPEEDUP * rate,
+                frame_prefix=frame_prefix,
             )  # fmt: skip
+            self.commands = CommandListener(world, self.participant)
+            self.services = ServiceServer(world, self.participant)
         except BaseException:
             self.participant.close()
             raise
-        self.commands = CommandListener(world, self.participant)
 
     def start(self) -> RosBridge:
+        """Starts the publisher process and waits until it is on the graph.
+
+        Raises: RequestError: the publisher could not start (its cause)."""
         self.recording.start()
+        if not self.recording.ready():
+            error = self.recording.stop(patience=STOP_PATIENCE_S).error
+            self.participant.close()
+            raise RequestError(
+                f"ROS 2 publisher ({self.scope.describe()})",
+                f"did not start ({error or 'no answer'})",
+                "see the server log (`twin logs`)",
+            )
         self.commands.start()
+        self.services.start()
         return self
 
     def retarget(self, world: World) -> None:
         """Follows the world the server loaded (its entities' topics and drives)."""
         self.recording.retarget(world)
         self.commands.retarget(world)
+        self.services.retarget(world)
 
     def stop(self) -> dict[str, Any]:
-        """Stops listening and publishing; the participant leaves the graph."""
+        """Stops listening and publishing; both participants leave the graph."""
         status = self.status()
         self.commands.stop()
-        self.recording.stop()  # closes its sink: the participant
+        self.services.stop()
+        self.recording.stop(patience=STOP_PATIENCE_S)
+        self.participant.close()
         return status
 
     def status(self) -> dict[str, Any]:
@@ -74,12 +97,15 @@ class RosBridge:
             "domain_id": self.scope.domain_id,
             "range": self.scope.range,
             "local_only": self.scope.local_only,
+            "loopback_device": self.participant.on_loopback_device,
             "scope": self.scope.describe(),
             "rate": self.recording.rate,
             "samples": recording.samples,
             "error": recording.error,
             "inputs": self.commands.topics,
             "commands": self.commands.commands,
+            "services": self.services.names,
+            "service_calls": self.services.calls,
         }
 
 

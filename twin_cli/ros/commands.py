@@ -11,6 +11,9 @@ command controllers, acted on through the calls `twin drive` and `twin command` 
   `twin joints` lists them; it goes to `World.command_joints` (all or none).
 - With position joints, `/<entity>/joint_trajectory_controller/joint_trajectory`
   (trajectory_msgs/JointTrajectory) goes to `follow_trajectory`, as `twin trajectory` does.
+- Where the robot's description names them (`plugin_names`), its drive plugin's namespace and
+  remapping rename `cmd_vel`, and the controllers of its gazebo_ros2_control YAML replace the
+  default controllers, with their joints in the YAML's order.
 
 A thread of the bridge's own polls the readers every POLL_S and follows spawns and deletes. A
 command that is refused (a sideways speed for a diff drive, a wrong number of targets) is
@@ -28,9 +31,9 @@ from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST, TWIST_STAMPED
+from twin_cli.ros.plugin_names import TRAJECTORY, Controller, plugin_names
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
-TRAJECTORY = "trajectory"  # an Input's mode: joint_trajectory_controller's topic
 
 if TYPE_CHECKING:
     from twin_cli.ros.participant import Participant
@@ -56,27 +59,42 @@ class Input:
 
 
 def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
-    """Each entity's inputs now: cmd_vel for a drive, a forward controller per command mode."""
+    """Each entity's inputs now: cmd_vel for a drive, and its controllers (the description's,
+    else a forward controller per command mode and a trajectory controller)."""
     with world.lock:
-        out = {}
-        for name in world.entity_names():
-            inputs = []
-            drives = [type(p).__name__ for p in world.entity(name).plugins]
-            drives = [k for k in drives if k in CONTROLLERS]
-            if drives:
-                topic = f"/{name}/cmd_vel"
-                inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
-            rows = world.joint_commands(name)
-            for mode in MODES:
-                joints = tuple(j for j, row in rows.items() if mode in row["modes"])
-                if joints:
-                    topic = f"/{name}/forward_{mode}_controller/commands"
-                    inputs.append(Input(topic, FLOAT64_ARRAY, mode, joints))
-                if joints and mode == "position":
-                    topic = f"/{name}/joint_trajectory_controller/joint_trajectory"
-                    inputs.append(Input(topic, JOINT_TRAJECTORY, TRAJECTORY, joints))
-            out[name] = tuple(inputs)
-        return out
+        return {name: _inputs(world, name) for name in world.entity_names()}
+
+
+def _inputs(world: World, name: str) -> tuple[Input, ...]:
+    entity = world.entity(name)
+    drives = [k for k in (type(p).__name__ for p in entity.plugins) if k in CONTROLLERS]
+    named = plugin_names(name, entity.description)
+    inputs = []
+    if drives:
+        topic = named.cmd_vel or f"/{name}/cmd_vel"
+        inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
+    if named.controllers:
+        return (*inputs, *(_controller_input(c) for c in named.controllers))
+    return (*inputs, *_default_controllers(name, world.joint_commands(name)))
+
+
+def _default_controllers(name: str, rows: dict[str, Any]) -> list[Input]:
+    """ros2_control demos' controller names, over every joint offering each mode."""
+    inputs = []
+    for mode in MODES:
+        joints = tuple(j for j, row in rows.items() if mode in row["modes"])
+        if joints:
+            topic = f"/{name}/forward_{mode}_controller/commands"
+            inputs.append(Input(topic, FLOAT64_ARRAY, mode, joints))
+        if joints and mode == "position":
+            topic = f"/{name}/joint_trajectory_controller/joint_trajectory"
+            inputs.append(Input(topic, JOINT_TRAJECTORY, TRAJECTORY, joints))
+    return inputs
+
+
+def _controller_input(controller: Controller) -> Input:
+    kind = JOINT_TRAJECTORY if controller.mode == TRAJECTORY else FLOAT64_ARRAY
+    return Input(controller.topic, kind, controller.mode, controller.joints)
 
 
 def twist_of(message: Any) -> tuple[float, float, float]:

@@ -69,9 +69,10 @@ def user_data(name: str) -> bytes:
     return f"typehash={ros.definition(name).rihs01};".encode()
 
 
-def dds_qos(qos: Qos, name: str) -> Any:
+def dds_qos(qos: Qos, name: str | None) -> Any:
     """`qos` as a cyclonedds Qos for an endpoint of message type `name` (plain CDR, XCDR1, as
-    rmw_cyclonedds_cpp writes it)."""
+    rmw_cyclonedds_cpp writes it); `name` None: no type hash (a service's halves: rmw hashes
+    the service's whole description, which rosbags does not build)."""
     from cyclonedds.qos import Policy
     from cyclonedds.qos import Qos as CycloneQos
 
@@ -83,13 +84,15 @@ def dds_qos(qos: Qos, name: str) -> Any:
     durability = (
         Policy.Durability.TransientLocal if qos.transient_local else Policy.Durability.Volatile
     )
-    return CycloneQos(
+    policies = [
         reliability,
         durability,
         Policy.History.KeepLast(qos.depth),
         Policy.DataRepresentation(use_cdrv0_representation=True),
-        Policy.Userdata(user_data(name)),
-    )
+    ]
+    if name is not None:
+        policies.append(Policy.Userdata(user_data(name)))
+    return CycloneQos(*policies)
 
 
 @cache
@@ -98,11 +101,16 @@ def idl_type(name: str) -> Any:
     type name and members, nested types included, as rosidl generates them."""
     from cyclonedds.idl import make_idl_struct
 
+    return make_idl_struct(name.rsplit("/", 1)[1] + "_", dds_type(name), idl_members(name))
+
+
+def idl_members(name: str) -> dict[str, Any]:
+    """The IDL members of message type `name` (rosidl's one uint8 for an empty message)."""
     _, fields = ros.typestore().fielddefs[name]
     members = {field: _member(node, detail) for field, (node, detail) in fields}
     if not members:
         members[_EMPTY_MEMBER] = _base("uint8")
-    return make_idl_struct(name.rsplit("/", 1)[1] + "_", dds_type(name), members)
+    return members
 
 
 def _member(node: int, detail: Any) -> Any:

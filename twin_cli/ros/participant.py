@@ -6,8 +6,9 @@ Writers send the CDR bytes rosbags encoded (a recording's very bytes) through a 
 `graph.idl_type`, so subscribers see the types rmw_cyclonedds_cpp announces; readers hand back
 the cyclonedds objects of those same types.
 
-As a recording sink (`set_topics`, `write`, `close`) it runs in the recording's worker thread;
-readers are polled by the command thread. Cyclone's entities are thread safe.
+As a recording sink (`set_topics`, `write`, `close`) it runs in the bridge's publisher process
+(node `/twin`); the server's own participant holds the readers (node `/twin_commands`), polled
+by the command thread. Cyclone's entities are thread safe.
 """
 
 from __future__ import annotations
@@ -19,9 +20,11 @@ from typing import Any
 
 from twin_cli.errors import RequestError
 from twin_cli.record.topics import Message, Topic
+from twin_cli.ros import graph
 from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
-from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, discovery_info
+from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, NODE_NAME, discovery_info
 from twin_cli.ros.scope import Scope, cyclone_config
+from twin_cli.ros.sockets import confine_to_loopback, open_sockets
 
 log = logging.getLogger("twin.ros")
 
@@ -42,9 +45,10 @@ def _encoded_type(name: str) -> type:
 
 
 class Participant:
-    """A DDS participant in `scope`'s domain, with a writer per topic set by `set_topics`."""
+    """A DDS participant in `scope`'s domain, with a writer per topic set by `set_topics`, and
+    one node, `node`."""
 
-    def __init__(self, scope: Scope) -> None:
+    def __init__(self, scope: Scope, node: str = NODE_NAME) -> None:
         """Raises: RequestError: Cyclone DDS refused the configuration (e.g. no such
         interface) or is not installed."""
         try:
@@ -55,9 +59,13 @@ class Participant:
                 "install it: pip install cyclonedds==11.0.1",
             ) from exc  # fmt: skip
         self.scope = scope
+        self.node = node
         self._lock = threading.Lock()
+        before = open_sockets()
         try:
             self._domain = Domain(scope.domain_id, cyclone_config(scope))
+            # before the participant announces itself: nothing is sent off the device
+            self.on_loopback_device = scope.local_only and confine_to_loopback(before)
             self._participant = DomainParticipant(scope.domain_id)
         except Exception as exc:  # cyclonedds raises DDSException with Cyclone's return code
             raise RequestError(
@@ -68,6 +76,7 @@ class Participant:
         self._topics: dict[tuple[str, str], Any] = {}
         self._writers: dict[str, tuple[Any, type]] = {}
         self._readers: list[Any] = []
+        self._service_writers: list[Any] = []
         self._closed = False
         with self._lock:
             self._info_writer = self._open_info_writer()
@@ -100,10 +109,12 @@ class Participant:
                 return
             self._closed = True
             entities = [w for w, _ in self._writers.values()] + self._readers
+            entities += self._service_writers
             entities.append(self._info_writer[0])
             entities += [*self._topics.values(), self._participant, self._domain]
             self._writers.clear()
             self._readers.clear()
+            self._service_writers.clear()
         for entity in entities:
             _delete(entity)
 
@@ -120,6 +131,29 @@ class Participant:
             self._readers.append(reader)
             self._announce()
         return reader
+
+    def service(self, name: str, service_type: str) -> tuple[Any, Any]:
+        """A reader of service `name`'s requests and a writer of its replies (`service_types`:
+        DDS topics and types as rmw_cyclonedds_cpp maps them; QoS: services' default)."""
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.sub import DataReader
+
+        from twin_cli.ros import service_types as srv
+
+        qos = dds_qos(graph.DEFAULT_QOS, None)
+        with self._lock:
+            request = self._dds_topic(
+                srv.request_topic(name), srv.service_idl(service_type, srv.REQUEST)
+            )
+            reply = self._dds_topic(
+                srv.reply_topic(name), srv.service_idl(service_type, srv.RESPONSE)
+            )
+            reader = DataReader(self._participant, request, qos=qos)
+            writer = DataWriter(self._participant, reply, qos=qos)
+            self._readers.append(reader)
+            self._service_writers.append(writer)
+            self._announce()
+        return reader, writer
 
     def drop_reader(self, reader: Any) -> None:
         with self._lock:
@@ -154,17 +188,21 @@ class Participant:
         if self._closed:
             return
         writers = [w.get_guid().bytes for w, _ in self._writers.values()]
+        writers += [w.get_guid().bytes for w in self._service_writers]
         readers = [r.get_guid().bytes for r in self._readers]
-        data = discovery_info(self._participant.get_guid().bytes, readers, writers)
+        data = discovery_info(self._participant.get_guid().bytes, readers, writers, self.node)
         writer, sample_type = self._info_writer
         writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
 
     def _topic(self, name: str, type_name: str) -> Any:
+        return self._dds_topic(dds_topic(name), idl_type(type_name))
+
+    def _dds_topic(self, dds_name: str, idl: type) -> Any:
         from cyclonedds.topic import Topic as DdsTopic
 
-        key = (name, type_name)
+        key = (dds_name, idl.__name__)
         if key not in self._topics:
-            self._topics[key] = DdsTopic(self._participant, dds_topic(name), idl_type(type_name))
+            self._topics[key] = DdsTopic(self._participant, dds_name, idl)
         return self._topics[key]
 
 

@@ -9,15 +9,24 @@ rosbags (an independent reader) and prints one JSON document on stdout.
 It also reads rmw's `ros_discovery_info` (rmw_dds_common/ParticipantEntitiesInfo), where
 `ros2 node list` finds node names.
 
-Usage: python ros_peer.py listen SECONDS ENTITY | scan SECONDS TOPIC |
+It calls gazebo_ros' entity services as rmw_cyclonedds_cpp does: request and reply topics
+`rq/<service>Request` and `rr/<service>Reply`, types from the official gazebo_msgs `.srv`
+definitions with rmw's request header (`guid` uint64, `seq` int64) first; the reply's bytes are
+decoded by rosbags after the header.
+
+An ENTITY argument that starts with `/` is the whole topic (a name the robot's plugins gave).
+
+Usage: python ros_peer.py listen SECONDS ENTITY | drain SECONDS ENTITY | scan SECONDS TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
-    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT
+    forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT |
+    call SERVICE JSON_FIELDS
 """
 
 # No `from __future__ import annotations`: cyclonedds reads the IDL annotations as objects.
 
 import json
 import os
+import struct
 import sys
 import time
 from dataclasses import dataclass
@@ -30,7 +39,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.qos import Policy, Qos
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 CONFIG = (
     '<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
@@ -226,13 +235,83 @@ class ParticipantEntitiesInfo(
     node_entities_info_seq: types.sequence[NodeEntitiesInfo]
 
 
-def qos(latched: bool = False) -> Qos:
-    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last 1."""
+# gazebo_msgs/srv: SpawnEntity, DeleteEntity, GetModelList (the official .srv fields)
+SERVICE_RESPONSES = {
+    "gazebo_msgs/srv/SpawnEntity_Response": "bool success\nstring status_message\n",
+    "gazebo_msgs/srv/DeleteEntity_Response": "bool success\nstring status_message\n",
+    "gazebo_msgs/srv/GetModelList_Response": (
+        "std_msgs/Header header\nstring[] model_names\nbool success\n"
+    ),
+}
+
+
+@dataclass
+class SpawnEntityRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::SpawnEntity_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    name: str
+    xml: str
+    robot_namespace: str
+    initial_pose: Pose
+    reference_frame: str
+
+
+@dataclass
+class SpawnEntityResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::SpawnEntity_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    success: bool
+    status_message: str
+
+
+@dataclass
+class DeleteEntityRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::DeleteEntity_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    name: str
+
+
+@dataclass
+class DeleteEntityResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::DeleteEntity_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    success: bool
+    status_message: str
+
+
+@dataclass
+class GetModelListRequest(IdlStruct, typename="gazebo_msgs::srv::dds_::GetModelList_Request_"):
+    guid: types.uint64
+    seq: types.int64
+    structure_needs_at_least_one_member: types.uint8 = 0
+
+
+@dataclass
+class GetModelListResponse(IdlStruct, typename="gazebo_msgs::srv::dds_::GetModelList_Response_"):
+    guid: types.uint64
+    seq: types.int64
+    header: Header
+    model_names: types.sequence[str]
+    success: bool
+
+
+SERVICES = {
+    "/spawn_entity": (SpawnEntityRequest, SpawnEntityResponse, "SpawnEntity"),
+    "/delete_entity": (DeleteEntityRequest, DeleteEntityResponse, "DeleteEntity"),
+    "/get_model_list": (GetModelListRequest, GetModelListResponse, "GetModelList"),
+}
+CLIENT_GUID = 0x5EED_0000_0000_0001  # this client's id in the request header
+SEQUENCE = 7
+
+
+def qos(latched: bool = False, depth: int = 1) -> Qos:
+    """ROS's default QoS (reliable, volatile, keep last 10); latched: transient local, last
+    `depth` (1 as ROS's publishers keep; the graph's readers keep 100: one per participant)."""
     if latched:
         return Qos(
             Policy.Reliability.Reliable(0),
             Policy.Durability.TransientLocal,
-            Policy.History.KeepLast(1),
+            Policy.History.KeepLast(depth),
             Policy.DataRepresentation(use_cdrv0_representation=True),
         )
     return Qos(
@@ -247,6 +326,25 @@ def participant() -> DomainParticipant:
     domain_id = int(os.environ.get("ROS_DOMAIN_ID", "0"))
     participant.domain = Domain(domain_id, CONFIG)  # kept alive with the participant
     return DomainParticipant(domain_id)
+
+
+def drain(seconds: float, entity: str) -> dict:
+    """Takes the world's state topics for `seconds` as bytes, decoding none (a compiled node's
+    receiving, for benchmarks)."""
+    dp = participant()
+    names = ["/clock", "/tf", f"/{entity}/joint_states", f"/{entity}/odom"]
+    kinds = [Clock, TFMessage, JointState, Odometry]
+    readers = [
+        DataReader(dp, Topic(dp, "rt" + n, k, qos=qos()), qos=qos())
+        for n, k in zip(names, kinds, strict=True)
+    ]
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    taken, end = 0, time.monotonic() + seconds
+    while time.monotonic() < end:
+        for reader in readers:
+            taken += len(ddspy_take(reader._ref, mask, 64))
+        time.sleep(0.01)
+    return {"taken": taken}
 
 
 def listen(seconds: float, entity: str) -> dict:
@@ -269,7 +367,7 @@ def listen(seconds: float, entity: str) -> dict:
     info = "rmw_dds_common/msg/ParticipantEntitiesInfo"
     wanted["ros_discovery_info"] = (ParticipantEntitiesInfo, info, True)
     topic = Topic(dp, "ros_discovery_info", ParticipantEntitiesInfo, qos=qos(True))
-    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True))
+    readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True, depth=100))
     out: dict[str, list] = {name: [] for name in wanted}
     types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
     end = time.monotonic() + seconds
@@ -287,11 +385,16 @@ def listen(seconds: float, entity: str) -> dict:
     return {"messages": out, "types": types_seen}
 
 
+def dds_name(entity: str, leaf: str) -> str:
+    """The DDS topic of `/<entity>/<leaf>`, or of `entity` itself when it is a topic (`/a/b`)."""
+    return "rt" + entity if entity.startswith("/") else f"rt/{entity}/{leaf}"
+
+
 def drive(entity: str, vx: float, wz: float, seconds: float, stamped: bool = False) -> dict:
     """Publishes a Twist (or TwistStamped) on /<entity>/cmd_vel every 0.1 s for `seconds`."""
     dp = participant()
     kind = TwistStamped if stamped else Twist
-    topic = Topic(dp, f"rt/{entity}/cmd_vel", kind, qos=qos())
+    topic = Topic(dp, dds_name(entity, "cmd_vel"), kind, qos=qos())
     writer = DataWriter(dp, topic, qos=qos())
     end, sent = time.monotonic() + seconds, 0
     while time.monotonic() < end:
@@ -320,7 +423,7 @@ def trajectory(entity: str, joint: str, position: float, at: float) -> dict:
     """Publishes one JointTrajectory (`joint` to `position` [rad or m] at `at` [s]) once it
     is matched, as a MoveIt or rqt_joint_trajectory_controller would."""
     dp = participant()
-    name = f"rt/{entity}/joint_trajectory_controller/joint_trajectory"
+    name = dds_name(entity, "joint_trajectory_controller/joint_trajectory")
     writer = DataWriter(dp, Topic(dp, name, JointTrajectory, qos=qos()), qos=qos())
     deadline = time.monotonic() + 10.0
     while not writer.get_matched_subscriptions() and time.monotonic() < deadline:
@@ -354,6 +457,43 @@ def scan(seconds: float, topic: str) -> dict:
     return {"scans": out}
 
 
+def call(service: str, fields: dict) -> dict:
+    """One request to `service` once both topics are matched; the reply with this request's
+    header, decoded by rosbags from the bytes after the header."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    registered = {}  # rosbags files a parsed type under `.../msg/...`
+    for name, text in SERVICE_RESPONSES.items():
+        parsed = get_types_from_msg(text, name)
+        store.register(parsed)
+        registered[name] = next(iter(parsed))
+    request_type, reply_type, kind = SERVICES[service]
+    dp = participant()
+    name = service.lstrip("/")
+    writer = DataWriter(dp, Topic(dp, f"rq/{name}Request", request_type, qos=qos()), qos=qos())
+    reader = DataReader(dp, Topic(dp, f"rr/{name}Reply", reply_type, qos=qos()), qos=qos())
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline and not (
+        writer.get_matched_subscriptions() and reader.get_matched_publications()
+    ):
+        time.sleep(0.05)
+    if "initial_pose" in fields:
+        p, q = fields["initial_pose"]["position"], fields["initial_pose"]["orientation"]
+        fields["initial_pose"] = Pose(Point(*p), Quaternion(*q))
+    writer.write(request_type(guid=CLIENT_GUID, seq=SEQUENCE, **fields))
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    while time.monotonic() < deadline + 30.0:
+        for cdr, info in ddspy_take(reader._ref, mask, 16):
+            if not info.valid_data:
+                continue
+            guid, seq = struct.unpack_from("<Qq", cdr, 4)
+            if (guid, seq) == (CLIENT_GUID, SEQUENCE):
+                name = registered[f"gazebo_msgs/srv/{kind}_Response"]
+                reply = store.deserialize_cdr(cdr[:4] + cdr[20:], name)
+                return {"reply": to_plain(reply), "header": [guid, seq]}
+        time.sleep(0.02)
+    return {"reply": None}
+
+
 def to_plain(value):
     if hasattr(value, "__dataclass_fields__"):
         return {k: to_plain(getattr(value, k)) for k in value.__dataclass_fields__ if k[0] != "_"}
@@ -367,6 +507,8 @@ def to_plain(value):
 if __name__ == "__main__":
     if sys.argv[1] == "listen":
         result = listen(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "drain":
+        result = drain(float(sys.argv[2]), sys.argv[3])
     elif sys.argv[1] == "forward":
         values = [float(v) for v in sys.argv[5:]]
         result = forward(sys.argv[2], sys.argv[3], float(sys.argv[4]), values)
@@ -375,6 +517,8 @@ if __name__ == "__main__":
         result = trajectory(*args)
     elif sys.argv[1] == "scan":
         result = scan(float(sys.argv[2]), sys.argv[3])
+    elif sys.argv[1] == "call":
+        result = call(sys.argv[2], json.loads(sys.argv[3]))
     else:
         stamped = sys.argv[1] == "drive_stamped"
         args = float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])

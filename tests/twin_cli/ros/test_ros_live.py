@@ -12,6 +12,7 @@ import json
 import math
 import os
 import re
+import socket
 import subprocess
 import sys
 import time
@@ -22,6 +23,7 @@ import numpy as np
 import pytest
 from models import CONTROL_RIG
 from sensor_models import lidar_post
+from sock_diag import sockets_of
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
 # One worker runs the module: its server and peers share one domain, of this process's own.
@@ -130,19 +132,27 @@ def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
     assert messages["/bot/odom"][-1][1]["child_frame_id"] == "bot/base_link"
 
 
-def test_the_node_is_announced_as_ros2_node_list_reads_it(served) -> None:
-    """ros_discovery_info (transient local) names node /twin, with a writer per published
-    topic and a reader per cmd_vel type of each drive."""
+def test_the_nodes_are_announced_as_ros2_node_list_reads_them(served) -> None:
+    """ros_discovery_info (transient local) names node /twin with a writer per published topic
+    (the publisher process's participant) and /twin_commands with a reader per input and the
+    entity services' readers and writers (the server's)."""
     root, _ = served
     got = _peer(root, "listen", "1", "bot")
     infos = [m for _, m in got["messages"]["ros_discovery_info"]]
-    nodes = [n for info in infos for n in info["node_entities_info_seq"]]
-    twin = [n for n in nodes if (n["node_namespace"], n["node_name"]) == ("/", "twin")]
-    assert twin, f"no /twin node announced: {nodes}"
-    assert len(twin[-1]["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
-    readers = 2 * 3 + 4  # per bot: Twist, TwistStamped, forward velocity; rig: 3 + trajectory
-    assert len(twin[-1]["reader_gid_seq"]) == readers, "a reader per input"
-    assert all(len(g["data"]) == 16 for g in twin[-1]["writer_gid_seq"]), "GIDs of 16 bytes"
+    nodes = {}
+    for info in infos:
+        for n in info["node_entities_info_seq"]:
+            nodes[(n["node_namespace"], n["node_name"])] = n
+    assert ("/", "twin") in nodes and ("/", "twin_commands") in nodes, f"nodes: {list(nodes)}"
+    twin, commands = nodes[("/", "twin")], nodes[("/", "twin_commands")]
+    assert len(twin["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
+    assert not twin["reader_gid_seq"], "the publisher reads nothing"
+    readers = 2 * 3 + 4 + 3  # per bot: Twist, TwistStamped, forward velocity; rig: 3 +
+    # trajectory; a request reader per entity service
+    assert len(commands["reader_gid_seq"]) == readers, "a reader per input"
+    assert len(commands["writer_gid_seq"]) == 3, "a reply writer per entity service"
+    gids = twin["writer_gid_seq"] + commands["reader_gid_seq"]
+    assert all(len(g["data"]) == 16 for g in gids), "GIDs of 16 bytes"
 
 
 def test_a_twist_on_cmd_vel_drives_the_base_as_twin_drive_does(served) -> None:
@@ -229,33 +239,109 @@ def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
     assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
 
 
+def _names(root: Path) -> list[str]:
+    return [e["name"] for e in json.loads(_twin(root, "list", "--json"))]
+
+
+def test_gazebo_ros_entity_services_spawn_list_and_delete_as_the_cli_does(served) -> None:
+    """/spawn_entity, /get_model_list and /delete_entity called as an rmw_cyclonedds client
+    calls them (rmw's request header echoed in each reply): the spawned entity is where the
+    request put it (yaw 90 degrees, relative to the world, then to another entity); a refused
+    request (a taken name, an unknown reference frame, an unknown entity) says why and leaves
+    the world as it was."""
+    root, _ = served
+    listed = _peer(root, "call", "/get_model_list", "{}")
+    assert listed["header"] == [0x5EED_0000_0000_0001, 7], "reply without the request's header"
+    initial = _names(root)
+    assert listed["reply"]["success"] and listed["reply"]["model_names"] == initial
+    xml = dm.two_wheel_base("")
+    half = math.sqrt(0.5)
+    pose = {"position": [4.0, -4.0, 0.3], "orientation": [0.0, 0.0, half, half]}
+    request = {"name": "svc_bot", "xml": xml, "robot_namespace": "", "initial_pose": pose,
+               "reference_frame": "world"}  # fmt: skip
+    spawned = _peer(root, "call", "/spawn_entity", json.dumps(request))["reply"]
+    assert spawned["success"], spawned
+    at = json.loads(_twin(root, "pose", "svc_bot", "--json"))
+    assert (at["x"], at["y"]) == pytest.approx((4.0, -4.0), abs=0.02), f"spawned at {at}"
+    assert at["yaw"] == pytest.approx(math.pi / 2, abs=0.02), f"spawned with yaw {at['yaw']}"
+    before = _names(root)
+    again = _peer(root, "call", "/spawn_entity", json.dumps(request))["reply"]
+    assert not again["success"] and "svc_bot" in again["status_message"], again
+    unknown = {**request, "name": "svc_other", "reference_frame": "no_such_frame"}
+    refused = _peer(root, "call", "/spawn_entity", json.dumps(unknown))["reply"]
+    assert not refused["success"] and "no_such_frame" in refused["status_message"], refused
+    assert _names(root) == before, "a refused spawn changed the world"
+    ahead_1m = {"position": [1.0, 0.0, 0.0], "orientation": [0.0, 0.0, 0.0, 1.0]}
+    relative = {**request, "name": "svc_rel", "reference_frame": "svc_bot",
+                "initial_pose": ahead_1m}  # fmt: skip
+    base = json.loads(_twin(root, "pose", "svc_bot", "--json"))
+    assert _peer(root, "call", "/spawn_entity", json.dumps(relative))["reply"]["success"]
+    rel = json.loads(_twin(root, "pose", "svc_rel", "--json"))
+    ahead = (base["x"] + math.cos(base["yaw"]), base["y"] + math.sin(base["yaw"]))
+    assert (rel["x"], rel["y"]) == pytest.approx(ahead, abs=0.02), "1 m ahead of svc_bot"
+    for name in ("svc_rel", "svc_bot"):
+        deleted = _peer(root, "call", "/delete_entity", json.dumps({"name": name}))["reply"]
+        assert deleted["success"], deleted
+    assert _names(root) == initial, "the world after deleting what the services spawned"
+    gone = _peer(root, "call", "/delete_entity", json.dumps({"name": "svc_bot"}))["reply"]
+    assert not gone["success"] and "svc_bot" in gone["status_message"], gone
+
+
+def _server_sockets(pid: int) -> list:
+    """The sockets of the server and of its child processes (the bridge's publisher)."""
+    children = [
+        int(c) for task in Path(f"/proc/{pid}/task").iterdir()
+        for c in (task / "children").read_text().split()
+    ]  # fmt: skip
+    return [s for p in (pid, *children) for s in sockets_of(p)]
+
+
 def test_the_server_binds_no_address_but_loopback(served) -> None:
-    """Every UDP socket of the server is on 127.0.0.1 or unbound to an address (Cyclone's
-    receive sockets), none is connected anywhere, and multicast is not joined."""
+    """Every internet socket of the server and its publisher process is bound to 127.0.0.1, or
+    to the loopback device (Cyclone's receive sockets, which it binds to the wildcard address):
+    none can receive from or send to another host, and none is connected outside 127.0.0.1
+    (the kernel's sock_diag)."""
     _, proc = served
-    inodes = {
-        m.group(1)
-        for fd in Path(f"/proc/{proc.pid}/fd").iterdir()
-        if (m := re.match(r"socket:\[(\d+)\]", os.readlink(fd)))
-    }
-    seen = []
-    for table in ("udp", "udp6"):
-        for line in Path(f"/proc/{proc.pid}/net/{table}").read_text().splitlines()[1:]:
-            fields = line.split()
-            if fields[9] in inodes:
-                seen.append((_address(fields[1]), _address(fields[2])))
-    assert seen, "the server has no UDP socket: is the bridge running?"
-    for local, remote in seen:
-        assert local[0] in ("127.0.0.1", "0.0.0.0"), f"socket bound to {local}"
-        assert remote[0] in ("0.0.0.0", "127.0.0.1"), f"socket connected to {remote}"
+    found = _server_sockets(proc.pid)
+    udp = [s for s in found if s.protocol.startswith("udp")]
+    assert len(udp) >= 6, f"not two participants' sockets: is the bridge on? {udp}"
+    loopback = socket.if_nametoindex("lo")
+    for s in found:
+        on_loopback = s.local[0] == "127.0.0.1" or s.device == loopback
+        assert on_loopback, f"{s.protocol} socket bound to {s.local} on device {s.device}"
+        assert s.remote[0] in ("0.0.0.0", "127.0.0.1"), f"{s.protocol} socket to {s.remote}"
+    status = json.loads(_twin(served[0], "ros", "status", "--json"))
+    assert status["local_only"] and status["loopback_device"], status
 
 
-def _address(text: str) -> tuple[str, int]:
-    """A /proc/net/udp address (hex, little-endian IPv4; IPv6 shown as its hex)."""
-    host, port = text.split(":")
-    if len(host) == 8:
-        host = ".".join(str(int(host[i : i + 2], 16)) for i in (6, 4, 2, 0))
-    return host, int(port, 16)
+def test_a_widened_interface_leaves_the_sockets_unbound_from_loopback_and_still_meets(
+    served,
+) -> None:
+    """`twin ros start --interface 127.0.0.1` (an explicit interface: multicast on, here on
+    loopback, so nothing leaves the machine) is a widened setting: Cyclone's sockets keep the
+    wildcard address with no device, and the loopback peer still finds the world through the
+    static peer. `twin ros start` without it confines them again."""
+    root, proc = served
+    _twin(root, "ros", "stop")
+    env = {**_env(root), "ROS_STATIC_PEERS": "127.0.0.1"}
+    try:
+        started = subprocess.run(
+            [sys.executable, "-m", "twin_cli", "ros", "start", "--interface", "127.0.0.1",
+             "--json", "--world", WORLD],
+            env=env, capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert started.returncode == 0, started.stderr
+        status = json.loads(started.stdout)
+        assert not status["local_only"] and not status["loopback_device"], status
+        wildcard = [s for s in _server_sockets(proc.pid) if s.local[0] == "0.0.0.0"]
+        assert wildcard and all(s.device == 0 for s in wildcard), wildcard
+        assert _peer(root, "listen", "1", "bot")["messages"]["/clock"], "no /clock (widened)"
+    finally:
+        _twin(root, "ros", "stop")
+        _twin(root, "ros", "start")
+    loopback = socket.if_nametoindex("lo")
+    wildcard = [s for s in _server_sockets(proc.pid) if s.local[0] == "0.0.0.0"]
+    assert wildcard and all(s.device == loopback for s in wildcard), wildcard
 
 
 def _world_pose(frame: str, edges: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -359,3 +445,75 @@ def test_the_bridge_follows_deletes_and_loads(served) -> None:
     assert got["/clock"] and got["/bot/joint_states"], "nothing after twin load"
     inputs = json.loads(_twin(root, "ros", "status", "--json"))["inputs"]
     assert "/bot/cmd_vel" in inputs and not [i for i in inputs if "twin_bot" in i], inputs
+
+
+NAMED_DIFF = DIFF.replace(
+    "</plugin>",
+    "<ros><namespace>/demo</namespace><remapping>cmd_vel:=cmd_demo</remapping></ros></plugin>",
+)
+CONTROLLERS_YAML = """controller_manager:
+  ros__parameters:
+    update_rate: 100
+    joint_state_broadcaster:
+      type: joint_state_broadcaster/JointStateBroadcaster
+    slide_controller:
+      type: joint_trajectory_controller/JointTrajectoryController
+    spin_speed:
+      type: velocity_controllers/JointGroupVelocityController
+slide_controller:
+  ros__parameters:
+    joints: [slide]
+    command_interfaces: [position]
+spin_speed:
+  ros__parameters:
+    joints: [spin]
+"""
+
+
+def test_inputs_take_the_names_the_robots_own_plugins_give(served) -> None:
+    """A diff drive's `<ros><namespace>/demo` and `<remapping>cmd_vel:=cmd_demo` make its
+    input /demo/cmd_demo; gazebo_ros2_control's `<parameters>` YAML (namespace /arm) replaces
+    the default controllers by its own: /arm/slide_controller/joint_trajectory and
+    /arm/spin_speed/commands. A Twist and a JointTrajectory sent there act."""
+    root, _ = served
+    base = root / "named_base.urdf"
+    base.write_text(dm.two_wheel_base(NAMED_DIFF))
+    _twin(root, "spawn", str(base), "--name", "named_bot", "-y", "-4", "--on-ground")
+    params = root / "controllers.yaml"
+    params.write_text(CONTROLLERS_YAML)
+    plugin = (
+        '<gazebo><plugin filename="libgazebo_ros2_control.so" name="gazebo_ros2_control">'
+        f"<ros><namespace>/arm</namespace></ros><parameters>{params}</parameters></plugin>"
+        "</gazebo></robot>"
+    )
+    rig = root / "named_rig.urdf"
+    rig.write_text(CONTROL_RIG.replace("</robot>", plugin))
+    _twin(root, "spawn", str(rig), "--name", "named_rig", "-x", "-6")
+    wanted = {
+        "/demo/cmd_demo",
+        "/arm/slide_controller/joint_trajectory",
+        "/arm/spin_speed/commands",
+    }
+    deadline = time.monotonic() + 10.0
+    while not wanted <= set(inputs := json.loads(_twin(root, "ros", "status", "--json"))["inputs"]):
+        assert time.monotonic() < deadline, f"inputs {inputs}, wanted {wanted}"
+        time.sleep(0.2)
+    kept = [i for i in inputs if i.startswith("/named_rig/") or i == "/named_bot/cmd_vel"]
+    assert not kept, f"default names kept beside the plugins' own: {kept}"
+    start = json.loads(_twin(root, "pose", "named_bot", "--json"))
+    assert _peer(root, "drive", "/demo/cmd_demo", "0.3", "0.0", "1.5")["matched"] == 1
+    end = json.loads(_twin(root, "pose", "named_bot", "--json"))
+    ahead, _, _ = _moved(start, end)
+    assert ahead > 0.1, f"named_bot moved {ahead} m on /demo/cmd_demo"
+    sent = _peer(
+        root, "trajectory", "/arm/slide_controller/joint_trajectory", "slide", "0.1", "0.5"
+    )
+    assert sent["matched"] == 1, "no reader on /arm/slide_controller/joint_trajectory"
+    deadline, position = time.monotonic() + 3.0, None
+    while time.monotonic() < deadline:
+        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "named_rig", "--json"))}
+        position = joints["slide"]["position"]
+        if abs(position - 0.1) < 0.005:
+            break
+        time.sleep(0.2)
+    assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"

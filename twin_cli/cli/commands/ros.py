@@ -37,8 +37,8 @@ def start(
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
-    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel and
-    forward controller commands in."""
+    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel,
+    controller commands and gazebo_ros' entity services in."""
     body: dict[str, Any] = {"environment": ros_environment()}
     if interface is not None:
         body["interface"] = interface
@@ -75,6 +75,9 @@ def _show(reply: dict[str, Any], json: bool, verb: str) -> None:
     out.line(f"{verb}: {reply['scope']}, {reply['samples']} samples at {reply['rate']:g} Hz")
     if reply["inputs"]:
         out.line(f"reading: {', '.join(reply['inputs'])} ({reply['commands']} commands taken)")
+    if reply.get("services"):
+        calls = reply.get("service_calls", 0)
+        out.line(f"services: {', '.join(reply['services'])} ({calls} calls answered)")
 
 
 def register(parent: typer.Typer) -> None:

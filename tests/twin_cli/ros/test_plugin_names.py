@@ -1,0 +1,63 @@
+"""The names a robot's description gives its ROS inputs, read as rclcpp and the controller
+manager read them (pure functions: no world, no DDS)."""
+
+from __future__ import annotations
+
+import pytest
+
+from twin_cli.ros.plugin_names import Controller, plugin_names
+
+
+def _robot(plugins: str) -> str:
+    return f'<robot name="r"><link name="base"/><gazebo>{plugins}</gazebo></robot>'
+
+
+def _drive(ros: str) -> str:
+    return f'<plugin name="d" filename="libgazebo_ros_diff_drive.so">{ros}</plugin>'
+
+
+@pytest.mark.parametrize(
+    ("ros", "topic"),
+    [
+        ("", "/bot/cmd_vel"),  # no <ros>: the entity's namespace (twin's)
+        ("<ros><namespace>/demo</namespace></ros>", "/demo/cmd_vel"),
+        ("<ros><namespace>demo/</namespace><remapping>cmd_vel:=cmd</remapping></ros>", "/demo/cmd"),
+        ("<ros><remapping>cmd_vel:=/base/cmd</remapping></ros>", "/base/cmd"),  # absolute
+        ("<ros><remapping>~/cmd_vel:=teleop</remapping></ros>", "/bot/teleop"),
+        ("<ros><remapping>odom:=odom_demo</remapping></ros>", "/bot/cmd_vel"),  # not cmd_vel
+    ],
+)
+def test_a_drive_plugins_namespace_and_remapping_name_its_cmd_vel(ros: str, topic: str) -> None:
+    assert plugin_names("bot", _robot(_drive(ros))).cmd_vel == topic
+
+
+def test_the_controller_yaml_names_the_controllers_their_modes_and_joints(tmp_path) -> None:
+    params = tmp_path / "controllers.yaml"
+    params.write_text(
+        "controller_manager:\n  ros__parameters:\n"
+        "    jsb: {type: joint_state_broadcaster/JointStateBroadcaster}\n"
+        "    arm: {type: joint_trajectory_controller/JointTrajectoryController}\n"
+        "    grip: {type: forward_command_controller/ForwardCommandController}\n"
+        "    wheels: {type: velocity_controllers/JointGroupVelocityController}\n"
+        "arm: {ros__parameters: {joints: [j2, j1]}}\n"
+        "grip: {ros__parameters: {joints: [f], interface_name: effort}}\n"
+        "/wheels: {ros__parameters: {joints: [l, r]}}\n"
+    )
+    plugin = (
+        '<plugin name="c" filename="libgazebo_ros2_control.so">'
+        f"<parameters>{params}</parameters></plugin>"
+    )
+    assert plugin_names("bot", _robot(plugin)).controllers == (
+        Controller("/bot/arm/joint_trajectory", "trajectory", ("j2", "j1")),
+        Controller("/bot/grip/commands", "effort", ("f",)),
+        Controller("/bot/wheels/commands", "velocity", ("l", "r")),
+    )
+
+
+def test_an_unreadable_controller_yaml_keeps_the_default_names(tmp_path) -> None:
+    plugin = (
+        '<plugin name="c" filename="libgazebo_ros2_control.so">'
+        f"<parameters>{tmp_path / 'missing.yaml'}</parameters></plugin>"
+    )
+    assert plugin_names("bot", _robot(plugin)).controllers == ()
+    assert plugin_names("bot", None).cmd_vel is None

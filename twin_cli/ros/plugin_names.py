@@ -1,0 +1,130 @@
+"""The names a robot's own description gives its ROS inputs: gazebo_ros plugins' `<ros>` blocks
+and the controllers of the YAML file gazebo_ros2_control loads.
+
+- A drive plugin (gazebo_ros' diff drive, skid steer, Ackermann, planar move, tricycle) takes
+  `cmd_vel` in its node's namespace: `<ros><namespace>` (else the entity's name, twin's
+  namespace for each robot), renamed by `<remapping>cmd_vel:=NAME</remapping>` (a name starting
+  with `/` is absolute), as rclcpp resolves a topic.
+- gazebo_ros2_control's `<parameters>` names the controller manager's YAML file: each controller
+  under `controller_manager: ros__parameters:` with a `type`, and its own `ros__parameters`
+  (`joints`, `interface_name` or the type's interface). Forward command controllers and the
+  joint group position, velocity and effort controllers take `<ns>/<controller>/commands`; a
+  joint_trajectory_controller takes `<ns>/<controller>/joint_trajectory`; `<ns>` is the
+  plugin's `<ros><namespace>`, else the entity's name.
+
+Only URDF descriptions carry these (`Entity.description`); a YAML file that cannot be read is
+logged once and the entity keeps twin's default controller names.
+"""
+
+from __future__ import annotations
+
+import logging
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+log = logging.getLogger("twin.ros")
+DRIVE_PLUGINS = ("diff_drive", "skid_steer", "ackermann", "planar_move", "tricycle")
+CONTROL_PLUGINS = ("gazebo_ros2_control", "gz_ros2_control")
+TRAJECTORY = "trajectory"  # a controller's mode: joint_trajectory_controller's topic
+CONTROLLER_MODES = {  # controller type → the command interface it writes
+    "position_controllers/JointGroupPositionController": "position",
+    "velocity_controllers/JointGroupVelocityController": "velocity",
+    "effort_controllers/JointGroupEffortController": "effort",
+    "joint_trajectory_controller/JointTrajectoryController": TRAJECTORY,
+}
+FORWARD = "forward_command_controller/ForwardCommandController"  # mode: its interface_name
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A controller the YAML names: its command topic, mode and joints (in the YAML's order)."""
+
+    topic: str
+    mode: str
+    joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class PluginNames:
+    """What an entity's description names: its drive's cmd_vel topic (None: twin's default)
+    and its controllers (empty: twin's default controller names)."""
+
+    cmd_vel: str | None = None
+    controllers: tuple[Controller, ...] = ()
+
+
+@lru_cache(maxsize=64)
+def plugin_names(entity: str, description: str | None) -> PluginNames:
+    """The names `description` (an entity's URDF text) gives its inputs (cached: the listener
+    asks every half second)."""
+    if not description:
+        return PluginNames()
+    try:
+        root = ET.fromstring(description)
+    except ET.ParseError:
+        return PluginNames()
+    cmd_vel, controllers = None, ()
+    for plugin in root.iter("plugin"):
+        filename = plugin.get("filename", "")
+        if cmd_vel is None and any(k in filename for k in DRIVE_PLUGINS):
+            cmd_vel = _resolve("cmd_vel", _namespace(plugin, entity), _remaps(plugin))
+        if not controllers and any(k in filename for k in CONTROL_PLUGINS):
+            controllers = _controllers(plugin, entity)
+    return PluginNames(cmd_vel, controllers)
+
+
+def _namespace(plugin: ET.Element, entity: str) -> str:
+    return (plugin.findtext("ros/namespace") or "").strip().strip("/") or entity
+
+
+def _remaps(plugin: ET.Element) -> dict[str, str]:
+    pairs = ((r.text or "").partition(":=") for r in plugin.findall("ros/remapping"))
+    return {a.strip(): b.strip() for a, sep, b in pairs if sep and a.strip() and b.strip()}
+
+
+def _resolve(name: str, namespace: str, remaps: dict[str, str]) -> str:
+    """A topic as rclcpp resolves `name` in `namespace` after the node's remappings."""
+    name = remaps.get(name, remaps.get(f"~/{name}", name))
+    return name if name.startswith("/") else f"/{namespace}/{name}"
+
+
+def _controllers(plugin: ET.Element, entity: str) -> tuple[Controller, ...]:
+    import yaml
+
+    namespace = _namespace(plugin, entity)
+    out: list[Controller] = []
+    for element in plugin.findall("parameters"):
+        path = Path((element.text or "").strip())
+        try:
+            document = yaml.safe_load(path.read_text()) or {}
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+            log.warning("[%s] %s not read (%s): default controller names", entity, path, exc)
+            continue
+        out += _from_yaml(document, namespace)
+    return tuple(out)
+
+
+def _from_yaml(document: Any, namespace: str) -> list[Controller]:
+    """The command-taking controllers the controller manager's YAML declares."""
+    manager = _params(document, "controller_manager")
+    out = []
+    for name, entry in manager.items():
+        kind = str(entry.get("type")) if isinstance(entry, dict) else ""
+        params = _params(document, name)
+        mode = params.get("interface_name") if kind == FORWARD else CONTROLLER_MODES.get(kind)
+        joints = tuple(str(j) for j in params.get("joints") or ())
+        if mode is None or not joints:
+            continue
+        leaf = "joint_trajectory" if mode == TRAJECTORY else "commands"
+        out.append(Controller(f"/{namespace}/{name}/{leaf}", str(mode), joints))
+    return out
+
+
+def _params(document: Any, node: str) -> dict:
+    """The `ros__parameters` of `node` in a ROS 2 parameter file (`/**` or the node's name)."""
+    entry = (document.get(node) or document.get(f"/{node}")) if isinstance(document, dict) else None
+    params = entry.get("ros__parameters") if isinstance(entry, dict) else None
+    return params if isinstance(params, dict) else {}

@@ -1,0 +1,68 @@
+"""Keeps the participant's UDP sockets on the loopback device in the loopback-only scope.
+
+Cyclone DDS 0.11 binds its receive sockets (the domain's discovery and data ports) to the
+wildcard address whatever its configuration says (its UDP transport asks for "any" for every
+receive socket; the option that once changed this is gone). So in the loopback-only scope twin
+binds each UDP socket the new domain opened to the loopback device (SO_BINDTODEVICE), right
+after Cyclone made it: the kernel then delivers to it only datagrams that arrived on loopback and
+routes what it sends only through loopback, so no other host can reach the twin's ports and none
+is reached from them. A socket bound to a device needs no privilege while it has none yet
+(Linux 5.7 and later).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+from pathlib import Path
+
+log = logging.getLogger("twin.ros")
+
+LOOPBACK_DEVICE = "lo"  # Linux's name for the loopback interface
+FD_DIR = Path("/proc/self/fd")
+
+
+def open_sockets() -> dict[int, str]:
+    """This process's socket descriptors, each with its kernel identity (`socket:[inode]`)."""
+    found: dict[int, str] = {}
+    try:
+        names = os.listdir(FD_DIR)
+    except OSError:  # no /proc: not Linux
+        return found
+    for name in names:
+        try:
+            target = os.readlink(FD_DIR / name)
+        except OSError:  # closed meanwhile
+            continue
+        if target.startswith("socket:"):
+            found[int(name)] = target
+    return found
+
+
+def confine_to_loopback(before: dict[int, str]) -> bool:
+    """Binds every UDP socket opened since `before` (`open_sockets`) to the loopback device.
+
+    Returns whether each was bound (False where the platform has no SO_BINDTODEVICE or no new
+    UDP socket was found: the caller says the sockets are then on the wildcard address).
+    """
+    option = getattr(socket, "SO_BINDTODEVICE", None)
+    if option is None:
+        return False
+    fresh = [fd for fd, ident in open_sockets().items() if before.get(fd) != ident]
+    bound = 0
+    for fd in fresh:
+        try:
+            sock = socket.socket(fileno=fd)  # borrowed: detached below, never closed here
+        except OSError:  # closed meanwhile
+            continue
+        try:
+            if sock.type == socket.SOCK_DGRAM and sock.family in (socket.AF_INET, socket.AF_INET6):
+                sock.setsockopt(socket.SOL_SOCKET, option, LOOPBACK_DEVICE.encode())
+                bound += 1
+        except OSError as exc:
+            log.warning("could not bind DDS socket %d to %s: %s", fd, LOOPBACK_DEVICE, exc)
+            return False
+        finally:
+            sock.detach()
+    return bound > 0
