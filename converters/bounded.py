@@ -1,0 +1,275 @@
+"""Work on a description in a child process the caller can bound: time, memory, an end on stop.
+
+Reading a description is arbitrary work on input nobody vetted: a parser, trimesh on a
+2-million-triangle STL (over 150 s and 830 MB), CoACD. Run inside a world server it held the
+interpreter lock and the world with it. `run` does it in a child forked from a fork server that
+imported the converter once (a fresh interpreter spent ~1 s importing it; a fork takes
+milliseconds), so the caller only waits on a pipe:
+- the child limits its own address space to the memory budget; the caller kills it when it
+  passes the time budget, and the error names the stage it was in (`stage`) and how to raise
+  the budget;
+- the child dies with the fork server, which ends with the caller (PR_SET_PDEATHSIG), and
+  `stop_all` kills every child at once, so a stopping world never waits on one;
+- the files the child read are announced in the caller with the audit event
+  `converters.read`, so a cache that watches a conversion's reads sees them.
+Results come back pickled: the child runs only the converter's own code (a served xacro runs in
+a sandboxed grandchild that answers in JSON), so the bytes on the pipe are the converter's.
+"""
+
+from __future__ import annotations
+
+import io
+import multiprocessing
+import os
+import pickle
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
+from converters.errors import ConversionBudgetError, ConversionError, ConversionStoppedError
+
+READ_EVENT = "converters.read"
+# What the fork server imports once, so that a conversion's child starts warm.
+PRELOAD = ["mujoco", "converters.served", "converters.collision.prepare", "converters.sdf", "converters.urdf.xacro_worker"]
+POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
+_CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")
+_WRITE_MODES = ("w", "a", "x", "+")
+
+
+@dataclass
+class Running:
+    """One child at work: what it converts, its last stage, when it started (`time.monotonic`)."""
+
+    subject: str
+    stage: str
+    started: float
+    process: Any
+
+
+def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str) -> Any:
+    """`work(job)` in a bounded child; its return value, or its error raised again here.
+
+    Args:
+        work: a module-level function (the child imports it by name).
+        job: its picklable argument.
+        budget: time [s] and address space [MiB] for the child.
+        subject: the file being converted, for messages.
+
+    Raises:
+        ConversionBudgetError: over time or memory; names the stage and the variable to raise.
+        ConversionStoppedError: `stop_all` was called meanwhile.
+        ConversionError: any subclass the work raised, as the same class.
+        RuntimeError: the work failed for another reason (a converter defect).
+    """
+    context = _context()
+    receive, send = context.Pipe(duplex=False)
+    process = context.Process(
+        target=_child, args=(send, work, job, budget.memory_mib), name="twin-conversion"
+    )
+    process.daemon = True
+    running = Running(subject, "starting", time.monotonic(), process)
+    with _LOCK:
+        if _STOPPING.is_set():
+            raise ConversionStoppedError(subject)
+        process.start()
+        _RUNNING.append(running)
+    send.close()
+    try:
+        message = _wait(receive, running, budget)
+    finally:
+        with _LOCK:
+            _RUNNING.remove(running)
+        if process.is_alive():
+            process.kill()
+        process.join(5)
+        receive.close()
+    return _outcome(message, running, budget)
+
+
+def stage(what: str) -> None:
+    """Say what the conversion is doing now (a step and its file). In a bounded child it goes to
+    the caller, which names it if the budget runs out and shows it as progress; elsewhere it is
+    only remembered."""
+    global _stage
+    _stage = what
+    channel = _channel
+    if channel is not None:
+        with _send_lock:
+            channel.send(("stage", what))
+
+
+def running() -> list[Running]:
+    """The children at work now (for progress and `twin stats`-like views)."""
+    with _LOCK:
+        return list(_RUNNING)
+
+
+def warm() -> None:
+    """Start the fork server now (it imports the converter in the background), so that the
+    first conversion does not wait for it."""
+    _context()
+
+
+def stop_all() -> None:
+    """Kill every child at work; from then on `run` fails at once (a process that is ending)."""
+    with _LOCK:
+        _STOPPING.set()
+        for each in _RUNNING:
+            each.process.kill()
+
+
+_LOCK = threading.Lock()
+_STOPPING = threading.Event()
+_RUNNING: list[Running] = []
+_started: Any = None
+_stage = ""
+_channel: Any = None  # in a child: the pipe to the caller
+_send_lock = threading.Lock()
+
+
+def _context() -> Any:
+    """The fork-server context, its server started with the converter preloaded."""
+    global _started
+    if _started is None:
+        context = multiprocessing.get_context("forkserver")
+        context.set_forkserver_preload(PRELOAD)
+        from multiprocessing import forkserver
+
+        forkserver.ensure_running()
+        _started = context
+    return _started
+
+
+def _wait(receive: Any, running: Running, budget: XacroBudget) -> tuple:
+    """The child's final message; stage messages update `running` meanwhile."""
+    deadline = running.started + budget.timeout_s
+    while True:
+        if _STOPPING.is_set():
+            raise ConversionStoppedError(running.subject)
+        left = deadline - time.monotonic()
+        if left <= 0:
+            problem = f"took over {budget.timeout_s:g} s"
+            raise ConversionBudgetError(running.subject, running.stage, problem, TIMEOUT_ENV)
+        if not receive.poll(min(left, POLL_S)):
+            continue
+        try:
+            message = receive.recv()
+        except (EOFError, OSError):
+            return ("died",)
+        if message[0] != "stage":
+            return message
+        running.stage = message[1]
+
+
+def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
+    """The result in `message`, or the error it carries raised again."""
+    kind = message[0]
+    if kind in ("died", "memory") and _STOPPING.is_set():
+        raise ConversionStoppedError(running.subject)
+    if kind in ("died", "memory"):
+        problem = f"needed more than {budget.memory_mib} MiB"
+        code = running.process.exitcode
+        if kind == "died" and code is not None and code < 0:
+            problem += f" (the worker ended with signal {-code})"
+        raise ConversionBudgetError(running.subject, running.stage, problem, MEMORY_ENV)
+    for name in message[2]:
+        sys.audit(READ_EVENT, name)
+    if kind == "done":
+        return pickle.loads(message[1])
+    if kind == "error":
+        raise _rebuilt(message[1][0], message[1][1])
+    raise RuntimeError(f"{running.subject}: the conversion failed while {running.stage}: {message[1]}")
+
+
+def _rebuilt(name: str, text: str) -> ConversionError:
+    """The child's error as the same class (constructors take facts, so not `pickle`)."""
+    from converters import errors
+
+    cls = getattr(errors, name, None)
+    if not (isinstance(cls, type) and issubclass(cls, ConversionError)):
+        cls = ConversionError
+    exc = cls.__new__(cls)
+    Exception.__init__(exc, text)
+    return exc
+
+
+# ----------------------------------------------------------------------------- the child
+def _child(send: Any, work: Callable[[Any], Any], job: Any, memory_mib: int) -> None:
+    """In the child: limit memory, record reads, run `work`, send one final message."""
+    import resource
+
+    global _channel
+    die_with_parent()
+    size = memory_mib * 1024 * 1024
+    resource.setrlimit(resource.RLIMIT_AS, (size, size))
+    _channel = send
+    files: set[str] = set()
+    sys.addaudithook(_reads(files))
+    try:
+        message: tuple = ("done", _dumps(work(job)))
+    except ConversionError as exc:
+        message = ("error", (type(exc).__name__, str(exc)))
+    except MemoryError:
+        message = ("memory",)
+    except Exception as exc:  # a converter defect: the caller reports it with the stage
+        message = ("crash", f"{type(exc).__name__}: {exc}")
+    with _send_lock:
+        send.send((*message, sorted(files)) if message[0] != "memory" else message)
+
+
+def _dumps(value: Any) -> bytes:
+    """Pickle `value`; read-only mappings (the description's) travel as dicts made read-only."""
+    buffer = io.BytesIO()
+    pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
+    pickler.dispatch_table = {MappingProxyType: _reduce_proxy}
+    pickler.dump(value)
+    return buffer.getvalue()
+
+
+def _reduce_proxy(proxy: MappingProxyType) -> tuple:
+    return read_only, (dict(proxy),)
+
+
+def read_only(mapping: dict) -> MappingProxyType:
+    """A read-only view of `mapping` (how a pickled `MappingProxyType` is rebuilt)."""
+    return MappingProxyType(mapping)
+
+
+def _reads(files: set[str]) -> Callable[[str, tuple], None]:
+    """An audit hook adding files opened for reading (not code) to `files`."""
+    code_dirs = tuple({sys.prefix, sys.base_prefix, sys.exec_prefix})
+
+    def hook(event: str, args: tuple) -> None:
+        if event == READ_EVENT:
+            files.add(os.fsdecode(args[0]))
+            return
+        if event != "open" or not isinstance(args[0], (str, bytes, os.PathLike)):
+            return
+        mode = args[1]
+        if isinstance(mode, str) and any(m in mode for m in _WRITE_MODES):
+            return
+        if isinstance(mode, int) and mode & (os.O_WRONLY | os.O_RDWR):
+            return
+        name = os.path.abspath(os.fsdecode(args[0]))
+        if not name.endswith(_CODE_SUFFIXES) and not name.startswith(code_dirs):
+            files.add(name)
+
+    return hook
+
+
+def die_with_parent() -> None:
+    """Ask the kernel to kill this process when the one that started it ends (Linux)."""
+    try:
+        import ctypes
+        import signal
+
+        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() == 1:  # the parent ended before the request took effect
+        os._exit(1)
