@@ -35,7 +35,13 @@ from converters.errors import ConversionBudgetError, ConversionError, Conversion
 
 READ_EVENT = "converters.read"
 # What the fork server imports once, so that a conversion's child starts warm.
-PRELOAD = ["mujoco", "converters.served", "converters.collision.prepare", "converters.sdf", "converters.urdf.xacro_worker"]
+PRELOAD = [
+    "mujoco",
+    "converters.served",
+    "converters.collision.prepare",
+    "converters.sdf",
+    "converters.urdf.xacro_worker",
+]
 POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
 _CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")
 _WRITE_MODES = ("w", "a", "x", "+")
@@ -69,7 +75,9 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
     context = _context()
     receive, send = context.Pipe(duplex=False)
     process = context.Process(
-        target=_child, args=(send, work, job, budget.memory_mib), name="twin-conversion"
+        target=_child,
+        args=(send, work, job, budget.memory_mib, (dict(os.environ), os.getcwd())),
+        name="twin-conversion",
     )
     process.daemon = True
     running = Running(subject, "starting", time.monotonic(), process)
@@ -183,7 +191,9 @@ def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
         return pickle.loads(message[1])
     if kind == "error":
         raise _rebuilt(message[1][0], message[1][1])
-    raise RuntimeError(f"{running.subject}: the conversion failed while {running.stage}: {message[1]}")
+    raise RuntimeError(
+        f"{running.subject}: the conversion failed while {running.stage}: {message[1]}"
+    )
 
 
 def _rebuilt(name: str, text: str) -> ConversionError:
@@ -199,12 +209,18 @@ def _rebuilt(name: str, text: str) -> ConversionError:
 
 
 # ----------------------------------------------------------------------------- the child
-def _child(send: Any, work: Callable[[Any], Any], job: Any, memory_mib: int) -> None:
-    """In the child: limit memory, record reads, run `work`, send one final message."""
+def _child(
+    send: Any, work: Callable[[Any], Any], job: Any, memory_mib: int, place: tuple[dict, str]
+) -> None:
+    """In the child: the caller's environment and folder (not the fork server's, which are
+    from its start), limited memory, reads recorded; run `work`, send one final message."""
     import resource
 
     global _channel
     die_with_parent()
+    os.environ.clear()
+    os.environ.update(place[0])
+    os.chdir(place[1])
     size = memory_mib * 1024 * 1024
     resource.setrlimit(resource.RLIMIT_AS, (size, size))
     _channel = send

@@ -362,7 +362,10 @@ def prepare_collision_meshes(
 
     def pack(parts: dict[str, list[MeshPart]]) -> dict[str, list[MeshPart | None]]:
         """A part that is its request's own mesh is kept as None: the builder shares it."""
-        return {k: [None if p.vertices is by_key[k].vertices else p for p in v] for k, v in parts.items()}
+        return {
+            k: [None if p.vertices is by_key[k].vertices else p for p in v]
+            for k, v in parts.items()
+        }
 
     def unpack(kept: dict[str, list[MeshPart | None]]) -> dict[str, list[MeshPart]]:
         whole = {k: MeshPart(r.vertices, r.faces) for k, r in by_key.items()}

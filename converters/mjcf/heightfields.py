@@ -19,8 +19,8 @@ from converters.errors import InputFileError
 from converters.mjcf.builder import COLLISION_CLASS, pose
 from converters.mjcf.geometry import HEIGHTMAP, static_bodies
 from converters.mjcf.lumping import WORLDBODY, LinkPlacement, plan_bodies
-from converters.report import Report
 from converters.replay import read_once
+from converters.report import Report
 from converters.resources.height_images import read_height_image
 
 if TYPE_CHECKING:
