@@ -25,7 +25,8 @@ import pickle
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
@@ -99,16 +100,29 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
     return _outcome(message, running, budget)
 
 
-def stage(what: str) -> None:
+def stage(what: str, *, own_progress: bool = False) -> None:
     """Say what the conversion is doing now (a step and its file). In a bounded child it goes to
-    the caller, which names it if the budget runs out and shows it as progress; elsewhere it is
-    only remembered."""
-    global _stage
-    _stage = what
-    channel = _channel
+    the caller, which names it if the budget runs out and shows it as progress; elsewhere it goes
+    to the `listening` callback, if any: None for a stage that shows its own progress
+    (`own_progress`, collision meshes), so that the callback's display makes way."""
+    channel, listener = _channel, _listener
     if channel is not None:
         with _send_lock:
             channel.send(("stage", what))
+    if listener is not None:
+        listener(None if own_progress else what)
+
+
+@contextmanager
+def listening(listener: Callable[[str | None], None]) -> Iterator[None]:
+    """Call `listener` with each stage of a conversion in this process meanwhile (a CLI's
+    progress display; the converter itself never writes to a stream)."""
+    global _listener
+    previous, _listener = _listener, listener
+    try:
+        yield
+    finally:
+        _listener = previous
 
 
 def running() -> list[Running]:
@@ -135,7 +149,7 @@ _LOCK = threading.Lock()
 _STOPPING = threading.Event()
 _RUNNING: list[Running] = []
 _started: Any = None
-_stage = ""
+_listener: Callable[[str | None], None] | None = None
 _channel: Any = None  # in a child: the pipe to the caller
 _send_lock = threading.Lock()
 

@@ -357,7 +357,7 @@ def prepare_collision_meshes(
     by_key = {r.key: r for r in requests}
 
     def compute() -> dict[str, list[MeshPart]]:
-        stage(f"preparing {len(requests)} collision meshes (hulls, CoACD)")
+        stage(f"preparing {len(requests)} collision meshes (hulls, CoACD)", own_progress=True)
         return prepare(requests, settings, report)
 
     def pack(parts: dict[str, list[MeshPart]]) -> dict[str, list[MeshPart | None]]:

@@ -14,8 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
+from tests.big_meshes import write_grid_obj
 from tests.cli_world import twin_in, twin_ok
 
 WORLD = "limits"
@@ -30,21 +29,6 @@ ROBOT = """<robot name="heavy"><link name="base">
   </inertial>
   <collision><geometry><mesh filename="{mesh}"/></geometry></collision>
 </link></robot>"""
-
-
-def write_grid_obj(path: Path, faces: int) -> None:
-    """A bumpy square of about `faces` triangles as OBJ text, with random heights so that no
-    earlier run's mesh store holds it."""
-    side = int(np.sqrt(faces / 2)) + 1
-    x, y = np.meshgrid(np.linspace(0, 1, side), np.linspace(0, 1, side))
-    z = np.random.default_rng().random(x.shape) * 0.01
-    index = np.arange(side * side).reshape(side, side) + 1
-    a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
-    c, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
-    triangles = np.concatenate([np.stack([a, b, c], 1), np.stack([b, d, c], 1)])
-    with path.open("w") as stream:
-        np.savetxt(stream, np.stack([x.ravel(), y.ravel(), z.ravel()], 1), "v %.6f %.6f %.6f")
-        np.savetxt(stream, triangles, "f %d %d %d")
 
 
 def _spawn_in_background(runtime: Path, robot: Path) -> subprocess.Popen:
