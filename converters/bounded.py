@@ -105,6 +105,8 @@ def stage(what: str, *, own_progress: bool = False) -> None:
     the caller, which names it if the budget runs out and shows it as progress; elsewhere it goes
     to the `listening` callback, if any: None for a stage that shows its own progress
     (`own_progress`, collision meshes), so that the callback's display makes way."""
+    global _stage
+    _stage = what
     channel, listener = _channel, _listener
     if channel is not None:
         with _send_lock:
@@ -150,6 +152,7 @@ _STOPPING = threading.Event()
 _RUNNING: list[Running] = []
 _started: Any = None
 _listener: Callable[[str | None], None] | None = None
+_stage = "starting"  # in a child: the stage it is in
 _channel: Any = None  # in a child: the pipe to the caller
 _send_lock = threading.Lock()
 
@@ -246,6 +249,9 @@ def _child(
         message = ("error", (type(exc).__name__, str(exc)))
     except MemoryError:
         message = ("memory",)
+    except RecursionError:  # a description nested past what a reader recurses through
+        problem = f"{_stage}: nests deeper than twin can follow; flatten the description"
+        message = ("error", ("ConversionError", problem))
     except Exception as exc:  # a converter defect: the caller reports it with the stage
         message = ("crash", f"{type(exc).__name__}: {exc}")
     with _send_lock:

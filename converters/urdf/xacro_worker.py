@@ -168,8 +168,25 @@ def _allowed_roots(path: Path, resolver: PackageResolver) -> tuple[str, ...]:
     roots += [Path(p).resolve() for p in resolver.explicit.values()]
     for variable in _SENT:
         roots += [Path(p).resolve() for p in os.environ.get(variable, "").split(os.pathsep) if p]
-    python = {sys.prefix, sys.base_prefix, *(p for p in sys.path if p)}
-    return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in python)
+    return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in _python_roots())
+
+
+def _python_roots() -> set[str]:
+    """Where Python's own files and the packages the expansion imports live: the prefixes, the
+    site folders and the folders holding `converters` and `xacro`. Not every `sys.path` entry:
+    a server started with `python -m` from a home folder has that folder there, and a xacro
+    could then read anything under it."""
+    import site
+
+    import xacro
+
+    import converters
+
+    folders = {sys.prefix, sys.base_prefix, sys.exec_prefix, site.getusersitepackages()}
+    folders |= set(site.getsitepackages())
+    for package in (converters, xacro):
+        folders.add(str(Path(package.__file__ or "").resolve().parent.parent))
+    return folders
 
 
 REFUSED_FIX = (
