@@ -60,8 +60,9 @@ def _refuse_circle(ctx: SdfContext, include: Any, parent: Any, element: Any) -> 
         raise ctx.error(include, f"includes a model that includes it ({circle})", "remove "
                         "the <include> that closes the circle")  # fmt: skip
     if len(chain) > MAX_INCLUDE_DEPTH:
-        raise ctx.error(include, f"nests includes {len(chain)} levels deep (from {chain[0]}); "
-                        f"twin follows at most {MAX_INCLUDE_DEPTH}", "flatten the model tree")  # fmt: skip
+        problem = f"nests includes {len(chain)} levels deep (from {chain[0]})"
+        limit = f"twin follows at most {MAX_INCLUDE_DEPTH}; flatten the model tree"
+        raise ctx.error(include, problem, limit)
 
 
 def included_element(ctx: SdfContext, include: Any) -> Any:
