@@ -102,6 +102,13 @@ def _conversion_cause(exc: BaseException) -> ConversionError | None:
 def _xacro_error(path: Path, exc: BaseException) -> XacroError:
     """xacro's failure, said once; a missing include names the package it was looked for in
     (a source checkout or another version of the package lacks files its install has)."""
+    if _caused_by(exc, RecursionError):
+        return XacroError(
+            str(path),
+            "macros or includes nest without end (maximum recursion depth exceeded)",
+            "look for a macro that calls itself with no stopping condition, or a file that "
+            "includes itself through others",
+        )
     missing = _missing_file(exc)
     if missing is None:
         return XacroError(str(path), str(exc) or type(exc).__name__)
@@ -116,6 +123,17 @@ def _xacro_error(path: Path, exc: BaseException) -> XacroError:
         f"that copy of '{pkg}' lacks the file (a source checkout, or a version other than the "
         f"robot was written for); give the right one with --package {pkg}=PATH",
     )
+
+
+def _caused_by(exc: BaseException, kind: type[BaseException]) -> bool:
+    """Whether `exc` or an exception it wraps (xacro's `.exc`, a cause) is a `kind`."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        if isinstance(seen, kind):
+            return True
+        inner = getattr(seen, "exc", None)
+        seen = inner if isinstance(inner, BaseException) else (seen.__cause__ or seen.__context__)
+    return False
 
 
 def _missing_file(exc: BaseException) -> str | None:
