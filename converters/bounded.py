@@ -18,6 +18,7 @@ a sandboxed grandchild that answers in JSON), so the bytes on the pipe are the c
 
 from __future__ import annotations
 
+import errno
 import io
 import multiprocessing
 import os
@@ -36,26 +37,27 @@ from converters.errors import ConversionBudgetError, ConversionError, Conversion
 
 READ_EVENT = "converters.read"
 # What the fork server imports once, so that a conversion's child starts warm.
-PRELOAD = [
-    "mujoco",
-    "converters.served",
-    "converters.collision.prepare",
-    "converters.sdf",
-    "converters.urdf.xacro_worker",
-]
+PRELOAD = ["mujoco", "converters.warm"]
 POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
+STAGE_BYTES = 512  # the stage text shared with the caller (a long path is cut)
 _CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")
 _WRITE_MODES = ("w", "a", "x", "+")
 
 
 @dataclass
 class Running:
-    """One child at work: what it converts, its last stage, when it started (`time.monotonic`)."""
+    """One child at work: what it converts, when it started (`time.monotonic`), its process,
+    and the shared buffer it writes its stage to."""
 
     subject: str
-    stage: str
     started: float
     process: Any
+    board: Any
+
+    @property
+    def stage(self) -> str:
+        """The stage the child said last (read without a lock: a torn read is only text)."""
+        return self.board.value.decode(errors="replace") or "starting"
 
 
 def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str) -> Any:
@@ -75,13 +77,14 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
     """
     context = _context()
     receive, send = context.Pipe(duplex=False)
+    board = context.RawArray("c", STAGE_BYTES)
     process = context.Process(
         target=_child,
-        args=(send, work, job, budget.memory_mib, (dict(os.environ), os.getcwd())),
+        args=(send, board, work, job, budget.memory_mib, (dict(os.environ), os.getcwd())),
         name="twin-conversion",
     )
     process.daemon = True
-    running = Running(subject, "starting", time.monotonic(), process)
+    running = Running(subject, time.monotonic(), process, board)
     with _LOCK:
         if _STOPPING.is_set():
             raise ConversionStoppedError(subject)
@@ -107,10 +110,9 @@ def stage(what: str, *, own_progress: bool = False) -> None:
     (`own_progress`, collision meshes), so that the callback's display makes way."""
     global _stage
     _stage = what
-    channel, listener = _channel, _listener
-    if channel is not None:
-        with _send_lock:
-            channel.send(("stage", what))
+    board, listener = _board, _listener
+    if board is not None:  # a write to shared memory: no system call, cheap for every mesh
+        board.value = what.encode(errors="replace")[: STAGE_BYTES - 1]
     if listener is not None:
         listener(None if own_progress else what)
 
@@ -153,8 +155,7 @@ _RUNNING: list[Running] = []
 _started: Any = None
 _listener: Callable[[str | None], None] | None = None
 _stage = "starting"  # in a child: the stage it is in
-_channel: Any = None  # in a child: the pipe to the caller
-_send_lock = threading.Lock()
+_board: Any = None  # in a child: the buffer shared with the caller
 
 
 def _context() -> Any:
@@ -171,7 +172,7 @@ def _context() -> Any:
 
 
 def _wait(receive: Any, running: Running, budget: XacroBudget) -> tuple:
-    """The child's final message; stage messages update `running` meanwhile."""
+    """The child's one message (its result, or its error), or ("died",)."""
     deadline = running.started + budget.timeout_s
     while True:
         if _STOPPING.is_set():
@@ -183,12 +184,9 @@ def _wait(receive: Any, running: Running, budget: XacroBudget) -> tuple:
         if not receive.poll(min(left, POLL_S)):
             continue
         try:
-            message = receive.recv()
+            return receive.recv()
         except (EOFError, OSError):
             return ("died",)
-        if message[0] != "stage":
-            return message
-        running.stage = message[1]
 
 
 def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
@@ -227,20 +225,25 @@ def _rebuilt(name: str, text: str) -> ConversionError:
 
 # ----------------------------------------------------------------------------- the child
 def _child(
-    send: Any, work: Callable[[Any], Any], job: Any, memory_mib: int, place: tuple[dict, str]
+    send: Any,
+    board: Any,
+    work: Callable[[Any], Any],
+    job: Any,
+    memory_mib: int,
+    place: tuple[dict, str],
 ) -> None:
     """In the child: the caller's environment and folder (not the fork server's, which are
     from its start), limited memory, reads recorded; run `work`, send one final message."""
     import resource
 
-    global _channel
+    global _board
     die_with_parent()
     os.environ.clear()
     os.environ.update(place[0])
     os.chdir(place[1])
     size = memory_mib * 1024 * 1024
     resource.setrlimit(resource.RLIMIT_AS, (size, size))
-    _channel = send
+    _board = board
     files: set[str] = set()
     sys.addaudithook(_reads(files))
     try:
@@ -252,10 +255,23 @@ def _child(
     except RecursionError:  # a description nested past what a reader recurses through
         problem = f"{_stage}: nests deeper than twin can follow; flatten the description"
         message = ("error", ("ConversionError", problem))
-    except Exception as exc:  # a converter defect: the caller reports it with the stage
-        message = ("crash", f"{type(exc).__name__}: {exc}")
-    with _send_lock:
-        send.send((*message, sorted(files)) if message[0] != "memory" else message)
+    except Exception as exc:  # a converter defect, unless memory ran out in another guise
+        message = ("memory",) if _out_of_memory(exc) else ("crash", f"{type(exc).__name__}: {exc}")
+    send.send((*message, sorted(files)) if message[0] != "memory" else message)
+
+
+def _out_of_memory(exc: BaseException) -> bool:
+    """Whether `exc` (or its cause) is the address-space limit in another guise: an import
+    whose library cannot be mapped, an OSError ENOMEM."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        text = str(seen).lower()
+        if isinstance(seen, OSError) and seen.errno == errno.ENOMEM:
+            return True
+        if "failed to map segment" in text or "cannot allocate memory" in text:
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 def _dumps(value: Any) -> bytes:
