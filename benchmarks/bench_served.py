@@ -29,7 +29,7 @@ def run() -> dict[str, object]:
     from converters.mjcf.builder import ConvertOptions
     from converters.served import ConversionJob, convert_job, convert_served
 
-    bounded.warm()
+    bounded.enable()
     robots = {r["id"]: r for r in tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]}
     results: dict[str, object] = {}
     for robot_id in ROBOTS:

@@ -135,10 +135,28 @@ def running() -> list[Running]:
         return list(_RUNNING)
 
 
-def warm() -> None:
-    """Start the fork server now (it imports the converter in the background), so that the
-    first conversion does not wait for it."""
+def enable() -> None:
+    """Bound this process's served conversions from now on (`enabled`), and start the fork
+    server now (it imports the converter in the background, so the first conversion finds it
+    warm). A world server calls it as it starts. Like any multiprocessing program, the process
+    needs a main module its children may import again: a script guards its code with
+    `if __name__ == "__main__":` (`python -m twin_cli` and the `twin` command do).
+    """
+    global _enabled
     _context()
+    _enabled = True
+
+
+def disable() -> None:
+    """Convert in this process again (the fork server stays, idle, until the process ends)."""
+    global _enabled
+    _enabled = False
+
+
+def enabled() -> bool:
+    """Whether `enable` is in force in this process (a library user's World converts in the
+    process, as before, with only xacro in a child)."""
+    return _enabled
 
 
 def stop_all() -> None:
@@ -153,6 +171,7 @@ _LOCK = threading.Lock()
 _STOPPING = threading.Event()
 _RUNNING: list[Running] = []
 _started: Any = None
+_enabled = False
 _listener: Callable[[str | None], None] | None = None
 _stage = "starting"  # in a child: the stage it is in
 _board: Any = None  # in a child: the buffer shared with the caller

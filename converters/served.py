@@ -45,14 +45,15 @@ class ConversionJob:
 def convert_served(job: ConversionJob, budget: XacroBudget) -> Conversion:
     """`job` converted under `budget`, with the world's process reading no description file.
 
-    In a daemonic worker process (which may not start children) it converts in the process.
+    It converts in this process when bounded conversions are not enabled here (`bounded.enable`:
+    a world server's choice), or in a daemonic worker process, which may not start children.
 
     Raises:
         ConversionBudgetError: over time or memory (which stage, how to raise the budget).
         ConversionStoppedError: the world began shutting down meanwhile.
         ConversionError: any subclass the conversion raised.
     """
-    if multiprocessing.current_process().daemon:
+    if not bounded.enabled() or multiprocessing.current_process().daemon:
         return convert_job(job)
     robot, report, reads = bounded.run(read_and_build, job, budget, job.source)
     with replay.replaying(reads):

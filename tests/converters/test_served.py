@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from converters import bounded
 from converters.bounded import READ_EVENT
 from converters.budget import XacroBudget
 from converters.errors import ConversionBudgetError, ResourceNotFoundError
@@ -39,6 +40,14 @@ ROBOT = """<robot name="cubes">
     <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="5" velocity="1"/>
   </joint>
 </robot>"""
+
+
+@pytest.fixture(autouse=True, scope="module")
+def bounded_here():
+    """Conversions in this module run as a world server's do (`bounded.enable`)."""
+    bounded.enable()
+    yield
+    bounded.disable()
 
 
 def mjb(spec: mujoco.MjSpec) -> bytes:

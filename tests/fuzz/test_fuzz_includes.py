@@ -21,6 +21,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from converters import bounded
 from converters.budget import XacroBudget
 from converters.errors import ConversionBudgetError, ConversionError, SDFError, XacroError
 from converters.mjcf.builder import ConvertOptions
@@ -44,6 +45,14 @@ INERTIAL = (
 )
 XACRO_HEAD = '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
 BASE = f'<link name="base">{INERTIAL}</link>'
+
+
+@pytest.fixture(autouse=True, scope="module")
+def bounded_here():
+    """Conversions in this module run as a world server's do (`bounded.enable`)."""
+    bounded.enable()
+    yield
+    bounded.disable()
 
 
 def attempt(path: Path, env: dict[str, str] | None = None) -> ConversionError | None:
