@@ -40,6 +40,7 @@ READ_EVENT = "converters.read"
 PRELOAD = ["mujoco", "converters.warm"]
 POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
 STAGE_BYTES = 512  # the stage text shared with the caller (a long path is cut)
+SLACK_S = 2.0  # [s] a child outlives its time budget by at most this much, caller or not
 _CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")
 _WRITE_MODES = ("w", "a", "x", "+")
 
@@ -80,7 +81,7 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
     board = context.RawArray("c", STAGE_BYTES)
     process = context.Process(
         target=_child,
-        args=(send, board, work, job, budget.memory_mib, (dict(os.environ), os.getcwd())),
+        args=(send, board, work, job, (budget.timeout_s, budget.memory_mib), _place()),
         name="twin-conversion",
     )
     process.daemon = True
@@ -213,9 +214,11 @@ def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
     kind = message[0]
     if kind in ("died", "memory") and _STOPPING.is_set():
         raise ConversionStoppedError(running.subject)
+    code = running.process.exitcode
+    if kind == "died" and running.stage == "starting" and (code or 0) > 0:
+        raise RuntimeError(f"{running.subject}: the conversion worker failed to start ({code})")
     if kind in ("died", "memory"):
         problem = f"needed more than {budget.memory_mib} MiB"
-        code = running.process.exitcode
         if kind == "died" and code is not None and code < 0:
             problem += f" (the worker ended with signal {-code})"
         raise ConversionBudgetError(running.subject, running.stage, problem, MEMORY_ENV)
@@ -248,15 +251,17 @@ def _child(
     board: Any,
     work: Callable[[Any], Any],
     job: Any,
-    memory_mib: int,
+    budget: tuple[float, int],
     place: tuple[dict, str],
 ) -> None:
     """In the child: the caller's environment and folder (not the fork server's, which are
     from its start), limited memory, reads recorded; run `work`, send one final message."""
     import resource
 
+    timeout_s, memory_mib = budget
     global _board
     die_with_parent()
+    _end_with_caller(send, timeout_s)
     os.environ.clear()
     os.environ.update(place[0])
     os.chdir(place[1])
@@ -277,6 +282,34 @@ def _child(
     except Exception as exc:  # a converter defect, unless memory ran out in another guise
         message = ("memory",) if _out_of_memory(exc) else ("crash", f"{type(exc).__name__}: {exc}")
     send.send((*message, sorted(files)) if message[0] != "memory" else message)
+
+
+def _place() -> tuple[dict, str]:
+    """This process's environment and folder, for the child (the fork server's are older)."""
+    return dict(os.environ), os.getcwd()
+
+
+def _end_with_caller(send: Any, timeout_s: float) -> None:
+    """End this child when its caller is gone or its time is up, whoever is still there.
+
+    Its parent is the fork server, which outlives a killed caller while a child holds the
+    server's "alive" pipe, so PR_SET_PDEATHSIG alone would leave a child working for nobody:
+    a thread waits for the result pipe's reader to close (POLLERR on the write end), and the
+    kernel ends the child SLACK_S after its budget (SIGALRM, default action), even inside C.
+    """
+    import select
+    import signal
+
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.setitimer(signal.ITIMER_REAL, timeout_s + SLACK_S)
+
+    def watch() -> None:
+        poller = select.poll()
+        poller.register(send.fileno(), select.POLLERR)
+        poller.poll()
+        os._exit(1)
+
+    threading.Thread(target=watch, name="twin-caller-watch", daemon=True).start()
 
 
 def _out_of_memory(exc: BaseException) -> bool:
