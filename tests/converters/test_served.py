@@ -129,3 +129,64 @@ def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path):
     message = str(caught.value)
     assert "needed more than 64 MiB" in message and "TWIN_CONVERT_MEMORY" in message, message
     assert str(robot) in message and "while " in message, message
+
+
+CALLER = """
+import sys, threading, time
+from converters import bounded
+from converters.budget import XacroBudget
+from converters.served import ConversionJob, convert_served
+
+if __name__ == "__main__":
+    bounded.enable()
+
+    def tell() -> None:
+        while not bounded.running():
+            time.sleep(0.05)
+        print(bounded.running()[0].process.pid, flush=True)
+
+    threading.Thread(target=tell, daemon=True).start()
+    convert_served(ConversionJob(sys.argv[1], path=sys.argv[1]), XacroBudget(600, 4096))
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_a_conversion_child_ends_with_its_killed_caller(tmp_path, monkeypatch):
+    """kill -9 of the caller (a world server) while its child reads a huge mesh with a 600 s
+    budget: the child and its fork server are gone within 3 s."""
+    import signal
+    import subprocess
+    import time
+
+    from tests.big_meshes import write_grid_obj
+
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+    write_grid_obj(tmp_path / "bumps.obj", 800_000)
+    robot = tmp_path / "heavy.urdf"
+    robot.write_text(ROBOT.replace("cube.obj", "bumps.obj").format(mesh="bumps.obj"))
+    script = tmp_path / "caller.py"
+    script.write_text(CALLER)
+    caller = subprocess.Popen(
+        [sys.executable, str(script), str(robot)], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        child = int(caller.stdout.readline())  # type: ignore[union-attr]
+        server = int(Path(f"/proc/{child}/stat").read_text().rsplit(")", 1)[1].split()[1])
+        time.sleep(0.5)
+        assert _alive(child), "the child ended before the caller was killed"
+        caller.send_signal(signal.SIGKILL)
+        caller.wait(timeout=10)
+        deadline = time.monotonic() + 3.0
+        while (_alive(child) or _alive(server)) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not _alive(child), "the conversion child outlived its killed caller"
+        assert not _alive(server), "the fork server outlived its killed caller"
+    finally:
+        caller.kill()
