@@ -70,7 +70,9 @@ class LoadedSource:
 def load_source(request: SpawnRequest) -> LoadedSource:
     """Reads the request's URDF/xacro/SDF (through the converter), MJCF, text or MjSpec.
 
-    The request's `env` (the caller's package search variables) goes over this process's.
+    The request's `env` (the caller's package search variables) goes over this process's. In a
+    world server a description is read in a bounded child (`convert_bounded`); MJCF is
+    MuJoCo's own parser, in this process.
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
