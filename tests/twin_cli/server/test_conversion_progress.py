@@ -17,8 +17,7 @@ from tests.big_meshes import write_grid_obj
 from tests.cli_world import twin_in, twin_ok
 
 WORLD = "progress"
-FACES = 190_000  # trimesh (imported) reads it in ~1 s, past SHOW_AFTER_S; the writer keeps
-# meshes as STL, which MuJoCo reads up to 200k faces
+FACES = 190_000  # trimesh (imported first) reads it in ~1 s, past SHOW_AFTER_S
 ROBOT = """<robot name="heavy"><link name="base">
   <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
   </inertial>
