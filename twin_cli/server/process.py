@@ -277,7 +277,10 @@ def _end_conversions_on_exit(server: Any) -> None:
     from converters import bounded
     from converters.urdf.xacro_worker import stop_all
 
-    bounded.enable()
+    try:
+        bounded.enable()
+    except (OSError, RuntimeError, ValueError) as exc:  # no fork server: convert here, as before
+        log.warning("conversions run in the server process: %s", exc)
 
     def watch() -> None:
         while not server.should_exit:
