@@ -18,31 +18,24 @@ a sandboxed grandchild that answers in JSON), so the bytes on the pipe are the c
 
 from __future__ import annotations
 
-import errno
-import io
 import multiprocessing
 import os
 import pickle
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
-from types import MappingProxyType
 from typing import Any
 
+from converters import bounded_child, stages
+from converters.bounded_child import READ_EVENT
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import ConversionBudgetError, ConversionError, ConversionStoppedError
 
-READ_EVENT = "converters.read"
 # What the fork server imports once, so that a conversion's child starts warm.
 PRELOAD = ["mujoco", "converters.warm"]
 POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
-STAGE_BYTES = 512  # the stage text shared with the caller (a long path is cut)
-SLACK_S = 2.0  # [s] a child outlives its time budget by at most this much, caller or not
-_CODE_SUFFIXES = (".py", ".pyc", ".so", ".zip", ".pth")
-_WRITE_MODES = ("w", "a", "x", "+")
 
 
 @dataclass
@@ -57,8 +50,8 @@ class Running:
 
     @property
     def stage(self) -> str:
-        """The stage the child said last (read without a lock: a torn read is only text)."""
-        return self.board.value.decode(errors="replace") or "starting"
+        """The stage the child said last (`converters.stages`)."""
+        return stages.read(self.board)
 
 
 def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str) -> Any:
@@ -78,10 +71,17 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
     """
     context = _context()
     receive, send = context.Pipe(duplex=False)
-    board = context.RawArray("c", STAGE_BYTES)
+    board = context.RawArray("c", stages.STAGE_BYTES)
     process = context.Process(
-        target=_child,
-        args=(send, board, work, job, (budget.timeout_s, budget.memory_mib), _place()),
+        target=bounded_child.serve,
+        args=(
+            send,
+            board,
+            work,
+            job,
+            (budget.timeout_s, budget.memory_mib),
+            (dict(os.environ), os.getcwd()),
+        ),
         name="twin-conversion",
     )
     process.daemon = True
@@ -102,32 +102,6 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
         process.join(5)
         receive.close()
     return _outcome(message, running, budget)
-
-
-def stage(what: str, *, own_progress: bool = False) -> None:
-    """Say what the conversion is doing now (a step and its file). In a bounded child it goes to
-    the caller, which names it if the budget runs out and shows it as progress; elsewhere it goes
-    to the `listening` callback, if any: None for a stage that shows its own progress
-    (`own_progress`, collision meshes), so that the callback's display makes way."""
-    global _stage
-    _stage = what
-    board, listener = _board, _listener
-    if board is not None:  # a write to shared memory: no system call, cheap for every mesh
-        board.value = what.encode(errors="replace")[: STAGE_BYTES - 1]
-    if listener is not None:
-        listener(None if own_progress else what)
-
-
-@contextmanager
-def listening(listener: Callable[[str | None], None]) -> Iterator[None]:
-    """Call `listener` with each stage of a conversion in this process meanwhile (a CLI's
-    progress display; the converter itself never writes to a stream)."""
-    global _listener
-    previous, _listener = _listener, listener
-    try:
-        yield
-    finally:
-        _listener = previous
 
 
 def running() -> list[Running]:
@@ -173,9 +147,6 @@ _STOPPING = threading.Event()
 _RUNNING: list[Running] = []
 _started: Any = None
 _enabled = False
-_listener: Callable[[str | None], None] | None = None
-_stage = "starting"  # in a child: the stage it is in
-_board: Any = None  # in a child: the buffer shared with the caller
 
 
 def _context() -> Any:
@@ -215,7 +186,7 @@ def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
     if kind in ("died", "memory") and _STOPPING.is_set():
         raise ConversionStoppedError(running.subject)
     code = running.process.exitcode
-    if kind == "died" and running.stage == "starting" and (code or 0) > 0:
+    if kind == "died" and running.stage == stages.STARTING and (code or 0) > 0:
         raise RuntimeError(f"{running.subject}: the conversion worker failed to start ({code})")
     if kind in ("died", "memory"):
         problem = f"needed more than {budget.memory_mib} MiB"
@@ -243,137 +214,3 @@ def _rebuilt(name: str, text: str) -> ConversionError:
     exc = cls.__new__(cls)
     Exception.__init__(exc, text)
     return exc
-
-
-# ----------------------------------------------------------------------------- the child
-def _child(
-    send: Any,
-    board: Any,
-    work: Callable[[Any], Any],
-    job: Any,
-    budget: tuple[float, int],
-    place: tuple[dict, str],
-) -> None:
-    """In the child: the caller's environment and folder (not the fork server's, which are
-    from its start), limited memory, reads recorded; run `work`, send one final message."""
-    import resource
-
-    timeout_s, memory_mib = budget
-    global _board
-    die_with_parent()
-    _end_with_caller(send, timeout_s)
-    os.environ.clear()
-    os.environ.update(place[0])
-    os.chdir(place[1])
-    size = memory_mib * 1024 * 1024
-    resource.setrlimit(resource.RLIMIT_AS, (size, size))
-    _board = board
-    files: set[str] = set()
-    sys.addaudithook(_reads(files))
-    try:
-        message: tuple = ("done", _dumps(work(job)))
-    except ConversionError as exc:
-        message = ("error", (type(exc).__name__, str(exc)))
-    except MemoryError:
-        message = ("memory",)
-    except RecursionError:  # a description nested past what a reader recurses through
-        problem = f"{_stage}: nests deeper than twin can follow; flatten the description"
-        message = ("error", ("ConversionError", problem))
-    except Exception as exc:  # a converter defect, unless memory ran out in another guise
-        message = ("memory",) if _out_of_memory(exc) else ("crash", f"{type(exc).__name__}: {exc}")
-    send.send((*message, sorted(files)) if message[0] != "memory" else message)
-
-
-def _place() -> tuple[dict, str]:
-    """This process's environment and folder, for the child (the fork server's are older)."""
-    return dict(os.environ), os.getcwd()
-
-
-def _end_with_caller(send: Any, timeout_s: float) -> None:
-    """End this child when its caller is gone or its time is up, whoever is still there.
-
-    Its parent is the fork server, which outlives a killed caller while a child holds the
-    server's "alive" pipe, so PR_SET_PDEATHSIG alone would leave a child working for nobody:
-    a thread waits for the result pipe's reader to close (POLLERR on the write end), and the
-    kernel ends the child SLACK_S after its budget (SIGALRM, default action), even inside C.
-    """
-    import select
-    import signal
-
-    signal.signal(signal.SIGALRM, signal.SIG_DFL)
-    signal.setitimer(signal.ITIMER_REAL, timeout_s + SLACK_S)
-
-    def watch() -> None:
-        poller = select.poll()
-        poller.register(send.fileno(), select.POLLERR)
-        poller.poll()
-        os._exit(1)
-
-    threading.Thread(target=watch, name="twin-caller-watch", daemon=True).start()
-
-
-def _out_of_memory(exc: BaseException) -> bool:
-    """Whether `exc` (or its cause) is the address-space limit in another guise: an import
-    whose library cannot be mapped, an OSError ENOMEM."""
-    seen: BaseException | None = exc
-    while seen is not None:
-        text = str(seen).lower()
-        if isinstance(seen, OSError) and seen.errno == errno.ENOMEM:
-            return True
-        if "failed to map segment" in text or "cannot allocate memory" in text:
-            return True
-        seen = seen.__cause__ or seen.__context__
-    return False
-
-
-def _dumps(value: Any) -> bytes:
-    """Pickle `value`; read-only mappings (the description's) travel as dicts made read-only."""
-    buffer = io.BytesIO()
-    pickler = pickle.Pickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
-    pickler.dispatch_table = {MappingProxyType: _reduce_proxy}
-    pickler.dump(value)
-    return buffer.getvalue()
-
-
-def _reduce_proxy(proxy: MappingProxyType) -> tuple:
-    return read_only, (dict(proxy),)
-
-
-def read_only(mapping: dict) -> MappingProxyType:
-    """A read-only view of `mapping` (how a pickled `MappingProxyType` is rebuilt)."""
-    return MappingProxyType(mapping)
-
-
-def _reads(files: set[str]) -> Callable[[str, tuple], None]:
-    """An audit hook adding files opened for reading (not code) to `files`."""
-    code_dirs = tuple({sys.prefix, sys.base_prefix, sys.exec_prefix})
-
-    def hook(event: str, args: tuple) -> None:
-        if event == READ_EVENT:
-            files.add(os.fsdecode(args[0]))
-            return
-        if event != "open" or not isinstance(args[0], (str, bytes, os.PathLike)):
-            return
-        mode = args[1]
-        if isinstance(mode, str) and any(m in mode for m in _WRITE_MODES):
-            return
-        if isinstance(mode, int) and mode & (os.O_WRONLY | os.O_RDWR):
-            return
-        name = os.path.abspath(os.fsdecode(args[0]))
-        if not name.endswith(_CODE_SUFFIXES) and not name.startswith(code_dirs):
-            files.add(name)
-
-    return hook
-
-
-def die_with_parent() -> None:
-    """Ask the kernel to kill this process when the one that started it ends (Linux)."""
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() == 1:  # the parent ended before the request took effect
-        os._exit(1)

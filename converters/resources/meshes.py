@@ -58,8 +58,8 @@ def load_mesh(path: Path, link: str) -> MeshData:
 
 
 def _read_mesh(path: Path, link: str) -> MeshData:
-    from converters.bounded import stage
     from converters.resources import mesh_store
+    from converters.stages import stage
 
     stage(f"reading mesh {path}{_size_of(path)}")
     try:

@@ -26,12 +26,11 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from converters.bounded_child import READ_EVENT, die_with_parent
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import ConversionError, XacroBudgetError, XacroError
 from converters.resources.packages import PackageResolver
 from converters.urdf.xacro_expand import XacroResult
-
-READ_EVENT = "converters.read"
 
 
 def expand_bounded(
@@ -135,7 +134,7 @@ def serve(request: dict[str, Any]) -> None:
     """The child's work: expand, print one JSON line (the result or the error) on stdout."""
     from converters.urdf.xacro_expand import expand_xacro
 
-    _die_with_parent()
+    die_with_parent()
     path = Path(request["path"])
     resolver = PackageResolver.create(path, request["packages"], dict(os.environ))
     import xacro  # noqa: F401 (loaded before the guard: Python's own files stay readable)
@@ -246,16 +245,3 @@ def _inside(name: str, roots: tuple[str, ...]) -> bool:
         if name == real or name.startswith(real.rstrip(os.sep) + os.sep):
             return True
     return False
-
-
-def _die_with_parent() -> None:
-    """Ask the kernel to kill this child when the server that started it ends (Linux)."""
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() == 1:  # the parent ended before the request took effect
-        os._exit(1)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from converters import bounded
-from converters.bounded import READ_EVENT
+from converters.bounded_child import READ_EVENT
 from converters.budget import XacroBudget
 from converters.errors import ConversionBudgetError, ResourceNotFoundError
 from converters.mjcf.builder import ConvertOptions
