@@ -64,7 +64,7 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
     from xacro import substitution_args as subst
 
     def find(pkg: str) -> str:
-        found = resolver.find_package(pkg, uri=f"$(find {pkg})", element="xacro $(find)")
+        found = resolver.find_package(pkg, uri=f"$(find {pkg})", element=_where())
         FOUND.get()[pkg] = str(found)
         return str(found)
 
@@ -86,6 +86,15 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
     finally:
         subst._eval_find, subst._eval_dict["find"] = saved  # noqa: SLF001
         xacro.grab_macro = original_grab
+
+
+def _where() -> str:
+    """The xacro file being expanded now (xacro's file stack), for a `$(find)` message."""
+    import xacro
+
+    stack = getattr(xacro, "filestack", None) or []
+    current = next((f for f in reversed(stack) if f), None)
+    return f"xacro $(find) in {current}" if current else "xacro $(find)"
 
 
 def _conversion_cause(exc: BaseException) -> ConversionError | None:

@@ -23,7 +23,13 @@ from hypothesis import strategies as st
 
 from converters import bounded
 from converters.budget import XacroBudget
-from converters.errors import ConversionBudgetError, ConversionError, SDFError, XacroError
+from converters.errors import (
+    ConversionBudgetError,
+    ConversionError,
+    PackageNotFoundError,
+    SDFError,
+    XacroError,
+)
 from converters.mjcf.builder import ConvertOptions
 from converters.served import ConversionJob, convert_served
 
@@ -221,6 +227,10 @@ XACRO_CASES = {
         XacroError,
     ),
     "env_of_the_server": (f'<link name="$(env {SECRET_VAR})"/>', XacroError),
+    "find_unknown_package": (
+        '<xacro:include filename="$(find elsewhere)/x.xacro"/>',
+        PackageNotFoundError,
+    ),
 }
 
 
@@ -235,6 +245,7 @@ XACRO_SAYS = {
     "include_parent_folder": "secret.yaml is outside the robot's own package",
     "load_yaml_outside": "secret.yaml is outside the robot's own package",
     "env_of_the_server": SECRET_VAR,
+    "find_unknown_package": "$(find) in ",  # the file that asked, found by the fuzzer
 }
 
 
