@@ -133,6 +133,28 @@ class XacroBudgetError(ConversionError):
         self.path = path
 
 
+class ConversionBudgetError(ConversionError):
+    """A served conversion passed its time or memory budget and was stopped."""
+
+    def __init__(self, path: str, stage: str, problem: str, variable: str) -> None:
+        super().__init__(
+            f"{path}: conversion {problem}, its budget, while {stage}, and was stopped; if the "
+            f"robot really needs more, start the world with a larger {variable} (twin stop; "
+            f"{variable}=... twin spawn ...), or convert it once with `twin convert` and spawn "
+            "the MJCF it writes"
+        )
+        self.path = path
+        self.stage = stage
+
+
+class ConversionStoppedError(ConversionError):
+    """A served conversion was stopped because its world is shutting down."""
+
+    def __init__(self, path: str) -> None:
+        super().__init__(f"{path}: conversion stopped: the world is shutting down; spawn it again")
+        self.path = path
+
+
 class MalformedXMLError(ConversionError):
     """The description is not well-formed XML."""
 

@@ -19,6 +19,7 @@ from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
 from converters.report import Report
 from converters.resources.packages import PackageResolver
+from converters.stages import stage
 from converters.urdf.reader import parse_urdf
 from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
@@ -57,12 +58,14 @@ def read_description(
             str(path), "no such file", "give the path of a .urdf, .xacro or .sdf file"
         )
     if not needs_xacro(path):
+        stage(f"reading {path}")
         if args:
             report.ignored("--arg", f"{path.name} is not xacro; xacro arguments are not used")
         try:
             return path.read_text()
         except (OSError, UnicodeDecodeError) as exc:
             raise InputFileError(str(path), f"cannot be read ({exc})", "check the file") from exc
+    stage(f"expanding xacro {path}")
     if budget is None:
         result = expand_xacro(path, args, resolver)
     else:
@@ -95,6 +98,7 @@ def read_robot(
         InputFileError: the text is MJCF (nothing to convert) or of no known format.
         ConversionError: any subclass from the format's reader.
     """
+    stage(f"parsing {source}")
     kind = format_of(text)
     if kind == "sdf":
         from converters.sdf import read_sdf_model
@@ -176,6 +180,7 @@ def build_description(
     options = options or ConvertOptions()
     report = report or Report(source=robot.source)
     report.robot = robot.name
+    stage(f"building the model of {robot.source}")
     check_references(robot, options, report)
     check_joints(robot)
     provenance = Provenance()

@@ -350,5 +350,25 @@ def prepare_collision_meshes(
         CollisionSettingsError: an unknown mode or preset. A mesh that fails to decompose
             never raises: it falls back to its convex hull and the report says why.
     """
+    from converters.replay import read_once
+    from converters.stages import stage
+
     check_settings(settings)
-    return prepare(requests, settings, report)
+    by_key = {r.key: r for r in requests}
+
+    def compute() -> dict[str, list[MeshPart]]:
+        stage(f"preparing {len(requests)} collision meshes (hulls, CoACD)", own_progress=True)
+        return prepare(requests, settings, report)
+
+    def pack(parts: dict[str, list[MeshPart]]) -> dict[str, list[MeshPart | None]]:
+        """A part that is its request's own mesh is kept as None: the builder shares it."""
+        return {
+            k: [None if p.vertices is by_key[k].vertices else p for p in v]
+            for k, v in parts.items()
+        }
+
+    def unpack(kept: dict[str, list[MeshPart | None]]) -> dict[str, list[MeshPart]]:
+        whole = {k: MeshPart(r.vertices, r.faces) for k, r in by_key.items()}
+        return {k: [whole[k] if p is None else p for p in v] for k, v in kept.items()}
+
+    return read_once("collision", tuple(by_key), compute, pack=pack, unpack=unpack)

@@ -19,6 +19,7 @@ from converters.errors import InputFileError
 from converters.mjcf.builder import COLLISION_CLASS, pose
 from converters.mjcf.geometry import HEIGHTMAP, static_bodies
 from converters.mjcf.lumping import WORLDBODY, LinkPlacement, plan_bodies
+from converters.replay import read_once
 from converters.report import Report
 from converters.resources.height_images import read_height_image
 
@@ -106,7 +107,7 @@ def _add_one(
 def _heights(path: Path, z_size: float) -> np.ndarray:
     """Heights [m] on MuJoCo's grid: row 0 at -y (the image's bottom row), column 0 at -x."""
     try:
-        brightness = read_height_image(path)
+        brightness = read_once("height image", (str(path),), lambda: read_height_image(path))
     except (OSError, ValueError) as exc:
         raise InputFileError(str(path), f"cannot be a height map ({exc})", "fix the image") from exc
     peak = float(brightness.max())

@@ -1,4 +1,4 @@
-"""MjSpec → an MJCF directory: `<robot>.xml`, `scene.xml`, `assets/*.stl`; atomic, reproducible."""
+"""MjSpec → an MJCF directory: `<robot>.xml`, `scene.xml`, STL/MSH assets; atomic, reproducible."""
 
 from __future__ import annotations
 
@@ -21,6 +21,9 @@ SCENE = "scene.xml"
 # Binary STL: 80-byte header, uint32 count, then per triangle normal + 3 vertices + attribute.
 _STL_HEADER = b"twin binary STL".ljust(80, b" ")
 _STL_DTYPE = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+# MuJoCo refuses an STL of more faces ("number of faces should be between 1 and 200000"): a
+# larger mesh is written as MSH, MuJoCo's binary format, which has no such limit.
+STL_MAX_FACES = 200_000
 
 
 def safe_name(name: str) -> str:
@@ -41,6 +44,15 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
     return _STL_HEADER + count + records.tobytes()
 
 
+def msh_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    """MuJoCo's own binary mesh (MSH: int32 vertex, normal, texcoord and face counts, then
+    float32 positions and int32 faces), for meshes past what MuJoCo reads from an STL."""
+    positions = np.asarray(vertices, dtype="<f4").reshape(-1, 3)
+    triangles = np.asarray(faces, dtype="<i4").reshape(-1, 3)
+    counts = np.array([len(positions), 0, 0, len(triangles)], dtype="<i4")
+    return counts.tobytes() + positions.tobytes() + triangles.tobytes()
+
+
 def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
     """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
     from converters.mjcf.export_servos import export_servos
@@ -55,8 +67,12 @@ def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
             continue
         vertices = np.asarray(mesh.uservert, dtype=float).reshape(-1, 3)
         faces = np.asarray(mesh.userface, dtype=np.int64).reshape(-1, 3)
-        filename = f"{safe_name(mesh.name)}.stl"
-        (assets_dir / filename).write_bytes(stl_bytes(vertices, faces))
+        if len(faces) <= STL_MAX_FACES:
+            filename = f"{safe_name(mesh.name)}.stl"
+            (assets_dir / filename).write_bytes(stl_bytes(vertices, faces))
+        else:
+            filename = f"{safe_name(mesh.name)}.msh"
+            (assets_dir / filename).write_bytes(msh_bytes(vertices, faces))
         mesh.file = f"{ASSETS}/{filename}"
         mesh.uservert = []
         mesh.userface = []

@@ -9,6 +9,7 @@ collision cache; a damaged entry is removed and the file loaded again.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -32,15 +33,21 @@ def store_dir() -> Path:
 
 def key_of(path: Path) -> str:
     """SHA-256 of the file's bytes, the format version and the loader's (trimesh's) version."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        loader = version("trimesh")
-    except PackageNotFoundError:
-        loader = "absent"
+    loader = loader_version()
     digest = hashlib.sha256(f"{FORMAT_VERSION} {loader} {path.suffix.lower()}".encode())
     digest.update(path.read_bytes())
     return digest.hexdigest()
+
+
+@functools.cache
+def loader_version() -> str:
+    """trimesh's version, read once per process (package metadata takes ~50 ms to search)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("trimesh")
+    except PackageNotFoundError:
+        return "absent"
 
 
 def load(key: str) -> MeshData | None:

@@ -46,13 +46,22 @@ class MeshCache:
 
 def load_mesh(path: Path, link: str) -> MeshData:
     """A mesh file's triangles in metres: from the mesh store when these bytes were loaded
-    before, else read with trimesh (and stored).
+    before, else read with trimesh (and stored); from the read log when a bounded conversion's
+    spec is built again (`converters.replay`).
 
     Raises:
         MeshError: the file cannot be parsed or holds no triangles.
     """
-    from converters.resources import mesh_store
+    from converters.replay import read_once
 
+    return read_once("mesh", (str(path),), lambda: _read_mesh(path, link))
+
+
+def _read_mesh(path: Path, link: str) -> MeshData:
+    from converters.resources import mesh_store
+    from converters.stages import stage
+
+    stage(f"reading mesh {path}{_size_of(path)}")
     try:
         key = mesh_store.key_of(path)
     except OSError as exc:
@@ -64,6 +73,13 @@ def load_mesh(path: Path, link: str) -> MeshData:
     if not np.all(np.isfinite(mesh.vertices)):
         raise MeshError(str(path), link, "holds vertices that are not numbers (NaN or infinity)")
     return mesh
+
+
+def _size_of(path: Path) -> str:
+    try:
+        return f" ({path.stat().st_size / 1e6:.1f} MB)"
+    except OSError:
+        return ""
 
 
 def read_mesh_file(path: Path, link: str) -> MeshData:

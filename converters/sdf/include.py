@@ -29,6 +29,9 @@ SHIPPED_MODELS = Path(__file__).resolve().parent / "models"
 INCLUDABLE = ("model", "light", "actor")
 # Fuel models twin ships an equivalent of (OpenRobotics' "Ground Plane" and "Sun").
 FUEL_SHIPPED = ("ground plane", "sun")
+# Includes nested deeper than this are refused: real model trees nest a few levels, and a chain
+# of 1,000 model:// includes overflowed the interpreter's stack (RecursionError, an exit 70).
+MAX_INCLUDE_DEPTH = 100
 
 
 def expand_includes(ctx: SdfContext, parent: Any) -> None:
@@ -56,6 +59,10 @@ def _refuse_circle(ctx: SdfContext, include: Any, parent: Any, element: Any) -> 
         circle = " → ".join([*chain[chain.index(source) :], source])
         raise ctx.error(include, f"includes a model that includes it ({circle})", "remove "
                         "the <include> that closes the circle")  # fmt: skip
+    if len(chain) > MAX_INCLUDE_DEPTH:
+        problem = f"nests includes {len(chain)} levels deep (from {chain[0]})"
+        limit = f"twin follows at most {MAX_INCLUDE_DEPTH}; flatten the model tree"
+        raise ctx.error(include, problem, limit)
 
 
 def included_element(ctx: SdfContext, include: Any) -> Any:

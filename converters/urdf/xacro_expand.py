@@ -64,7 +64,7 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
     from xacro import substitution_args as subst
 
     def find(pkg: str) -> str:
-        found = resolver.find_package(pkg, uri=f"$(find {pkg})", element="xacro $(find)")
+        found = resolver.find_package(pkg, uri=f"$(find {pkg})", element=_where())
         FOUND.get()[pkg] = str(found)
         return str(found)
 
@@ -88,6 +88,15 @@ def _patched_find(resolver: PackageResolver) -> Iterator[list[str]]:
         xacro.grab_macro = original_grab
 
 
+def _where() -> str:
+    """The xacro file being expanded now (xacro's file stack), for a `$(find)` message."""
+    import xacro
+
+    stack = getattr(xacro, "filestack", None) or []
+    current = next((f for f in reversed(stack) if f), None)
+    return f"xacro $(find) in {current}" if current else "xacro $(find)"
+
+
 def _conversion_cause(exc: BaseException) -> ConversionError | None:
     """Our own error if xacro wrapped one (e.g. an unknown package inside `$(find)`)."""
     seen: BaseException | None = exc
@@ -102,6 +111,13 @@ def _conversion_cause(exc: BaseException) -> ConversionError | None:
 def _xacro_error(path: Path, exc: BaseException) -> XacroError:
     """xacro's failure, said once; a missing include names the package it was looked for in
     (a source checkout or another version of the package lacks files its install has)."""
+    if _caused_by(exc, RecursionError):
+        return XacroError(
+            str(path),
+            "macros or includes nest without end (maximum recursion depth exceeded)",
+            "look for a macro that calls itself with no stopping condition, or a file that "
+            "includes itself through others",
+        )
     missing = _missing_file(exc)
     if missing is None:
         return XacroError(str(path), str(exc) or type(exc).__name__)
@@ -116,6 +132,17 @@ def _xacro_error(path: Path, exc: BaseException) -> XacroError:
         f"that copy of '{pkg}' lacks the file (a source checkout, or a version other than the "
         f"robot was written for); give the right one with --package {pkg}=PATH",
     )
+
+
+def _caused_by(exc: BaseException, kind: type[BaseException]) -> bool:
+    """Whether `exc` or an exception it wraps (xacro's `.exc`, a cause) is a `kind`."""
+    seen: BaseException | None = exc
+    while seen is not None:
+        if isinstance(seen, kind):
+            return True
+        inner = getattr(seen, "exc", None)
+        seen = inner if isinstance(inner, BaseException) else (seen.__cause__ or seen.__context__)
+    return False
 
 
 def _missing_file(exc: BaseException) -> str | None:

@@ -26,12 +26,11 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from converters.bounded_child import READ_EVENT, die_with_parent
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import ConversionError, XacroBudgetError, XacroError
 from converters.resources.packages import PackageResolver
 from converters.urdf.xacro_expand import XacroResult
-
-READ_EVENT = "converters.read"
 
 
 def expand_bounded(
@@ -135,7 +134,7 @@ def serve(request: dict[str, Any]) -> None:
     """The child's work: expand, print one JSON line (the result or the error) on stdout."""
     from converters.urdf.xacro_expand import expand_xacro
 
-    _die_with_parent()
+    die_with_parent()
     path = Path(request["path"])
     resolver = PackageResolver.create(path, request["packages"], dict(os.environ))
     import xacro  # noqa: F401 (loaded before the guard: Python's own files stay readable)
@@ -168,8 +167,25 @@ def _allowed_roots(path: Path, resolver: PackageResolver) -> tuple[str, ...]:
     roots += [Path(p).resolve() for p in resolver.explicit.values()]
     for variable in _SENT:
         roots += [Path(p).resolve() for p in os.environ.get(variable, "").split(os.pathsep) if p]
-    python = {sys.prefix, sys.base_prefix, *(p for p in sys.path if p)}
-    return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in python)
+    return tuple(str(r) for r in roots) + tuple(os.path.realpath(p) for p in _python_roots())
+
+
+def _python_roots() -> set[str]:
+    """Where Python's own files and the packages the expansion imports live: the prefixes, the
+    site folders and the folders holding `converters` and `xacro`. Not every `sys.path` entry:
+    a server started with `python -m` from a home folder has that folder there, and a xacro
+    could then read anything under it."""
+    import site
+
+    import xacro
+
+    import converters
+
+    folders = {sys.prefix, sys.base_prefix, sys.exec_prefix, site.getusersitepackages()}
+    folders |= set(site.getsitepackages())
+    for package in (converters, xacro):
+        folders.add(str(Path(package.__file__ or "").resolve().parent.parent))
+    return folders
 
 
 REFUSED_FIX = (
@@ -229,16 +245,3 @@ def _inside(name: str, roots: tuple[str, ...]) -> bool:
         if name == real or name.startswith(real.rstrip(os.sep) + os.sep):
             return True
     return False
-
-
-def _die_with_parent() -> None:
-    """Ask the kernel to kill this child when the server that started it ends (Linux)."""
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() == 1:  # the parent ended before the request took effect
-        os._exit(1)

@@ -113,7 +113,7 @@ def spawn(
     request = spawn_request(
         file, xml, arg, package, joint, on_ground, repair_inertia, drop_dangling
     )
-    with connect_world(world, start=True) as c:
+    with connect_world(world, start=True) as c, _progress(world, file, json):
         if many:
             results = c.spawn_batch(request, poses=poses, names=listed, base=name)
         else:
@@ -122,6 +122,18 @@ def spawn(
             url = c.request("POST", "/view", body={})["url"]
             sys.stderr.write(f"twin: viewer on {url}\n")
     _report(results if many else results[0], json)
+
+
+def _progress(world: str, file: Path | None, json: bool) -> Any:
+    """The world's conversion stage on a terminal while the spawn waits (nothing with --json)."""
+    from contextlib import nullcontext
+
+    from twin_cli.cli.conversion_progress import WorldProgress
+
+    if json:
+        return nullcontext()
+    source = None if file is None or str(file) == "-" else str(file.expanduser().resolve())
+    return WorldProgress(world, source)
 
 
 def batch_placements(

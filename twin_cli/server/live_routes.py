@@ -1,5 +1,5 @@
 """Routes of the live look inside: `/topics` (`twin topics`), `/topics/echo` (`twin topics
-echo`) and `/entities/{name}/model` (`twin model`).
+echo`), `/entities/{name}/model` (`twin model`) and `/conversions` (`twin spawn`'s progress).
 
 The echo is one streamed HTTP reply (NDJSON: one message per line), not a sample route polled
 by the client: polling would read the world at the client's wall-clock pace (messages missed or
@@ -35,6 +35,21 @@ def topics(world: WorldDep) -> list[dict]:
     from twin_cli.live import live_topics
 
     return [t.to_dict() for t in live_topics(world)]
+
+
+@router.get("/conversions")
+def conversions() -> list[dict]:
+    """The descriptions being converted now (`twin spawn`'s progress): the file or text label,
+    the stage the conversion is in, and how long it has run [s, wall]."""
+    import time
+
+    from converters import bounded
+
+    now = time.monotonic()
+    return [
+        {"source": r.subject, "stage": r.stage, "seconds": round(now - r.started, 3)}
+        for r in bounded.running()
+    ]
 
 
 @router.get("/entities/{name}/model")

@@ -268,15 +268,24 @@ def serve(opts: ServeOptions) -> None:
 
 
 def _end_conversions_on_exit(server: Any) -> None:
-    """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every xacro
-    expansion still running: the requests waiting on them end, and the process with them."""
+    """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every conversion
+    still running: the requests waiting on them end, and the process with them. Conversions
+    are bounded from now on (`converters.bounded.enable`): their fork server starts now, so
+    that the first spawn finds it warm."""
     import threading
 
+    from converters import bounded
     from converters.urdf.xacro_worker import stop_all
+
+    try:
+        bounded.enable()
+    except (OSError, RuntimeError, ValueError) as exc:  # no fork server: convert here, as before
+        log.warning("conversions run in the server process: %s", exc)
 
     def watch() -> None:
         while not server.should_exit:
             time.sleep(0.1)
+        bounded.stop_all()
         stop_all()
 
     threading.Thread(target=watch, name="twin-conversion-stop", daemon=True).start()

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from converters.urdf.xacro_worker import READ_EVENT
+from converters.bounded_child import READ_EVENT
 from twin_cli.package_env import PACKAGE_ENVS
 from twin_cli.spawn_request import SpawnRequest
 

@@ -25,6 +25,7 @@ from twin_cli.world.scene import adopt_world_globals
 
 if TYPE_CHECKING:
     from converters.mjcf.builder import ConvertOptions
+    from converters.pipeline import Conversion
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
 URDF_SUFFIXES = (".urdf", ".xacro")
@@ -69,7 +70,9 @@ class LoadedSource:
 def load_source(request: SpawnRequest) -> LoadedSource:
     """Reads the request's URDF/xacro/SDF (through the converter), MJCF, text or MjSpec.
 
-    The request's `env` (the caller's package search variables) goes over this process's.
+    The request's `env` (the caller's package search variables) goes over this process's. In a
+    world server a description is read in a bounded child (`convert_bounded`); MJCF is
+    MuJoCo's own parser, in this process.
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
@@ -110,6 +113,29 @@ def convert_options(request: SpawnRequest) -> ConvertOptions:
     )
 
 
+def convert_bounded(request: SpawnRequest, *, source: str, **given: str | None) -> Conversion:
+    """The request's description converted in a bounded child process (`converters.served`):
+    whatever the description holds, the world keeps stepping and answering, and a conversion
+    over `TWIN_CONVERT_TIMEOUT` / `TWIN_CONVERT_MEMORY` is stopped with what it was doing.
+
+    Args:
+        source: the file, or a name for a text.
+        given: `path=` a file, or `text=` and `base_dir=` a description sent as text.
+    """
+    from converters.budget import XacroBudget
+    from converters.served import ConversionJob, convert_served
+
+    job = ConversionJob(
+        source,
+        args=tuple(sorted(request.args.items())),
+        package_paths=tuple((k, str(v)) for k, v in sorted(request.package_paths.items())),
+        options=convert_options(request),
+        env=resolving_env(request),
+        **given,
+    )
+    return convert_served(job, XacroBudget.from_env())
+
+
 def resolving_env(request: SpawnRequest) -> dict[str, str] | None:
     """The environment to resolve packages in: the caller's variables over this process's
     (unset ones: this process's), or None for this process's own."""
@@ -130,7 +156,6 @@ def _sniff(path: Path) -> str | None:
 def _load_text(request: SpawnRequest) -> LoadedSource:
     """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
     from converters.formats import format_of
-    from converters.pipeline import convert_text
 
     text, label = request.xml or "", request.label
     if format_of(text) == "mjcf":
@@ -139,14 +164,8 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
         except ValueError as exc:
             raise SpawnError(label, label, f"not valid MJCF ({exc})", "fix it") from exc
         return LoadedSource(spec, label, None, text, spec.modelname or "model")
-    done = convert_text(
-        text,
-        source=label,
-        base_dir=request.base_dir,
-        package_paths=dict(request.package_paths),
-        options=convert_options(request),
-        env=resolving_env(request),
-    )
+    base_dir = str(request.base_dir) if request.base_dir is not None else None
+    done = convert_bounded(request, source=label, text=text, base_dir=base_dir)
     name = done.report.robot or "model"
     return LoadedSource(
         done.spec,
@@ -201,15 +220,7 @@ def _load_description(path: Path, request: SpawnRequest) -> LoadedSource:
 
 
 def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
-    from converters.pipeline import convert_full
-
-    done = convert_full(
-        path,
-        args=dict(request.args),
-        package_paths=dict(request.package_paths),
-        options=convert_options(request),
-        env=resolving_env(request),
-    )
+    done = convert_bounded(request, source=str(path), path=str(path))
     spec, report = done.spec, done.report
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)

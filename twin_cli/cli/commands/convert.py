@@ -134,6 +134,7 @@ def convert_command(
     """Convert a xacro/URDF (with Gazebo tags) or SDF robot into a MuJoCo MJCF directory."""
     from converters.mjcf.writer import write_model
     from converters.pipeline import convert_full
+    from twin_cli.cli.conversion_progress import LocalProgress
     from twin_cli.cli.output import Output
 
     settings = _collision_settings(
@@ -149,11 +150,12 @@ def convert_command(
         coacd_time_limit,
         coacd_threshold_m,
     )
-    done = convert_full(
-        robot,
-        **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, settings, as_written, drop_dangling),
-    )
+    with LocalProgress():
+        done = convert_full(
+            robot,
+            **source_inputs(arg, package),
+            options=_options(keep_fixed, repair_inertia, settings, as_written, drop_dangling),
+        )
     if print_xml:
         typer.echo(done.spec.to_xml(), nl=False)
         if out_dir is None:
