@@ -7,16 +7,22 @@ as entities are spawned and deleted. A latched topic's last message is sent agai
 subscribes to it (the WebSocket protocol has no transient-local durability).
 
 What guards it: foxglove-sdk's server (0.30) has no authentication and no Host or Origin check
-(only TLS), so twin binds loopback and refuses any other address unless the caller passes
-`allow_public`. Clients can only read: no capability that acts on the world is advertised
-(no client publish, parameters or services), so a page of another site that reaches the port
-(or a DNS-rebound name) can watch the world's topics but not drive it.
+(only TLS), and no hook to add one. So the SDK listens on 127.0.0.1 at a port browsers refuse to
+open (`INNER_PORTS`), and the port the user asked for is a relay in its own process that checks
+Host and Origin first (`twin_cli.view.foxglove_guard`): a page of another site or a DNS-rebound
+name is refused, Foxglove's app and scripts get through. Any other address than loopback is
+refused unless the caller passes `allow_public`. Clients can only read: no capability that acts
+on the world is advertised (no client publish, parameters or services).
 """
 
 from __future__ import annotations
 
 import ipaddress
 import logging
+import os
+import select
+import subprocess
+import sys
 import threading
 from typing import Any
 
@@ -27,6 +33,11 @@ from twin_cli.record.topics import Message, Topic
 log = logging.getLogger("twin.foxglove")
 DEFAULT_PORT = 8765  # Foxglove's own default
 LOOPBACK = "127.0.0.1"
+# Loopback ports every mainstream browser refuses to connect to (Chromium's and Firefox's "unsafe
+# ports") that an unprivileged process may bind: the SDK listens on the first free one, so no
+# page can reach it past the guard, whatever name it uses.
+INNER_PORTS = (6665, 6666, 6667, 6668, 6669, 6679, 6697, 10080, 6566, 4190, 3659, 4045, 1719)
+GUARD_START_S = 20.0  # [s] for the guard process to import and bind
 PUBLIC_WARNING = (
     "the Foxglove stream listens on {host}:{port}, not only on this machine: it has no "
     "password, and anyone who reaches that port can watch the world's topics"
@@ -72,22 +83,22 @@ class LiveStream:
         _check_address(host, port, allow_public=allow_public)
         self._context = foxglove.Context()
         self._listener = _Subscriptions()
-        try:
-            self._server = foxglove.start_server(
+        self._server = self._start_inner(
+            lambda inner: foxglove.start_server(
                 name=name,
-                host=host,
-                port=port,
+                host=LOOPBACK,
+                port=inner,
                 capabilities=[Capability.Time],
                 server_listener=self._listener,
                 supported_encodings=["cdr"],
                 context=self._context,
             )
-        except Exception as exc:  # the SDK raises its own error types for bind failures
-            raise RequestError(
-                f"Foxglove port {host}:{port}",
-                f"cannot be opened ({exc})",
-                "choose another port (e.g. --port 8766), or stop what listens there",
-            ) from exc
+        )
+        try:
+            self._guard, self._port = _start_guard(host, port, int(self._server.port))
+        except RequestError:
+            self._server.stop()
+            raise
         self.warning: str | None = None  # what the reply and the terminal must say
         if not ipaddress.ip_address(host).is_loopback:
             self.warning = PUBLIC_WARNING.format(host=host, port=self.port)
@@ -96,10 +107,25 @@ class LiveStream:
         self._latched: dict[str, bytes] = {}
         self._last_time = -1
 
+    @staticmethod
+    def _start_inner(start: Any) -> Any:
+        """The SDK's server on the first free port of INNER_PORTS."""
+        errors = []
+        for inner in INNER_PORTS:
+            try:
+                return start(inner)
+            except Exception as exc:  # the SDK raises its own error types for bind failures
+                errors.append(f"{inner}: {exc}")
+        raise RequestError(
+            "Foxglove stream",
+            f"found no free loopback port for its server ({'; '.join(errors[-2:])})",
+            "stop what listens on 127.0.0.1 ports 6665-6669",
+        )
+
     @property
     def port(self) -> int:
-        """The port the server listens on (useful with port 0)."""
-        return int(self._server.port)
+        """The port the stream listens on, its guard's (useful with port 0)."""
+        return self._port
 
     def set_topics(self, topics: list[Topic]) -> None:
         """Opens channels for new topics and closes those of entities that are gone."""
@@ -139,7 +165,49 @@ class LiveStream:
         for channel in self._channels.values():
             channel.close()
         self._channels.clear()
+        self._guard.terminate()
         self._server.stop()
+        try:
+            self._guard.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            self._guard.kill()
+
+
+def _start_guard(host: str, port: int, inner: int) -> tuple[subprocess.Popen, int]:
+    """Starts the guard process on host:port (`twin_cli.view.foxglove_guard`); its bound port.
+
+    Raises:
+        RequestError: it could not bind (the port is in use) or did not start in time.
+    """
+    command = [sys.executable, "-m", "twin_cli.view.foxglove_guard", host, str(port), str(inner)]
+    guard = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        stdin=subprocess.DEVNULL,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert guard.stdout is not None and guard.stderr is not None
+    ready, _, _ = select.select([guard.stdout], [], [], GUARD_START_S)
+    line = guard.stdout.readline().strip() if ready else b""
+    if line.isdigit():
+        threading.Thread(target=_drain, args=(guard,), daemon=True).start()
+        return guard, int(line)
+    guard.kill()
+    detail = guard.stderr.read().decode(errors="replace").strip().splitlines()
+    raise RequestError(
+        f"Foxglove port {host}:{port}",
+        f"cannot be opened ({detail[-1] if detail else 'its guard did not start'})",
+        "choose another port (e.g. --port 8766), or stop what listens there",
+    )
+
+
+def _drain(guard: subprocess.Popen) -> None:
+    """Reads the guard's output so a full pipe never blocks it."""
+    for stream in (guard.stdout, guard.stderr):
+        if stream is not None:
+            for _ in stream:
+                pass
 
 
 def ros2_channel(topic: Topic, context: Any, metadata: dict[str, str] | None = None) -> Any:

@@ -37,7 +37,7 @@ class ViewGuard:
         """Why `request` (a websockets `Request`) is refused, or None."""
         hosts, origins = request.headers.get_all("Host"), request.headers.get_all("Origin")
         given = hosts[0] if len(hosts) == 1 else None
-        if given is None or not self._host_allowed(given):
+        if given is None or not self.host_allowed(given):
             return f"Host {given!r} is not this viewer's address; open {self.example_url()}"
         if origins and (len(origins) > 1 or origins[0].lower() != f"http://{given}".lower()):
             return f"Origin {origins!r} is not this viewer's page; open {self.example_url()}"
@@ -55,7 +55,8 @@ class ViewGuard:
         name = COOKIE.format(port=self.port)
         return f"{name}={self.token}; Path=/; HttpOnly; SameSite=Strict"
 
-    def _host_allowed(self, header: str) -> bool:
+    def host_allowed(self, header: str) -> bool:
+        """Whether a Host header names this address and port."""
         try:
             split = urllib.parse.urlsplit(f"//{header}")
             name, port = (split.hostname or ""), (split.port or 80)

@@ -1,32 +1,89 @@
-"""The Foxglove stream cannot act on the world: what it advertises, and what a client's writes do.
+"""The Foxglove stream is guarded like a local daemon and cannot act on the world.
 
-foxglove-sdk's server has no Host or Origin check to hook (docs/viewer.md, "The Foxglove stream's
-guard"), so a page that reaches the loopback port can connect. What keeps the world safe is that
-the server offers reading only: its serverInfo advertises the Time capability and nothing that
-writes (client publish, parameters, services, playback control), and a client's attempts to
-write anyway are refused by the server, not executed.
+foxglove-sdk's server has no Host or Origin check to hook, so it listens on a loopback port that
+browsers refuse to open and the user's port is a guard process (`twin_cli.view.foxglove_guard`):
+a foreign Origin or Host is refused before the handshake, Foxglove's web app and clients without
+an Origin get through. Behind it the server offers reading only: its serverInfo advertises the
+Time capability and nothing that writes, and a client's attempts to write anyway are refused.
 """
 
 from __future__ import annotations
 
 import asyncio
 import json
+import socket
 
-from twin_cli.record.foxglove import LiveStream
+import pytest
+
+from twin_cli.record.foxglove import INNER_PORTS, LiveStream
 
 SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 WRITING = {"clientPublish", "parameters", "parametersSubscribe", "services", "assets",
            "connectionGraph", "playbackControl"}  # fmt: skip
 
 
-def test_the_stream_offers_reading_only_even_to_a_foreign_origin() -> None:
+@pytest.fixture
+def stream():
+    live = LiveStream(port=0)
+    yield live
+    live.close()
+
+
+def _handshake(port: int, headers: dict[str, str]) -> str:
+    """'open' with serverInfo received, or the refusal's HTTP status."""
     import websockets
 
-    stream = LiveStream(port=0)
+    async def attempt() -> str:
+        try:
+            async with websockets.connect(
+                f"ws://127.0.0.1:{port}", subprotocols=SUBPROTOCOLS, additional_headers=headers
+            ) as ws:
+                info = json.loads(await asyncio.wait_for(ws.recv(), 10))
+                return "open" if info["op"] == "serverInfo" else str(info)
+        except websockets.InvalidStatus as exc:
+            return str(exc.response.status_code)
+
+    return asyncio.run(attempt())
+
+
+@pytest.mark.parametrize(
+    ("headers", "expected"),
+    [
+        ({}, "open"),
+        ({"Origin": "https://app.foxglove.dev"}, "open"),
+        ({"Origin": "http://attacker.example"}, "403"),
+        ({"Host": "rebound.attacker.example"}, "403"),
+    ],
+    ids=["no origin", "foxglove app", "foreign origin", "rebound host"],
+)
+def test_only_this_machines_clients_and_foxglove_open_the_stream(stream, headers, expected):
+    with socket.create_connection(("127.0.0.1", stream.port)):
+        pass  # the guard listens
+    assert _handshake(stream.port, headers) == expected, headers
+
+
+def test_the_sdk_listens_where_no_browser_page_can_connect(stream) -> None:
+    """The SDK's own port is one of the ports browsers refuse, on loopback only."""
+    inner = [p for p in INNER_PORTS if _listening("127.0.0.1", p)]
+    assert inner, "the SDK's server listens on one of INNER_PORTS"
+    assert stream.port not in INNER_PORTS
+    assert _handshake(inner[0], {}) == "open", "the SDK answers there (the guard's upstream)"
+
+
+def _listening(host: str, port: int) -> bool:
+    try:
+        with socket.create_connection((host, port), timeout=0.5):
+            return True
+    except OSError:
+        return False
+
+
+def test_the_stream_offers_reading_only(stream) -> None:
+    import websockets
 
     async def session() -> tuple[dict, list[dict]]:
         url = f"ws://127.0.0.1:{stream.port}"
-        headers = {"Origin": "http://attacker.example"}
+        headers = {"Origin": "https://app.foxglove.dev"}
         async with websockets.connect(
             url, subprotocols=SUBPROTOCOLS, additional_headers=headers
         ) as ws:
@@ -47,10 +104,7 @@ def test_the_stream_offers_reading_only_even_to_a_foreign_origin() -> None:
                 if isinstance(frame, str):
                     replies.append(json.loads(frame))
 
-    try:
-        info, replies = asyncio.run(session())
-    finally:
-        stream.close()
+    info, replies = asyncio.run(session())
     assert info["op"] == "serverInfo", info
     offered = set(info.get("capabilities", []))
     assert offered == {"time"}, f"advertised capabilities: {sorted(offered)}"

@@ -1,0 +1,118 @@
+"""The Foxglove stream's front door: Host and Origin checked before a WebSocket reaches the SDK.
+
+foxglove-sdk's server has no hook on the handshake, so it cannot refuse a page of another site,
+nor a DNS-rebound name. twin therefore runs the SDK on a loopback port that browsers refuse to
+open (their "unsafe ports": IRC's 6665-6669 and the like, `twin_cli.record.foxglove.INNER_PORTS`),
+and serves the port the
+user asked for from this relay, in a process of its own so relaying costs the world's loop
+nothing. The relay accepts a handshake only when:
+  - Host names the address it is bound to (as the viewer's guard, `twin_cli.view.guard`);
+  - Origin is absent (Foxglove's desktop app, scripts) or a page allowed to show the stream:
+    Foxglove's web app, or one listed in TWIN_FOXGLOVE_ORIGINS (comma-separated);
+and then copies frames both ways between the client and the SDK, with the subprotocol the
+client asked for.
+
+Run as `python -m twin_cli.view.foxglove_guard HOST PORT INNER_PORT`; it prints the port it
+bound on its first line and ends with the process that started it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import sys
+from http import HTTPStatus
+from typing import Any
+
+from twin_cli.view.guard import ViewGuard
+
+FOXGLOVE_APP = "https://app.foxglove.dev"
+ORIGINS_VARIABLE = "TWIN_FOXGLOVE_ORIGINS"
+# In the order the relay prefers them; the SDK (0.30) speaks the first and refuses a client that
+# offers only the second, as it would without the relay.
+SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")
+
+
+def allowed_origins() -> frozenset[str]:
+    """Foxglove's web app and the origins the user lists in TWIN_FOXGLOVE_ORIGINS."""
+    extra = os.environ.get(ORIGINS_VARIABLE, "")
+    listed = {o.strip().rstrip("/").lower() for o in extra.split(",") if o.strip()}
+    return frozenset({FOXGLOVE_APP, *listed})
+
+
+def refusal(guard: ViewGuard, request: Any, origins: frozenset[str]) -> str | None:
+    """Why a handshake is refused (None: let it through)."""
+    hosts = request.headers.get_all("Host")
+    given = hosts[0] if len(hosts) == 1 else None
+    if given is None or not guard.host_allowed(given):
+        return f"Host {given!r} is not this stream's address ({guard.host}:{guard.port})"
+    sent = request.headers.get_all("Origin")
+    if sent and (len(sent) > 1 or sent[0].rstrip("/").lower() not in origins):
+        return (
+            f"Origin {sent!r} may not open this stream; allow a page with "
+            f"{ORIGINS_VARIABLE}=https://its.origin (Foxglove's web app is allowed)"
+        )
+    return None
+
+
+async def _relay(client: Any, inner_port: int) -> None:
+    from websockets.asyncio.client import connect
+
+    chosen = [client.subprotocol] if client.subprotocol else list(SUBPROTOCOLS)
+    uri = f"ws://127.0.0.1:{inner_port}/"
+    async with connect(uri, subprotocols=chosen, max_size=None, compression=None) as inner:
+        await asyncio.gather(_pump(client, inner), _pump(inner, client), return_exceptions=True)
+        await client.close()
+
+
+async def _pump(source: Any, sink: Any) -> None:
+    """Copies every frame from `source` to `sink` until either side closes."""
+    try:
+        async for frame in source:
+            await sink.send(frame)
+    finally:
+        await sink.close()
+
+
+async def serve(host: str, port: int, inner_port: int) -> None:
+    """Serves the guarded port until the process ends; prints the bound port first."""
+    from websockets.asyncio.server import serve as ws_serve
+
+    origins = allowed_origins()
+    guard_for: dict[str, ViewGuard] = {}
+
+    def process_request(connection: Any, request: Any) -> Any:
+        guard = guard_for["guard"]
+        why = refusal(guard, request, origins)
+        if why is not None:
+            return connection.respond(HTTPStatus.FORBIDDEN, f"twin foxglove: {why}\n")
+        return None
+
+    def select(connection: Any, offered: Any) -> Any:
+        return next((p for p in SUBPROTOCOLS if p in offered), None)
+
+    async with ws_serve(
+        lambda client: _relay(client, inner_port),
+        host,
+        port,
+        process_request=process_request,
+        select_subprotocol=select,
+        max_size=None,
+        compression=None,
+    ) as server:
+        bound = server.sockets[0].getsockname()[1]
+        guard_for["guard"] = ViewGuard(host, int(bound))
+        print(bound, flush=True)
+        await server.serve_forever()
+
+
+def main(argv: list[str]) -> None:
+    from converters.bounded_child import die_with_parent
+
+    die_with_parent()
+    host, port, inner_port = argv[0], int(argv[1]), int(argv[2])
+    asyncio.run(serve(host, port, inner_port))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
