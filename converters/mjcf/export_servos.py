@@ -95,11 +95,18 @@ def _to_servo(
     inertia: float,
     timestep: float,
 ) -> None:
-    """One motor (gear 1) → MuJoCo's position or velocity actuator, its effort as the bound."""
+    """One motor (gear 1) → MuJoCo's position or velocity actuator, its effort as the bound.
+
+    The tags' own PID gains (ros2_control `pos_kp`/`pos_kd`, a gz-sim controller's p and d)
+    replace the inertia rule, as in the world (docs/control.md).
+    """
     import mujoco
 
+    mode = record["modes"][0]
     kv = inertia / timestep
-    if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+    limited = actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
+    effort = float(np.max(np.abs(actuator.ctrlrange))) if limited else np.inf
+    if limited:
         actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         actuator.forcerange = np.asarray(actuator.ctrlrange, dtype=float)
     low, high = _target_range(spec, actuator.target, record)
@@ -107,12 +114,17 @@ def _to_servo(
         mujoco.mjtLimited.mjLIMITED_TRUE if np.isfinite(high) else mujoco.mjtLimited.mjLIMITED_FALSE
     )
     actuator.ctrlrange = np.array([low, high]) if np.isfinite(high) else np.zeros(2)
-    if record["modes"][0] == "position":
-        effort = float(actuator.forcerange[1]) if actuator.forcelimited else np.inf
-        kp = _position_gain(inertia, kv, effort, record.get("velocity_limit"), high - low)
+    pid = record.get("pid", {}).get(mode)
+    if mode == "position":
+        if pid:  # the world's rule: kv = max(kd, 2√(kp·I)), at most I/h with an effort limit
+            kp = float(pid[0])
+            damping = max(float(pid[2]), 2.0 * np.sqrt(max(kp, 0.0) * inertia))
+            kv = min(damping, kv) if np.isfinite(effort) else damping
+        else:
+            kp = _position_gain(inertia, kv, effort, record.get("velocity_limit"), high - low)
         actuator.set_to_position(kp=kp, kv=kv)
     else:
-        actuator.set_to_velocity(kv=kv)
+        actuator.set_to_velocity(kv=float(pid[0]) if pid else kv)
 
 
 def _position_gain(

@@ -26,7 +26,7 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from converters.bounded_child import READ_EVENT, die_with_parent
+from converters.bounded_child import CHILD_NICENESS, READ_EVENT, die_with_parent
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import ConversionError, XacroBudgetError, XacroError
 from converters.resources.packages import PackageResolver
@@ -135,6 +135,7 @@ def serve(request: dict[str, Any]) -> None:
     from converters.urdf.xacro_expand import expand_xacro
 
     die_with_parent()
+    os.nice(CHILD_NICENESS)  # the world's loop and its other requests come first
     path = Path(request["path"])
     resolver = PackageResolver.create(path, request["packages"], dict(os.environ))
     import xacro  # noqa: F401 (loaded before the guard: Python's own files stay readable)

@@ -118,3 +118,46 @@ def test_a_world_spawning_the_exported_file_has_the_sources_motors(
         world.step(500)
     a, b = (w.data.qpos.copy() for w in (from_file, from_source))
     assert np.array_equal(a, b), f"{robot_id}: the commanded robots differ by {np.abs(a - b).max()}"
+
+
+# Two 1 kg discs on vertical hinges fixed to the world (no gravity load), commanded by position
+# through ros2_control: d0 with no effort limit (effort 0) and a 1 rad/s velocity limit, d1 with
+# its own PID gains (pos_kp 120, pos_kd 4) and a 5 N m effort limit.
+TWO_DISCS = """<robot name="discs"><link name="world"/>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="disc0"><inertial><mass value="1"/><inertia ixx="0.003" iyy="0.003" izz="0.005"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="disc1"><inertial><mass value="1"/><inertia ixx="0.003" iyy="0.003" izz="0.005"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="d0" type="revolute"><parent link="base"/><child link="disc0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+  <joint name="d1" type="revolute"><origin xyz="0.3 0 0"/><parent link="base"/>
+    <child link="disc1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="5" velocity="4"/>
+  </joint>
+  <ros2_control name="discs" type="system"><hardware><plugin>x</plugin></hardware>
+    <joint name="d0"><command_interface name="position"/></joint>
+    <joint name="d1"><param name="pos_kp">120</param><param name="pos_kd">4</param>
+      <command_interface name="position_pid"/></joint>
+  </ros2_control>
+  <gazebo><plugin name="control" filename="libgazebo_ros2_control.so"/></gazebo></robot>"""
+
+
+def test_servo_gains_follow_the_effort_bound_and_the_tags_pid(tmp_path: Path) -> None:
+    from converters.pipeline import convert
+
+    source = tmp_path / "discs.urdf"
+    source.write_text(TWO_DISCS)
+    spec, report = convert(source)
+    model = mujoco.MjModel.from_xml_path(str(write_model(spec, report, tmp_path / "out")))
+    inertia, h = 0.005, 0.001  # [kg m²] each disc about its hinge, [s] the world's step
+    d0, d1 = model.actuator("d0"), model.actuator("d1")
+    # No effort limit: no force bound, and kp critically damped on I, not capped by v_max.
+    assert not model.actuator_forcelimited[d0.id]
+    assert d0.biasprm[2] == pytest.approx(-inertia / h)
+    assert d0.gainprm[0] == pytest.approx((inertia / h) ** 2 / (4 * inertia))
+    # The tags' PID: kp = pos_kp, kv = max(pos_kd, 2√(kp·I)) within I/h (an effort limit).
+    assert d1.gainprm[0] == pytest.approx(120.0)
+    assert -d1.biasprm[2] == pytest.approx(min(max(4.0, 2 * np.sqrt(120 * inertia)), inertia / h))
+    assert list(d1.forcerange) == [-5.0, 5.0]

@@ -127,6 +127,11 @@ class LiveStream:
         """The port the stream listens on, its guard's (useful with port 0)."""
         return self._port
 
+    @property
+    def inner_port(self) -> int:
+        """The SDK server's own loopback port, behind the guard (one of INNER_PORTS)."""
+        return int(self._server.port)
+
     def set_topics(self, topics: list[Topic]) -> None:
         """Opens channels for new topics and closes those of entities that are gone."""
         wanted = {t.name: t for t in topics}
@@ -165,12 +170,14 @@ class LiveStream:
         for channel in self._channels.values():
             channel.close()
         self._channels.clear()
-        self._guard.terminate()
+        if self._guard.stdin is not None:
+            self._guard.stdin.close()  # the guard's signal to end
         self._server.stop()
         try:
             self._guard.wait(timeout=5)
         except subprocess.TimeoutExpired:
             self._guard.kill()
+            self._guard.wait()
 
 
 def _start_guard(host: str, port: int, inner: int) -> tuple[subprocess.Popen, int]:
@@ -184,14 +191,15 @@ def _start_guard(host: str, port: int, inner: int) -> tuple[subprocess.Popen, in
         command,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        stdin=subprocess.DEVNULL,
+        stdin=subprocess.PIPE,  # held open until close(): its end ends the guard
         env={**os.environ, "PYTHONUNBUFFERED": "1"},
     )
     assert guard.stdout is not None and guard.stderr is not None
     ready, _, _ = select.select([guard.stdout], [], [], GUARD_START_S)
     line = guard.stdout.readline().strip() if ready else b""
     if line.isdigit():
-        threading.Thread(target=_drain, args=(guard,), daemon=True).start()
+        for stream in (guard.stdout, guard.stderr):  # one reader each: neither pipe fills
+            threading.Thread(target=_drain, args=(stream,), daemon=True).start()
         return guard, int(line)
     guard.kill()
     detail = guard.stderr.read().decode(errors="replace").strip().splitlines()
@@ -202,12 +210,10 @@ def _start_guard(host: str, port: int, inner: int) -> tuple[subprocess.Popen, in
     )
 
 
-def _drain(guard: subprocess.Popen) -> None:
-    """Reads the guard's output so a full pipe never blocks it."""
-    for stream in (guard.stdout, guard.stderr):
-        if stream is not None:
-            for _ in stream:
-                pass
+def _drain(stream: Any) -> None:
+    """Reads one of the guard's outputs to its end, logging it, so a full pipe never blocks it."""
+    for line in stream:
+        log.debug("foxglove guard: %s", line.decode(errors="replace").rstrip())
 
 
 def ros2_channel(topic: Topic, context: Any, metadata: dict[str, str] | None = None) -> Any:

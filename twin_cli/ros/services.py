@@ -22,6 +22,7 @@ import math
 import threading
 from typing import TYPE_CHECKING, Any
 
+from converters.errors import ConversionError
 from twin_cli.errors import EntityNotFoundError, TwinError
 from twin_cli.ros.graph import idl_type
 from twin_cli.ros.service_types import DELETE, MODEL_LIST, RESPONSE, SPAWN, service_idl
@@ -87,8 +88,11 @@ class ServiceServer:
             pose = self._pose_in_world(request.initial_pose, request.reference_frame)
             spawn = SpawnRequest(xml=request.xml).absolute()
             result = self._world.spawn(spawn, name=request.name or None, pose=pose)
-        except TwinError as exc:
+        except (TwinError, ConversionError) as exc:
             return {"success": False, "status_message": str(exc)}
+        except Exception as exc:  # a caller must always get its answer
+            log.exception("spawn_entity")
+            return {"success": False, "status_message": f"spawn failed: {exc}"}
         log.info("spawned %s (/spawn_entity)", result.name)
         return {"success": True, "status_message": f"spawned entity [{result.name}]"}
 

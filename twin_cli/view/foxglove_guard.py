@@ -7,13 +7,17 @@ and serves the port the
 user asked for from this relay, in a process of its own so relaying costs the world's loop
 nothing. The relay accepts a handshake only when:
   - Host names the address it is bound to (as the viewer's guard, `twin_cli.view.guard`);
-  - Origin is absent (Foxglove's desktop app, scripts) or a page allowed to show the stream:
-    Foxglove's web app, or one listed in TWIN_FOXGLOVE_ORIGINS (comma-separated);
-and then copies frames both ways between the client and the SDK, with the subprotocol the
-client asked for.
+  - Origin is absent (scripts, native clients) or a page allowed to show the stream:
+    Foxglove's web app, a local app page (`file://`), or one listed in TWIN_FOXGLOVE_ORIGINS
+    (comma-separated). `null`, what a sandboxed frame of any site sends, is not allowed unless
+    listed;
+  - the client speaks the SDK's subprotocol;
+and then copies frames both ways between the client and the SDK.
 
 Run as `python -m twin_cli.view.foxglove_guard HOST PORT INNER_PORT`; it prints the port it
-bound on its first line and ends with the process that started it.
+bound on its first line and ends when its standard input closes: the server holds the other end,
+so the guard ends with the server however it ends (a parent-death signal would follow the thread
+that started it, not the process).
 """
 
 from __future__ import annotations
@@ -26,18 +30,16 @@ from typing import Any
 
 from twin_cli.view.guard import ViewGuard
 
-FOXGLOVE_APP = "https://app.foxglove.dev"
+ALLOWED_BY_DEFAULT = ("https://app.foxglove.dev", "file://")
 ORIGINS_VARIABLE = "TWIN_FOXGLOVE_ORIGINS"
-# In the order the relay prefers them; the SDK (0.30) speaks the first and refuses a client that
-# offers only the second, as it would without the relay.
-SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")
+SUBPROTOCOL = "foxglove.sdk.v1"  # the one the SDK (0.30) speaks; it refuses clients without it
 
 
 def allowed_origins() -> frozenset[str]:
     """Foxglove's web app and the origins the user lists in TWIN_FOXGLOVE_ORIGINS."""
     extra = os.environ.get(ORIGINS_VARIABLE, "")
     listed = {o.strip().rstrip("/").lower() for o in extra.split(",") if o.strip()}
-    return frozenset({FOXGLOVE_APP, *listed})
+    return frozenset({*ALLOWED_BY_DEFAULT, *listed})
 
 
 def refusal(guard: ViewGuard, request: Any, origins: frozenset[str]) -> str | None:
@@ -52,15 +54,17 @@ def refusal(guard: ViewGuard, request: Any, origins: frozenset[str]) -> str | No
             f"Origin {sent!r} may not open this stream; allow a page with "
             f"{ORIGINS_VARIABLE}=https://its.origin (Foxglove's web app is allowed)"
         )
+    offered = ",".join(request.headers.get_all("Sec-WebSocket-Protocol")).replace(" ", "")
+    if SUBPROTOCOL not in offered.split(","):
+        return f"this stream speaks {SUBPROTOCOL}: use a Foxglove client that offers it"
     return None
 
 
 async def _relay(client: Any, inner_port: int) -> None:
     from websockets.asyncio.client import connect
 
-    chosen = [client.subprotocol] if client.subprotocol else list(SUBPROTOCOLS)
     uri = f"ws://127.0.0.1:{inner_port}/"
-    async with connect(uri, subprotocols=chosen, max_size=None, compression=None) as inner:
+    async with connect(uri, subprotocols=[SUBPROTOCOL], max_size=None, compression=None) as inner:
         await asyncio.gather(_pump(client, inner), _pump(inner, client), return_exceptions=True)
         await client.close()
 
@@ -89,7 +93,7 @@ async def serve(host: str, port: int, inner_port: int) -> None:
         return None
 
     def select(connection: Any, offered: Any) -> Any:
-        return next((p for p in SUBPROTOCOLS if p in offered), None)
+        return SUBPROTOCOL if SUBPROTOCOL in offered else None
 
     async with ws_serve(
         lambda client: _relay(client, inner_port),
@@ -103,13 +107,24 @@ async def serve(host: str, port: int, inner_port: int) -> None:
         bound = server.sockets[0].getsockname()[1]
         guard_for["guard"] = ViewGuard(host, int(bound))
         print(bound, flush=True)
-        await server.serve_forever()
+        await _stdin_closed()
+
+
+async def _stdin_closed() -> None:
+    """Returns when standard input reaches its end (the server closed it, or ended)."""
+    loop, closed = asyncio.get_running_loop(), asyncio.Event()
+    fd = sys.stdin.fileno()
+
+    def readable() -> None:
+        if not os.read(fd, 4096):
+            loop.remove_reader(fd)
+            closed.set()
+
+    loop.add_reader(fd, readable)
+    await closed.wait()
 
 
 def main(argv: list[str]) -> None:
-    from converters.bounded_child import die_with_parent
-
-    die_with_parent()
     host, port, inner_port = argv[0], int(argv[1]), int(argv[2])
     asyncio.run(serve(host, port, inner_port))
 

@@ -64,18 +64,49 @@ def test_only_this_machines_clients_and_foxglove_open_the_stream(stream, headers
 
 def test_the_sdk_listens_where_no_browser_page_can_connect(stream) -> None:
     """The SDK's own port is one of the ports browsers refuse, on loopback only."""
-    inner = [p for p in INNER_PORTS if _listening("127.0.0.1", p)]
-    assert inner, "the SDK's server listens on one of INNER_PORTS"
+    assert stream.inner_port in INNER_PORTS
     assert stream.port not in INNER_PORTS
-    assert _handshake(inner[0], {}) == "open", "the SDK answers there (the guard's upstream)"
+    assert _handshake(stream.inner_port, {}) == "open", "the SDK answers there, behind the guard"
 
 
-def _listening(host: str, port: int) -> bool:
+def test_a_client_without_the_sdks_subprotocol_is_told_why() -> None:
+    live = LiveStream(port=0)
     try:
-        with socket.create_connection((host, port), timeout=0.5):
-            return True
+        import websockets
+
+        async def attempt() -> str:
+            try:
+                async with websockets.connect(
+                    f"ws://127.0.0.1:{live.port}", subprotocols=["foxglove.websocket.v1"]
+                ):
+                    return "open"
+            except websockets.InvalidStatus as exc:
+                return f"{exc.response.status_code} {exc.response.body.decode()}"
+
+        assert asyncio.run(attempt()).startswith("403 twin foxglove: this stream speaks")
+    finally:
+        live.close()
+
+
+def test_the_guard_outlives_the_thread_that_started_it_and_ends_with_close() -> None:
+    """A request thread that opened the stream may end; the guard stays until close()."""
+    import threading
+    import time
+
+    made: list[LiveStream] = []
+    starter = threading.Thread(target=lambda: made.append(LiveStream(port=0)))
+    starter.start()
+    starter.join()
+    live = made[0]
+    time.sleep(1.0)
+    assert _handshake(live.port, {}) == "open", "the guard still answers"
+    live.close()
+    try:
+        socket.create_connection(("127.0.0.1", live.port), timeout=1).close()
+        closed = False
     except OSError:
-        return False
+        closed = True
+    assert closed, "close() ends the guard: its port no longer answers"
 
 
 def test_the_stream_offers_reading_only(stream) -> None:

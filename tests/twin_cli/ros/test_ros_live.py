@@ -270,6 +270,9 @@ def test_gazebo_ros_entity_services_spawn_list_and_delete_as_the_cli_does(served
     unknown = {**request, "name": "svc_other", "reference_frame": "no_such_frame"}
     refused = _peer(root, "call", "/spawn_entity", json.dumps(unknown))["reply"]
     assert not refused["success"] and "no_such_frame" in refused["status_message"], refused
+    malformed = {**request, "name": "svc_bad", "xml": "<robot name='svc_bad'><link name="}
+    broken = _peer(root, "call", "/spawn_entity", json.dumps(malformed))["reply"]
+    assert not broken["success"] and broken["status_message"], f"bad XML answered: {broken}"
     assert _names(root) == before, "a refused spawn changed the world"
     ahead_1m = {"position": [1.0, 0.0, 0.0], "orientation": [0.0, 0.0, 0.0, 1.0]}
     relative = {**request, "name": "svc_rel", "reference_frame": "svc_bot",
