@@ -5,6 +5,7 @@ WebSocket client speaking the published Foxglove protocol (no Foxglove code on t
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import os
 import signal
@@ -192,10 +193,17 @@ def _foxglove_session(port: int, client, steps: int) -> dict:
                 subscribed[k] = topic
                 subs.append({"id": k, "channelId": channels[topic]["id"]})
             await ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
-            # The protocol does not acknowledge a subscription; give the server's thread time
-            # to take it even on a loaded 2-core machine before the last sample is published.
-            await asyncio.sleep(2.0)
-            await asyncio.to_thread(client.step, steps - 50)
+            # The protocol does not acknowledge a subscription, and on a loaded 2-core machine
+            # it can take seconds to reach the server (through the stream's guard process):
+            # step in tens until both topics arrive, then the rest in one go.
+            stepped = 50
+            while not (got["/tf"] and got["/h/joint_states"]) and stepped < steps - 10:
+                await asyncio.to_thread(client.step, 10)
+                stepped += 10
+                with contextlib.suppress(TimeoutError):
+                    await pump(lambda: bool(got["/tf"] and got["/h/joint_states"]), timeout=1.0)
+            assert got["/tf"] and got["/h/joint_states"], "the subscription never took"
+            await asyncio.to_thread(client.step, steps - stepped)
             await pump(
                 lambda: (
                     got["/tf"] and got["/h/joint_states"][-1:][0][0] == steps * 10**6
