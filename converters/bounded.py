@@ -31,7 +31,11 @@ from typing import Any
 from converters import bounded_child, stages
 from converters.bounded_child import READ_EVENT
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
-from converters.errors import ConversionBudgetError, ConversionError, ConversionStoppedError
+from converters.errors import (
+    ConversionBudgetError,
+    ConversionStoppedError,
+    rebuilt_error,
+)
 
 # What the fork server imports once, so that a conversion's child starts warm.
 PRELOAD = ["mujoco", "converters.warm"]
@@ -198,19 +202,7 @@ def _outcome(message: tuple, running: Running, budget: XacroBudget) -> Any:
     if kind == "done":
         return pickle.loads(message[1])
     if kind == "error":
-        raise _rebuilt(message[1][0], message[1][1])
+        raise rebuilt_error(message[1][0], message[1][1])
     raise RuntimeError(
         f"{running.subject}: the conversion failed while {running.stage}: {message[1]}"
     )
-
-
-def _rebuilt(name: str, text: str) -> ConversionError:
-    """The child's error as the same class (constructors take facts, so not `pickle`)."""
-    from converters import errors
-
-    cls = getattr(errors, name, None)
-    if not (isinstance(cls, type) and issubclass(cls, ConversionError)):
-        cls = ConversionError
-    exc = cls.__new__(cls)
-    Exception.__init__(exc, text)
-    return exc

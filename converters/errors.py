@@ -244,3 +244,14 @@ class DanglingReferenceError(ConversionError):
         )
         self.source = source
         self.problems = problems
+
+
+def rebuilt_error(name: str, text: str) -> ConversionError:
+    """A child process's error as the same class, from its class name and text (the classes'
+    constructors take facts, so they cannot be pickled through a pipe)."""
+    cls = globals().get(name)
+    if not (isinstance(cls, type) and issubclass(cls, ConversionError)):
+        cls = ConversionError
+    exc = cls.__new__(cls)
+    Exception.__init__(exc, text)
+    return exc

@@ -28,7 +28,7 @@ from typing import Any
 
 from converters.bounded_child import CHILD_NICENESS, READ_EVENT, die_with_parent
 from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
-from converters.errors import ConversionError, XacroBudgetError, XacroError
+from converters.errors import ConversionError, XacroBudgetError, XacroError, rebuilt_error
 from converters.resources.packages import PackageResolver
 from converters.urdf.xacro_expand import XacroResult
 
@@ -114,19 +114,8 @@ def _result(path: Path, done: subprocess.CompletedProcess, budget: XacroBudget) 
     for name in answer.get("files", []):
         sys.audit(READ_EVENT, name)
     if "error" in answer:
-        raise _rebuilt(answer["error"], answer["message"])
+        raise rebuilt_error(answer["error"], answer["message"])
     return XacroResult(answer["text"], tuple(answer["unexpanded"]), tuple(answer["warnings"]))
-
-
-def _rebuilt(name: str, message: str) -> ConversionError:
-    from converters import errors
-
-    cls = getattr(errors, name, None)
-    if not (isinstance(cls, type) and issubclass(cls, ConversionError)):
-        cls = ConversionError
-    exc = cls.__new__(cls)
-    Exception.__init__(exc, message)
-    return exc
 
 
 # ----------------------------------------------------------------------------- the child
