@@ -38,17 +38,22 @@ SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
 
 
-def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> None:
-    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc)."""
+def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str, str]:
+    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc).
+
+    Returns:
+        Each joint given a servo, with its mode ("position" or "velocity").
+    """
     text = spec.text(CONTROL_TEXT)
     if text is None:
-        return
+        return {}
     records = json.loads(text.data)
     chosen = [
         (i, a, records[a.target]) for i, a in enumerate(spec.actuators) if _servoed(a, records)
     ]
     if not chosen:
-        return
+        return {}
+    servoed: dict[str, str] = {}
     inertia, home = _home_inertia(spec)
     key = _home_key(spec)
     ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
@@ -65,11 +70,13 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> None:
             "forcelimited": int(actuator.forcelimited),
         }
         _to_servo(spec, actuator, record, inertia[joint], timestep)
+        servoed[joint] = record["modes"][0]
         if key is not None and record["modes"][0] == "position":
             ctrl[i] = home[joint]
     if key is not None:
         key.ctrl = ctrl
     text.data = json.dumps(records)
+    return servoed
 
 
 def _servoed(actuator: mujoco.MjsActuator, records: dict) -> bool:

@@ -53,14 +53,36 @@ def msh_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
     return counts.tobytes() + positions.tobytes() + triangles.tobytes()
 
 
-def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
-    """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
+def exported_spec(spec: mujoco.MjSpec) -> tuple[mujoco.MjSpec, dict[str, str]]:
+    """A copy of `spec` as the exported file carries it: the world's contact rules and the
+    servos of what the robot's tags command by position or velocity.
+
+    Returns:
+        The copy, and each joint given a servo with its mode.
+    """
     from converters.mjcf.export_servos import export_servos
     from converters.mjcf.world_rules import finish_robot_spec
 
     copy = spec.copy()
     finish_robot_spec(copy)  # priorities and solrefs as a world attaches the robot
-    export_servos(copy)  # what the robot's tags command by position or velocity, as servos
+    return copy, export_servos(copy)
+
+
+def standalone_xml(spec: mujoco.MjSpec) -> str:
+    """The exported robot's MJCF with its meshes inline: one text, no asset files."""
+    from converters.mjcf.precision import restore_precision
+
+    copy, _ = exported_spec(spec)
+    return restore_precision(copy.to_xml(), copy)
+
+
+def robot_xml(spec: mujoco.MjSpec, assets_dir: Path) -> str:
+    """The robot's MJCF with every in-spec mesh written to `assets_dir` and referenced by file."""
+    return _with_mesh_files(exported_spec(spec)[0], assets_dir)
+
+
+def _with_mesh_files(copy: mujoco.MjSpec, assets_dir: Path) -> str:
+    """`copy`'s MJCF, each in-spec mesh moved out to a file in `assets_dir` (changes `copy`)."""
     copy.modelfiledir = str(assets_dir.parent)  # to_xml compiles: let it find the new files
     for mesh in copy.meshes:
         if len(mesh.uservert) == 0:
@@ -114,7 +136,9 @@ def write_model(spec: mujoco.MjSpec, report: Report, out_dir: str | Path) -> Pat
     try:
         (staging / ASSETS).mkdir()
         robot_file = f"{name}.xml"
-        (staging / robot_file).write_text(robot_xml(spec, staging / ASSETS))
+        exported, servoed = exported_spec(spec)
+        (staging / robot_file).write_text(_with_mesh_files(exported, staging / ASSETS))
+        _report_servos(report, servoed)
         (staging / SCENE).write_text(scene_xml(robot_file, name))
         os.chmod(staging, 0o755)
         _replace(staging, out)
@@ -122,6 +146,22 @@ def write_model(spec: mujoco.MjSpec, report: Report, out_dir: str | Path) -> Pat
         shutil.rmtree(staging, ignore_errors=True)
         raise
     return out / robot_file
+
+
+def _report_servos(report: Report, servoed: dict[str, str]) -> None:
+    """One line per mode: which joints the file drives by servo instead of by torque."""
+    for mode in ("position", "velocity"):
+        joints = sorted(j for j, m in servoed.items() if m == mode)
+        if not joints:
+            continue
+        names = ", ".join(f"'{j}'" for j in joints)
+        report.mapped(
+            f"exported {mode} servos",
+            f"{len(joints)} joint(s) {names}: ctrl is the {mode} target, force within ±effort, "
+            "gains from the reflected inertia at home (a world that spawns the file restores "
+            "the torque motors)",
+            tag="ros2_control",
+        )
 
 
 def _replace(staging: Path, out: Path) -> None:

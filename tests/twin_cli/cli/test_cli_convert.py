@@ -209,6 +209,27 @@ def test_print_writes_mjcf_to_stdout(tmp_path: Path) -> None:
     assert model.nu == 11, f"humanoid motors in printed MJCF: {model.nu}"
 
 
+def test_print_is_the_model_the_directory_holds(tmp_path: Path) -> None:
+    """--print gives what the written file gives: contact priorities and exported servos."""
+    import mujoco
+    import numpy as np
+    from interface_models import panda_arm
+
+    source = tmp_path / "panda.urdf"
+    source.write_text(panda_arm())
+    printed = twin("convert", str(source), "--print", cwd=tmp_path)
+    assert printed.returncode == 0, printed.stderr
+    written = twin("convert", str(source), "-o", str(tmp_path / "out"), "--json", cwd=tmp_path)
+    assert written.returncode == 0, written.stderr
+    a = mujoco.MjModel.from_xml_string(printed.stdout)
+    b = mujoco.MjModel.from_xml_path(json.loads(written.stdout)["model"])
+    assert (a.geom_priority > 0).any(), "printed geoms carry the Gazebo min-μ priority"
+    for field in ("geom_priority", "actuator_gainprm", "actuator_biasprm", "actuator_ctrlrange"):
+        assert np.array_equal(getattr(a, field), getattr(b, field)), field
+    servos = [e for e in json.loads(written.stdout)["entries"] if "servos" in e["subject"]]
+    assert servos and "panda_joint1" in servos[0]["detail"], "the report names the servos"
+
+
 def test_inspect_json_reports_total_mass_and_tree(tmp_path: Path) -> None:
     from converters.pipeline import convert_full
 

@@ -132,7 +132,7 @@ def convert_command(
     as_written: AsWrittenOpt = False,
 ) -> None:
     """Convert a xacro/URDF (with Gazebo tags) or SDF robot into a MuJoCo MJCF directory."""
-    from converters.mjcf.writer import write_model
+    from converters.mjcf.writer import standalone_xml, write_model
     from converters.pipeline import convert_full
     from twin_cli.cli.conversion_progress import LocalProgress
     from twin_cli.cli.output import Output
@@ -157,7 +157,7 @@ def convert_command(
             options=_options(keep_fixed, repair_inertia, settings, as_written, drop_dangling),
         )
     if print_xml:
-        typer.echo(done.spec.to_xml(), nl=False)
+        typer.echo(standalone_xml(done.spec), nl=False)
         if out_dir is None:
             return
     target = out_dir or Path(f"{robot.name.split('.')[0]}_mjcf")
