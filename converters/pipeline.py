@@ -188,7 +188,9 @@ def build_description(
     add_height_fields(spec, robot, report, keep_fixed=options.keep_fixed)  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
-    plugins = read_plugins(robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link)
+    plugins = read_plugins(
+        robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link, report
+    )
     add_drive_motors(spec, plugins, report)
     add_passive_motors(spec, robot, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)

@@ -15,7 +15,9 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from converters.description import CONTROL_PLUGINS
 from converters.description.gazebo import Blob
+from converters.gazebo.controller_drives import read_controller_drives
 from converters.gazebo.drive_motors import add_drive_motors
 from converters.gazebo.drive_notes import drive_notes
 from converters.gazebo.drive_readers import READERS, ReadContext, plugin_key
@@ -41,7 +43,7 @@ __all__ = [
 ]
 
 DIFF_DRIVE_FILES = ("libgazebo_ros_diff_drive.so", "gazebo_ros_diff_drive")
-CONTROL_FILES = ("libgazebo_ros2_control.so", "libgazebo_ros_control.so", "gazebo_ros2_control")
+CONTROL_FILES = (*CONTROL_PLUGINS, "gazebo_ros2_control")  # gazebo_ros(2)_control, gz_ros2_control
 # gz-sim system names (the `name` attribute) that identify a drive whatever its filename says.
 SYSTEM_NAMES = {
     "DiffDrive": "gz-sim-diff-drive-system",
@@ -118,14 +120,18 @@ def read_plugins(
     spec: mujoco.MjSpec | None = None,
     model: str = "",
     base_link: str = "base_link",
+    report: Report | None = None,
 ) -> tuple[DriveRecord | Rotor, ...]:
-    """Every drive, joint controller and multicopter rotor among a model's plugins.
+    """Every drive, joint controller and multicopter rotor among a model's plugins, and the
+    diff_drive_controllers of a ros2_control plugin's parameter file
+    (`converters.gazebo.controller_drives`).
 
     Args:
         blobs: the model's `<plugin>` elements; source: the file, for messages; spec: the
             robot (gazebo_ros' Ackermann and tricycle plugins measure their wheels on it);
             model, base_link: the model's name and canonical link (gz-sim's default odometry
-            frames are `<model>/odom` and `<model>/<link>`).
+            frames are `<model>/odom` and `<model>/<link>`); report: where a parameter file
+            that cannot be read is said.
 
     Raises:
         GazeboTagError: a parameter is not what its plugin needs. PluginJointError: a joint
@@ -146,6 +152,12 @@ def read_plugins(
             out.append(replace(record, notes=record.notes + notes))
         elif kind == "vendor_drive":
             out.append(read_vendor_diff_drive(Params.of(blob, source), blob))
+        elif kind == "command_interfaces":
+            drives, problems = read_controller_drives(blob, source)
+            out += drives
+            for problem in problems:
+                if report is not None:
+                    report.warn("model", f"<plugin> '{blob.name}' <parameters>: {problem}")
         elif kind == "multicopter":
             rotor = read_rotor(blob, source)
             if rotor is not None:

@@ -22,6 +22,9 @@ if TYPE_CHECKING:
     from converters.gazebo.drive_records import DiffDrive
     from twin_cli.world.engine import World
 
+# Drive families whose odometry integrates the wheels' joint positions (the others their speeds).
+POSITION_ENCODERS = ("gz_", "diff_drive_controller")
+
 
 class DiffDriveController(DriveController):
     """Drives one entity's wheels from (v, ω) commands; reports its odometry.
@@ -77,11 +80,12 @@ class DiffDriveController(DriveController):
         return float(np.mean(left)), float(np.mean(right))
 
     def _encoder_motion(self, dt: float) -> tuple[float, float]:
-        """gz-sim's DiffDrive measures how far the wheels turned since the last update (their
-        joint positions), so its odometry holds at any update rate; gazebo_ros' plugins sample
+        """gz-sim's DiffDrive and ros2_control's diff_drive_controller measure how far the wheels
+        turned since the last update (their joint positions), so their odometry holds at any
+        update rate; gazebo_ros' plugins sample
         the wheels' speeds. Measured on gz-sim bases' 1.2 m turns: 6-7 mm from the world pose
         from positions, 8-9 mm from sampled speeds."""
-        if not self.plugin.family.startswith("gz_"):
+        if not self.plugin.family.startswith(POSITION_ENCODERS):
             return super()._encoder_motion(dt)
         angles = self.wheel_angles()
         (left0, right0), self.angles = self.angles, angles

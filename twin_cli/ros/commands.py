@@ -68,11 +68,11 @@ def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
 def _inputs(world: World, name: str) -> tuple[Input, ...]:
     entity = world.entity(name)
     drives = [k for k in (type(p).__name__ for p in entity.plugins) if k in CONTROLLERS]
-    named = plugin_names(name, entity.description)
+    named = plugin_names(name, entity.description, entity.source)
     inputs = []
     if drives:
-        topic = named.cmd_vel or f"/{name}/cmd_vel"
-        inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
+        for topic in named.cmd_vel or (f"/{name}/cmd_vel",):
+            inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
     if named.controllers:
         return (*inputs, *(_controller_input(c) for c in named.controllers))
     return (*inputs, *_default_controllers(name, world.joint_commands(name)))

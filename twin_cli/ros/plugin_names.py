@@ -9,8 +9,10 @@ and the controllers of the YAML file gazebo_ros2_control loads.
   under `controller_manager: ros__parameters:` with a `type`, and its own `ros__parameters`
   (`joints`, `interface_name` or the type's interface). Forward command controllers and the
   joint group position, velocity and effort controllers take `<ns>/<controller>/commands`; a
-  joint_trajectory_controller takes `<ns>/<controller>/joint_trajectory`; `<ns>` is the
-  plugin's `<ros><namespace>`, else the entity's name.
+  joint_trajectory_controller takes `<ns>/<controller>/joint_trajectory`; a
+  diff_drive_controller takes `<ns>/<controller>/cmd_vel` (TwistStamped, and Twist as well) and,
+  as Humble's does with `use_stamped_vel: false`, `<ns>/<controller>/cmd_vel_unstamped`; `<ns>`
+  is the plugin's `<ros><namespace>`, else the entity's name.
 
 Only URDF descriptions carry these (`Entity.description`); a YAML file that cannot be read is
 logged once and the entity keeps twin's default controller names.
@@ -22,13 +24,21 @@ import logging
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import lru_cache
-from pathlib import Path
 from typing import Any
+
+from converters.gazebo.controller_drives import DIFF_DRIVE_TYPE
+from converters.gazebo.controller_yaml import (
+    controller_types,
+    load_parameters,
+    node_parameters,
+    parameter_files,
+)
 
 log = logging.getLogger("twin.ros")
 DRIVE_PLUGINS = ("diff_drive", "skid_steer", "ackermann", "planar_move", "tricycle")
 CONTROL_PLUGINS = ("gazebo_ros2_control", "gz_ros2_control")
 TRAJECTORY = "trajectory"  # a controller's mode: joint_trajectory_controller's topic
+DRIVE = "drive"  # a controller's mode: diff_drive_controller's cmd_vel
 CONTROLLER_MODES = {  # controller type → the command interface it writes
     "position_controllers/JointGroupPositionController": "position",
     "velocity_controllers/JointGroupVelocityController": "velocity",
@@ -49,31 +59,35 @@ class Controller:
 
 @dataclass(frozen=True)
 class PluginNames:
-    """What an entity's description names: its drive's cmd_vel topic (None: twin's default)
+    """What an entity's description names: its drive's cmd_vel topics (empty: twin's default)
     and its controllers (empty: twin's default controller names)."""
 
-    cmd_vel: str | None = None
+    cmd_vel: tuple[str, ...] = ()
     controllers: tuple[Controller, ...] = ()
 
 
 @lru_cache(maxsize=64)
-def plugin_names(entity: str, description: str | None) -> PluginNames:
-    """The names `description` (an entity's URDF text) gives its inputs (cached: the listener
-    asks every half second)."""
+def plugin_names(entity: str, description: str | None, source: str = "") -> PluginNames:
+    """The names `description` (an entity's URDF text, read from the file `source`) gives its
+    inputs (cached: the listener asks every half second). A relative `<parameters>` path starts
+    at `source`'s folder, as the converter reads it."""
     if not description:
         return PluginNames()
     try:
         root = ET.fromstring(description)
     except ET.ParseError:
         return PluginNames()
-    cmd_vel, controllers = None, ()
+    cmd_vel: tuple[str, ...] = ()
+    controllers: tuple[Controller, ...] = ()
     for plugin in root.iter("plugin"):
         filename = plugin.get("filename", "")
-        if cmd_vel is None and any(k in filename for k in DRIVE_PLUGINS):
-            cmd_vel = _resolve("cmd_vel", _namespace(plugin, entity), _remaps(plugin))
+        if not cmd_vel and any(k in filename for k in DRIVE_PLUGINS):
+            cmd_vel = (_resolve("cmd_vel", _namespace(plugin, entity), _remaps(plugin)),)
         if not controllers and any(k in filename for k in CONTROL_PLUGINS):
-            controllers = _controllers(plugin, entity)
-    return PluginNames(cmd_vel, controllers)
+            controllers = _controllers(plugin, entity, source)
+    drive_topics = tuple(c.topic for c in controllers if c.mode == DRIVE)
+    named = tuple(c for c in controllers if c.mode != DRIVE)
+    return PluginNames(cmd_vel or drive_topics, named)
 
 
 def _namespace(plugin: ET.Element, entity: str) -> str:
@@ -91,29 +105,34 @@ def _resolve(name: str, namespace: str, remaps: dict[str, str]) -> str:
     return name if name.startswith("/") else f"/{namespace}/{name}"
 
 
-def _controllers(plugin: ET.Element, entity: str) -> tuple[Controller, ...]:
-    import yaml
-
+def _controllers(plugin: ET.Element, entity: str, source: str) -> tuple[Controller, ...]:
     namespace = _namespace(plugin, entity)
     out: list[Controller] = []
-    for element in plugin.findall("parameters"):
-        path = Path((element.text or "").strip())
-        try:
-            document = yaml.safe_load(path.read_text()) or {}
-        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-            log.warning("[%s] %s not read (%s): default controller names", entity, path, exc)
+    for path in parameter_files(ET.tostring(plugin, encoding="unicode"), source):
+        document = load_parameters(path)
+        if isinstance(document, str):
+            log.warning("[%s] %s not read (%s): default controller names", entity, path, document)
             continue
         out += _from_yaml(document, namespace)
     return tuple(out)
 
 
+def _drive_topics(name: str, namespace: str) -> list[Controller]:
+    """A diff_drive_controller's inputs: `~/cmd_vel`, and Humble's `~/cmd_vel_unstamped`."""
+    return [
+        Controller(f"/{namespace}/{name}/{leaf}", DRIVE, ())
+        for leaf in ("cmd_vel", "cmd_vel_unstamped")
+    ]
+
+
 def _from_yaml(document: Any, namespace: str) -> list[Controller]:
     """The command-taking controllers the controller manager's YAML declares."""
-    manager = _params(document, "controller_manager")
     out = []
-    for name, entry in manager.items():
-        kind = str(entry.get("type")) if isinstance(entry, dict) else ""
-        params = _params(document, name)
+    for name, kind in controller_types(document).items():
+        if kind == DIFF_DRIVE_TYPE:
+            out += _drive_topics(name, namespace)
+            continue
+        params = node_parameters(document, name)
         mode = params.get("interface_name") if kind == FORWARD else CONTROLLER_MODES.get(kind)
         joints = tuple(str(j) for j in params.get("joints") or ())
         if mode is None or not joints:
@@ -121,10 +140,3 @@ def _from_yaml(document: Any, namespace: str) -> list[Controller]:
         leaf = "joint_trajectory" if mode == TRAJECTORY else "commands"
         out.append(Controller(f"/{namespace}/{name}/{leaf}", str(mode), joints))
     return out
-
-
-def _params(document: Any, node: str) -> dict:
-    """The `ros__parameters` of `node` in a ROS 2 parameter file (`/**` or the node's name)."""
-    entry = (document.get(node) or document.get(f"/{node}")) if isinstance(document, dict) else None
-    params = entry.get("ros__parameters") if isinstance(entry, dict) else None
-    return params if isinstance(params, dict) else {}

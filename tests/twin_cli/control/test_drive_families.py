@@ -88,6 +88,44 @@ MECANUM = (
     "right_rear_joint</back_right_joint><wheel_separation>0.3</wheel_separation><wheelbase>0.12"
     "</wheelbase><wheel_radius>0.05</wheel_radius></plugin>"
 )
+# A ROS 2 base with no drive plugin: ros2_control velocity interfaces on its wheels and a
+# diff_drive_controller in the controller manager's parameter file, named relative to the robot.
+ROS2_CONTROL = (
+    '<plugin filename="libgazebo_ros2_control.so" name="gazebo_ros2_control">'
+    "<parameters>controllers.yaml</parameters></plugin>"
+)
+WHEEL_INTERFACES = "".join(
+    f'<joint name="{j}"><command_interface name="velocity"/><state_interface name="position"/>'
+    '<state_interface name="velocity"/></joint>'
+    for j in ("wheel_left_joint", "wheel_right_joint")
+)
+CONTROLLERS_YAML = """controller_manager:
+  ros__parameters:
+    update_rate: 100
+    diff_cont:
+      type: diff_drive_controller/DiffDriveController
+    joint_broad:
+      type: joint_state_broadcaster/JointStateBroadcaster
+diff_cont:
+  ros__parameters:
+    publish_rate: 50.0
+    base_frame_id: base_link
+    left_wheel_names: ["wheel_left_joint"]
+    right_wheel_names: ["wheel_right_joint"]
+    wheel_separation: 0.3
+    wheel_radius: 0.05
+    use_stamped_vel: false
+"""
+
+
+def _ros2_control_base() -> str:
+    block = (
+        '<ros2_control name="GazeboSystem" type="system"><hardware><plugin>'
+        f"gazebo_ros2_control/GazeboSystem</plugin></hardware>{WHEEL_INTERFACES}</ros2_control>"
+    )
+    return dm.two_wheel_base(ROS2_CONTROL).replace("</robot>", f"{block}</robot>")
+
+
 PLANAR = (
     '<plugin name="mover" filename="libgazebo_ros_planar_move.so"><update_rate>100</update_rate>'
     "<odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
@@ -102,6 +140,7 @@ class Family:
     suffix: str
     model: str  # "unicycle", "bicycle" or "holonomic"
     turn: dict  # drive() keywords of the turn
+    files: tuple[tuple[str, str], ...] = ()  # (name, text) written beside the robot
 
 
 FAMILIES = {
@@ -116,6 +155,13 @@ FAMILIES = {
     ),
     "vendor_kobuki": Family(
         lambda: dm.two_wheel_base(KOBUKI), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "ros2_control_diff_drive_controller": Family(
+        _ros2_control_base,
+        "urdf",
+        "unicycle",
+        {"angular": 0.5},
+        (("controllers.yaml", CONTROLLERS_YAML),),
     ),
     "gz_diff_drive_sdf": Family(
         lambda: dm.sdf_diff_drive(GZ_DIFF.format(file="gz-sim-diff-drive-system")),
@@ -179,6 +225,8 @@ def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
     family = FAMILIES[name]
     path = tmp_path / f"{name}.{family.suffix}"
     path.write_text(family.robot())
+    for file_name, text in family.files:
+        (tmp_path / file_name).write_text(text)
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
     world.step(300)  # settle on the ground [ms]

@@ -28,7 +28,7 @@ def _drive(ros: str) -> str:
     ],
 )
 def test_a_drive_plugins_namespace_and_remapping_name_its_cmd_vel(ros: str, topic: str) -> None:
-    assert plugin_names("bot", _robot(_drive(ros))).cmd_vel == topic
+    assert plugin_names("bot", _robot(_drive(ros))).cmd_vel == (topic,)
 
 
 def test_the_controller_yaml_names_the_controllers_their_modes_and_joints(tmp_path) -> None:
@@ -60,4 +60,20 @@ def test_an_unreadable_controller_yaml_keeps_the_default_names(tmp_path) -> None
         f"<parameters>{tmp_path / 'missing.yaml'}</parameters></plugin>"
     )
     assert plugin_names("bot", _robot(plugin)).controllers == ()
-    assert plugin_names("bot", None).cmd_vel is None
+    assert plugin_names("bot", None).cmd_vel == ()
+
+
+def test_a_diff_drive_controller_takes_cmd_vel_under_its_own_name(tmp_path) -> None:
+    """A relative `<parameters>` path starts at the description's folder."""
+    (tmp_path / "ddc.yaml").write_text(
+        "controller_manager:\n  ros__parameters:\n"
+        "    base: {type: diff_drive_controller/DiffDriveController}\n"
+        "base: {ros__parameters: {left_wheel_names: [l], right_wheel_names: [r]}}\n"
+    )
+    plugin = (
+        '<plugin name="c" filename="gz_ros2_control-system"><ros><namespace>/tb</namespace>'
+        "</ros><parameters>ddc.yaml</parameters></plugin>"
+    )
+    names = plugin_names("bot", _robot(plugin), str(tmp_path / "bot.urdf"))
+    assert names.cmd_vel == ("/tb/base/cmd_vel", "/tb/base/cmd_vel_unstamped")
+    assert names.controllers == (), "a drive is not a joint command controller"

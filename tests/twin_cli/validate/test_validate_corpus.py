@@ -36,6 +36,12 @@ UPSTREAM = {
         "friction-cone edge, so the robot drifts backwards (~0.9 m/s) instead of coming to rest; "
         "in a standing posture (-J, STANDING below) it passes"
     ),
+    ("franka_panda", "stability"): (
+        "franka_ros' gazebo:=true arm has <self_collide> on, and at its zero posture (joint4 "
+        "clamped to -0.0698) link7 lies 41 mm inside link5: the contact pushes them apart "
+        "(energy gain 5.2 % measured). Gazebo spawns it at its launch file's ready posture (-J), "
+        "where it passes (READY below)"
+    ),
 }
 
 # Start postures (`twin validate -J`, scenario `[robot] joints`) [rad] for robots whose home
@@ -45,6 +51,16 @@ STANDING = {
         f"{leg}_{part}_joint": value
         for leg in ("FR", "FL", "RR", "RL")
         for part, value in (("hip", 0.0), ("thigh", 0.8), ("calf", -1.5))
+    },
+}
+# franka_gazebo's launch-file posture (its `initial_joint_positions` -J arguments) [rad].
+READY = {
+    "franka_panda": {
+        "panda_joint2": -math.pi / 4,
+        "panda_joint4": -3 * math.pi / 4,
+        "panda_joint6": math.pi / 2,
+        "panda_joint7": math.pi / 4,
+        "panda_finger_joint1": 0.001,
     },
 }
 
@@ -90,6 +106,16 @@ def test_aliengo_stands_still_in_a_standing_start_posture(check, converted_corpu
     scenario = with_joints(next(s for s in load_builtin() if s.check == check), STANDING["aliengo"])
     outcome = run_check(robot, scenario, debug=True)
     assert outcome.status is Status.PASS, f"aliengo {check}: {outcome.measured}; {outcome.hints}"
+
+
+@pytest.mark.skipif("franka_panda" not in CORPUS, reason="corpus: no franka_panda entry")
+@pytest.mark.parametrize("check", ["stability", "initial_overlap", "joint_limits"])
+def test_franka_panda_passes_from_its_ready_posture(check, converted_corpus):
+    done = converted_corpus("franka_panda")
+    robot = robot_from_conversion(done, CORPUS["franka_panda"]["entry"], repair_inertia=True)
+    scenario = next(s for s in plan() if s.check == check)
+    outcome = run_check(robot, with_joints(scenario, READY["franka_panda"]), debug=True)
+    assert outcome.status is Status.PASS, f"franka {check}: {outcome.measured}; {outcome.hints}"
 
 
 # Run with debug=True on every corpus robot elsewhere (a crash raises there): the checks above,

@@ -149,6 +149,9 @@ CORPUS_EXPECTED_FAILURES: dict[str, set[str]] = {
     # Gazebo file puts the RealSense 'intel_realsense_r200' on 'camera_link', which the robot
     # does not have (Gazebo drops the camera).
     "open_manipulator_x": {"inertia_plausible", "sensor_links"},
+    # franka_ros' gazebo:=true arm self-collides at its zero posture (link7 41 mm inside link5),
+    # as it would in Gazebo; its launch file spawns it at a ready posture instead.
+    "franka_panda": {"initial_overlap"},
 }
 
 
