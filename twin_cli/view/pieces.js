@@ -76,10 +76,11 @@
   const mujocoLoad = loadModelBytes;
   // eslint-disable-next-line no-global-assign
   loadModelBytes = function (bytes) {
+    const started = Date.now();
     const crc = mujocoLoad(bytes);
     // shown: the next animation frame began; presented: the one after it began, by which the
     // page's render loop has drawn the new model (its frame with new meshes runs in between).
-    const load = { crc: crc, parsed: Date.now(), shown: null, presented: null };
+    const load = { crc: crc, started: started, parsed: Date.now(), shown: null, presented: null };
     record.loads.push(load);
     requestAnimationFrame(() => {
       load.shown = Date.now();
