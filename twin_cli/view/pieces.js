@@ -20,11 +20,37 @@
     }
   }
 
+  // While the worker fetches a new model the page draws no frames. In SwiftShader a frame of a
+  // large robot costs about a CPU-second, and the page takes the new model only between two
+  // frames: a frame begun during the fetch delays the new robot by up to that long and takes
+  // the CPU the fetch needs. MuJoCo's render loop (Emscripten's MainLoop, a global of its page
+  // script) is paused when the worker sees a new model and resumed once it is loaded, after
+  // HOLD_MAX_MS at the latest.
+  const HOLD_MAX_MS = 3000;
+  let held = null; // the timer that resumes the render loop, while it is paused
+  function hold() {
+    const loop = typeof MainLoop === "undefined" ? null : MainLoop;
+    if (held || !loop || !loop.func || !currentModelCrc || !Module.pauseMainLoop) return;
+    Module.pauseMainLoop();
+    held = setTimeout(release, HOLD_MAX_MS);
+  }
+  function release() {
+    if (!held) return;
+    clearTimeout(held);
+    held = null;
+    Module.resumeMainLoop();
+  }
+
   worker.onmessage = (event) => {
-    const { crc, model, error, published } = event.data;
+    const { crc, model, error, published, coming } = event.data;
+    if (coming) {
+      if (coming !== currentModelCrc) hold();
+      return;
+    }
     if (error) {
       console.warn("[twin] pieces failed:", error);
       settle(crc, null);
+      release();
       return;
     }
     const s = model.stats;
@@ -38,6 +64,7 @@
     cacheModel(model.crc, model.bytes);
     settle(model.crc, model.bytes);
     if (published) showPublished(model.crc);
+    release();
   };
 
   // The server's newest model shows as soon as the worker has it, not when the state stream

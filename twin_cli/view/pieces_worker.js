@@ -102,6 +102,7 @@ async function watch() {
         const crc = Number(await resp.text()) >>> 0;
         if (crc && crc !== lastCrc) {
           lastCrc = crc;
+          postMessage({ coming: crc }); // the page may hold its frames until the model is here
           await deliver(crc, true, Date.now());
         }
       }
