@@ -24,6 +24,9 @@ the busy loops), seconds after the spawn's reply:
 | second (0.09 MB, no mesh bytes) | 0.30 | 1.59 | 1.84 | 3.80 |
 | third and fourth, two busy loops (0.12-0.15 MB) | 1.16-3.20 | 2.67-6.17 | 3.06-8.01 | 5.11-13.07 |
 
+Those were measured before the page held its render loop during a fetch; with the hold, at load
+15.1-16.6: drawn at 3.31 and 4.00 s idle, 9.71 and 11.12 s with the busy loops.
+
 The 2 s target from the reply to drawn is not met here. Twin's part ends when the worker has
 the model; the rest is the browser's: the wait for the page's main thread (busy in frames that
 each cost about a CPU-second in SwiftShader with this robot), MuJoCo's parse and rebuild of the

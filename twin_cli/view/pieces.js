@@ -3,8 +3,8 @@
 // bytes) off the main thread. Loaded after MuJoCo's page script, it puts each bundle the
 // worker posts into that script's model cache (a cache hit loads at once when the state stream
 // names the model), replaces its downloadModel (a global function) to ask the worker, and
-// wraps loadModelBytes to record when each model showed. If the worker fails, MuJoCo's own
-// download runs.
+// wraps loadModelBytes to record when each model showed. While the worker fetches a new model
+// the page draws no frames. If the worker fails, MuJoCo's own download runs.
 (() => {
   const WORKER_WAIT_MS = 30000; // then MuJoCo's whole download
   // What the page received and when models showed; read by tests and in the console.

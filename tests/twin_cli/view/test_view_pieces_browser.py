@@ -31,7 +31,7 @@ APPEAR_S = 2.0  # [s] from the spawn's reply to the new model drawn on the page 
 # Frames (as long as the page's frames before the spawns) the browser may take on top of
 # APPEAR_S: one to take the bundle between two frames, one to parse it and build its scene
 # (MuJoCo's WASM: 0.2-0.8 s for this arm), one or two to upload and draw 136,000 triangles in
-# SwiftShader. Measured on the 2-core VM at load 6-8: frames 0.7-1.8 s apart, drawn 2.3-3.4 s
+# SwiftShader. Measured on the 2-core VM at load 5-8: frames 0.6-1.8 s apart, drawn 1.7-3.4 s
 # after the reply; with frames ~0.1 s apart the whole budget is about APPEAR_S.
 DRAW_FRAMES = 4
 FIRST_LOAD_S = 120.0  # [s] the page's first load: WASM and WebGL in SwiftShader, ~12 s
