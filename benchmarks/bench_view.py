@@ -101,7 +101,7 @@ def _realtime(world: World) -> dict:
     }
 
 
-def measure(browser: object | None) -> dict:
+def measure(browser: Any | None) -> dict:
     """Windows without a viewer, with one and no page open, then with the page open.
 
     One viewer per process: MuJoCo 4.0.0's web viewer hangs when a process starts its third,
