@@ -3,8 +3,8 @@
 // bytes) off the main thread. Loaded after MuJoCo's page script, it puts each bundle the
 // worker posts into that script's model cache (a cache hit loads at once when the state stream
 // names the model), replaces its downloadModel (a global function) to ask the worker, and
-// wraps loadModelBytes to record when each model showed. If the worker fails, MuJoCo's own
-// download runs.
+// wraps loadModelBytes to record when each model showed. While the worker fetches a new model
+// the page draws no frames. If the worker fails, MuJoCo's own download runs.
 (() => {
   const WORKER_WAIT_MS = 30000; // then MuJoCo's whole download
   // What the page received and when models showed; read by tests and in the console.
@@ -20,11 +20,37 @@
     }
   }
 
+  // While the worker fetches a new model the page draws no frames. In SwiftShader a frame of a
+  // large robot costs about a CPU-second, and the page takes the new model only between two
+  // frames: a frame begun during the fetch delays the new robot by up to that long and takes
+  // the CPU the fetch needs. MuJoCo's render loop (Emscripten's MainLoop, a global of its page
+  // script) is paused when the worker sees a new model and resumed once it is loaded, after
+  // HOLD_MAX_MS at the latest.
+  const HOLD_MAX_MS = 3000;
+  let held = null; // the timer that resumes the render loop, while it is paused
+  function hold() {
+    const loop = typeof MainLoop === "undefined" ? null : MainLoop;
+    if (held || !loop || !loop.func || !currentModelCrc || !Module.pauseMainLoop) return;
+    Module.pauseMainLoop();
+    held = setTimeout(release, HOLD_MAX_MS);
+  }
+  function release() {
+    if (!held) return;
+    clearTimeout(held);
+    held = null;
+    Module.resumeMainLoop();
+  }
+
   worker.onmessage = (event) => {
-    const { crc, model, error, published } = event.data;
+    const { crc, model, error, published, coming } = event.data;
+    if (coming) {
+      if (coming !== currentModelCrc) hold();
+      return;
+    }
     if (error) {
       console.warn("[twin] pieces failed:", error);
       settle(crc, null);
+      release();
       return;
     }
     const s = model.stats;
@@ -38,6 +64,7 @@
     cacheModel(model.crc, model.bytes);
     settle(model.crc, model.bytes);
     if (published) showPublished(model.crc);
+    release();
   };
 
   // The server's newest model shows as soon as the worker has it, not when the state stream
@@ -45,18 +72,23 @@
   // second. State payloads still in flight for the model before then name a superseded model:
   // MuJoCo's page would load it again (the robot would vanish for a moment), so those reloads
   // are skipped; its payloads, sized for the other model, are dropped by the page meanwhile.
+  // The payload after them names the model already shown, and MuJoCo's page would load that
+  // one again too: rebuild its scene and upload every mesh a second time (measured: 34 MiB of
+  // vertex buffers and 0.2-0.5 s of the main thread for an arm of 136,000 triangles), so a
+  // reload of the model in place is skipped as well.
   let newest = 0;
   const superseded = new Set();
+  const mujocoReload = reloadModel;
   function showPublished(crc) {
     if (newest && newest !== crc) superseded.add(newest);
     superseded.delete(crc);
     newest = crc;
-    if (currentModelCrc && currentModelCrc !== crc) reloadModel(crc);
+    if (currentModelCrc && currentModelCrc !== crc) mujocoReload(crc);
   }
-  const mujocoReload = reloadModel;
   // eslint-disable-next-line no-global-assign
   reloadModel = function (crc) {
-    if (superseded.has((crc || 0) >>> 0)) return Promise.resolve();
+    const asked = (crc || 0) >>> 0;
+    if (superseded.has(asked) || (asked && asked === currentModelCrc)) return Promise.resolve();
     return mujocoReload(crc);
   };
 
@@ -76,10 +108,11 @@
   const mujocoLoad = loadModelBytes;
   // eslint-disable-next-line no-global-assign
   loadModelBytes = function (bytes) {
+    const started = Date.now();
     const crc = mujocoLoad(bytes);
     // shown: the next animation frame began; presented: the one after it began, by which the
     // page's render loop has drawn the new model (its frame with new meshes runs in between).
-    const load = { crc: crc, parsed: Date.now(), shown: null, presented: null };
+    const load = { crc: crc, started: started, parsed: Date.now(), shown: null, presented: null };
     record.loads.push(load);
     requestAnimationFrame(() => {
       load.shown = Date.now();

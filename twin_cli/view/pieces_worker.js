@@ -42,7 +42,7 @@ async function fetchBatch(batch, got, stats) {
   if (offset !== body.length) throw new Error("pieces: " + body.length + " bytes, not " + offset);
 }
 
-async function assemble(crc) {
+async function assemble(crc, seenAt) {
   const started = performance.now();
   const resp = await fetch("manifest" + (crc ? "?crc32=" + crc : ""), { cache: "no-store" });
   if (!resp.ok) throw new Error("manifest: HTTP " + resp.status);
@@ -54,6 +54,8 @@ async function assemble(crc) {
     return true;
   });
   const stats = { bytes: 0, assetBytes: 0, pieces: missing.length, of: manifest.pieces.length };
+  stats.seen = seenAt || Date.now();
+  stats.manifestMs = performance.now() - started;
   const got = new Map();
   const queue = batches(missing);
   await Promise.all(
@@ -74,12 +76,13 @@ async function assemble(crc) {
   return { crc: manifest.crc32, bytes: bytes, stats: stats };
 }
 
-function deliver(crc, published) {
+function deliver(crc, published, seenAt) {
   let job = inflight.get(crc);
   if (!job) {
-    job = assemble(crc).then(
+    job = assemble(crc, seenAt).then(
       (model) => {
         // A copy: the worker keeps its pieces as views of its own bytes.
+        model.stats.posted = Date.now();
         postMessage({ crc: crc, model: model, published: published });
         return model;
       },
@@ -99,7 +102,8 @@ async function watch() {
         const crc = Number(await resp.text()) >>> 0;
         if (crc && crc !== lastCrc) {
           lastCrc = crc;
-          await deliver(crc, true);
+          postMessage({ coming: crc }); // the page may hold its frames until the model is here
+          await deliver(crc, true, Date.now());
         }
       }
     } catch (e) {
