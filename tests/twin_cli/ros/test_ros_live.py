@@ -101,6 +101,8 @@ def test_clock_advances_in_sim_time_at_the_stated_rate(served) -> None:
     assert np.allclose(steps, np.round(steps), atol=1e-6), "/clock off its 100 Hz grid"
     assert np.median(steps) == pytest.approx(1.0), "/clock: most messages 10 ms of sim time apart"
     assert got["types"]["/clock"] == "rosgraph_msgs::msg::dds_::Clock_"
+    status = json.loads(_twin(root, "ros", "status", "--json"))
+    assert status["stride"] == 1, f"a real-time world observed at 1/{status['stride']} the rate"
 
 
 def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
