@@ -7,8 +7,9 @@ in its `drain` mode: every message received, none decoded).
 
 - `ros_vs_plain`: the unthrottled loop's throughput with the bridge's sampling over without,
   alternating every WINDOW steps on one world and one running bridge (benchmarks/paired.py;
-  `set_sampling`). Unthrottled, the world runs ~15x real time, so the bridge publishes
-  WALL_SPEEDUP × RATE samples per wall second of it (the rest are thinned). Target ≥ 0.95.
+  `set_sampling`). Unthrottled, the world runs ~15x real time, so the bridge observes every
+  k-th sample of its 100 Hz grid (`live_recording.stride`, k from the world's speed) and
+  publishes at most WALL_SPEEDUP × RATE samples per wall second. Target ≥ 0.95.
   `thread_vs_plain`: the same for the bridge's former design, measured in the same run: the
   messages built and published by a worker thread of the server (`Recording` with the
   participant as its sink) instead of the publisher process. `publisher_ms_per_sample`: the

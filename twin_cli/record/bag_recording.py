@@ -106,7 +106,9 @@ class BagRecording(Follows):
             self._until = None if self._duration is None else now + self._duration
             self._capture()
             if not self._done.is_set():
-                self._handle = self._world.add_observer(self._capture, self.rate)
+                self._handle = self._world.add_observer(
+                    self._capture, self._observer_rate(self.rate)
+                )
         self._follow_sensors(self._world)
         return self
 
@@ -129,7 +131,9 @@ class BagRecording(Follows):
             if self._done.is_set() or (self._handle is not None) == on:
                 return
             if on:
-                self._handle = self._world.add_observer(self._capture, self.rate)
+                self._handle = self._world.add_observer(
+                    self._capture, self._observer_rate(self.rate)
+                )
             else:
                 self._world.remove_observer(self._handle)
                 self._handle = None

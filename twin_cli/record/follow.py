@@ -22,6 +22,7 @@ class Follows:
     sensor observers both recorders share (`_follow_sensors` calls their `_capture_sensors`)."""
 
     _sensor_handles: tuple[int, ...] | list[int] = ()  # sensor observers of `_sensor_world`
+    _sensor_rates: list[float] = []  # [Hz] they capture at (`_capture_sensors`' argument)
     _frame_prefix: str = "{entity}/"  # the recording's (`frames.prefix_template`)
 
     def retarget(self, world: World) -> None:
@@ -48,7 +49,7 @@ class Follows:
                 self._until = now + max(0.0, self._until - old_time)
             self._capture()
             if not self._done.is_set():
-                self._handle = world.add_observer(self._capture, self.rate)
+                self._handle = world.add_observer(self._capture, self._observer_rate(self.rate))
         self._follow_sensors(world)
 
     def _watch_sensors(self) -> None:
@@ -67,10 +68,22 @@ class Follows:
             with world.lock:
                 self._capture_sensors()
                 self._sensor_world = world
-                self._sensor_handles = [
-                    world.add_observer(lambda rate=rate: self._capture_sensors(rate), rate)
-                    for rate in rates
-                ]
+                self._sensor_handles = self._observe_sensors(world, rates)
+
+    def _observe_sensors(self, world: World, rates: list[float]) -> list[int]:
+        """Registers one observer per sensor rate [Hz] (lock held); their handles."""
+        self._sensor_rates = list(rates)
+        return [
+            world.add_observer(
+                lambda rate=rate: self._capture_sensors(rate), self._observer_rate(rate)
+            )
+            for rate in rates
+        ]
+
+    def _observer_rate(self, rate: float) -> float:
+        """The sim-time rate [Hz] an observer asking for `rate` is registered at: `rate` itself
+        (a live view that thins a fast world asks for a whole fraction of it)."""
+        return rate
 
     def _stop_sensors(self) -> None:
         for handle in getattr(self, "_sensor_handles", ()):

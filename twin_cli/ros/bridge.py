@@ -8,9 +8,10 @@ stamps are those of a recording, sensors included; `/tf_static` and `robot_descr
 sent when an entity comes or goes, and a paused world's state is sent again every half second.
 The publisher sends only the newest sample, at most WALL_SPEEDUP × RATE a wall second: a world
 up to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
-echo`), and none of this holds the loop's interpreter. `CommandListener` takes `cmd_vel` and
-the controllers' topics the other way, and `ServiceServer` answers gazebo_ros' entity services,
-through the server's participant (node `/twin_commands`).
+echo`; from four times real time the stepping thread takes only every k-th sample,
+`live_recording.stride`), and none of this holds the loop's interpreter. `CommandListener`
+takes `cmd_vel` and the controllers' topics the other way, and `ServiceServer` answers
+gazebo_ros' entity services, through the server's participant (node `/twin_commands`).
 """
 
 from __future__ import annotations
@@ -101,6 +102,7 @@ class RosBridge:
             "scope": self.scope.describe(),
             "rate": self.recording.rate,
             "samples": recording.samples,
+            "stride": self.recording.stride,
             "error": recording.error,
             "inputs": self.commands.topics,
             "commands": self.commands.commands,

@@ -1,13 +1,22 @@
 """Keeps the participant's UDP sockets on the loopback device in the loopback-only scope.
 
-Cyclone DDS 0.11 binds its receive sockets (the domain's discovery and data ports) to the
-wildcard address whatever its configuration says (its UDP transport asks for "any" for every
-receive socket; the option that once changed this is gone). So in the loopback-only scope twin
-binds each UDP socket the new domain opened to the loopback device (SO_BINDTODEVICE), right
-after Cyclone made it: the kernel then delivers to it only datagrams that arrived on loopback and
-routes what it sends only through loopback, so no other host can reach the twin's ports and none
-is reached from them. A socket bound to a device needs no privilege while it has none yet
-(Linux 5.7 and later).
+Cyclone DDS 11.0.1 binds its receive sockets (the domain's discovery and data ports) to the
+wildcard address whatever its configuration says: its UDP transport binds every socket made to
+receive, unicast or multicast, to INADDR_ANY and only its send socket to the configured
+interface's address; its TCP transport binds to the wildcard as well, and no configuration
+element (interfaces, external address, the internal options) changes that. Replacing a wildcard
+socket with one bound to 127.0.0.1 on the same port is not safe either: Cyclone's receive threads
+already wait on the sockets when the domain is made, one through epoll, which would go on
+watching the replaced socket and never see the new one; and the sockets are bound without
+SO_REUSEADDR, so the port would be free to any process between the close and the new bind.
+
+So in the loopback-only scope twin binds each UDP socket the new domain opened to the loopback
+device (SO_BINDTODEVICE), right after Cyclone made it: the kernel then delivers to it only
+datagrams that arrived on loopback, which carries only this host's own traffic, and routes what it
+sends only through loopback, so no other host can reach the twin's ports and none is reached from
+them. Such a socket still shows its address as 0.0.0.0 wherever the device is not reported
+(/proc/net/udp); the kernel's socket diagnostics (`ss`) show 0.0.0.0%lo. A socket bound to a
+device needs no privilege while it has none yet (Linux 5.7 and later).
 """
 
 from __future__ import annotations

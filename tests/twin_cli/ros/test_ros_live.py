@@ -32,6 +32,7 @@ pytestmark = pytest.mark.xdist_group("ros_live")
 WORLD = "ros_live"
 PEER = Path(__file__).with_name("ros_peer.py")
 DOMAIN_ID = str(100 + os.getpid() % 100)  # one domain per test process
+DDS_BASE_PORT = 7400  # DDSI's port base: domain d uses 7400 + 250·d onwards
 STATE_PERIOD = 0.01  # [s] of sim time between /clock, /tf and joint_states messages (100 Hz)
 POSE_TOL = 1e-9  # [m, rad] tf composed against `twin model`: the same numbers, two routes
 DIFF = (
@@ -100,6 +101,8 @@ def test_clock_advances_in_sim_time_at_the_stated_rate(served) -> None:
     assert np.allclose(steps, np.round(steps), atol=1e-6), "/clock off its 100 Hz grid"
     assert np.median(steps) == pytest.approx(1.0), "/clock: most messages 10 ms of sim time apart"
     assert got["types"]["/clock"] == "rosgraph_msgs::msg::dds_::Clock_"
+    status = json.loads(_twin(root, "ros", "status", "--json"))
+    assert status["stride"] == 1, f"a real-time world observed at 1/{status['stride']} the rate"
 
 
 def test_tf_and_joint_states_match_twin_model_and_twin_joints(served) -> None:
@@ -300,18 +303,26 @@ def _server_sockets(pid: int) -> list:
 
 
 def test_the_server_binds_no_address_but_loopback(served) -> None:
-    """Every internet socket of the server and its publisher process is bound to 127.0.0.1, or
-    to the loopback device (Cyclone's receive sockets, which it binds to the wildcard address):
-    none can receive from or send to another host, and none is connected outside 127.0.0.1
-    (the kernel's sock_diag)."""
+    """Every internet socket of the server and its publisher process is bound to 127.0.0.1,
+    except Cyclone's receive sockets, which Cyclone binds to the wildcard address whatever its
+    configuration says: those are UDP sockets on the domain's unicast ports (7400 + 250·id + 10
+    + 2·index and + 11) bound to the loopback device, so none can receive from or send to
+    another host. None is connected outside 127.0.0.1 (the kernel's sock_diag)."""
     _, proc = served
     found = _server_sockets(proc.pid)
     udp = [s for s in found if s.protocol.startswith("udp")]
     assert len(udp) >= 6, f"not two participants' sockets: is the bridge on? {udp}"
     loopback = socket.if_nametoindex("lo")
+    domain_ports = range(
+        DDS_BASE_PORT + 250 * int(DOMAIN_ID) + 10, DDS_BASE_PORT + 250 * (int(DOMAIN_ID) + 1)
+    )
+    wildcard = [s for s in found if s.local[0] != "127.0.0.1"]
+    for s in wildcard:
+        receiving = s.protocol == "udp" and s.local[0] == "0.0.0.0" and s.local[1] in domain_ports
+        assert receiving, f"{s.protocol} socket bound to {s.local}: not a Cyclone receive socket"
+        assert s.device == loopback, f"UDP socket {s.local} not on the loopback device ({s.device})"
+    assert len(wildcard) >= 4, f"not two participants' receive sockets: {wildcard}"
     for s in found:
-        on_loopback = s.local[0] == "127.0.0.1" or s.device == loopback
-        assert on_loopback, f"{s.protocol} socket bound to {s.local} on device {s.device}"
         assert s.remote[0] in ("0.0.0.0", "127.0.0.1"), f"{s.protocol} socket to {s.remote}"
     status = json.loads(_twin(served[0], "ros", "status", "--json"))
     assert status["local_only"] and status["loopback_device"], status
