@@ -6,7 +6,7 @@ The single entry of `converters`; each stage adds its findings to one report.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -100,15 +100,17 @@ def read_robot(
     """
     stage(f"parsing {source}")
     kind = format_of(text)
-    if kind == "sdf":
-        from converters.sdf import read_sdf_model
-
-        return read_sdf_model(text, source, base_dir, resolver, report)
     if kind == "mjcf":
         raise InputFileError(
             source, "is MJCF, already MuJoCo's format", "spawn it directly; nothing to convert"
         )
-    return parse_urdf(text, source, base_dir, resolver, as_written=as_written)
+    if kind == "sdf":
+        from converters.sdf import read_sdf_model
+
+        robot = read_sdf_model(text, source, base_dir, resolver, report)
+    else:
+        robot = parse_urdf(text, source, base_dir, resolver, as_written=as_written)
+    return replace(robot, base_dir=str(base_dir))
 
 
 def convert_full(
@@ -188,8 +190,9 @@ def build_description(
     add_height_fields(spec, robot, report, keep_fixed=options.keep_fixed)  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
+    base = Path(robot.base_dir) if robot.base_dir else Path(robot.source).parent
     plugins = read_plugins(
-        robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link, report
+        robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link, report, base
     )
     add_drive_motors(spec, plugins, report)
     add_passive_motors(spec, robot, report)

@@ -14,6 +14,7 @@ from converters.description.control import (
     CommandInterface,
     JointControl,
     PidGains,
+    is_control_plugin,
     merge_controls,
 )
 from converters.description.gazebo import (
@@ -46,6 +47,7 @@ from converters.description.world import Light, PlacedModel, WorldDescription
 
 __all__ = [
     "CONTROL_PLUGINS",
+    "is_control_plugin",
     "HARDWARE_INTERFACES",
     "MODES",
     "CommandInterface",

@@ -27,11 +27,18 @@ HARDWARE_INTERFACES = {
 # Plugins that run `<ros2_control>` / `<transmission>` interfaces in Gazebo.
 CONTROL_PLUGINS = (
     "libgazebo_ros2_control.so",
+    "gazebo_ros2_control",
     "libgazebo_ros_control.so",
     "gz_ros2_control-system",
     "libgz_ros2_control-system.so",
     "ign_ros2_control-system",
+    "libign_ros2_control-system.so",
 )
+
+
+def is_control_plugin(filename: str | None) -> bool:
+    """Whether a `<plugin>` filename (with or without its folder) is a ros2_control plugin."""
+    return (filename or "").rsplit("/", 1)[-1] in CONTROL_PLUGINS
 
 
 @dataclass(frozen=True)

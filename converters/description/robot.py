@@ -187,6 +187,8 @@ class RobotDescription:
         model_frame_site: mark the model frame with a `__model__` site when it is not the root
             link's frame (SDF), so a running world can report the model's pose as Gazebo does.
         controls: the command interfaces each `<ros2_control>`/`<transmission>` joint declares.
+        base_dir: where the file's relative paths start (its folder; for a text description,
+            the folder it was sent from); empty: the folder of `source`.
     """
 
     name: str
@@ -201,6 +203,7 @@ class RobotDescription:
     frames: tuple[Frame, ...] = ()
     model_frame_site: bool = False
     controls: tuple[JointControl, ...] = ()
+    base_dir: str = ""
 
     def link(self, name: str) -> Link:
         """The link called `name` (KeyError when there is none)."""

@@ -9,8 +9,10 @@ them from `cmd_vel`. twin runs that controller as a differential drive (`DiffDri
 - `left_wheel_names`, `right_wheel_names`, `wheel_separation`, `wheel_radius` (required), times
   `wheel_separation_multiplier` and the wheel radius multipliers;
 - `linear.x.max_velocity`, `angular.z.max_velocity` clip the twist; `linear.x.max_acceleration`
-  ramps the wheels' rim speeds (limits count where the value is a finite number and, in the
-  older form, its `has_velocity_limits` / `has_acceleration_limits` flag is not false);
+  ramps the wheels' rim speeds. A limit counts where its value is a number and its
+  `has_velocity_limits` / `has_acceleration_limits` flag is true (Humble's rule, which Gazebo
+  Classic's gazebo_ros2_control runs) or not false (Jazzy's, for gz_ros2_control);
+- `cmd_vel_timeout` (default 0.5 s): a cmd_vel taken over ROS holds that long;
 - odometry from the wheels' joint positions, in `odom_frame_id` → `base_frame_id`;
 - the controller manager's `update_rate` (default 100 Hz).
 What twin does not reproduce is listed tag by tag in the record's notes.
@@ -25,9 +27,10 @@ from typing import Any
 from converters.description.gazebo import Blob
 from converters.errors import InputFileError
 from converters.gazebo.controller_yaml import (
-    MANAGER,
     controller_types,
     load_parameters,
+    manager_name,
+    merged_nodes,
     node_parameters,
     parameter,
     parameter_files,
@@ -37,15 +40,24 @@ from converters.gazebo.drive_records import DiffDrive
 DIFF_DRIVE_TYPE = "diff_drive_controller/DiffDriveController"
 FAMILY = "diff_drive_controller"
 DEFAULT_UPDATE_RATE = 100.0  # [Hz] the controller manager's default update_rate
-# Parameters twin reads as the controller does, and ones it does not reproduce (with why).
+DEFAULT_CMD_VEL_TIMEOUT = 0.5  # [s] the controller stops the wheels this long after a command
+# Gazebo Classic's plugin runs Humble's controllers: a limit counts only with its has_*_limits
+# flag set (Jazzy's count wherever the value is a number).
+FLAGGED_LIMIT_PLUGINS = ("libgazebo_ros2_control.so", "gazebo_ros2_control")
+# Parameters twin does not reproduce, with what it does instead.
 NOT_RUN = {
-    "cmd_vel_timeout": "a command holds until the next one (`twin drive -d` sets a duration)",
     "open_loop": "odometry is always integrated from the wheels' joint positions",
     "position_feedback": "odometry is always integrated from the wheels' joint positions",
     "enable_odom_tf": "`twin serve --ros` always publishes the odom frame in /tf",
     "tf_frame_prefix_enable": "frames are prefixed with the entity's name",
     "tf_frame_prefix": "frames are prefixed with the entity's name",
+    "use_stamped_vel": "cmd_vel and cmd_vel_unstamped each take Twist and TwistStamped",
     "angular.z.max_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",
+    "linear.x.min_acceleration": "the wheels ramp symmetrically at linear.x.max_acceleration",
+    "angular.z.min_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",
+    "linear.x.max_deceleration": "the wheels ramp symmetrically at linear.x.max_acceleration",
+    "linear.x.max_acceleration_reverse": "the wheels ramp at linear.x.max_acceleration",
+    "linear.x.max_deceleration_reverse": "the wheels ramp at linear.x.max_acceleration",
     "linear.x.min_velocity": "the twist is clipped symmetrically at max_velocity",
     "angular.z.min_velocity": "the twist is clipped symmetrically at max_velocity",
     "linear.x.max_jerk": "no jerk limit",
@@ -55,45 +67,70 @@ NOT_RUN = {
 
 
 def read_controller_drives(
-    blob: Blob, source: str
+    blob: Blob, source: str, base: Path, joints: set[str] | None = None
 ) -> tuple[tuple[DiffDrive, ...], tuple[str, ...]]:
     """Every diff_drive_controller in the parameter files a ros2_control plugin names.
 
+    Args:
+        blob: the plugin; source: the description, for messages; base: where relative
+            `<parameters>` paths start; joints: the model's joints (None: not checked).
+
     Returns:
-        The drives, and a note for each parameter file that could not be read (the plugin's
-        command interfaces still work without it).
+        The drives, and a note for each parameter file that could not be read and for each
+        listed drive whose parameters were not found (the plugin's command interfaces still
+        work without them).
 
     Raises:
-        InputFileError: a diff_drive_controller parameter that is missing or not a number (the
-            message names the file, controller and parameter).
+        InputFileError: a diff_drive_controller parameter that is missing, not a number or
+            names a joint the model does not have (the message names the file, controller and
+            parameter).
     """
-    drives: list[DiffDrive] = []
+    documents: list[dict] = []
     problems: list[str] = []
-    for path in parameter_files(blob.xml, source):
+    paths = parameter_files(blob.xml, base)
+    for path in paths:
         document = load_parameters(path)
         if isinstance(document, str):
             problems.append(f"{path} not read ({document}): no controllers from it")
+        else:
+            documents.append(document)
+    nodes = merged_nodes(documents)
+    manager = manager_name(blob.xml)
+    where = ", ".join(str(p) for p in paths)
+    rate = _number(node_parameters(nodes, manager), "update_rate", where, manager)
+    limits_need_flags = (blob.kind or "").rsplit("/", 1)[-1] in FLAGGED_LIMIT_PLUGINS
+    drives = []
+    for name, kind in controller_types(nodes, manager).items():
+        if kind != DIFF_DRIVE_TYPE:
             continue
-        rate = _number(node_parameters(document, MANAGER), "update_rate", path, MANAGER)
-        for name, kind in controller_types(document).items():
-            if kind == DIFF_DRIVE_TYPE:
-                params = node_parameters(document, name)
-                drives.append(_diff_drive(name, params, path, rate or DEFAULT_UPDATE_RATE))
+        params = node_parameters(nodes, name)
+        if not any(k != "type" for k in params):
+            problems.append(f"{DIFF_DRIVE_TYPE} '{name}': no parameters for it in {where}")
+            continue
+        drive = _diff_drive(name, params, where, rate or DEFAULT_UPDATE_RATE, limits_need_flags)
+        _check_joints(drive, params, where, joints)
+        drives.append(drive)
     return tuple(drives), tuple(problems)
 
 
-def _diff_drive(name: str, params: dict, path: Path, rate: float) -> DiffDrive:
+def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -> DiffDrive:
     """One diff_drive_controller's parameters as a `DiffDrive` record."""
-    left = _wheels(params, "left_wheel_names", path, name)
-    right = _wheels(params, "right_wheel_names", path, name)
-    separation = _required(params, "wheel_separation", path, name)
-    separation *= _number(params, "wheel_separation_multiplier", path, name) or 1.0
-    radius = _required(params, "wheel_radius", path, name)
+    left = _wheels(params, "left_wheel_names", where, name)
+    right = _wheels(params, "right_wheel_names", where, name)
+    separation = _required(params, "wheel_separation", where, name)
+    separation *= _number(params, "wheel_separation_multiplier", where, name) or 1.0
+    radius = _required(params, "wheel_radius", where, name)
     multipliers = [
-        _number(params, key, path, name) or 1.0
+        _number(params, key, where, name) or 1.0
         for key in ("left_wheel_radius_multiplier", "right_wheel_radius_multiplier")
     ]
-    notes = [f"{DIFF_DRIVE_TYPE} '{name}' from {path}: run by twin as a differential drive"]
+    timeout = _number(params, "cmd_vel_timeout", where, name)
+    timeout = DEFAULT_CMD_VEL_TIMEOUT if timeout is None else max(timeout, 0.0)
+    notes = [
+        f"{DIFF_DRIVE_TYPE} '{name}' from {where}: run by twin as a differential drive; a "
+        f"cmd_vel over ROS holds for cmd_vel_timeout {timeout:g} s (`twin drive` until replaced "
+        "or -d)"
+    ]
     if multipliers[0] != multipliers[1]:
         notes.append(
             f"left/right_wheel_radius_multiplier {multipliers[0]}/{multipliers[1]}: both wheels "
@@ -102,25 +139,41 @@ def _diff_drive(name: str, params: dict, path: Path, rate: float) -> DiffDrive:
     notes += [f"{key}: {why}" for key, why in NOT_RUN.items() if parameter(params, key) is not None]
     return DiffDrive(
         name=name,
-        where=f"{path} {name}",
+        where=f"{where} {name}",
         left_joints=left,
         right_joints=right,
         wheel_separation=separation,
         wheel_diameter=radius * (multipliers[0] + multipliers[1]),
         max_wheel_torque=math.inf,  # the speed is set; the joint's own motor bounds it
-        max_wheel_acceleration=_limit(params, "linear.x", "acceleration", path, name) or 0.0,
+        max_wheel_acceleration=_limit(params, "linear.x", "acceleration", where, name, flags),
         odometry_source="encoder",
         update_rate=rate,
         family=FAMILY,
         odometry_frame=str(parameter(params, "odom_frame_id", "odom")),
         robot_base_frame=str(parameter(params, "base_frame_id", "base_link")),
-        max_linear_velocity=_limit(params, "linear.x", "velocity", path, name) or math.inf,
-        max_angular_velocity=_limit(params, "angular.z", "velocity", path, name) or math.inf,
+        max_linear_velocity=_limit(params, "linear.x", "velocity", where, name, flags, math.inf),
+        max_angular_velocity=_limit(params, "angular.z", "velocity", where, name, flags, math.inf),
+        command_timeout=timeout,
         notes=tuple(notes),
     )
 
 
-def _wheels(params: dict, key: str, path: Path, controller: str) -> tuple[str, ...]:
+def _check_joints(drive: DiffDrive, params: dict, where: str, joints: set[str] | None) -> None:
+    for key, names in (
+        ("left_wheel_names", drive.left_joints),
+        ("right_wheel_names", drive.right_joints),
+    ):
+        for joint in names:
+            if joints is not None and joint not in joints:
+                raise InputFileError(
+                    where,
+                    f"controller '{drive.name}' ({DIFF_DRIVE_TYPE}): {key} names joint "
+                    f"'{joint}', which the model does not have",
+                    f"name one of its joints ({', '.join(sorted(joints)) or 'none'})",
+                )
+
+
+def _wheels(params: dict, key: str, path: str, controller: str) -> tuple[str, ...]:
     value = parameter(params, key)
     if isinstance(value, str):
         value = [value]
@@ -134,7 +187,7 @@ def _wheels(params: dict, key: str, path: Path, controller: str) -> tuple[str, .
     return tuple(value)
 
 
-def _required(params: dict, key: str, path: Path, controller: str) -> float:
+def _required(params: dict, key: str, path: str, controller: str) -> float:
     value = _number(params, key, path, controller)
     if value is None or not value > 0:
         raise InputFileError(
@@ -146,11 +199,17 @@ def _required(params: dict, key: str, path: Path, controller: str) -> float:
     return value
 
 
-def _number(params: dict, key: str, path: Path, controller: str) -> float | None:
-    """A numeric parameter, None when absent or NaN (ros2_control's "unset")."""
+def _number(params: dict, key: str, path: str, controller: str) -> float | None:
+    """A numeric parameter, None when absent or NaN (ros2_control's "unset"). A string that is a
+    number counts: YAML 1.1 reads `5e-2` as text, ROS's parser as a double."""
     value: Any = parameter(params, key)
     if value is None:
         return None
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            pass
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise InputFileError(
             str(path),
@@ -160,10 +219,19 @@ def _number(params: dict, key: str, path: Path, controller: str) -> float | None
     return None if math.isnan(value) else float(value)
 
 
-def _limit(params: dict, axis: str, kind: str, path: Path, controller: str) -> float | None:
-    """`<axis>.max_<kind>` where it limits: a finite number whose `has_<kind>_limits` flag (the
-    older form) is not false."""
-    if parameter(params, f"{axis}.has_{kind}_limits") is False:
-        return None
+def _limit(
+    params: dict,
+    axis: str,
+    kind: str,
+    path: str,
+    controller: str,
+    flags: bool,
+    unlimited: float = 0.0,
+) -> float:
+    """`<axis>.max_<kind>` where it limits, else `unlimited`: a finite number whose
+    `has_<kind>_limits` flag is true (Humble's rule, `flags`) or not false (Jazzy's)."""
+    flag = parameter(params, f"{axis}.has_{kind}_limits")
+    if flag is False or (flags and flag is not True):
+        return unlimited
     value = _number(params, f"{axis}.max_{kind}", path, controller)
-    return abs(value) if value is not None and math.isfinite(value) and value != 0 else None
+    return abs(value) if value is not None and math.isfinite(value) else unlimited

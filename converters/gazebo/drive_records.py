@@ -57,7 +57,9 @@ class DiffDrive(_Record):
         step). family: the plugin (`gazebo_ros_diff_drive`, `gazebo_ros_skid_steer_drive`,
         `gz_diff_drive`, `vendor:<filename>`); odometry_frame, robot_base_frame: the odometry's
         frame names; max_linear_velocity [m/s], max_angular_velocity [rad/s] (gz-sim's limits);
-        notes: what was approximated or ignored, one entry per tag.
+        command_timeout [s]: how long a ROS cmd_vel holds (diff_drive_controller's
+        cmd_vel_timeout; 0: until the next); notes: what was approximated or ignored, one entry
+        per tag.
     """
 
     name: str
@@ -75,6 +77,7 @@ class DiffDrive(_Record):
     robot_base_frame: str = "base_footprint"
     max_linear_velocity: float = math.inf
     max_angular_velocity: float = math.inf
+    command_timeout: float = 0.0
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:

@@ -13,6 +13,7 @@ parameters, as not run.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from converters.description import CONTROL_PLUGINS
@@ -43,7 +44,7 @@ __all__ = [
 ]
 
 DIFF_DRIVE_FILES = ("libgazebo_ros_diff_drive.so", "gazebo_ros_diff_drive")
-CONTROL_FILES = (*CONTROL_PLUGINS, "gazebo_ros2_control")  # gazebo_ros(2)_control, gz_ros2_control
+CONTROL_FILES = CONTROL_PLUGINS  # gazebo_ros(2)_control, gz_ros2_control and its ign_ names
 # gz-sim system names (the `name` attribute) that identify a drive whatever its filename says.
 SYSTEM_NAMES = {
     "DiffDrive": "gz-sim-diff-drive-system",
@@ -121,6 +122,7 @@ def read_plugins(
     model: str = "",
     base_link: str = "base_link",
     report: Report | None = None,
+    base: Path | None = None,
 ) -> tuple[DriveRecord | Rotor, ...]:
     """Every drive, joint controller and multicopter rotor among a model's plugins, and the
     diff_drive_controllers of a ros2_control plugin's parameter file
@@ -131,7 +133,8 @@ def read_plugins(
             robot (gazebo_ros' Ackermann and tricycle plugins measure their wheels on it);
             model, base_link: the model's name and canonical link (gz-sim's default odometry
             frames are `<model>/odom` and `<model>/<link>`); report: where a parameter file
-            that cannot be read is said.
+            that cannot be read is said; base: where relative parameter file paths start
+            (default: the folder of `source`).
 
     Raises:
         GazeboTagError: a parameter is not what its plugin needs. PluginJointError: a joint
@@ -153,7 +156,9 @@ def read_plugins(
         elif kind == "vendor_drive":
             out.append(read_vendor_diff_drive(Params.of(blob, source), blob))
         elif kind == "command_interfaces":
-            drives, problems = read_controller_drives(blob, source)
+            joints = {j.name for j in spec.joints} if spec is not None else None
+            folder = base if base is not None else Path(source).parent
+            drives, problems = read_controller_drives(blob, source, folder, joints)
             out += drives
             for problem in problems:
                 if report is not None:

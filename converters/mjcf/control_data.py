@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from converters.control_text import set_control_record
-from converters.description import CONTROL_PLUGINS, MODES, Joint, JointControl, RobotDescription
+from converters.description import MODES, Joint, JointControl, RobotDescription, is_control_plugin
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ def add_control_data(
     joint offers and which rule applies: one line per group of joints whose lines would read
     the same (a Panda's seven arm joints are one line, not seven)."""
     controls = {c.joint: c for c in robot.controls}
-    plugins = [p.kind for p in robot.gazebo.plugins if p.kind in CONTROL_PLUGINS]
+    plugins = [p.kind for p in robot.gazebo.plugins if is_control_plugin(p.kind)]
     enabled = plugins[0] if plugins else None
     groups: dict[str, list[str]] = {}
     ignored: dict[tuple[str, ...], list[str]] = {}

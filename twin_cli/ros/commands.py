@@ -25,6 +25,7 @@ from __future__ import annotations
 import logging
 import threading
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
@@ -56,6 +57,7 @@ class Input:
     mode: str | None = None
     joints: tuple[str, ...] = ()
     drive: str = ""
+    timeout: float | None = None  # [s] a cmd_vel holds (None: until the next)
 
 
 def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
@@ -67,15 +69,28 @@ def entity_inputs(world: World) -> dict[str, tuple[Input, ...]]:
 
 def _inputs(world: World, name: str) -> tuple[Input, ...]:
     entity = world.entity(name)
-    drives = [k for k in (type(p).__name__ for p in entity.plugins) if k in CONTROLLERS]
-    named = plugin_names(name, entity.description, entity.source)
+    drives = [p for p in entity.plugins if type(p).__name__ in CONTROLLERS]
+    named = plugin_names(name, entity.description, _base_dir(entity))
     inputs = []
     if drives:
+        kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
         for topic in named.cmd_vel or (f"/{name}/cmd_vel",):
-            inputs += [Input(topic, kind, drive=drives[0]) for kind in (TWIST, TWIST_STAMPED)]
+            inputs += [
+                Input(topic, message, drive=kind, timeout=timeout or None)
+                for message in (TWIST, TWIST_STAMPED)
+            ]
     if named.controllers:
         return (*inputs, *(_controller_input(c) for c in named.controllers))
     return (*inputs, *_default_controllers(name, world.joint_commands(name)))
+
+
+def _base_dir(entity: Any) -> str:
+    """Where the entity's description's relative paths start: the folder a text description
+    was sent from, else the description file's folder."""
+    request = getattr(entity, "request", None)
+    if getattr(request, "xml", None) and getattr(request, "base_dir", None):
+        return str(request.base_dir)
+    return str(Path(entity.source).parent)
 
 
 def _default_controllers(name: str, rows: dict[str, Any]) -> list[Input]:
@@ -196,7 +211,7 @@ class CommandListener:
             if spec.mode is None:
                 linear, lateral, angular = twist_of(message)
                 lateral = lateral if spec.drive == HOLONOMIC else 0.0
-                drive(self._world, entity, linear, angular, lateral=lateral)
+                drive(self._world, entity, linear, angular, spec.timeout, lateral=lateral)
             elif spec.mode == TRAJECTORY:
                 follow_trajectory(
                     self._world, entity, trajectory_from_dict(trajectory_doc(message))

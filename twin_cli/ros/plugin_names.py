@@ -24,19 +24,21 @@ import logging
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from pathlib import Path
 
+from converters.description import is_control_plugin
 from converters.gazebo.controller_drives import DIFF_DRIVE_TYPE
 from converters.gazebo.controller_yaml import (
     controller_types,
     load_parameters,
+    manager_name,
+    merged_nodes,
     node_parameters,
     parameter_files,
 )
 
 log = logging.getLogger("twin.ros")
 DRIVE_PLUGINS = ("diff_drive", "skid_steer", "ackermann", "planar_move", "tricycle")
-CONTROL_PLUGINS = ("gazebo_ros2_control", "gz_ros2_control")
 TRAJECTORY = "trajectory"  # a controller's mode: joint_trajectory_controller's topic
 DRIVE = "drive"  # a controller's mode: diff_drive_controller's cmd_vel
 CONTROLLER_MODES = {  # controller type → the command interface it writes
@@ -67,10 +69,10 @@ class PluginNames:
 
 
 @lru_cache(maxsize=64)
-def plugin_names(entity: str, description: str | None, source: str = "") -> PluginNames:
-    """The names `description` (an entity's URDF text, read from the file `source`) gives its
-    inputs (cached: the listener asks every half second). A relative `<parameters>` path starts
-    at `source`'s folder, as the converter reads it."""
+def plugin_names(entity: str, description: str | None, base: str = "") -> PluginNames:
+    """The names `description` (an entity's URDF text) gives its inputs (cached: the listener
+    asks every half second). A relative `<parameters>` path starts at `base`, the folder the
+    converter read the description from."""
     if not description:
         return PluginNames()
     try:
@@ -83,8 +85,8 @@ def plugin_names(entity: str, description: str | None, source: str = "") -> Plug
         filename = plugin.get("filename", "")
         if not cmd_vel and any(k in filename for k in DRIVE_PLUGINS):
             cmd_vel = (_resolve("cmd_vel", _namespace(plugin, entity), _remaps(plugin)),)
-        if not controllers and any(k in filename for k in CONTROL_PLUGINS):
-            controllers = _controllers(plugin, entity, source)
+        if not controllers and is_control_plugin(filename):
+            controllers = _controllers(plugin, entity, base)
     drive_topics = tuple(c.topic for c in controllers if c.mode == DRIVE)
     named = tuple(c for c in controllers if c.mode != DRIVE)
     return PluginNames(cmd_vel or drive_topics, named)
@@ -105,16 +107,17 @@ def _resolve(name: str, namespace: str, remaps: dict[str, str]) -> str:
     return name if name.startswith("/") else f"/{namespace}/{name}"
 
 
-def _controllers(plugin: ET.Element, entity: str, source: str) -> tuple[Controller, ...]:
-    namespace = _namespace(plugin, entity)
-    out: list[Controller] = []
-    for path in parameter_files(ET.tostring(plugin, encoding="unicode"), source):
+def _controllers(plugin: ET.Element, entity: str, base: str) -> tuple[Controller, ...]:
+    xml = ET.tostring(plugin, encoding="unicode")
+    documents = []
+    for path in parameter_files(xml, Path(base)):
         document = load_parameters(path)
         if isinstance(document, str):
             log.warning("[%s] %s not read (%s): default controller names", entity, path, document)
             continue
-        out += _from_yaml(document, namespace)
-    return tuple(out)
+        documents.append(document)
+    nodes = merged_nodes(documents)
+    return tuple(_from_yaml(nodes, manager_name(xml), _namespace(plugin, entity)))
 
 
 def _drive_topics(name: str, namespace: str) -> list[Controller]:
@@ -125,14 +128,14 @@ def _drive_topics(name: str, namespace: str) -> list[Controller]:
     ]
 
 
-def _from_yaml(document: Any, namespace: str) -> list[Controller]:
-    """The command-taking controllers the controller manager's YAML declares."""
+def _from_yaml(nodes: dict[str, dict], manager: str, namespace: str) -> list[Controller]:
+    """The command-taking controllers the controller manager's parameter files declare."""
     out = []
-    for name, kind in controller_types(document).items():
+    for name, kind in controller_types(nodes, manager).items():
         if kind == DIFF_DRIVE_TYPE:
             out += _drive_topics(name, namespace)
             continue
-        params = node_parameters(document, name)
+        params = node_parameters(nodes, name)
         mode = params.get("interface_name") if kind == FORWARD else CONTROLLER_MODES.get(kind)
         joints = tuple(str(j) for j in params.get("joints") or ())
         if mode is None or not joints:

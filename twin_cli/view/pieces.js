@@ -88,7 +88,13 @@
   // eslint-disable-next-line no-global-assign
   reloadModel = function (crc) {
     const asked = (crc || 0) >>> 0;
-    if (superseded.has(asked) || (asked && asked === currentModelCrc)) return Promise.resolve();
+    if (superseded.has(asked)) return Promise.resolve();
+    if (asked && asked === currentModelCrc) {
+      // As MuJoCo's own reload would: a load of another model still in flight is dropped, so
+      // a world that went back to the shown model (a spawn, then a delete) keeps showing it.
+      loadGeneration++;
+      return Promise.resolve();
+    }
     return mujocoReload(crc);
   };
 

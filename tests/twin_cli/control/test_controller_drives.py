@@ -83,7 +83,8 @@ def test_the_controllers_parameters_become_the_drive(tmp_path: Path) -> None:
     assert (drive.odometry_frame, drive.robot_base_frame) == ("odom_demo", "base_footprint")
     assert drive.family == "diff_drive_controller" and drive.odometry_source == "encoder"
     details = [e.detail for e in done.report.entries]
-    assert any("cmd_vel_timeout: a command holds" in d for d in details), "what is not run is said"
+    assert any("holds for cmd_vel_timeout 0.5 s" in d for d in details), "the timeout is said"
+    assert drive.command_timeout == 0.5
     plugin = "<plugin> 'control' gz_ros2_control-system: enables the robot's"
     assert any(d.startswith(plugin) for d in details), "gz_ros2_control is run, not 'not run'"
 
@@ -101,7 +102,7 @@ def test_a_limit_whose_flag_is_false_does_not_limit(tmp_path: Path) -> None:
         (("wheel_radius: 0.05", "wheel_radius: wide"), "wheel_radius is 'wide', not a number"),
         (("    wheel_radius: 0.05\n", ""), "wheel_radius is None, not a length > 0"),
         (('left_wheel_names: ["wheel_left_joint"]', "left_wheel_names: 3"), "left_wheel_names"),
-        (('["wheel_right_joint"]', '["no_such_joint"]'), "no_such_joint"),
+        (('["wheel_right_joint"]', '["no_such_joint"]'), "right_wheel_names names joint"),
     ],
 )
 def test_a_broken_controller_is_one_clear_error(
@@ -111,8 +112,93 @@ def test_a_broken_controller_is_one_clear_error(
     result = _twin("convert", "base.urdf", "-o", "out", cwd=tmp_path)
     assert result.returncode == 2, result.stderr
     assert needle in result.stderr and "Traceback" not in result.stderr, result.stderr
-    assert "ddc.yaml" in result.stderr or "no_such_joint" in needle, "the file is named"
+    assert "ddc.yaml" in result.stderr and "controller 'base_controller'" in result.stderr
     assert not (tmp_path / "out").exists(), "nothing written"
+
+
+def test_humbles_limits_count_only_with_their_flags_under_gazebo_classic(tmp_path: Path) -> None:
+    """Gazebo Classic's plugin runs Humble's controller: `angular.z.max_velocity` without
+    `has_velocity_limits: true` does not limit; gz_ros2_control's (Jazzy's) does."""
+    classic = convert_full(_base(tmp_path, plugin="libgazebo_ros2_control.so"))
+    (drive,) = [p for p in classic.plugins if isinstance(p, DiffDrive)]
+    assert drive.max_linear_velocity == 0.4 and math.isinf(drive.max_angular_velocity)
+
+
+@pytest.mark.parametrize(
+    "layout",
+    ["own_type", "namespaced", "wildcard", "nested", "split_files"],
+)
+def test_parameter_files_are_read_as_ros_reads_them(tmp_path: Path, layout: str) -> None:
+    """The controller's type among its own parameters (gz_ros2_control's demos), node names
+    with a namespace or `/**`, nested namespace maps, and the manager and the controller in two
+    files: each gives the same drive."""
+    params = (
+        'left_wheel_names: ["wheel_left_joint"]\n'
+        'right_wheel_names: ["wheel_right_joint"]\n'
+        "wheel_separation: 0.25\nwheel_radius: 5e-2\n"
+    )
+    body = "".join(f"      {line}\n" for line in params.splitlines())
+    manager = "controller_manager:\n  ros__parameters:\n    dd:\n      type: {t}\n"
+    kind = "diff_drive_controller/DiffDriveController"
+    texts = {
+        "own_type": "controller_manager:\n  ros__parameters:\n    update_rate: 100\n"
+        f"dd:\n  ros__parameters:\n    type: {kind}\n{body.replace('      ', '    ')}",
+        "namespaced": manager.format(t=kind).replace(
+            "controller_manager:", "/robot/controller_manager:"
+        )
+        + f"/robot/dd:\n  ros__parameters:\n{body.replace('      ', '    ')}",
+        "wildcard": manager.format(t=kind).replace("controller_manager:", "/**/controller_manager:")
+        + f"/**/dd:\n  ros__parameters:\n{body.replace('      ', '    ')}",
+        "nested": "robot:\n  "
+        + manager.format(t=kind).replace("\n", "\n  ").rstrip()
+        + f"\n  dd:\n    ros__parameters:\n{body}",
+    }
+    plugin = '<plugin filename="gz_ros2_control-system" name="control">{}</plugin>'
+    if layout == "split_files":
+        (tmp_path / "a.yaml").write_text(manager.format(t=kind))
+        (tmp_path / "b.yaml").write_text(
+            f"dd:\n  ros__parameters:\n{body.replace('      ', '    ')}"
+        )
+        files = "<parameters>a.yaml</parameters><parameters>b.yaml</parameters>"
+    else:
+        (tmp_path / "ddc.yaml").write_text(texts[layout])
+        files = "<parameters>ddc.yaml</parameters>"
+    block = (
+        '<ros2_control name="sim" type="system"><hardware><plugin>gz_ros2_control/GazeboSimSystem'
+        f"</plugin></hardware>{INTERFACES}</ros2_control>"
+    )
+    text = dm.two_wheel_base(plugin.format(files)).replace("</robot>", f"{block}</robot>")
+    (tmp_path / "base.urdf").write_text(text)
+    done = convert_full(tmp_path / "base.urdf")
+    (drive,) = [p for p in done.plugins if isinstance(p, DiffDrive)]
+    assert (drive.name, drive.wheel_separation, drive.wheel_diameter) == ("dd", 0.25, 0.1)
+
+
+def test_a_text_description_reads_its_parameters_beside_where_it_was_sent_from(
+    tmp_path: Path,
+) -> None:
+    from converters.pipeline import convert_text
+
+    robot = _base(tmp_path)
+    done = convert_text(robot.read_text(), source="<xml>", base_dir=tmp_path)
+    assert [p.name for p in done.plugins if isinstance(p, DiffDrive)] == ["base_controller"]
+
+
+def test_a_ros_cmd_vel_holds_for_the_controllers_timeout(tmp_path: Path) -> None:
+    """The bridge's cmd_vel inputs carry cmd_vel_timeout (0.5 s in the file) as the command's
+    duration, as the controller stops a base whose commands stop."""
+    from twin_cli.ros.commands import entity_inputs
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    world = World()
+    world.spawn(SpawnRequest(str(_base(tmp_path)), on_ground=True), name="base")
+    drives = [i for i in entity_inputs(world)["base"] if i.mode is None]
+    assert {i.topic for i in drives} == {
+        "/base/base_controller/cmd_vel",
+        "/base/base_controller/cmd_vel_unstamped",
+    }
+    assert {i.timeout for i in drives} == {0.5}
 
 
 def test_an_unreadable_parameter_file_is_a_warning_and_no_drive(tmp_path: Path) -> None:

@@ -64,16 +64,17 @@ def test_an_unreadable_controller_yaml_keeps_the_default_names(tmp_path) -> None
 
 
 def test_a_diff_drive_controller_takes_cmd_vel_under_its_own_name(tmp_path) -> None:
-    """A relative `<parameters>` path starts at the description's folder."""
+    """A relative `<parameters>` path starts at the description's folder; the plugin's ign_
+    name is a ros2_control plugin as well."""
     (tmp_path / "ddc.yaml").write_text(
         "controller_manager:\n  ros__parameters:\n"
         "    base: {type: diff_drive_controller/DiffDriveController}\n"
         "base: {ros__parameters: {left_wheel_names: [l], right_wheel_names: [r]}}\n"
     )
     plugin = (
-        '<plugin name="c" filename="gz_ros2_control-system"><ros><namespace>/tb</namespace>'
+        '<plugin name="c" filename="libign_ros2_control-system.so"><ros><namespace>/tb</namespace>'
         "</ros><parameters>ddc.yaml</parameters></plugin>"
     )
-    names = plugin_names("bot", _robot(plugin), str(tmp_path / "bot.urdf"))
+    names = plugin_names("bot", _robot(plugin), str(tmp_path))
     assert names.cmd_vel == ("/tb/base/cmd_vel", "/tb/base/cmd_vel_unstamped")
     assert names.controllers == (), "a drive is not a joint command controller"
