@@ -1,4 +1,4 @@
-"""The physics options of a twin world (SDF defaults, Newton, implicit, noslip) for an MjSpec.
+"""The physics options of a twin world (SDF defaults, Newton, implicit) written into an MjSpec.
 
 One source for the world engine (`twin_cli.world.scene`) and the exported `scene.xml`
 (`converters.mjcf.writer`), so a model opened in plain MuJoCo steps with the physics that
@@ -48,14 +48,6 @@ SOLVER = "newton"
 # move 1.4e-7 m (and scaling the tolerance by meaninertia·nv, as once done here, 6 mm); 1e-12
 # keeps it within 1.3e-13 m for 0.3 % more solver iterations (1145 against 1142 in 700 steps).
 SOLVER_TOLERANCE = 1e-12
-# ODE solves friction as a hard velocity constraint: a contact whose tangential load stays inside
-# its friction bound does not slip. MuJoCo's friction rows share the contact's softness, so such a
-# contact creeps; the noslip pass re-solves the friction rows without softness after the main
-# solver. Measured after a 2 s settle: solo12 lying limp on its splayed legs rolled 7.2 mrad in
-# 60 s without it, 0.0003 mrad in 20 s with it; a limp Panda fixed to the world folded 8.6 mm
-# in 60 s over a link resting with 0.84 of its friction bound, 0.003 mm with it. It costs 28 %
-# of the step on the humanoid (2.6x on anymal_c, which has many mesh contacts).
-NOSLIP_ITERATIONS = 10
 
 
 @dataclass(frozen=True)
@@ -75,11 +67,10 @@ class WorldOptions:
 
 
 def apply_world_options(spec: mujoco.MjSpec, options: WorldOptions = WorldOptions()) -> None:
-    """Writes the timestep, gravity, solver, integrator and their settings into `spec.option`."""
+    """Writes timestep, gravity, iterations, solver, integrator and tolerance into `spec.option`."""
     spec.option.timestep = options.timestep
     spec.option.gravity = np.array(options.gravity)
     spec.option.iterations = options.iterations
     spec.option.solver = SOLVERS[options.solver]
     spec.option.integrator = INTEGRATORS[options.integrator]
     spec.option.tolerance = SOLVER_TOLERANCE
-    spec.option.noslip_iterations = NOSLIP_ITERATIONS

@@ -18,14 +18,15 @@ SECONDS = 10.0  # of sim time per robot and mode
 # 2.7 N m): 2e6 rad/s² reach the velocity limit in half a millisecond and throw the legs into
 # their stops; MuJoCo raises BADQACC within 50 ms (effort, velocity) and 0.7 s (position) of
 # random commands over the full ranges. Its position and velocity targets are drawn within 10 %
-# of each range around its centre (measured: peaks of 36-140 rad/s, no warning in 10 s), its
-# efforts within 1 N m (0.001 of the range): even 1 N m spins its legs to 250-330 rad/s, and its
-# real motors' 2.7 N m to 400-750 rad/s, where the gate is at its edge (seeds 0-4 of
-# `default_rng` without the noslip pass: all but seed 3 ran 10 s; with it seed 0 raised BADQACC).
-# With implicitfast, which leaves Coriolis forces explicit, 1 % of the ranges was the most it
-# took, and 2.7 N m efforts diverged after 1.3 s.
+# of each range around its centre (measured, implicit integrator: peaks of 68 and 160 rad/s,
+# no warning in 10 s), its efforts at its real motors' 2.7 N m (0.0027 of the range; 10 N m
+# raise warnings after 0.2 s). With implicitfast, which leaves Coriolis forces explicit, 1 % of
+# the ranges was the most it took, and its efforts diverged after 1.3 s. The efforts still spin
+# its legs to 400-750 rad/s, so their gate is close to its edge: seeds 0-4 (of
+# `default_rng`), 10 s each, passed in position and velocity mode, and in effort mode all but
+# seed 3 (BADQACC at 2.45 s).
 RANGE_SCALE = {"solo12": 0.1}
-EFFORT_SCALE = {"solo12": 0.001}
+EFFORT_SCALE = {"solo12": 0.0027}
 
 
 def _random_targets(world: World, name: str, mode: str, rng, scale: float) -> dict[str, float]:
