@@ -30,6 +30,8 @@ MOVED_M, TURNED_RAD = 1e-3, 1e-3
 # - solo12, untagged and limp, lies on its splayed legs: it sinks 0.35 mm and rolls 7.2 mrad
 #   in the 60 s (still 2.1 mrad in the 60 s after a 32 s settle);
 # - booster_t1 topples from standing until about 3.5 s, then creeps 0.72 mm and 2.5 mrad in 60 s.
+# MuJoCo's noslip pass (friction re-solved hard) stops both creeps, but it made one robot's motion
+# depend on another's spawn and held self-colliding links from pushing apart.
 STILL_FALLING = ("solo12", "booster_t1")
 
 
