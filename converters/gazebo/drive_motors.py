@@ -17,8 +17,8 @@ on the free joint (world-frame x, y) would need new targets as the heading turns
 `xfrc_applied` PD would act only at the controller's rate. The site sits at the robot's centre
 of mass, so the force does not pitch the base (at the link origin, below it, a 0.3 m/s step
 flipped a box on four feet). kv = M/PLANAR_TAU (I_zz/PLANAR_TAU for the yaw), integrated
-implicitly by implicitfast, so the twist is reached within a few steps and a friction load
-μ·M·g leaves only μ·g·PLANAR_TAU of error (1 mm/s at μ = 1).
+implicitly by the implicit integrator, so the twist is reached within a few steps and a
+friction load μ·M·g leaves only μ·g·PLANAR_TAU of error (1 mm/s at μ = 1).
 """
 
 from __future__ import annotations

@@ -119,7 +119,7 @@ def _report_joint_flags(ext: JointExtension, subject: str, report: Report) -> No
     if ext.implicit_spring_damper is not None:
         report.approximated(
             subject,
-            "MuJoCo integrates joint damping implicitly with the implicitfast integrator; "
+            "MuJoCo integrates joint damping implicitly with the implicit integrator; "
             "springs stay explicit",
             tag="implicitSpringDamper",
         )

@@ -6,9 +6,9 @@ servo *inside MuJoCo* by rewriting its gain, bias, force range and dynamics: a p
 (every converted robot's, and an MJCF `<motor>`) tracks a reference in its activation
 (`twin_cli.world.servos`: ramps, PI); an actuator with its own bias or dynamics (an MJCF
 `<position>`, a rotor's lag) a PD on ctrl (force = kp·(target − q) − kv·q̇). Either way it
-runs in C at every step with no Python in the hot path, and `implicitfast` integrates the kv
-term implicitly. Commands are rewritten into each new model after a recompile, since compiling
-restores the spec's motor.
+runs in C at every step with no Python in the hot path, and the implicit integrator integrates
+the kv term implicitly. Commands are rewritten into each new model after a recompile, since
+compiling restores the spec's motor.
 
 A multicopter rotor's joint actuator (converters.gazebo.multicopter) also sets, per command, its
 thrust and drag actuators (`<actuator>:thrust`, `:drag_x`, `:drag_y`) and the motor lag.
@@ -106,7 +106,8 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
       with a gain reaching full effort within VELOCITY_BAND·v, and force range
       [min(0, u), max(0, u)]: force = u while q̇ ≤ v·(1 − VELOCITY_BAND), falls linearly to 0 at
       v and stays 0 beyond (the servo's pull reverses sign and the range clips it to 0).
-      implicitfast integrates the gain's velocity term implicitly, so it is stable at any gain.
+      The implicit integrator integrates the gain's velocity term implicitly, so it is stable at
+      any gain.
     """
     sleeping.wake_actuated(model, data, (a,))  # a sleeping robot must feel its new command
     gear = abs(model.actuator_gear[a][0]) or 1.0

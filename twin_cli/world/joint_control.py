@@ -28,7 +28,8 @@ import numpy as np
 from converters.description import MODES
 from twin_cli.world import servos
 
-MAX_OMEGA_DT = 0.5  # ω·dt of the position servo's spring (explicit in implicitfast: < 2)
+# ω·dt of the position servo's spring (MuJoCo's implicit integrators leave springs explicit: < 2)
+MAX_OMEGA_DT = 0.5
 SPEED_MARGIN = 0.95  # position servo's design speed, as a fraction of the velocity limit
 FULL_EFFORT_SPEED = 1.0  # [rad/s or m/s] velocity error at full effort without a velocity limit
 
