@@ -88,9 +88,8 @@ def _base_dir(entity: Any) -> str:
     """Where the entity's description's relative paths start: the folder a text description
     was sent from, else the description file's folder."""
     request = getattr(entity, "request", None)
-    if getattr(request, "xml", None) and getattr(request, "base_dir", None):
-        return str(request.base_dir)
-    return str(Path(entity.source).parent)
+    base = getattr(request, "base_dir", None) if getattr(request, "xml", None) else None
+    return str(base) if base else str(Path(entity.source).parent)
 
 
 def _default_controllers(name: str, rows: dict[str, Any]) -> list[Input]:
