@@ -13,7 +13,8 @@ them from `cmd_vel`. twin runs that controller as a differential drive (`DiffDri
   `has_velocity_limits` / `has_acceleration_limits` flag is true (Humble's rule, which Gazebo
   Classic's gazebo_ros2_control runs) or not false (Jazzy's, for gz_ros2_control);
 - `cmd_vel_timeout` (default 0.5 s): a cmd_vel taken over ROS holds that long;
-- odometry from the wheels' joint positions, in `odom_frame_id` → `base_frame_id`;
+- odometry from the wheels' joint positions, in `odom_frame_id` → `base_frame_id`, on the
+  controller's `~/odom` (`<ns>/<controller>/odom`);
 - the controller manager's `update_rate` (default 100 Hz).
 What twin does not reproduce is listed tag by tag in the record's notes.
 """
@@ -21,6 +22,7 @@ What twin does not reproduce is listed tag by tag in the record's notes.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +38,7 @@ from converters.gazebo.controller_yaml import (
     parameter_files,
 )
 from converters.gazebo.drive_records import DiffDrive
+from converters.gazebo.plugin_params import Params
 
 DIFF_DRIVE_TYPE = "diff_drive_controller/DiffDriveController"
 FAMILY = "diff_drive_controller"
@@ -108,6 +111,7 @@ def read_controller_drives(
             problems.append(f"{DIFF_DRIVE_TYPE} '{name}': no parameters for it in {where}")
             continue
         drive = _diff_drive(name, params, where, rate or DEFAULT_UPDATE_RATE, limits_need_flags)
+        drive = replace(drive, odom_topic=Params.of(blob, source).ros_topic(f"{name}/odom"))
         _check_joints(drive, params, where, joints)
         drives.append(drive)
     return tuple(drives), tuple(problems)

@@ -79,6 +79,7 @@ def read_ros_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         update_rate=p.number(DEFAULT_RATE, "update_rate", "updateRate"),
         odometry_frame=p.text("odom", "odometry_frame", "odometryFrame"),
         robot_base_frame=p.text("base_footprint", "robot_base_frame", "robotBaseFrame"),
+        odom_topic=p.ros_topic("odom", "odometryTopic", "robotNamespace"),
     )
 
 
@@ -99,6 +100,7 @@ def read_skid_steer(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         family="gazebo_ros_skid_steer_drive",
         odometry_frame=p.text("odom", "odometryFrame"),
         robot_base_frame=p.text("base_footprint", "robotBaseFrame"),
+        odom_topic=p.ros_topic("odom", "odometryTopic", "robotNamespace"),
     )
 
 

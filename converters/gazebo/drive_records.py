@@ -58,8 +58,9 @@ class DiffDrive(_Record):
         `gz_diff_drive`, `vendor:<filename>`); odometry_frame, robot_base_frame: the odometry's
         frame names; max_linear_velocity [m/s], max_angular_velocity [rad/s] (gz-sim's limits);
         command_timeout [s]: how long a ROS cmd_vel holds (diff_drive_controller's
-        cmd_vel_timeout; 0: until the next); notes: what was approximated or ignored, one entry
-        per tag.
+        cmd_vel_timeout; 0: until the next); odom_topic: the odometry's ROS topic as the plugin
+        names it (relative: under the entity's name); notes: what was approximated or ignored,
+        one entry per tag.
     """
 
     name: str
@@ -78,6 +79,7 @@ class DiffDrive(_Record):
     max_linear_velocity: float = math.inf
     max_angular_velocity: float = math.inf
     command_timeout: float = 0.0
+    odom_topic: str = "odom"
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:

@@ -117,6 +117,24 @@ class Params:
             return named[text]
         return default
 
+    def ros_topic(self, name: str, ros1_topic: str = "", ros1_namespace: str = "") -> str:
+        """The topic the plugin's node gives `name`, as rclcpp resolves it: `<ros><remapping>`
+        (`name:=NEW` or `~/name:=NEW`) in `<ros><namespace>`; for ROS 1 plugins, the
+        `ros1_topic` and `ros1_namespace` tags. Absolute (`/ns/odom`) where a namespace or an
+        absolute remapping names it, else relative (the world puts it under the entity's name).
+        """
+        pairs = ((r.text or "").partition(":=") for r in self.root.findall("ros/remapping"))
+        remaps = {a.strip(): b.strip() for a, sep, b in pairs if sep and a.strip() and b.strip()}
+        topic = remaps.get(name, remaps.get(f"~/{name}", ""))
+        topic = topic or (self.text("", ros1_topic) if ros1_topic else "") or name
+        namespace = (self.root.findtext("ros/namespace") or "").strip().strip("/")
+        namespace = namespace or (
+            self.text("", ros1_namespace).strip("/") if ros1_namespace else ""
+        )
+        if topic.startswith("/") or not namespace:
+            return topic
+        return f"/{namespace}/{topic}"
+
     def given(self) -> dict[str, str]:
         """Every parameter element's tag and text, for reports (`<ros>` blocks shown by tag)."""
         out: dict[str, str] = {}

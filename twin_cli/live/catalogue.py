@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from twin_cli.errors import TopicNotFoundError
 from twin_cli.record import messages as ros
+from twin_cli.record.frames import odom_topic, unique_odom_topics
 from twin_cli.record.sensor_messages import spec_topic
 from twin_cli.record.topics import CLOCK, TF, TF_STATIC
 
@@ -54,6 +55,9 @@ def live_topics(world: World) -> list[LiveTopic]:
         step_rate = 1.0 / float(world.model.opt.timestep)
         entities = [(n, world.entity(n), world.index_of(n).free_qpos) for n in world.entity_names()]
     state = min(STATE_RATE, step_rate)
+    odom = unique_odom_topics(
+        {n: odom_topic(n, record.plugins) for n, record, free in entities if free >= 0}
+    )
     out = [
         LiveTopic(CLOCK.name, CLOCK.type, state),
         LiveTopic(TF.name, TF.type, state),
@@ -64,7 +68,7 @@ def live_topics(world: World) -> list[LiveTopic]:
         if record.description:
             out.append(LiveTopic(f"/{name}/robot_description", ros.STRING, 0.0, True, name))
         if free_qpos >= 0:
-            out.append(LiveTopic(f"/{name}/odom", ros.ODOMETRY, state, entity=name))
+            out.append(LiveTopic(odom[name], ros.ODOMETRY, state, entity=name))
         for spec in record.sensors:
             topic = spec_topic(name, spec)
             if topic is not None:

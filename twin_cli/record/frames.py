@@ -67,12 +67,14 @@ class Sources:
         description: URDF text after xacro, or None (the model's body tree is used).
         drive: (odometry frame, base frame) of its drive plugin, or None.
         sensors: its sensors' frames.
+        odom_topic: its odometry's topic (`odom_topic`), or "" (`/<entity>/odom`).
     """
 
     prefix: str
     description: str | None = None
     drive: tuple[str, str] | None = None
     sensors: tuple[SensorFrame, ...] = ()
+    odom_topic: str = ""
 
 
 def sources_of(world: World, name: str, template: str, description: str | None) -> Sources:
@@ -88,7 +90,30 @@ def sources_of(world: World, name: str, template: str, description: str | None) 
         isinstance(p, DiffDrive) and p.family == "gazebo_ros_diff_drive" for p in record.plugins
     ):
         drive = drive_frames(text)
-    return Sources(template.replace("{entity}", name), text, drive, sensors)
+    topic = odom_topic(name, record.plugins)
+    return Sources(template.replace("{entity}", name), text, drive, sensors, topic)
+
+
+def unique_odom_topics(topics: dict[str, str]) -> dict[str, str]:
+    """Each entity's odometry topic (entity → topic, in spawn order); a topic an earlier entity
+    already publishes (two robots from one file with a fixed namespace) becomes the later
+    entity's `/<entity>/odom`, so no two entities write one topic."""
+    seen: set[str] = set()
+    out: dict[str, str] = {}
+    for name, topic in topics.items():
+        out[name] = topic if topic not in seen else f"/{name}/odom"
+        seen.add(out[name])
+    return out
+
+
+def odom_topic(entity: str, plugins: Sequence[object]) -> str:
+    """The odometry's topic: as the first drive among the entity's plugin records names it
+    (a relative name under the entity's), else `/<entity>/odom`."""
+    for plugin in plugins:
+        topic = getattr(plugin, "odom_topic", None)
+        if topic:
+            return topic if topic.startswith("/") else f"/{entity}/{topic.strip('/')}"
+    return f"/{entity}/odom"
 
 
 def record_frames(plugins: Sequence[object]) -> tuple[str, str] | None:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin_cli.record.frames import Pose, Sources
+from twin_cli.record.frames import Pose, Sources, unique_odom_topics
 from twin_cli.record.tf_tree import Edge, EntityTree, entity_tree, model_names, static_pose
 from twin_cli.world.entities import EntityIndex, element_names
 
@@ -36,6 +36,7 @@ class EntityLayout:
         free_qpos, free_dof: the root free joint's qpos and dof addresses, or -1 (fixed base).
         description: URDF text for `/<entity>/robot_description`, or None.
         ball_joints: positions in `joint_ids` of ball joints (JointState: angle and speed).
+        odom_topic: its odometry's topic (its drive's name for it, else `/<entity>/odom`).
     """
 
     name: str
@@ -46,6 +47,7 @@ class EntityLayout:
     free_dof: int
     description: str | None
     ball_joints: tuple[int, ...] = ()
+    odom_topic: str = ""
 
     @property
     def root_frame(self) -> str:
@@ -105,9 +107,12 @@ def make_layout(
     """The layout of entities `index` (name → EntityIndex) in `model`, frames named from
     `sources` (name → Sources)."""
     names = model_names(model)
+    odom = unique_odom_topics(
+        {n: sources[n].odom_topic for n, ix in index.items() if ix.free_qpos >= 0}
+    )
     entities = tuple(
         entity_layout(model, name, ix, entity_tree(model, names, name, ix, sources[name]),
-                      sources[name].description)
+                      sources[name].description, odom.get(name, ""))
         for name, ix in index.items()
     )  # fmt: skip
     edges = [edge for e in entities for edge in e.tree.edges]
@@ -121,7 +126,12 @@ def make_layout(
 
 
 def entity_layout(
-    model: mujoco.MjModel, name: str, ix: EntityIndex, tree: EntityTree, description: str | None
+    model: mujoco.MjModel,
+    name: str,
+    ix: EntityIndex,
+    tree: EntityTree,
+    description: str | None,
+    odom_topic: str = "",
 ) -> EntityLayout:
     """One entity's layout (see EntityLayout)."""
     joints = np.array([j for j in ix.joints if model.jnt_type[j] != _FREE], dtype=np.int64)
@@ -136,6 +146,7 @@ def entity_layout(
         free_dof=int(model.jnt_dofadr[free[0]]) if free else -1,
         description=description,
         ball_joints=tuple(k for k, j in enumerate(joints) if is_ball(model, j)),
+        odom_topic=odom_topic or f"/{name}/odom",
     )
 
 

@@ -195,7 +195,7 @@ class _Odometry:
     def __init__(self, T: Any, layout: Layout, e: EntityLayout, stamp: Any) -> None:
         self._qpos, self._dof = e.free_qpos, e.free_dof
         self._root = int(layout.model.dof_bodyid[e.free_dof])  # the free joint's body
-        self._topic = f"/{e.name}/odom"
+        self._topic = e.odom_topic
         vector, zeros = T["geometry_msgs/msg/Vector3"], np.zeros(36)
         pose = T["geometry_msgs/msg/Pose"](
             position=T["geometry_msgs/msg/Point"](x=0.0, y=0.0, z=0.0),

@@ -8,8 +8,9 @@
   whenever the set of entities changes (tf2's static broadcaster does the same).
 - `/<entity>/joint_states` sensor_msgs/JointState: position, velocity, actuator effort, as
   `World.joint_states`; `/<entity>/robot_description` std_msgs/String, the URDF after xacro,
-  latched; `/<entity>/odom` nav_msgs/Odometry for floating bases (pose in `world` or the diff
-  drive's odometry frame, twist in the root link's frame, as ROS defines it).
+  latched; `/<entity>/odom` (or the name its drive gives it) nav_msgs/Odometry for floating
+  bases (pose in `world` or the diff drive's odometry frame, twist in the root link's frame, as
+  ROS defines it).
 Every stamp is sim time. Messages are rosbags objects; `Message.cdr` encodes them. This
 module names the topics and builds the latched messages; `live_messages` refills the per-sample
 ones.
@@ -64,7 +65,7 @@ def topics(layout: Layout) -> list[Topic]:
         if e.description:
             out.append(Topic(f"/{e.name}/robot_description", ros.STRING, latched=True))
         if e.free_qpos >= 0:
-            out.append(Topic(f"/{e.name}/odom", ros.ODOMETRY))
+            out.append(Topic(e.odom_topic, ros.ODOMETRY))
     return out
 
 

@@ -199,6 +199,9 @@ def test_a_ros_cmd_vel_holds_for_the_controllers_timeout(tmp_path: Path) -> None
         "/base/base_controller/cmd_vel_unstamped",
     }
     assert {i.timeout for i in drives} == {0.5}
+    from twin_cli.live.catalogue import live_topics
+
+    assert "/base/base_controller/odom" in {t.name for t in live_topics(world)}, "its ~/odom"
 
 
 def test_an_unreadable_parameter_file_is_a_warning_and_no_drive(tmp_path: Path) -> None:
