@@ -80,6 +80,7 @@ class DiffDrive(_Record):
     max_angular_velocity: float = math.inf
     command_timeout: float = 0.0
     odom_topic: str = "odom"
+    cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -122,6 +123,7 @@ class AckermannDrive(_Record):
     robot_base_frame: str = "base_footprint"
     family: str = "gazebo_ros_ackermann_drive"
     angular_is_steering: bool = True
+    cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -167,6 +169,7 @@ class TricycleDrive(_Record):
     robot_base_frame: str = "base_link"
     family: str = "gazebo_ros_tricycle_drive"
     angular_is_steering: bool = True
+    cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -198,6 +201,7 @@ class HolonomicDrive(_Record):
     odometry_source: str = "world"
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
+    cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:

@@ -151,6 +151,9 @@ def read_plugins(
             if geometry is not None:
                 geometry.plugin = blob.name or key
             record = READERS[key](params, blob, ctx)
+            if key.startswith("gazebo_ros") and hasattr(record, "cmd_vel_topic"):
+                topic = params.ros_topic("cmd_vel", "commandTopic", "robotNamespace")
+                record = replace(record, cmd_vel_topic=topic)  # SDF models carry it too
             notes = drive_notes(key, params, getattr(record, "initial", 0.0))
             out.append(replace(record, notes=record.notes + notes))
         elif kind == "vendor_drive":

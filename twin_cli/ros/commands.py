@@ -74,7 +74,9 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     inputs = []
     if drives:
         kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
-        for topic in named.cmd_vel or (f"/{name}/cmd_vel",):
+        own = getattr(drives[0], "cmd_vel_topic", "")  # as the converter read its plugin
+        own = own if not own or own.startswith("/") else f"/{name}/{own}"
+        for topic in named.cmd_vel or (own or f"/{name}/cmd_vel",):
             inputs += [
                 Input(topic, message, drive=kind, timeout=timeout or None)
                 for message in (TWIST, TWIST_STAMPED)

@@ -78,3 +78,27 @@ def test_a_diff_drive_controller_takes_cmd_vel_under_its_own_name(tmp_path) -> N
     names = plugin_names("bot", _robot(plugin), str(tmp_path))
     assert names.cmd_vel == ("/tb/base/cmd_vel", "/tb/base/cmd_vel_unstamped")
     assert names.controllers == (), "a drive is not a joint command controller"
+
+
+def test_an_sdf_models_drive_plugin_names_its_cmd_vel_too(tmp_path) -> None:
+    """An SDF model has no URDF text: the converter's drive record carries the name its
+    gazebo_ros plugin gives cmd_vel, and odom the same way."""
+    import drive_models as dm
+
+    from twin_cli.live.catalogue import live_topics
+    from twin_cli.ros.commands import entity_inputs
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    plugin = (
+        '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><ros><namespace>/sdfbot'
+        "</namespace></ros><left_joint>wheel_left_joint</left_joint><right_joint>"
+        "wheel_right_joint</right_joint><wheel_separation>0.3</wheel_separation>"
+        "<wheel_diameter>0.1</wheel_diameter></plugin>"
+    )
+    path = tmp_path / "bot.sdf"
+    path.write_text(dm.sdf_diff_drive(plugin))
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="b")
+    assert {i.topic for i in entity_inputs(world)["b"] if i.mode is None} == {"/sdfbot/cmd_vel"}
+    assert "/sdfbot/odom" in {t.name for t in live_topics(world)}
