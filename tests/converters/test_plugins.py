@@ -3,6 +3,7 @@ and what the report says of every plugin."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
@@ -40,7 +41,8 @@ def test_diff_drive_parameters_read_under_both_ros_spellings(tmp_path: Path, plu
     expected = DiffDrive(
         "dd", done.plugins[0].where, ("lj",), ("rj",), 0.2, 0.1, 3.0, 2.0, "encoder", 50.0
     )
-    assert done.plugins == (expected,)
+    # No <ros> block (ROS 2) or commandTopic (ROS 1): cmd_vel under the entity's namespace.
+    assert done.plugins == (replace(expected, cmd_vel_topic="cmd_vel"),)
 
 
 def test_plugin_defaults_are_gazebo_ros_diff_drives(tmp_path: Path) -> None:
