@@ -31,7 +31,9 @@ pytestmark = pytest.mark.xdist_group("ros_live")
 
 WORLD = "ros_live"
 PEER = Path(__file__).with_name("ros_peer.py")
-DOMAIN_ID = str(100 + os.getpid() % 100)  # one domain per test process
+# One domain per test process, 30-69: its ports (7400 + 250·id + ...) stay below Linux's
+# ephemeral range (32768 on), so no client socket of another program can hold one.
+DOMAIN_ID = str(30 + os.getpid() % 40)
 DDS_BASE_PORT = 7400  # DDSI's port base: domain d uses 7400 + 250·d onwards
 STATE_PERIOD = 0.01  # [s] of sim time between /clock, /tf and joint_states messages (100 Hz)
 POSE_TOL = 1e-9  # [m, rad] tf composed against `twin model`: the same numbers, two routes
