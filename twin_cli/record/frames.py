@@ -112,8 +112,14 @@ def odom_topic(entity: str, plugins: Sequence[object]) -> str:
     for plugin in plugins:
         topic = getattr(plugin, "odom_topic", None)
         if topic:
-            return topic if topic.startswith("/") else f"/{entity}/{topic.strip('/')}"
+            return entity_topic(entity, topic)
     return f"/{entity}/odom"
+
+
+def entity_topic(entity: str, topic: str) -> str:
+    """A topic a plugin names: absolute as it is, relative under the entity's name (twin's
+    namespace for each robot)."""
+    return topic if topic.startswith("/") else f"/{entity}/{topic.strip('/')}"
 
 
 def record_frames(plugins: Sequence[object]) -> tuple[str, str] | None:

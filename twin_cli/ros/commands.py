@@ -11,9 +11,10 @@ command controllers, acted on through the calls `twin drive` and `twin command` 
   `twin joints` lists them; it goes to `World.command_joints` (all or none).
 - With position joints, `/<entity>/joint_trajectory_controller/joint_trajectory`
   (trajectory_msgs/JointTrajectory) goes to `follow_trajectory`, as `twin trajectory` does.
-- Where the robot's description names them (`plugin_names`), its drive plugin's namespace and
-  remapping rename `cmd_vel`, and the controllers of its gazebo_ros2_control YAML replace the
-  default controllers, with their joints in the YAML's order.
+- A gazebo_ros drive plugin's namespace and remapping rename `cmd_vel` (its drive record's
+  `cmd_vel_topic`), a diff_drive_controller takes its own `cmd_vel` topics, and the controllers
+  of the robot's ros2_control YAML replace the default controllers, with their joints in the
+  YAML's order (`plugin_names`).
 
 A thread of the bridge's own polls the readers every POLL_S and follows spawns and deletes. A
 command that is refused (a sideways speed for a diff drive, a wrong number of targets) is
@@ -31,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.record.frames import entity_topic
 from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST, TWIST_STAMPED
 from twin_cli.ros.plugin_names import TRAJECTORY, Controller, plugin_names
 
@@ -75,8 +77,8 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     if drives:
         kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
         own = getattr(drives[0], "cmd_vel_topic", "")  # as the converter read its plugin
-        own = own if not own or own.startswith("/") else f"/{name}/{own}"
-        for topic in named.cmd_vel or (own or f"/{name}/cmd_vel",):
+        topics = (entity_topic(name, own),) if own else named.cmd_vel or (f"/{name}/cmd_vel",)
+        for topic in topics:
             inputs += [
                 Input(topic, message, drive=kind, timeout=timeout or None)
                 for message in (TWIST, TWIST_STAMPED)

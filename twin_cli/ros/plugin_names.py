@@ -1,10 +1,7 @@
-"""The names a robot's own description gives its ROS inputs: gazebo_ros plugins' `<ros>` blocks
-and the controllers of the YAML file gazebo_ros2_control loads.
+"""The names a robot's ros2_control parameter files give its ROS inputs: the controllers of the
+YAML files gazebo_ros2_control (or gz_ros2_control) loads. (A gazebo_ros drive plugin's own
+`cmd_vel` name is read by the converter into its drive record: `cmd_vel_topic`.)
 
-- A drive plugin (gazebo_ros' diff drive, skid steer, Ackermann, planar move, tricycle) takes
-  `cmd_vel` in its node's namespace: `<ros><namespace>` (else the entity's name, twin's
-  namespace for each robot), renamed by `<remapping>cmd_vel:=NAME</remapping>` (a name starting
-  with `/` is absolute), as rclcpp resolves a topic.
 - gazebo_ros2_control's `<parameters>` names the controller manager's YAML file: each controller
   under `controller_manager: ros__parameters:` with a `type`, and its own `ros__parameters`
   (`joints`, `interface_name` or the type's interface). Forward command controllers and the
@@ -38,7 +35,6 @@ from converters.gazebo.controller_yaml import (
 )
 
 log = logging.getLogger("twin.ros")
-DRIVE_PLUGINS = ("diff_drive", "skid_steer", "ackermann", "planar_move", "tricycle")
 TRAJECTORY = "trajectory"  # a controller's mode: joint_trajectory_controller's topic
 DRIVE = "drive"  # a controller's mode: diff_drive_controller's cmd_vel
 CONTROLLER_MODES = {  # controller type → the command interface it writes
@@ -61,8 +57,8 @@ class Controller:
 
 @dataclass(frozen=True)
 class PluginNames:
-    """What an entity's description names: its drive's cmd_vel topics (empty: twin's default)
-    and its controllers (empty: twin's default controller names)."""
+    """What an entity's description names: a diff_drive_controller's cmd_vel topics (empty:
+    none) and its controllers (empty: twin's default controller names)."""
 
     cmd_vel: tuple[str, ...] = ()
     controllers: tuple[Controller, ...] = ()
@@ -79,32 +75,18 @@ def plugin_names(entity: str, description: str | None, base: str = "") -> Plugin
         root = ET.fromstring(description)
     except ET.ParseError:
         return PluginNames()
-    cmd_vel: tuple[str, ...] = ()
     controllers: tuple[Controller, ...] = ()
     for plugin in root.iter("plugin"):
-        filename = plugin.get("filename", "")
-        if not cmd_vel and any(k in filename for k in DRIVE_PLUGINS):
-            cmd_vel = (_resolve("cmd_vel", _namespace(plugin, entity), _remaps(plugin)),)
-        if not controllers and is_control_plugin(filename):
+        if is_control_plugin(plugin.get("filename", "")):
             controllers = _controllers(plugin, entity, base)
+            break
     drive_topics = tuple(c.topic for c in controllers if c.mode == DRIVE)
     named = tuple(c for c in controllers if c.mode != DRIVE)
-    return PluginNames(cmd_vel or drive_topics, named)
+    return PluginNames(drive_topics, named)
 
 
 def _namespace(plugin: ET.Element, entity: str) -> str:
     return (plugin.findtext("ros/namespace") or "").strip().strip("/") or entity
-
-
-def _remaps(plugin: ET.Element) -> dict[str, str]:
-    pairs = ((r.text or "").partition(":=") for r in plugin.findall("ros/remapping"))
-    return {a.strip(): b.strip() for a, sep, b in pairs if sep and a.strip() and b.strip()}
-
-
-def _resolve(name: str, namespace: str, remaps: dict[str, str]) -> str:
-    """A topic as rclcpp resolves `name` in `namespace` after the node's remappings."""
-    name = remaps.get(name, remaps.get(f"~/{name}", name))
-    return name if name.startswith("/") else f"/{namespace}/{name}"
 
 
 def _controllers(plugin: ET.Element, entity: str, base: str) -> tuple[Controller, ...]:

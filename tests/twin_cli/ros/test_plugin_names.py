@@ -1,5 +1,6 @@
 """The names a robot's description gives its ROS inputs, read as rclcpp and the controller
-manager read them (pure functions: no world, no DDS)."""
+manager read them (the YAML's names as pure functions; a drive plugin's through a world's
+inputs; no DDS)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,10 @@ def _robot(plugins: str) -> str:
 
 
 def _drive(ros: str) -> str:
-    return f'<plugin name="d" filename="libgazebo_ros_diff_drive.so">{ros}</plugin>'
+    return (
+        f'<plugin name="d" filename="libgazebo_ros_diff_drive.so">{ros}<left_joint>'
+        "wheel_left_joint</left_joint><right_joint>wheel_right_joint</right_joint></plugin>"
+    )
 
 
 @pytest.mark.parametrize(
@@ -27,8 +31,20 @@ def _drive(ros: str) -> str:
         ("<ros><remapping>odom:=odom_demo</remapping></ros>", "/bot/cmd_vel"),  # not cmd_vel
     ],
 )
-def test_a_drive_plugins_namespace_and_remapping_name_its_cmd_vel(ros: str, topic: str) -> None:
-    assert plugin_names("bot", _robot(_drive(ros))).cmd_vel == (topic,)
+def test_a_drive_plugins_namespace_and_remapping_name_its_cmd_vel(
+    tmp_path, ros: str, topic: str
+) -> None:
+    import drive_models as dm
+
+    from twin_cli.ros.commands import entity_inputs
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    path = tmp_path / "bot.urdf"
+    path.write_text(dm.two_wheel_base(_drive(ros)))
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="bot")
+    assert {i.topic for i in entity_inputs(world)["bot"] if i.mode is None} == {topic}
 
 
 def test_the_controller_yaml_names_the_controllers_their_modes_and_joints(tmp_path) -> None:

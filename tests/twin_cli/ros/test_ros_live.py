@@ -227,6 +227,18 @@ def test_forward_controller_commands_set_the_joint_targets(served) -> None:
     assert (held["slide"]["mode"], held["slide"]["target"]) == ("position", 0.2), held["slide"]
 
 
+def _slide_reaches(root: Path, entity: str, target: float) -> float:
+    """The `slide` joint's position [m] once within 5 mm of `target`, or after 3 s of wall."""
+    deadline, position = time.monotonic() + 3.0, float("nan")
+    while time.monotonic() < deadline:
+        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", entity, "--json"))}
+        position = joints["slide"]["position"]
+        if abs(position - target) < 0.005:
+            break
+        time.sleep(0.2)
+    return position
+
+
 def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
     """trajectory_msgs/JointTrajectory on /rig/joint_trajectory_controller/joint_trajectory
     (slide to 0.1 m in 0.5 s) is followed as `twin trajectory` follows one: the joint gets
@@ -234,13 +246,7 @@ def test_a_joint_trajectory_moves_the_joint_there(served) -> None:
     root, _ = served
     sent = _peer(root, "trajectory", "rig", "slide", "0.1", "0.5")
     assert sent["matched"] == 1, "the twin's JointTrajectory reader did not match"
-    deadline, position = time.monotonic() + 3.0, None
-    while time.monotonic() < deadline:
-        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "rig", "--json"))}
-        position = joints["slide"]["position"]
-        if abs(position - 0.1) < 0.005:
-            break
-        time.sleep(0.2)
+    position = _slide_reaches(root, "rig", 0.1)
     assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
 
 
@@ -525,11 +531,5 @@ def test_inputs_take_the_names_the_robots_own_plugins_give(served) -> None:
         root, "trajectory", "/arm/slide_controller/joint_trajectory", "slide", "0.1", "0.5"
     )
     assert sent["matched"] == 1, "no reader on /arm/slide_controller/joint_trajectory"
-    deadline, position = time.monotonic() + 3.0, None
-    while time.monotonic() < deadline:
-        joints = {j["name"]: j for j in json.loads(_twin(root, "joints", "named_rig", "--json"))}
-        position = joints["slide"]["position"]
-        if abs(position - 0.1) < 0.005:
-            break
-        time.sleep(0.2)
+    position = _slide_reaches(root, "named_rig", 0.1)
     assert position == pytest.approx(0.1, abs=0.005), f"slide at {position} m"
