@@ -27,10 +27,13 @@ the busy loops), seconds after the spawn's reply:
 Those were measured before the page held its render loop during a fetch; with the hold, at load
 15.1-16.6: drawn at 3.31 and 4.00 s idle, 9.71 and 11.12 s with the busy loops.
 
-The 2 s target from the reply to drawn is not met here. Twin's part ends when the worker has
-the model; the rest is the browser's: the wait for the page's main thread (busy in frames that
-each cost about a CPU-second in SwiftShader with this robot), MuJoCo's parse and rebuild of the
-whole scene, and the frame that uploads and draws every mesh.
+With the fast look (`twin_cli.view.look`, which the page gets in SwiftShader) franka_panda was
+drawn 0.93-1.25 s after the reply idle (load 3.1), 1.94-5.10 s with the busy loops (load 4.8).
+
+With the full look the 2 s target from the reply to drawn is not met here. Twin's part ends
+when the worker has the model; the rest is the browser's: the wait for the page's main thread
+(busy in frames that each cost about a CPU-second in SwiftShader with this robot), MuJoCo's
+parse and rebuild of the whole scene, and the frame that uploads and draws every mesh.
 """
 
 from __future__ import annotations

@@ -207,6 +207,7 @@ class ViewBody(Body):
 
     port: Annotated[int, Field(ge=0, le=65535)] = 0
     host: str = "127.0.0.1"
+    quality: Literal["auto", "full", "fast"] | None = None  # None: auto, or the running one's
 
 
 class SnapshotBody(Body):

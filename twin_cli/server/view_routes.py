@@ -51,7 +51,7 @@ def start_view(body: ViewBody, request: Request) -> Any:
     from twin_cli.view.service import ViewConflictError
 
     try:
-        status = views(request).start(host=body.host, port=body.port)
+        status = views(request).start(host=body.host, port=body.port, quality=body.quality)
     except ViewConflictError as exc:
         return error_reply(409, "InvalidRequestError", str(exc))
     log.info("viewer on %s:%d", status["host"], status["port"])  # the URL may carry the token

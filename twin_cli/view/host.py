@@ -6,7 +6,9 @@ keeps stepping in its own thread; a sync thread here calls `ViewerHandle.sync` a
 wall time, holding the world's lock only for that call (0.25-0.6 ms measured), so the page sees
 the world ~30 times a second and the stepping loop never runs Python per step for it. When a
 spawn or delete has recompiled the world, `sync` is given the new model and sends it; the page
-swaps it in place (no reload) and keeps its camera, since the model path stays "".
+swaps it in place (no reload) and keeps its camera, since the model path stays "". The model
+sent is the world's own, or its copy with the fast look for a software-rendered page
+(`twin_cli.view.look`).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from mujoco.studio import messages
 
 from twin_cli.view.bridge import WorldBridge
 from twin_cli.view.guard import ViewGuard, armed, protect
+from twin_cli.view.look import PageLook
 from twin_cli.view.piece_routes import PieceRoutes, PieceStore
 
 log = logging.getLogger("twin.view")
@@ -58,7 +61,9 @@ class ViewAddress:
         return not ipaddress.ip_address(self.host).is_loopback
 
 
-def _viewer_class(host: str, token: str | None, store: PieceStore) -> type:
+def _viewer_class(
+    host: str, token: str | None, store: PieceStore, on_renderer: Callable[[str], None]
+) -> type:
     """`WebViewer` bound to `host` instead of the "::" (all interfaces) it hard-codes, its
     server behind twin's Host, Origin and token checks (`twin_cli.view.guard`), each model it
     serves also cut into `store`'s pieces (`twin_cli.view.piece_routes`).
@@ -80,7 +85,7 @@ def _viewer_class(host: str, token: str | None, store: PieceStore) -> type:
         def _start_server(self) -> None:
             """Registers the guard for the bound socket before MuJoCo's server starts on it."""
             guard = ViewGuard(host, self._http_port, token)
-            protect(self._http_sock, guard, PieceRoutes(store).wrap)
+            protect(self._http_sock, guard, PieceRoutes(store, on_renderer).wrap)
             super()._start_server()
             # Only the current bundle is kept: the page never goes back to an old one by crc,
             # and MuJoCo's page would otherwise download every earlier model in the background.
@@ -130,6 +135,7 @@ class WebHost:
         port: TCP port; 0 takes the first free one from 8080 on (MuJoCo's rule).
         rate: syncs per second of wall time.
         token: what every request must carry (None: no token, for loopback).
+        quality: the page's look, `twin_cli.view.look.QUALITIES`.
     """
 
     def __init__(
@@ -140,8 +146,10 @@ class WebHost:
         port: int = 0,
         rate: float = SYNC_HZ,
         token: str | None = None,
+        quality: str = "auto",
     ) -> None:
         self._current = current_world
+        self.look = PageLook(quality)
         self._host, self._port, self._period = host, port, 1.0 / rate
         self._token = token
         self._bridge = WorldBridge(current_world())
@@ -162,7 +170,7 @@ class WebHost:
         from mujoco.studio import launch_thread, viewer_protocol
 
         bound: queue.Queue[Any] = queue.Queue()
-        viewer_class = _viewer_class(self._host, self._token, self.pieces)
+        viewer_class = _viewer_class(self._host, self._token, self.pieces, self.look.report)
         config = viewer_protocol.ViewerConfig(gfx="web", http_port=self._port, title="twin")
 
         def run(endpoint: Any) -> None:
@@ -190,7 +198,7 @@ class WebHost:
         self.address = ViewAddress(self._host, int(reply.getsockname()[1]), self._token)
         world = self._current()
         with world.lock:
-            self._handle.set_model(world.model, data=world.data)
+            self._handle.set_model(self.look.model_for(world.model), data=world.data)
         self._thread = threading.Thread(target=self._run, name="twin-view-sync", daemon=True)
         self._thread.start()
         log.info("viewer on port %d (bound to %s)", self.address.port, self._host)
@@ -212,12 +220,13 @@ class WebHost:
             log.exception("viewer sync ended")
 
     def sync_once(self) -> None:
-        """One sync: page actions in, the world's model (if new) and state out; lock held."""
+        """One sync: page actions in, the world's model (if new, or its look changed) and state
+        out; lock held."""
         world = self._current()
         self._bridge.world = world
         with world.lock:
             self._bridge.show_pause_state()
-            self._handle.sync(world.model, world.data)
+            self._handle.sync(self.look.model_for(world.model), world.data)
         self.syncs += 1
 
     def close(self) -> None:

@@ -5,7 +5,9 @@ fetching it). `PieceRoutes` answers, ahead of MuJoCo's own routes on the same po
 same guard): `/` (MuJoCo's page with `pieces.js` added), `/twin/pieces.js`,
 `/twin/pieces_worker.js`, `/twin/current` (the newest model's crc32),
 `/twin/manifest[?crc32=N]` (the pieces of a model, JSON, a few KiB) and
-`/twin/pieces?keys=K,K,...` (the bytes of those pieces, in order). The page's worker fetches
+`/twin/pieces?keys=K,K,...` (the bytes of those pieces, in order) and
+`/twin/renderer?name=R` (the page's WebGL renderer, which decides the fast look,
+`twin_cli.view.look`). The page's worker fetches
 only the pieces it lacks, in requests of its own, off the page's main thread: the `/state`
 WebSocket, which carries the world's state, never waits for a model.
 """
@@ -81,8 +83,9 @@ class PieceStore:
 class PieceRoutes:
     """Twin's routes on the viewer's port, in front of MuJoCo's (`wrap`)."""
 
-    def __init__(self, store: PieceStore) -> None:
+    def __init__(self, store: PieceStore, on_renderer: Callable[[str], None]) -> None:
         self.store = store
+        self._on_renderer = on_renderer
         self._page: bytes | None = None
 
     def wrap(self, inner: ProcessRequest | None) -> ProcessRequest:
@@ -96,6 +99,7 @@ class PieceRoutes:
                 "/twin/current": self._current,
                 "/twin/manifest": self._manifest,
                 "/twin/pieces": self._pieces,
+                "/twin/renderer": self._renderer,
             }.get(path)
             if handler is not None:
                 return handler(path, urllib.parse.parse_qs(query))
@@ -127,6 +131,14 @@ class PieceRoutes:
         if manifest is None:
             return _response(404, "text/plain", b"model no longer kept\n")
         return _response(200, "application/json", json.dumps(manifest.as_json()).encode())
+
+    def _renderer(self, _path: str, query: dict) -> Any:
+        """The page's WebGL renderer, sent once when it loads."""
+        name = query.get("name", [""])[0]
+        if not name:
+            return _response(400, "text/plain", b"give name=RENDERER\n")
+        self._on_renderer(name)
+        return _response(204, "text/plain", b"")
 
     def _pieces(self, _path: str, query: dict) -> Any:
         keys = [k for k in query.get("keys", [""])[0].split(",") if k]

@@ -13,6 +13,22 @@
   const waiting = new Map(); // crc32 (0: the current model) -> [resolve]
   const worker = new Worker("twin/pieces_worker.js");
 
+  // The server sends a software-rendered page the fast look (no shadows, no multisampling:
+  // frames 2-3 times quicker), so it is told which renderer this page's WebGL uses. A canvas of
+  // its own: MuJoCo's is not created yet.
+  function reportRenderer() {
+    const gl = document.createElement("canvas").getContext("webgl2");
+    if (!gl) return;
+    const info = gl.getExtension("WEBGL_debug_renderer_info");
+    const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    record.renderer = name;
+    gl.getExtension("WEBGL_lose_context")?.loseContext();
+    fetch("twin/renderer?name=" + encodeURIComponent(name), { cache: "no-store" }).catch((e) =>
+      console.warn("[twin] renderer not reported:", e),
+    );
+  }
+  reportRenderer();
+
   function settle(crc, bytes) {
     for (const key of [crc, 0]) {
       for (const resolve of waiting.get(key) || []) resolve(bytes);

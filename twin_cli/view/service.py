@@ -17,6 +17,7 @@ from typing import Any
 
 from twin_cli.errors import InvalidRequestError, RequestError
 from twin_cli.view.host import LOOPBACK, WebHost
+from twin_cli.view.look import check_quality
 
 log = logging.getLogger("twin.view")
 PUBLIC_WARNING = (
@@ -49,8 +50,10 @@ class ViewService:
         self.host: WebHost | None = None
         self._closed_once = False
 
-    def start(self, *, host: str = LOOPBACK, port: int = 0) -> dict:
-        """Starts the viewer (or reports the running one, asked with the same options).
+    def start(self, *, host: str = LOOPBACK, port: int = 0, quality: str | None = None) -> dict:
+        """Starts the viewer (or reports the running one, asked with the same options); a
+        `quality` (`twin_cli.view.look.QUALITIES`, None: auto for a new viewer) applies to the
+        running one as well.
 
         Raises:
             ViewConflictError: a viewer runs on another host or port.
@@ -60,12 +63,16 @@ class ViewService:
         with self._lock:
             if self.host is not None and self.host.running:
                 self._check_same(host, port)
+                if quality is not None:
+                    self.host.look.quality = check_quality(quality)
                 return self.status()
             if self.host is not None:
                 self.close()
             self._refuse_restart()
             token = (self._world_token() or secrets.token_urlsafe(32)) if public else None
-            web = WebHost(self._current, host=host, port=port, token=token)
+            web = WebHost(
+                self._current, host=host, port=port, token=token, quality=quality or "auto"
+            )
             try:
                 web.start()
             except (RuntimeError, OSError) as exc:
@@ -105,8 +112,8 @@ class ViewService:
             )
 
     def status(self) -> dict:
-        """`{url, host, port, public, token_required, token, syncs, warning}`; raises when no
-        viewer runs."""
+        """`{url, host, port, public, token_required, token, syncs, look, warning}` (`look`:
+        `twin_cli.view.look.PageLook.status`); raises when no viewer runs."""
         if self.host is None or self.host.address is None:
             raise InvalidRequestError("viewer", "none is running", "start one with `twin view`")
         address = self.host.address
@@ -118,6 +125,7 @@ class ViewService:
             "token_required": address.token is not None,
             "token": address.token,
             "syncs": self.host.syncs,
+            "look": self.host.look.status(),
             "warning": PUBLIC_WARNING.format(host=address.host, port=address.port)
             if address.public
             else None,

@@ -174,11 +174,13 @@ def test_a_wildcard_viewer_takes_any_address_of_the_machine_but_never_a_foreign_
 
 def test_the_view_reply_says_a_public_viewer_needs_its_token_and_the_url_carries_it():
     from twin_cli.view.host import ViewAddress
+    from twin_cli.view.look import PageLook
     from twin_cli.view.service import ViewService
 
     class Running:
         address = ViewAddress("0.0.0.0", 8080, "abc")
         syncs = 0
+        look = PageLook()
 
     service = ViewService(lambda: None, lambda: "abc")
     service.host = Running()  # type: ignore[assignment]

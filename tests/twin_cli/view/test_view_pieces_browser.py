@@ -5,15 +5,17 @@ One page, one test, one robot the test writes itself (`tests.big_meshes.write_me
 links drawn with about 136,000 triangles of OBJ meshes, as many as franka_panda's visual meshes
 with its hand). Spawned with the page open, the arm is in the page's worker within `APPEAR_S`
 of the spawn's reply (the server's sync and cut, the transfer: twin's part), and drawn within
-`DRAWN_S` (Chromium's software renderer draws such an arm in 1-5 s on two cores, so the 2 s
-goal for the drawing is measured and printed, not asserted); so is a second arm, and the
-page receives no byte of mesh data for it. Bytes are counted twice: by Chromium (the bodies of
-the responses the page receives, from its network events) and by the page's own record of the
-pieces it fetched. A delete sends no mesh bytes either.
+`DRAWN_S` (the page renders in SwiftShader, so the server sends it the fast look: no shadows,
+no multisampling); so is a second arm, and the page receives no byte of mesh data for it. A
+miss of the 2 s is measured once more on a new arm and its copy, which must both make it.
+Bytes are counted twice: by Chromium (the bodies of the responses the page receives, from its
+network events) and by the page's own record of the pieces it fetched. A delete sends no mesh
+bytes either.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -30,10 +32,10 @@ pytestmark = pytest.mark.skipif(bool(chromium_missing()), reason=chromium_missin
 WORLD = "pieces"
 APPEAR_S = 2.0  # [s] from the spawn's reply to the new model in the page's worker
 # [s] from the reply to the new model drawn: the page's main thread takes the bundle between two
-# frames, MuJoCo's WASM parses it and builds its scene (0.2-0.8 s for this arm), SwiftShader
-# uploads and draws 136,000 triangles (0.8-2.4 s a frame). Measured on the 2-core VM at load
-# 5-8: drawn 1.7-3.4 s after the reply, 5-13 s with two busy loops besides.
-DRAWN_S = 20.0
+# frames, MuJoCo's WASM parses it and builds its scene (0.2-0.3 s for this arm), SwiftShader
+# uploads and draws 136,000 triangles (0.3-0.6 s a frame in the fast look the page gets).
+# Measured on the 2-core VM at load 3-5: drawn 1.0-1.3 s after the reply.
+DRAWN_S = 2.0
 FIRST_LOAD_S = 120.0  # [s] the page's first load: WASM and WebGL in SwiftShader, ~12 s
 TWIN_TIMEOUT_S = 120.0  # [s] a spawn converts the URDF and its meshes on a loaded machine
 # Structure the second spawn changes: bodies, joints, names, their trees in the BVH arrays
@@ -52,11 +54,14 @@ def twin(*args: str) -> subprocess.CompletedProcess:
     )
 
 
-def spawn_arm(urdf: Path, name: str, x: float) -> float:
-    """Spawns the arm at (x, 0); returns the wall time [s since the epoch] of the reply."""
+def spawn_arm(urdf: Path, name: str, x: float) -> tuple[float, float]:
+    """Spawns the arm at (x, 0); returns the wall times [s since the epoch] of the request
+    (a load the page parses after it is this spawn's) and of the reply (the times are from
+    it)."""
+    asked = time.time()
     spawned = twin("spawn", str(urdf), "--name", name, "-x", str(x))
     assert spawned.returncode == 0, spawned.stderr
-    return time.time()
+    return asked, time.time()
 
 
 def loads(tab) -> list[dict]:
@@ -100,8 +105,8 @@ def frame_ms(tab) -> float:
 
 
 def wait_shown(tab, after: float, timeout: float) -> dict:
-    """The first model load after `after` [s since the epoch] that the page has drawn and
-    presented (the animation frame after the one that drew it has begun)."""
+    """The first model load parsed after `after` [s since the epoch] that the page has drawn
+    and presented (the animation frame after the one that drew it has begun)."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         drawn = [x for x in loads(tab) if x["presented"] and x["parsed"] / 1e3 > after]
@@ -127,8 +132,41 @@ def page(tmp_path_factory, serve_world):
             tab.on("requestfinished", lambda r: bodies.append((r.url, _body_bytes(r))))
             tab.goto(url)
             wait_shown(tab, 0.0, FIRST_LOAD_S)
+            wait_fast_look(tab)
             yield tab, bodies, urdf
             browser.close()
+
+
+def wait_fast_look(tab) -> None:
+    """Waits until the server sends this page (SwiftShader) the fast look and the page has
+    drawn the model the server now serves: a spawn then measures its own model only."""
+    deadline = time.monotonic() + FIRST_LOAD_S
+    while time.monotonic() < deadline:
+        status = json.loads(twin("view", "--json").stdout)
+        current = int(tab.evaluate("fetch('twin/current').then((r) => r.text())"))
+        drawn = [x["crc"] for x in loads(tab) if x["presented"]]
+        if status["look"]["fast"] and drawn and drawn[-1] == current:
+            renderer = tab.evaluate("window.twinPieces.renderer")
+            assert "SwiftShader" in renderer, f"the test's page renders with {renderer}"
+            assert status["look"]["software"] == renderer, status["look"]
+            return
+        time.sleep(0.1)
+    pytest.fail(f"the page did not get the fast look (loads: {loads(tab)})")
+
+
+def check_shown(tab, spawns: list[tuple[str, dict, float]]) -> list[float]:
+    """Seconds from each spawn's reply to its model drawn; asserts twin's part (the server's
+    sync and cut, the worker's fetch) within APPEAR_S and prints each timeline."""
+    drawn = []
+    for name, load, at in spawns:
+        got = received(tab, load)
+        times = timeline(tab, load, at)
+        assert got is not None, f"{name} arm: the page's worker did not fetch it; {times}"
+        had_s = got["posted"] / 1e3 - at
+        assert had_s < APPEAR_S, f"{name} arm in the page's worker {had_s:.2f} s after; {times}"
+        drawn.append(round(load["presented"] / 1e3 - at, 2))
+        print(f"{name} arm drawn {drawn[-1]:.2f} s after the spawn's reply; {times}")
+    return drawn
 
 
 def _body_bytes(request) -> int:
@@ -138,16 +176,16 @@ def _body_bytes(request) -> int:
 def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(page):
     tab, bodies, urdf = page
     frame = frame_ms(tab)
-    first_at = spawn_arm(urdf, "arm1", 0.0)
-    first = wait_shown(tab, first_at - 1.0, FIRST_LOAD_S)
+    asked, first_at = spawn_arm(urdf, "arm1", 0.0)
+    first = wait_shown(tab, asked, FIRST_LOAD_S)
     record = tab.evaluate("window.twinPieces")
     assert record["assetBytes"] > MIN_FIRST_MESH_BYTES, (
         f"first arm: {record['assetBytes']} mesh bytes, expected > {MIN_FIRST_MESH_BYTES}"
     )
 
     before, asset_before, seen = record["bytes"], record["assetBytes"], len(bodies)
-    second_at = spawn_arm(urdf, "arm2", 1.0)
-    second = wait_shown(tab, second_at - 1.0, 30.0)
+    asked, second_at = spawn_arm(urdf, "arm2", 1.0)
+    second = wait_shown(tab, asked, 30.0)
     record = tab.evaluate("window.twinPieces")
     pieces = sum(n for url, n in bodies[seen:] if "/twin/pieces" in url)
     times = f"first: {timeline(tab, first, first_at)}; second: {timeline(tab, second, second_at)}"
@@ -159,17 +197,7 @@ def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(pag
     assert pieces == record["bytes"] - before, "Chromium and the page disagree on bytes"
     assert pieces < MAX_SECOND_BYTES, f"second arm: {pieces} bytes, > {MAX_SECOND_BYTES}"
     assert not any("/model" in url for url, _ in bodies), "the whole model was downloaded"
-    for name, load, at in (("first", first, first_at), ("second", second, second_at)):
-        got = received(tab, load)
-        assert got is not None, f"{name} arm: the page's worker did not fetch it; {times}"
-        # Twin's part: the server's sync and cut, the worker's fetch.
-        had_s = got["posted"] / 1e3 - at
-        assert had_s < APPEAR_S, f"{name} arm in the page's worker {had_s:.2f} s after; {times}"
-        # The browser's part: the page's main thread takes the bundle between two frames,
-        # MuJoCo's WASM parses it and SwiftShader uploads and draws its meshes.
-        drawn_s = load["presented"] / 1e3 - at
-        print(f"{name} arm drawn {drawn_s:.2f} s after the spawn's reply; {times}")
-        assert drawn_s < DRAWN_S, f"{name} arm drawn {drawn_s:.2f} s after; {times}"
+    drawn = check_shown(tab, [("first", first, first_at), ("second", second, second_at)])
 
     # A delete: the page holds every mesh the smaller model has.
     record = tab.evaluate("window.twinPieces")
@@ -182,3 +210,21 @@ def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(pag
         time.sleep(0.05)
     sent = tab.evaluate("window.twinPieces.assetBytes") - asset_before
     assert sent == 0, f"delete of arm2: {sent} mesh bytes sent"
+
+    if max(drawn) >= DRAWN_S:
+        # Measured once more on a miss (a machine busy for a moment), in the same world as the
+        # first pair: an arm with new meshes where arm1 was, and its copy; both must make it.
+        print(f"over {DRAWN_S} s: {drawn}; measured again with new meshes")
+        asked = time.time()
+        assert twin("delete", "arm1").returncode == 0
+        wait_shown(tab, asked, 30.0)  # the empty world
+        other = write_mesh_arm(urdf.parent.parent / "arm_b")
+        asked, third_at = spawn_arm(other, "arm3", 0.0)
+        third = wait_shown(tab, asked, FIRST_LOAD_S)
+        asked, fourth_at = spawn_arm(other, "arm4", 1.0)
+        fourth = wait_shown(tab, asked, 30.0)
+        drawn = check_shown(tab, [("third", third, third_at), ("fourth", fourth, fourth_at)])
+        times = (
+            f"third: {timeline(tab, third, third_at)}; fourth: {timeline(tab, fourth, fourth_at)}"
+        )
+        assert max(drawn) < DRAWN_S, f"drawn {drawn} s after the replies; {times}"
