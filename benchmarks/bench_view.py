@@ -14,9 +14,11 @@ Spawn to drawn (`spawn_to_drawn`): a robot spawned with the page open, twice idl
 page's worker had the model, when the page's main thread took it, how long MuJoCo's WASM
 parsed it, and when the page drew it. The robot is `TWIN_BENCH_VIEW_ROBOT` (a description file,
 with xacro arguments in `TWIN_BENCH_VIEW_ARGS`, `name:=value` separated by spaces), else the
-bundled humanoid. franka_panda with its hand (136,000 triangles of DAE visual meshes, a 23.7 MiB
-bundle) on the 2-core VM shared with other sessions' tests (load average 11.1 idle, 12.8 with
-the busy loops), seconds after the spawn's reply:
+bundled humanoid. The page's look is `TWIN_BENCH_VIEW_QUALITY` (auto, full or fast; auto, the
+default, gives the fast look to the page in SwiftShader), recorded in the result. franka_panda
+with its hand (136,000 triangles of DAE visual meshes, a 23.7 MiB bundle), full look, on the
+2-core VM shared with other sessions' tests (load average 11.1 idle, 12.8 with the busy loops),
+seconds after the spawn's reply:
 
 | | worker had it | page took it | parsed | drawn |
 |---|---|---|---|---|
@@ -57,6 +59,7 @@ PAGE_LOAD_S = 20.0  # [s] for the page to load and connect before a window
 REALTIME_SECONDS = 10.0  # [s]
 TARGETS = {"viewer_vs_plain": 0.95, "realtime_factor": (0.99, 1.01)}
 ROBOT_ENV, ARGS_ENV = "TWIN_BENCH_VIEW_ROBOT", "TWIN_BENCH_VIEW_ARGS"
+QUALITY_ENV = "TWIN_BENCH_VIEW_QUALITY"  # the page's look (auto: fast in SwiftShader)
 BUSY_LOOPS = 2  # the cores of a 2-core CI runner, busy
 SPAWNS = 2  # per condition: the first brings new meshes (idle), the rest none
 DRAWN_TIMEOUT_S = 60.0  # [s] for the page to draw a spawned robot on a loaded machine
@@ -118,7 +121,7 @@ def measure(browser: Any | None) -> dict:
     try:
         inside: dict[str, list[float]] = {"plain": [], "viewer": [], "browser": []}
         plain = [_steps_per_s(world, inside["plain"]) for _ in range(WINDOWS)]
-        host = WebHost(lambda: world)
+        host = WebHost(lambda: world, quality=os.environ.get(QUALITY_ENV, "auto"))
         address = host.start()
         attached = [_steps_per_s(world, inside["viewer"]) for _ in range(WINDOWS)]
         page = None
@@ -129,6 +132,7 @@ def measure(browser: Any | None) -> dict:
         before, start = host.syncs, time.perf_counter()
         viewed = [_steps_per_s(world, inside["browser"]) for _ in range(WINDOWS)]
         syncs = (host.syncs - before) / (time.perf_counter() - start)
+        look = host.look.status()
         realtime = _realtime(world)
         if page is not None:
             page.close()
@@ -142,6 +146,7 @@ def measure(browser: Any | None) -> dict:
         "viewer_steps_per_s": [round(x) for x in viewed],
         "share_in_mj_step": {k: round(statistics.median(v), 3) for k, v in inside.items() if v},
         "syncs_per_s": syncs,
+        "look": look,
         "realtime_with_viewer": realtime,
     }
 
@@ -176,7 +181,7 @@ def spawn_to_drawn(browser: Any) -> dict:
     args = dict(a.split(":=", 1) for a in os.environ.get(ARGS_ENV, "").split() if ":=" in a)
     world = World(WorldSettings())
     world.start()
-    host = WebHost(lambda: world)
+    host = WebHost(lambda: world, quality=os.environ.get(QUALITY_ENV, "auto"))
     busy: list[subprocess.Popen] = []
     result: dict = {"robot": str(path), "args": args}
     spawned = 0
@@ -195,6 +200,7 @@ def spawn_to_drawn(browser: Any) -> dict:
                 spawned += 1
                 figures.append(_page_drawn(page, time.time()))
             result[condition] = {"spawns": figures, "load_average": os.getloadavg()[0]}
+        result["look"] = host.look.status()
         page.close()
     finally:
         for loop in busy:

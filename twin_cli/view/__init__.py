@@ -4,7 +4,8 @@ A consumer of the world, like `twin_cli.record`: it reads the world under its lo
 and acts on it only through `World`'s methods. Modules: `bridge` (the page's actions → World),
 `host` (the viewer thread, its bind address, the sync thread), `guard` (the Host, Origin and
 token checks on its port), `pieces` and `piece_routes` (each model as pieces keyed by
-content, so the page fetches only what it lacks), `service` (the server's one viewer),
+content, so the page fetches only what it lacks), `look` (the fast look a software-rendered
+page is sent), `service` (the server's one viewer),
 `offscreen` (PNG snapshots with mujoco.Renderer on EGL). Exports load lazily, so that
 importing the package imports neither mujoco nor the viewer.
 """

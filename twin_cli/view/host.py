@@ -224,6 +224,7 @@ class WebHost:
         out; lock held."""
         world = self._current()
         self._bridge.world = world
+        self.look.prepare(world.model)  # a new model's copy, outside the world's lock
         with world.lock:
             self._bridge.show_pause_state()
             self._handle.sync(self.look.model_for(world.model), world.data)

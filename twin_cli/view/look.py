@@ -3,8 +3,8 @@
 A browser without a GPU draws WebGL in software (Chromium's SwiftShader, Mesa's llvmpipe). There
 MuJoCo's page spends most of a frame on the sun's shadow map (every mesh drawn a second time)
 and on multisampling: measured at 640×480 with an arm of 136,000 triangles, a frame took
-0.7-1.2 s with both, 0.55-0.75 s without shadows and 0.3-0.5 s without either, and a spawned
-arm was drawn 0.8-1.1 s after the spawn's reply instead of 1.6-2.4 s. The fast look turns off
+0.84-1.17 s with both, 0.55-0.85 s without shadows and 0.29-0.52 s without either, and a spawned
+arm was drawn 0.80-1.34 s after the spawn's reply instead of 1.61-2.44 s. The fast look turns off
 shadows and multisampling in a copy of the model sent to the page; the world's model (its
 physics, `twin snapshot`, the exported scene) is never changed.
 
@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import copy
 import re
-import threading
 from typing import Any
 
 QUALITIES = ("auto", "full", "fast")
@@ -42,8 +41,8 @@ def fast_copy(model: Any) -> Any:
 class PageLook:
     """The quality asked for, the software renderer a page reported, and the model to send.
 
-    `report` runs in the viewer's server thread, `model_for` in the sync thread (with the
-    world's lock held): the fields each writes are single assignments.
+    `report` runs in the viewer's server thread, `prepare` and `model_for` in the sync thread
+    (`model_for` with the world's lock held): each field is written by single assignments.
     """
 
     def __init__(self, quality: str = "auto") -> None:
@@ -51,7 +50,6 @@ class PageLook:
         self.software: str | None = None  # the first software renderer a page reported
         self._source: Any = None  # the world's model the copy was made from
         self._shown: Any = None
-        self._lock = threading.Lock()
 
     @property
     def fast(self) -> bool:
@@ -62,19 +60,24 @@ class PageLook:
         if is_software(renderer) and self.software is None:
             self.software = renderer[:200]
 
+    def prepare(self, model: Any) -> None:
+        """Makes the fast copy of the world's `model` if it will be needed, without the world's
+        lock: a copy costs 4-27 ms for 24 MiB of meshes (three franka_panda), and the world
+        replaces its model on a change rather than editing it (in place it changes only its
+        options, copied by `model_for`, and actuator gains, which the page does not draw)."""
+        if self.fast and model is not self._source:
+            self._shown, self._source = fast_copy(model), model
+
     def model_for(self, model: Any) -> Any:
-        """The model to send for the world's `model`: itself, or its fast copy. The copy is
-        made once per world model; the options the world changes in place (gravity, timestep,
-        solver) are copied into it on every call, so the page shows them."""
+        """The model to send for the world's `model`: itself, or its fast copy (made here if
+        `prepare` did not). The options the world changes in place (gravity, timestep, solver)
+        are copied into it on every call, so the page shows them."""
         if not self.fast:
             self._source = self._shown = None
             return model
-        with self._lock:
-            if model is not self._source or self._shown is None:
-                self._shown, self._source = fast_copy(model), model
-            if self._shown.opt != model.opt:
-                self._shown.opt = model.opt
-            return self._shown
+        self.prepare(model)
+        self._shown.opt = model.opt  # 0.4 µs; comparing the two first costs ~80 µs
+        return self._shown
 
     def status(self) -> dict:
         """`{quality, fast, software}` for `twin view --json`."""

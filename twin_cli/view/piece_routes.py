@@ -17,6 +17,7 @@ from __future__ import annotations
 import collections
 import json
 import logging
+import re
 import threading
 import urllib.parse
 from collections.abc import Callable
@@ -30,6 +31,7 @@ log = logging.getLogger("twin.view")
 
 KEEP_MODELS = 2  # the current model and the one before it
 MAX_KEYS = 256  # pieces one request may ask for
+RENDERER_NAME = re.compile(r"[\x20-\x7e]{1,200}")  # a WebGL renderer's name: printable ASCII
 PAGE_SCRIPT = '<script src="twin/pieces.js"></script>\n    <script async src="web_client.js">'
 MUJOCO_SCRIPT = '<script async src="web_client.js">'
 
@@ -99,8 +101,9 @@ class PieceRoutes:
                 "/twin/current": self._current,
                 "/twin/manifest": self._manifest,
                 "/twin/pieces": self._pieces,
-                "/twin/renderer": self._renderer,
             }.get(path)
+            if path == "/twin/renderer":
+                return self._renderer(request, urllib.parse.parse_qs(query))
             if handler is not None:
                 return handler(path, urllib.parse.parse_qs(query))
             return inner(connection, request) if inner is not None else None
@@ -132,11 +135,17 @@ class PieceRoutes:
             return _response(404, "text/plain", b"model no longer kept\n")
         return _response(200, "application/json", json.dumps(manifest.as_json()).encode())
 
-    def _renderer(self, _path: str, query: dict) -> Any:
-        """The page's WebGL renderer, sent once when it loads."""
+    def _renderer(self, request: Any, query: dict) -> Any:
+        """The page's WebGL renderer, sent once when it loads. The only route that changes
+        anything: a browser sends no Origin on another site's plain GET (an image, a link), so
+        a request its browser marks as coming from another site (`Sec-Fetch-Site`) is
+        refused too."""
+        site = request.headers.get("Sec-Fetch-Site")
+        if site is not None and site != "same-origin":
+            return _response(403, "text/plain", b"only the viewer's own page reports\n")
         name = query.get("name", [""])[0]
-        if not name:
-            return _response(400, "text/plain", b"give name=RENDERER\n")
+        if not RENDERER_NAME.fullmatch(name):
+            return _response(400, "text/plain", b"give name=RENDERER (printable ASCII)\n")
         self._on_renderer(name)
         return _response(204, "text/plain", b"")
 

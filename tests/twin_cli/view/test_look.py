@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+import urllib.error
 import urllib.parse
 import urllib.request
 from pathlib import Path
@@ -87,9 +88,21 @@ def test_options_the_world_changes_in_place_reach_the_copy(world):
     assert list(look.model_for(world.model).opt.gravity) == [0.0, 0.0, -9.81]
 
 
-def test_a_unknown_quality_is_refused():
+def test_a_unknown_quality_is_refused_and_every_layer_offers_the_same_ones():
+    import typing
+    import warnings
+
+    from twin_cli.server.models import ViewBody
+
+    with warnings.catch_warnings():  # typer's own import of click's deprecated names
+        warnings.simplefilter("ignore", DeprecationWarning)
+        from twin_cli.cli.commands.view import QUALITIES as CLI
+    from twin_cli.view.look import QUALITIES
+
     with pytest.raises(ValueError, match="auto, full, fast"):
         PageLook("low")
+    body = typing.get_args(ViewBody.model_fields["quality"].annotation)[0]
+    assert CLI == QUALITIES == typing.get_args(body)
 
 
 def twin(*args: str, world: str) -> subprocess.CompletedProcess:
@@ -102,10 +115,20 @@ def twin(*args: str, world: str) -> subprocess.CompletedProcess:
     )
 
 
-def viewer_get(url: str, path: str) -> bytes:
+def viewer_get(url: str, path: str, headers: dict | None = None) -> bytes:
     """GET `path` on the viewer's port, as its own page would (Host: the page's address)."""
-    with urllib.request.urlopen(urllib.parse.urljoin(url, path), timeout=10) as reply:
+    request = urllib.request.Request(urllib.parse.urljoin(url, path), headers=headers or {})
+    with urllib.request.urlopen(request, timeout=10) as reply:
         return reply.read()
+
+
+def refused(url: str, path: str, headers: dict | None = None) -> int:
+    """The HTTP status of a GET that the viewer must refuse."""
+    try:
+        viewer_get(url, path, headers)
+    except urllib.error.HTTPError as exc:
+        return exc.code
+    pytest.fail(f"{path} with {headers} was answered")
 
 
 def test_a_software_page_gets_the_fast_model_and_the_quality_switches_live(tmp_path, serve_world):
@@ -118,14 +141,22 @@ def test_a_software_page_gets_the_fast_model_and_the_quality_switches_live(tmp_p
         status = json.loads(started.stdout)
         assert status["look"] == {"quality": "auto", "fast": False, "software": None}
         url = status["url"]
-        full_crc = int(viewer_get(url, "twin/current"))
+        full_crc = wait_new_model(url, 0)
         name = urllib.parse.quote(SOFTWARE_NAMES[0])
-        viewer_get(url, f"twin/renderer?name={name}")
+        # Another site's page (an image pointing here: no Origin, but Sec-Fetch-Site) and a
+        # name that is not printable text change nothing.
+        assert refused(url, f"twin/renderer?name={name}", {"Sec-Fetch-Site": "cross-site"}) == 403
+        assert refused(url, "twin/renderer?name=llvmpipe%1b%5b31m") == 400
+        status = json.loads(twin("view", "--json", world="look").stdout)
+        assert not status["look"]["fast"], status["look"]
+        viewer_get(url, f"twin/renderer?name={name}", {"Sec-Fetch-Site": "same-origin"})
         status = json.loads(twin("view", "--json", world="look").stdout)
         assert status["look"]["fast"] and status["look"]["software"] == SOFTWARE_NAMES[0]
         fast_crc = wait_new_model(url, full_crc)
         # `--quality full` on the running viewer: the world's own model again, the page's
         # address unchanged.
+        human = twin("view", "--quality", "fast", world="look")
+        assert human.stdout.strip() == url and "fast look" in human.stderr, human.stderr
         full = json.loads(twin("view", "--quality", "full", "--json", world="look").stdout)
         assert full["look"]["quality"] == "full" and not full["look"]["fast"]
         assert full["url"] == url

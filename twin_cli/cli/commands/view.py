@@ -33,9 +33,10 @@ def view(
     quality: Annotated[
         str | None,
         typer.Option(
+            metavar="[auto|full|fast]",
             help="The page's look: full (shadows, multisampling), fast (neither: 2-3x quicker "
             "frames in a browser without a GPU), auto (fast once a page renders in software). "
-            "Default: auto, or what the running viewer has."
+            "Default: auto, or what the running viewer has.",
         ),
     ] = None,
     json: JsonOpt = False,
@@ -54,6 +55,10 @@ def view(
         raise InvalidRequestError(
             f"--quality [{quality}]", "unknown", f"use one of {', '.join(QUALITIES)}"
         )
+    if quality is not None and stop:
+        raise InvalidRequestError(
+            "--quality with --stop", "there is no page to set it for", "give one or the other"
+        )
     with connect(world) as client:
         if stop:
             reply = client.request("DELETE", "/view")
@@ -69,6 +74,10 @@ def view(
         return
     if reply.get("warning"):
         sys.stderr.write(f"twin: warning: {reply['warning']}\n")
+    look = reply.get("look") or {}
+    if look.get("fast"):
+        why = f"a page renders with {look['software']}" if look.get("software") else "asked"
+        sys.stderr.write(f"twin: the page gets the fast look (no shadows): {why}\n")
     out.line(reply["url"])
     if open_page:
         webbrowser.open(reply["url"], new=2)
