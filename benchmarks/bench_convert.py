@@ -54,8 +54,9 @@ def _wall(command: list[str], env: dict[str, str] | None) -> float:
     return round(time.perf_counter() - start, 3)
 
 
-# The import floor of any conversion: a fresh interpreter importing what every build needs.
-FLOOR = "import mujoco, numpy"
+# The import floor of any conversion: a fresh interpreter importing what every build needs, as
+# `twin convert` imports it (mujoco without its GL backend: a conversion never renders).
+FLOOR = "import os; os.environ['MUJOCO_GL'] = 'disable'; import mujoco, numpy"
 FLOOR_MARGIN_S = 0.1  # [s] a conversion may cost over the floor (or take < PRIMITIVE_TARGET_S)
 PRIMITIVE_TARGET_S = 0.5
 

@@ -18,6 +18,7 @@ from converters.mjcf.writer import stl_bytes
 from scenarios import HUMANOID
 
 MESH_LIBRARIES = {"trimesh", "scipy", "coacd", "yourdfpy"}
+BOX = '<box size="0.1 0.1 0.1"/>'
 # A visual STL mesh on a box-collision link: the mesh is read, never decomposed.
 STL_VISUAL = """<robot name="stl_visual"><link name="base">
 <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
@@ -25,8 +26,9 @@ STL_VISUAL = """<robot name="stl_visual"><link name="base">
 <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>"""
 
 
-def twin_imports(args: list[str], cache: Path) -> set[str]:
-    """Top-level packages a fresh `twin ARGS` imports (with an empty twin cache at `cache`)."""
+def twin_imports(args: list[str], cache: Path, *, full: bool = False) -> set[str]:
+    """Top-level packages (`full`: modules) a fresh `twin ARGS` imports (with an empty twin
+    cache at `cache`)."""
     env = {**os.environ, "TWIN_CACHE_DIR": str(cache)}
     proc = subprocess.run(
         [sys.executable, "-X", "importtime", "-m", "twin_cli", *args],
@@ -37,7 +39,7 @@ def twin_imports(args: list[str], cache: Path) -> set[str]:
     )
     assert proc.returncode == 0, f"twin {args}: {proc.stderr[-2000:]}"
     names = re.findall(r"^import time:\s+\d+ \|\s+\d+ \|\s*([\w.]+)", proc.stderr, re.M)
-    return {name.split(".")[0] for name in names}
+    return set(names) if full else {name.split(".")[0] for name in names}
 
 
 def test_convert_of_a_binary_stl_visual_imports_no_mesh_library(tmp_path: Path) -> None:
@@ -49,6 +51,18 @@ def test_convert_of_a_binary_stl_visual_imports_no_mesh_library(tmp_path: Path) 
     imported = twin_imports(["convert", str(robot), "-o", str(tmp_path / "out")], tmp_path / "c")
     assert not imported & MESH_LIBRARIES, f"imported {sorted(imported & MESH_LIBRARIES)}"
     assert (tmp_path / "out" / "assets").is_dir(), "the visual mesh was written"
+
+
+def test_convert_imports_no_gl_backend_and_no_world_client(tmp_path: Path) -> None:
+    """A conversion never renders or talks to a world: `import mujoco` without its GL backend
+    (glfw: ~60 ms), and the world commands' actions (~44 ms) only when one runs."""
+    robot = tmp_path / "box.urdf"
+    robot.write_text(STL_VISUAL.replace('<mesh filename="tet.stl" scale="0.5 0.5 0.5"/>', BOX))
+    args = ["convert", str(robot), "-o", str(tmp_path / "out")]
+    imported = twin_imports(args, tmp_path / "c", full=True)
+    assert "mujoco" in imported and (tmp_path / "out" / "scene.xml").is_file()
+    unwanted = {"glfw", "mujoco.glfw", "mujoco.egl", "OpenGL", "twin_cli.cli.world_actions"}
+    assert not imported & unwanted, f"imported {sorted(imported & unwanted)}"
 
 
 def test_validate_of_the_primitive_humanoid_imports_no_mesh_or_plot_library(
