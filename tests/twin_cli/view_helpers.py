@@ -23,6 +23,17 @@ CHROMIUM_FLAGS = [
 ]
 
 
+def twin_in(world: str, *args: str) -> subprocess.CompletedProcess:
+    """`twin ARGS --world WORLD` as a user runs it: a fresh process, output captured."""
+    return subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", world],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=os.environ.copy(),
+    )
+
+
 @functools.cache
 def chromium_missing() -> str | None:
     """Why the browser tests cannot run here, or None."""

@@ -12,12 +12,12 @@ import signal
 import socket
 import struct
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 from record_helpers import read_bag, seconds
+from view_helpers import twin_in
 
 import scenarios
 
@@ -34,13 +34,7 @@ def free_port() -> int:
 
 
 def twin(*args: str, world: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", world],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=os.environ.copy(),
-    )
+    return twin_in(world, *args)
 
 
 def test_twin_record_for_a_duration_writes_a_bag(tmp_path, serve_world):

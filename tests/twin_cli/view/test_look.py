@@ -8,9 +8,7 @@ browser's side (a page in SwiftShader reports its renderer) is in test_view_piec
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 import urllib.error
 import urllib.parse
 import urllib.request
@@ -18,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from view_helpers import twin_in
 
 from twin_cli.view.look import PageLook, fast_copy, is_software
 
@@ -106,13 +105,7 @@ def test_a_unknown_quality_is_refused_and_every_layer_offers_the_same_ones():
 
 
 def twin(*args: str, world: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", world],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=os.environ.copy(),
-    )
+    return twin_in(world, *args)
 
 
 def viewer_get(url: str, path: str, headers: dict | None = None) -> bytes:

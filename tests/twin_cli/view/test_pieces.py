@@ -9,7 +9,6 @@ import json
 import os
 import random
 import subprocess
-import sys
 import time
 import urllib.error
 import urllib.request
@@ -18,6 +17,7 @@ import zlib
 import pytest
 from corpus_registry import CORPUS, needs_corpus, package_paths
 from mesh_models import write_mesh_package
+from view_helpers import twin_in
 
 from twin_cli.view.pieces import MAX_PIECE, array_ranges, split_bundle
 
@@ -84,13 +84,7 @@ def test_a_second_robot_of_the_same_description_adds_no_mesh_piece():
 
 
 def twin(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", WORLD],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=os.environ.copy(),
-    )
+    return twin_in(WORLD, *args)
 
 
 def get(url: str) -> bytes:

@@ -2,26 +2,18 @@
 
 from __future__ import annotations
 
-import os
 import socket
 import subprocess
-import sys
 
 import numpy as np
 import pytest
-from view_helpers import box_corners, egl_missing, project, pure_red, red_box
+from view_helpers import box_corners, egl_missing, project, pure_red, red_box, twin_in
 
 PIXEL_TOL = 3  # [px] red region vs projected box: rasterisation and anti-aliasing at the edges
 
 
 def twin(*args: str, world: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", world],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=os.environ.copy(),
-    )
+    return twin_in(world, *args)
 
 
 def free_port() -> int:

@@ -9,15 +9,13 @@ from __future__ import annotations
 
 import io
 import json
-import os
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing, pure_red, red_box
+from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing, pure_red, red_box, twin_in
 
 import scenarios
 
@@ -40,13 +38,7 @@ SHOTS: Path | None = None  # where the page's screenshots go (named in failure m
 
 
 def twin(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", WORLD],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=os.environ.copy(),
-    )
+    return twin_in(WORLD, *args)
 
 
 def cloth_blue(pixels: np.ndarray) -> np.ndarray:
