@@ -34,7 +34,7 @@ def build_app() -> typer.Typer:
     )
     commands.register_all(app)
     app.callback()(_root)
-    app.command()(version)
+    app.command("version")(version)
     return app
 
 

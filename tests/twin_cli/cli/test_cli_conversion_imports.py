@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from converters.mjcf.writer import stl_bytes
 from scenarios import HUMANOID
@@ -26,10 +27,13 @@ STL_VISUAL = """<robot name="stl_visual"><link name="base">
 <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link></robot>"""
 
 
-def twin_imports(args: list[str], cache: Path, *, full: bool = False) -> set[str]:
+def twin_imports(
+    args: list[str], cache: Path, *, full: bool = False, gl: str | None = None
+) -> set[str]:
     """Top-level packages (`full`: modules) a fresh `twin ARGS` imports (with an empty twin
-    cache at `cache`)."""
-    env = {**os.environ, "TWIN_CACHE_DIR": str(cache)}
+    cache at `cache`; `gl`: MUJOCO_GL, None: unset)."""
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    env.update({"TWIN_CACHE_DIR": str(cache)}, **({"MUJOCO_GL": gl} if gl else {}))
     proc = subprocess.run(
         [sys.executable, "-X", "importtime", "-m", "twin_cli", *args],
         env=env,
@@ -53,16 +57,38 @@ def test_convert_of_a_binary_stl_visual_imports_no_mesh_library(tmp_path: Path) 
     assert (tmp_path / "out" / "assets").is_dir(), "the visual mesh was written"
 
 
-def test_convert_imports_no_gl_backend_and_no_world_client(tmp_path: Path) -> None:
+@pytest.mark.parametrize("command", ["convert", "inspect"])
+@pytest.mark.parametrize("gl", [None, "egl"])
+def test_convert_imports_no_gl_backend_and_no_world_client(
+    tmp_path: Path, command: str, gl: str | None
+) -> None:
     """A conversion never renders or talks to a world: `import mujoco` without its GL backend
-    (glfw: ~60 ms), and the world commands' actions (~44 ms) only when one runs."""
+    (glfw: ~60 ms; EGL's loads PyOpenGL), and the world commands' actions (~44 ms) only when one
+    runs; whatever MUJOCO_GL says."""
     robot = tmp_path / "box.urdf"
     robot.write_text(STL_VISUAL.replace('<mesh filename="tet.stl" scale="0.5 0.5 0.5"/>', BOX))
-    args = ["convert", str(robot), "-o", str(tmp_path / "out")]
-    imported = twin_imports(args, tmp_path / "c", full=True)
-    assert "mujoco" in imported and (tmp_path / "out" / "scene.xml").is_file()
+    args = [command, str(robot)] + (["-o", str(tmp_path / "out")] if command == "convert" else [])
+    imported = twin_imports(args, tmp_path / "c", full=True, gl=gl)
+    assert "mujoco" in imported
     unwanted = {"glfw", "mujoco.glfw", "mujoco.egl", "OpenGL", "twin_cli.cli.world_actions"}
     assert not imported & unwanted, f"imported {sorted(imported & unwanted)}"
+
+
+def test_the_gl_less_import_puts_mujoco_gl_back() -> None:
+    """Processes a command starts later (a world server) see the user's MUJOCO_GL."""
+    script = (
+        "import os, sys\n"
+        "from twin_cli.cli.commands.convert import import_mujoco_without_gl\n"
+        "import_mujoco_without_gl()\n"
+        "print(os.environ.get('MUJOCO_GL'), 'mujoco' in sys.modules, 'glfw' in sys.modules)\n"
+    )
+    for given, expected in (("egl", "egl"), (None, "None")):
+        env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+        env.update({"MUJOCO_GL": given} if given else {})
+        proc = subprocess.run(
+            [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120
+        )
+        assert proc.stdout.split() == [expected, "True", "False"], proc.stderr
 
 
 def test_validate_of_the_primitive_humanoid_imports_no_mesh_or_plot_library(

@@ -41,7 +41,10 @@ def import_mujoco_without_gl() -> None:
 
     A conversion never renders, and `import mujoco` otherwise loads glfw (about 60 ms of a 0.5 s
     conversion, `-X importtime`). Only this import sees `MUJOCO_GL=disable`: the variable is put
-    back at once, so processes started later (a world server) render as before.
+    back at once, so processes started later (a world server) render as before. This process
+    cannot render afterwards (mujoco has no GL context class then), and the variable changes for
+    the whole process for the moment of the import: call it only from a command's own process
+    before any thread starts, as `twin convert` and `twin inspect` do.
     """
     import os
     import sys
