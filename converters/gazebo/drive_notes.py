@@ -152,10 +152,10 @@ USED: dict[str, set[str]] = {
 
 APPROXIMATED: dict[str, tuple[str, ...]] = {
     "gazebo_ros_skid_steer_drive": (
-        "four wheels driven as the two sides of a diff drive, as the plugin does; in a turn they "
-        "slide sideways, and the base turns much slower than the unicycle model (a test base: "
-        "0.15 rad/s for 0.5; Coulomb friction predicts 0.43): MuJoCo's sliding contacts lift "
-        "the wheels",
+        "four wheels driven as the two sides of a diff drive, as the plugin does; they slide "
+        "sideways in a turn, so twin trims the two sides' speeds from the base's heading until it "
+        "turns as commanded (a track multiplier it learns, within 0.5-5; on a square base the "
+        "turn still falls short)",
     ),
     "gz-sim-diff-drive-system": (
         "max_linear_acceleration applied at the wheel rims; wheels as velocity servos without a "

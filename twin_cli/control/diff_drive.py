@@ -5,7 +5,9 @@ of gazebo_ros_diff_drive: each update ramps the wheels' rim speeds v ∓ ω·b/2
 (`kinematics.ramp`, the plugin's `max_wheel_acceleration`) and writes them as velocity targets
 through the world's joint command API (a velocity servo whose force is capped at the wheel
 motor's ±`max_wheel_torque`, Gazebo's `fmax`). gz-sim's speed limits clip the twist first. A skid
-steer's four wheels are two sides of one diff drive, as its plugin treats them.
+steer's four wheels are two sides of one diff drive, as its plugin treats them; a drive with
+several wheels a side also trims their differential from the base's heading (`skid_trim`), so it
+turns as commanded, as it does on Gazebo's hard friction.
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twin_cli.control.drive_base import DriveController
+from twin_cli.control.drive_base import STOP, DriveController
 from twin_cli.control.kinematics import body_twist, ramp, rim_speeds
+from twin_cli.control.skid_trim import SkidTrim
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import DiffDrive
@@ -37,7 +40,10 @@ class DiffDriveController(DriveController):
 
     def __init__(self, world: World, entity: str, plugin: DiffDrive) -> None:
         self.radius = plugin.wheel_diameter / 2.0
-        self.rims = (0.0, 0.0)  # rim speeds [m/s] written at the last update
+        self.rims = (0.0, 0.0)  # rim speeds [m/s] the ramp has reached
+        self.written = (0.0, 0.0)  # rim speeds [m/s] written at the last update
+        skids = len(plugin.left_joints) > 1 or len(plugin.right_joints) > 1
+        self.trim = SkidTrim() if skids else None
         super().__init__(world, entity, plugin)
 
     def goals(self) -> tuple[float, float]:
@@ -47,19 +53,45 @@ class DiffDriveController(DriveController):
         w = _clip(self.twist.angular, p.max_angular_velocity)
         return rim_speeds(v, w, p.wheel_separation)
 
+    @property
+    def separation(self) -> float:
+        """The track [m] the wheels are driven and read with: the plugin's, times the skid
+        steer's learned multiplier χ."""
+        chi = self.trim.chi if self.trim else 1.0
+        return self.plugin.wheel_separation * chi
+
     def _reset_targets(self) -> None:
-        self.rims = (0.0, 0.0)
+        self.rims = self.written = (0.0, 0.0)
+        if self.trim:
+            self.trim = SkidTrim()
 
     def _apply(self, dt: float, force: bool) -> bool:
         goals = self.goals()
         accel = self.plugin.max_wheel_acceleration
-        rims = (ramp(self.rims[0], goals[0], accel, dt), ramp(self.rims[1], goals[1], accel, dt))
-        if rims != self.rims or force:
-            self.rims = rims  # written only on a change: a held command costs the loop nothing
-            targets = {j: rims[0] / self.radius for j in self.plugin.left_joints}
-            targets.update({j: rims[1] / self.radius for j in self.plugin.right_joints})
+        self.rims = (
+            ramp(self.rims[0], goals[0], accel, dt),
+            ramp(self.rims[1], goals[1], accel, dt),
+        )
+        wheels, trimming = self._trimmed(self.rims, dt)
+        if wheels != self.written or force:
+            self.written = wheels  # written only on a change: a held command costs nothing
+            targets = {j: wheels[0] / self.radius for j in self.plugin.left_joints}
+            targets.update({j: wheels[1] / self.radius for j in self.plugin.right_joints})
             self._write(targets, "velocity")
-        return rims == goals
+        return self.rims == goals and not trimming
+
+    def _trimmed(self, rims: tuple[float, float], dt: float) -> tuple[tuple[float, float], bool]:
+        """The rim speeds to write for the ramped `rims`, and whether the heading loop runs (it
+        then keeps the fast rate its gains are set for). Without a trim: `rims` as they are."""
+        if self.trim is None:
+            return rims, False
+        b = self.plugin.wheel_separation
+        v, omega = (rims[0] + rims[1]) / 2.0, (rims[1] - rims[0]) / b
+        heading = self.world.get_pose(self.entity).yaw
+        if rims == (0.0, 0.0) and self.twist == STOP:
+            omega = self.trim.hold(heading, dt)  # turned back to the commanded heading, briefly
+            return (rims, False) if omega is None else (rim_speeds(0.0, omega, b), True)
+        return rim_speeds(v, self.trim.update(omega, heading, dt), b), True
 
     def wheel_speeds(self) -> tuple[list[float], list[float]]:
         """Left and right wheel joint speeds [rad/s] now (world lock held)."""
@@ -90,19 +122,22 @@ class DiffDriveController(DriveController):
         angles = self.wheel_angles()
         (left0, right0), self.angles = self.angles, angles
         distance, turn = body_twist(
-            angles[0] - left0, angles[1] - right0, self.radius, self.plugin.wheel_separation
+            angles[0] - left0, angles[1] - right0, self.radius, self.separation
         )
         return distance, turn
 
     def _encoder_twist(self) -> tuple[float, float]:
         left, right = self.wheel_speeds()
-        return body_twist(
-            float(np.mean(left)), float(np.mean(right)), self.radius, self.plugin.wheel_separation
-        )
+        return body_twist(float(np.mean(left)), float(np.mean(right)), self.radius, self.separation)
 
     def command_reply(self) -> dict[str, Any]:
         left, right = self.goals()
-        return {"wheel_speeds": {"left": left / self.radius, "right": right / self.radius}}
+        reply: dict[str, Any] = {
+            "wheel_speeds": {"left": left / self.radius, "right": right / self.radius}
+        }
+        if self.trim:
+            reply["track_multiplier"] = self.trim.chi
+        return reply
 
 
 def _clip(value: float, limit: float) -> float:

@@ -7,7 +7,8 @@ for diff drives and skid steer, the bicycle (θ' = v tan φ / L, at the fixed ax
 Ackermann and tricycle bases, the holonomic base (body twist vx, vy, ω) for planar move, each
 through the speed ramp its plugin (or twin, for planar move) applies. Bounds: the end position
 within 2 % of the distance driven and the heading within 2 % of the turn (0.02 rad on a
-straight line); the plugin's odometry within 1 cm of the world pose.
+straight line); the plugin's odometry within 1 cm of the world pose (5 cm for encoders on a skid
+steer, below).
 """
 
 from __future__ import annotations
@@ -42,6 +43,20 @@ SKID = (
     "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
     "</rightRearJoint><wheelSeparation>0.3</wheelSeparation><wheelDiameter>0.1</wheelDiameter>"
     "<torque>5</torque></plugin>"
+)
+DIFF_ROS2_PAIRS = (  # ROS 2's diff drive on four wheels: a skid steer with encoder odometry
+    '<plugin name="dd4" filename="libgazebo_ros_diff_drive.so"><num_wheel_pairs>2'
+    "</num_wheel_pairs><left_joint>left_front_joint</left_joint><right_joint>right_front_joint"
+    "</right_joint><left_joint>left_rear_joint</left_joint><right_joint>right_rear_joint"
+    "</right_joint><wheel_separation>0.3</wheel_separation><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><wheel_diameter>0.1</wheel_diameter>"
+    "<max_wheel_torque>5</max_wheel_torque><odometry_source>0</odometry_source></plugin>"
+)
+GZ_DIFF_PAIRS = (  # gz-sim's DiffDrive with two joints a side (X1- and Husky-like SDF models)
+    '<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive"><left_joint>'
+    "left_front_joint</left_joint><left_joint>left_rear_joint</left_joint><right_joint>"
+    "right_front_joint</right_joint><right_joint>right_rear_joint</right_joint>"
+    "<wheel_separation>0.3</wheel_separation><wheel_radius>0.05</wheel_radius></plugin>"
 )
 KOBUKI = (  # a vendor's diff drive under its own name and tags (kobuki's)
     '<plugin name="kobuki_controller" filename="libgazebo_ros_kobuki.so"><publish_tf>1'
@@ -150,6 +165,12 @@ FAMILIES = {
     "gazebo_ros_skid_steer_drive": Family(
         lambda: dm.skid_steer_bot(SKID, wheelbase=0.12), "urdf", "unicycle", {"angular": 0.5}
     ),
+    "gazebo_ros_diff_drive_two_pairs": Family(
+        lambda: dm.skid_steer_bot(DIFF_ROS2_PAIRS), "urdf", "unicycle", {"angular": 0.5}
+    ),
+    "gz_diff_drive_two_pairs": Family(
+        lambda: dm.skid_steer_bot(GZ_DIFF_PAIRS), "urdf", "unicycle", {"angular": 0.5}
+    ),
     "gazebo_ros_diff_drive_wide_wheels": Family(
         lambda: dm.two_wheel_base(DIFF_ROS2, width=0.03), "urdf", "unicycle", {"angular": 0.5}
     ),
@@ -240,27 +261,17 @@ def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
     return world, family, (start.x, start.y, start.yaw), reply
 
 
-# A skid steer's turn misses the model: its wheels must slide sideways to turn. Coulomb friction
-# the same in every direction predicts 0.43 rad/s of the 0.5 commanded for this base; twin's rigid
-# contacts give 0.165 rad/s, as MuJoCo leans a rigid contact's friction force towards the
-# direction that moves more inertia (sideways, the base) rather than along the slip (the wheel's
-# light spin): measured, a wheel slipping 0.058 m/s along its rolling direction and 0.008 m/s
-# sideways is pushed 14 N along it and 50 N sideways. The sliding wheels also hop (a wheel off the
-# ground in 87 % of steps), but without the hop the turn stays at 0.13 rad/s.
-SAGS = {"gazebo_ros_skid_steer_drive"}
+# Encoders on a skid steer read the wheels' slip as motion: each side's wheels run at
+# χ·ω·b/2 (`skid_trim`, χ the track multiplier it learns) while the base turns at ω, and the
+# odometry divides by the χ of the moment, which overshoots while it is learned (measured: 3.7 and
+# 3.9 cm off over the 1.2 m turn, 2 cm of it in the first 0.5 s). Gazebo's encoder odometry on
+# a skid steer reports the commanded turn whatever the base does.
+SKID_ENCODER_TOLERANCE = 0.05  # [m]
+SKID_ENCODERS = {"gazebo_ros_diff_drive_two_pairs", "gz_diff_drive_two_pairs"}
 
 
 def _cases() -> list:
-    sag = pytest.mark.xfail(reason="rigid contacts lean the skid steer's friction off its slip")
-
-    def marks(name: str, motion: str) -> list:
-        return [sag] if motion == "turn" and name in SAGS else []
-
-    return [
-        pytest.param(name, motion, marks=marks(name, motion))
-        for name in sorted(FAMILIES)
-        for motion in ("straight", "turn")
-    ]
+    return [(name, motion) for name in sorted(FAMILIES) for motion in ("straight", "turn")]
 
 
 @pytest.mark.parametrize(("name", "motion"), _cases())
@@ -280,7 +291,8 @@ def test_drive_follows_its_kinematic_model_and_odometry_the_world_pose(
     assert heading <= allowed, f"{name}: heading {heading:.4f} rad off of a {turned:.3f} rad turn"
     odom = odometry(world, "base")
     ox, oy = odom["pose"]["position"][:2]
-    assert math.hypot(ox - end.x, oy - end.y) <= ODOM_TOLERANCE, (
+    tolerance = SKID_ENCODER_TOLERANCE if name in SKID_ENCODERS else ODOM_TOLERANCE
+    assert math.hypot(ox - end.x, oy - end.y) <= tolerance, (
         f"{name}: {odom['source']} odometry ({ox:.4f}, {oy:.4f}) vs world ({end.x:.4f}, "
         f"{end.y:.4f})"
     )
