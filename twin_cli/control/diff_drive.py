@@ -73,8 +73,15 @@ class DiffDriveController(DriveController):
             ramp(self.rims[1], goals[1], accel, dt),
         )
         wheels, trimming = self._trimmed(self.rims, dt)
+        if trimming:  # the heading loop's corrections obey the plugin's acceleration too
+            wheels = (
+                ramp(self.written[0], wheels[0], accel, dt),
+                ramp(self.written[1], wheels[1], accel, dt),
+            )
         if wheels != self.written or force:
-            self.written = wheels  # written only on a change: a held command costs nothing
+            # written only on a change: a held command costs nothing (a skid steer's heading
+            # loop changes them at each update while it moves)
+            self.written = wheels
             targets = {j: wheels[0] / self.radius for j in self.plugin.left_joints}
             targets.update({j: wheels[1] / self.radius for j in self.plugin.right_joints})
             self._write(targets, "velocity")

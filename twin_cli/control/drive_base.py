@@ -128,8 +128,11 @@ class DriveController:
 
     def _update(self) -> None:
         """One plugin update (world lock held): odometry, timeout, targets."""
-        if self.entity not in self.world.entity_names():
-            self.stop()
+        if self.entity not in self.world.entity_names() or (
+            self.entity_record is not None
+            and self.world.entity(self.entity) is not self.entity_record
+        ):
+            self.stop()  # deleted, or respawned under the same name: not this drive's robot
             return
         now = float(self.world.data.time)
         if now < self.last_time:  # the world was reset: start over, wheels stopped

@@ -34,11 +34,14 @@ CHI_RANGE = (0.5, 5.0)
 """Bounds of χ: a base that cannot turn (held, or its wheels in the air) stops learning there."""
 MAX_LAG = 0.3
 """[rad] most heading the loop owes: a base held from turning does not store a spin for later."""
-SETTLED = 1e-3
-"""[rad] heading owed below which a stopped base is left alone."""
 HOLD_S = 1.0
-"""[s] longest a stopped base is turned back to the heading it was commanded to (it coasts on its
-sliding wheels after a turn)."""
+"""[s] how long a base is held at the heading it was commanded to after a command stops: it
+coasts on its sliding wheels after a turn, for longer than the stop takes."""
+
+
+JUMP = 0.1
+"""[rad] heading change between two updates that no drive makes (25 rad/s at 250 Hz): the base
+was moved (`twin set-pose`, a respawn), so the loop starts over from where it is."""
 
 
 @dataclass
@@ -49,35 +52,39 @@ class SkidTrim:
     reference: float | None = None  # θ_ref [rad]
     heading: float = 0.0  # θ at the last update [rad], unwrapped
     held: float = 0.0  # [s] since the command stopped
+    armed: bool = False  # a command ran since the last stop: the stop may turn the base back
 
     def start(self, heading: float) -> None:
         """Owes nothing from the base's heading now [rad] (a reset, a stop, a new drive)."""
         self.reference = self.heading = heading
-        self.held = 0.0
-
-    def hold(self, heading: float, dt: float) -> float | None:
-        """After a stop: the wheels' yaw rate [rad/s] that brings the base back to the heading
-        it was commanded to, or None (and nothing owed any more) once it is there or HOLD_S has
-        passed."""
-        self.held += dt
-        if self.reference is None or self.held > HOLD_S:
-            self.start(heading)
-            return None
-        omega = self.update(0.0, heading, dt)
-        if abs(self.reference - self.heading) < SETTLED:
-            self.start(heading)
-            return None
-        return omega
+        self.held, self.armed = 0.0, False
 
     def update(self, omega_ref: float, heading: float, dt: float) -> float:
         """The wheels' yaw rate [rad/s] for the commanded `omega_ref` [rad/s], given the base's
         world `heading` [rad] now, `dt` [s] after the last update."""
+        omega = self._step(omega_ref, heading, dt)
+        self.held, self.armed = 0.0, True
+        return omega
+
+    def hold(self, heading: float, dt: float) -> float | None:
+        """After a stop: the wheels' yaw rate [rad/s] that brings the base back to the heading
+        it was commanded to, or None (and nothing owed any more) once HOLD_S has passed or when
+        no command ran since the last stop (a stopped base is never steered)."""
+        self.held += dt
+        if not self.armed or self.held > HOLD_S:
+            self.start(heading)
+            return None
+        return self._step(0.0, heading, dt)
+
+    def _step(self, omega_ref: float, heading: float, dt: float) -> float:
         if self.reference is None:
             self.start(heading)
+        turned = math.remainder(heading - self.heading, 2.0 * math.pi)
+        if abs(turned) > JUMP:
+            self.start(heading)
+            turned = 0.0
         assert self.reference is not None
-        if omega_ref != 0.0:
-            self.held = 0.0
-        self.heading += math.remainder(heading - self.heading, 2.0 * math.pi)
+        self.heading += turned
         self.reference += omega_ref * dt
         lag = self.reference - self.heading
         if abs(lag) > MAX_LAG:

@@ -4,9 +4,11 @@ the base owing no heading; a base that cannot turn must not wind the loop up."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
-from twin_cli.control.skid_trim import CHI_RANGE, HOLD_S, MAX_LAG, SETTLED, SkidTrim
+from twin_cli.control.skid_trim import CHI_RANGE, HOLD_S, MAX_LAG, SkidTrim
 
 RATE = 250.0  # [Hz] the drive's update rate while its targets move
 LAG_S = 0.02  # [s] the base's response time to a change of wheel speeds
@@ -59,18 +61,52 @@ def test_a_straight_line_holds_the_heading_and_learns_nothing() -> None:
 def test_a_stopped_base_is_turned_back_then_left_alone() -> None:
     """It coasts past the commanded heading on its sliding wheels: turned back, for HOLD_S."""
     trim = SkidTrim()
-    trim.start(0.0)
-    first = trim.hold(0.05, 1.0 / RATE)  # 0.05 rad past
+    trim.update(0.0, 0.0, 1.0 / RATE)  # a command ran
+    first = trim.hold(0.05, 1.0 / RATE)  # stopped, 0.05 rad past
     assert first is not None and first < 0.0
     # a base that does not answer is left alone once HOLD_S has passed, owing nothing
     answers = [trim.hold(0.05, 1.0 / RATE) for _ in range(round(2 * HOLD_S * RATE))]
     assert answers[-1] is None and trim.reference == trim.heading
-    # one that answers stops being turned once it is within SETTLED
+    # one that answers is back at the commanded heading when the hold ends
     trim.start(0.0)
-    heading = 0.05
-    for _ in range(round(HOLD_S * RATE)):
+    trim.update(0.0, 0.0, 1.0 / RATE)
+    heading, omega = 0.05, 0.0
+    while omega is not None:
         omega = trim.hold(heading, 1.0 / RATE)
-        if omega is None:
-            break
-        heading += omega / RATE
-    assert omega is None and abs(heading) < SETTLED
+        heading += (omega or 0.0) / RATE
+    assert abs(heading) < 1e-6
+
+
+def test_a_base_never_commanded_or_already_settled_is_not_steered() -> None:
+    """Only a stop after a command turns the base back: a push or a set pose on a stopped base
+    stays, and a second stop owes nothing."""
+    trim = SkidTrim()
+    assert trim.hold(0.0, 1.0 / RATE) is None  # never commanded
+    assert trim.hold(0.05, 1.0 / RATE) is None  # pushed 0.05 rad while stopped
+    trim.update(0.5, 0.05, 1.0 / RATE)
+    assert trim.hold(0.05, 1.0 / RATE) is not None  # the stop after a command
+    for _ in range(round(2 * HOLD_S * RATE)):
+        trim.hold(0.05, 1.0 / RATE)  # the base did not answer; the hold ran out
+    assert trim.hold(0.2, 1.0 / RATE) is None  # later pushes are left alone
+
+
+def test_a_moved_base_starts_over_and_a_turn_through_pi_is_one_turn() -> None:
+    trim = SkidTrim()
+    trim.start(math.pi - 0.001)
+    # across +π the heading reads -π + ε: one small step, not a 2π jump
+    omega = trim.update(0.5, -math.pi + 0.001, 1.0 / RATE)
+    assert trim.heading == pytest.approx(math.pi + 0.001)
+    assert abs(omega) < 1.0
+    # a set pose (1 rad in one update) is not heading owed
+    trim.update(0.5, -math.pi + 1.0, 1.0 / RATE)
+    assert trim.reference is not None and abs(trim.reference - trim.heading) < 0.01
+
+
+def test_a_straight_line_after_an_interrupted_hold_gives_the_next_stop_its_full_hold() -> None:
+    trim = SkidTrim()
+    trim.update(0.5, 0.0, 1.0 / RATE)
+    for _ in range(round(0.8 * RATE)):
+        trim.hold(0.1, 1.0 / RATE)  # interrupted 0.8 s into a hold
+    for _ in range(round(2 * RATE)):
+        trim.update(0.0, 0.1, 1.0 / RATE)  # a straight line
+    assert trim.held == 0.0
