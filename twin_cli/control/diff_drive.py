@@ -73,11 +73,13 @@ class DiffDriveController(DriveController):
             ramp(self.rims[1], goals[1], accel, dt),
         )
         wheels, trimming = self._trimmed(self.rims, dt)
-        if trimming:  # the heading loop's corrections obey the plugin's acceleration too
+        if trimming and self.trim:  # the heading loop's corrections obey the acceleration too
+            asked = wheels
             wheels = (
-                ramp(self.written[0], wheels[0], accel, dt),
-                ramp(self.written[1], wheels[1], accel, dt),
+                ramp(self.written[0], asked[0], accel, dt),
+                ramp(self.written[1], asked[1], accel, dt),
             )
+            self.trim.learning = wheels == asked  # χ does not wind up while the bound binds
         if wheels != self.written or force:
             # written only on a change: a held command costs nothing (a skid steer's heading
             # loop changes them at each update while it moves)

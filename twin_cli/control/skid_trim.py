@@ -53,6 +53,8 @@ class SkidTrim:
     heading: float = 0.0  # θ at the last update [rad], unwrapped
     held: float = 0.0  # [s] since the command stopped
     armed: bool = False  # a command ran since the last stop: the stop may turn the base back
+    learning: bool = True  # the last update's wheels were delivered (no acceleration bound cut
+    # them), so the heading they left owed says something about χ
 
     def start(self, heading: float) -> None:
         """Owes nothing from the base's heading now [rad] (a reset, a stop, a new drive)."""
@@ -90,7 +92,7 @@ class SkidTrim:
         if abs(lag) > MAX_LAG:
             lag = math.copysign(MAX_LAG, lag)
             self.reference = self.heading + lag
-        if abs(omega_ref) >= MIN_TURN and dt > 0.0:
+        if self.learning and abs(omega_ref) >= MIN_TURN and dt > 0.0:
             chi = self.chi + KI * lag * dt / omega_ref
             self.chi = min(max(chi, CHI_RANGE[0]), CHI_RANGE[1])
         return self.chi * omega_ref + KP * lag

@@ -1,0 +1,81 @@
+"""A skid steer's loops in a world (`twin_cli.control.skid_trim`, the controller's side of it):
+a stopped base is left where it is put, and the loops' corrections obey the plugin's wheel
+acceleration. Robots the tests write (tests/drive_models.py)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import drive_models as dm
+import pytest
+
+from twin_cli.control import drive
+from twin_cli.control.drives import controller_of
+from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import World
+from twin_cli.world.engine import Pose
+
+ACCEL = 1.0  # [m/s² at the rim]
+SKID_ROS2 = (
+    '<plugin name="dd4" filename="libgazebo_ros_diff_drive.so"><num_wheel_pairs>2'
+    "</num_wheel_pairs><left_joint>left_front_joint</left_joint><right_joint>right_front_joint"
+    "</right_joint><left_joint>left_rear_joint</left_joint><right_joint>right_rear_joint"
+    "</right_joint><wheel_separation>0.3</wheel_separation><wheel_separation>0.3"
+    "</wheel_separation><wheel_diameter>0.1</wheel_diameter><wheel_diameter>0.1</wheel_diameter>"
+    f"<max_wheel_torque>5</max_wheel_torque><max_wheel_acceleration>{ACCEL}"
+    "</max_wheel_acceleration></plugin>"
+)
+
+
+def _skid_world(tmp_path: Path) -> World:
+    path = tmp_path / "skid.urdf"
+    path.write_text(dm.skid_steer_bot(SKID_ROS2))
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    world.step(300)
+    return world
+
+
+def test_a_stopped_skid_steer_is_left_where_it_is_put(tmp_path: Path) -> None:
+    world = _skid_world(tmp_path)
+    drive(world, "base", 0.0, angular=0.5, duration=1.0)
+    world.step(3000)  # the turn, its ramp down and the 1 s hold after it
+    controller = controller_of(world, "base")
+    pose = world.get_pose("base")
+    moved = Pose(pose.x, pose.y, pose.z, pose.roll, pose.pitch, pose.yaw + 0.05)  # a nudge
+    world.set_pose("base", moved)
+    written = dict(world.commands())
+    world.step(2000)
+    after = world.get_pose("base")
+    turned = abs(math.remainder(after.yaw - moved.yaw, 2 * math.pi))
+    assert turned < 1e-3, f"turned back {turned:.4f} rad after a set pose on a stopped base"
+    assert dict(world.commands()) == written, "no wheel target written while it stands"
+    assert controller.observed_rate == controller.plugin_rate, "back at the plugin's rate"
+
+
+def test_the_loops_corrections_obey_the_wheel_acceleration(tmp_path: Path) -> None:
+    world = _skid_world(tmp_path)
+    drive(world, "base", 0.0, angular=0.5, duration=2.0)
+    controller = controller_of(world, "base")
+    rims, steps, worst = controller.written, 0, 0.0
+    while steps < 3000:
+        world.step(4)  # one update at 250 Hz
+        steps += 4
+        written = controller.written
+        worst = max(worst, *(abs(a - b) for a, b in zip(written, rims, strict=True)))
+        rims = written
+    assert worst <= ACCEL * 0.004 * (1 + 1e-9), f"a rim speed stepped {worst:.5f} m/s in 4 ms"
+    assert controller.trim is not None and controller.trim.chi > 1.5, "the loop did turn it"
+
+
+def test_a_skid_steer_moved_while_it_turns_turns_on_from_where_it_was_put(tmp_path: Path) -> None:
+    """A set pose is not heading owed: the turn goes on from the new heading."""
+    world = _skid_world(tmp_path)
+    drive(world, "base", 0.0, angular=0.5, duration=3.0)
+    world.step(1000)
+    pose = world.get_pose("base")
+    world.set_pose("base", Pose(pose.x, pose.y, pose.z, pose.roll, pose.pitch, pose.yaw + 0.5))
+    world.step(3000)  # the other 2 s of the turn and the hold after it
+    turned = math.remainder(world.get_pose("base").yaw - (pose.yaw + 0.5), 2 * math.pi)
+    assert turned == pytest.approx(1.0, abs=0.02), f"turned {turned:.4f} rad of 1.0 after the move"
