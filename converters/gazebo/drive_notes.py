@@ -154,8 +154,7 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
     "gazebo_ros_skid_steer_drive": (
         "four wheels driven as the two sides of a diff drive, as the plugin does; they slide "
         "sideways in a turn, so twin trims the two sides' speeds from the base's heading until it "
-        "turns as commanded (a track multiplier it learns, within 0.5-5; on a square base the "
-        "turn still falls short)",
+        "turns as commanded (a track multiplier it learns, within 0.5-5)",
     ),
     "gz-sim-diff-drive-system": (
         "max_linear_acceleration applied at the wheel rims; wheels as velocity servos without a "
