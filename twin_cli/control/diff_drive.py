@@ -15,11 +15,12 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+import mujoco
 import numpy as np
 
 from twin_cli.control.drive_base import STOP, DriveController
 from twin_cli.control.kinematics import body_twist, ramp, rim_speeds
-from twin_cli.control.skid_trim import SkidTrim
+from twin_cli.control.skid_trim import CHI_RANGE, SkidTrim
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import DiffDrive
@@ -43,7 +44,7 @@ class DiffDriveController(DriveController):
         self.rims = (0.0, 0.0)  # rim speeds [m/s] the ramp has reached
         self.written = (0.0, 0.0)  # rim speeds [m/s] written at the last update
         skids = len(plugin.left_joints) > 1 or len(plugin.right_joints) > 1
-        self.trim = SkidTrim() if skids else None
+        self.trim = SkidTrim(chi=_coulomb_chi(world, entity, plugin)) if skids else None
         super().__init__(world, entity, plugin)
 
     def goals(self) -> tuple[float, float]:
@@ -151,3 +152,22 @@ class DiffDriveController(DriveController):
 
 def _clip(value: float, limit: float) -> float:
     return value if math.isinf(limit) else max(-limit, min(limit, value))
+
+
+def _coulomb_chi(world: World, entity: str, plugin: DiffDrive) -> float:
+    """χ that Coulomb friction predicts for the wheels' layout, 1 + (a/c)² (a half the wheel
+    base, c half the track, measured at the wheel joints in the base's frame): the loop
+    starts there instead of learning it from 1."""
+    m, d = world.model, world.data
+    root = world.index_of(entity).root
+    rot = np.asarray(d.xmat[root]).reshape(3, 3)
+    points = []
+    for joint in plugin.left_joints + plugin.right_joints:
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{entity}/{joint}")
+        if j >= 0:
+            points.append(rot.T @ (np.asarray(d.xanchor[j]) - np.asarray(d.xpos[root])))
+    if len(points) < 3:
+        return 1.0
+    xy = np.array(points)[:, :2]
+    a, c = np.abs(xy - xy.mean(axis=0)).mean(axis=0)
+    return min(max(1.0 + (a / c) ** 2, CHI_RANGE[0]), CHI_RANGE[1]) if c > 0 else 1.0

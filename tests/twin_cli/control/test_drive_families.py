@@ -7,8 +7,8 @@ for diff drives and skid steer, the bicycle (θ' = v tan φ / L, at the fixed ax
 Ackermann and tricycle bases, the holonomic base (body twist vx, vy, ω) for planar move, each
 through the speed ramp its plugin (or twin, for planar move) applies. Bounds: the end position
 within 2 % of the distance driven and the heading within 2 % of the turn (0.02 rad on a
-straight line); the plugin's odometry within 1 cm of the world pose (2.5 cm for encoders on a skid
-steer, below).
+straight line); the plugin's odometry within 1 cm of the world pose (encoders on a skid steer
+included).
 """
 
 from __future__ import annotations
@@ -261,15 +261,6 @@ def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
     return world, family, (start.x, start.y, start.yaw), reply
 
 
-# Encoders on a skid steer read the wheels' slip as motion: each side's wheels run at
-# χ·ω·b/2 (`skid_trim`, χ the track multiplier it learns) while the base turns at ω, and the
-# odometry divides by the χ of the moment, which overshoots while it is learned (measured: 14 and
-# 16 mm off over the 1.2 m turn). Gazebo's encoder odometry on a skid steer reports the commanded
-# turn whatever the base does.
-SKID_ENCODER_TOLERANCE = 0.025  # [m]
-SKID_ENCODERS = {"gazebo_ros_diff_drive_two_pairs", "gz_diff_drive_two_pairs"}
-
-
 def _cases() -> list:
     return [(name, motion) for name in sorted(FAMILIES) for motion in ("straight", "turn")]
 
@@ -291,8 +282,7 @@ def test_drive_follows_its_kinematic_model_and_odometry_the_world_pose(
     assert heading <= allowed, f"{name}: heading {heading:.4f} rad off of a {turned:.3f} rad turn"
     odom = odometry(world, "base")
     ox, oy = odom["pose"]["position"][:2]
-    tolerance = SKID_ENCODER_TOLERANCE if name in SKID_ENCODERS else ODOM_TOLERANCE
-    assert math.hypot(ox - end.x, oy - end.y) <= tolerance, (
+    assert math.hypot(ox - end.x, oy - end.y) <= ODOM_TOLERANCE, (
         f"{name}: {odom['source']} odometry ({ox:.4f}, {oy:.4f}) vs world ({end.x:.4f}, "
         f"{end.y:.4f})"
     )

@@ -122,3 +122,10 @@ def test_wheels_at_the_unicycles_speeds_turn_the_base_as_coulomb_friction_does(
     assert rate == pytest.approx(coulomb, rel=COULOMB_TOLERANCE), (
         f"a/c {a / c:.2f}: turns at {rate:.4f} rad/s, Coulomb friction {coulomb:.4f}"
     )
+
+
+def test_the_loop_starts_from_coulombs_track_multiplier(tmp_path: Path) -> None:
+    """1 + (a/c)² of the wheels' layout (a = 0.06 m, c = 0.15 m): nothing to learn at the start."""
+    world = _skid_world(tmp_path)
+    trim = controller_of(world, "base").trim
+    assert trim is not None and trim.chi == pytest.approx(1 + (0.06 / 0.15) ** 2, rel=1e-6)
