@@ -6,8 +6,8 @@ of gazebo_ros_diff_drive: each update ramps the wheels' rim speeds v ∓ ω·b/2
 through the world's joint command API (a velocity servo whose force is capped at the wheel
 motor's ±`max_wheel_torque`, Gazebo's `fmax`). gz-sim's speed limits clip the twist first. A skid
 steer's four wheels are two sides of one diff drive, as its plugin treats them; a drive with
-several wheels a side also trims their differential from the base's heading (`skid_trim`), so it
-turns as commanded, as it does on Gazebo's hard friction.
+several wheels a side also trims their differential from the base's heading (`skid_trim`) and
+softens their contacts while it turns (`skid_contacts`), so it turns as commanded.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import numpy as np
 
 from twin_cli.control.drive_base import STOP, DriveController
 from twin_cli.control.kinematics import body_twist, ramp, rim_speeds
+from twin_cli.control.skid_contacts import WheelContacts
 from twin_cli.control.skid_trim import CHI_RANGE, SkidTrim
 
 if TYPE_CHECKING:
@@ -45,6 +46,7 @@ class DiffDriveController(DriveController):
         self.written = (0.0, 0.0)  # rim speeds [m/s] written at the last update
         skids = len(plugin.left_joints) > 1 or len(plugin.right_joints) > 1
         self.trim = SkidTrim(chi=_coulomb_chi(world, entity, plugin)) if skids else None
+        self.contacts = WheelContacts(world, entity, plugin.left_joints + plugin.right_joints)
         super().__init__(world, entity, plugin)
 
     def goals(self) -> tuple[float, float]:
@@ -64,7 +66,8 @@ class DiffDriveController(DriveController):
     def _reset_targets(self) -> None:
         self.rims = self.written = (0.0, 0.0)
         if self.trim:
-            self.trim = SkidTrim()
+            self.trim = SkidTrim(chi=_coulomb_chi(self.world, self.entity, self.plugin))
+            self.contacts.restore()
 
     def _apply(self, dt: float, force: bool) -> bool:
         goals = self.goals()
@@ -99,8 +102,15 @@ class DiffDriveController(DriveController):
         v, omega = (rims[0] + rims[1]) / 2.0, (rims[1] - rims[0]) / b
         heading = self.world.get_pose(self.entity).yaw
         if rims == (0.0, 0.0) and self.twist == STOP:
-            omega = self.trim.hold(heading, dt)  # turned back to the commanded heading, briefly
-            return (rims, False) if omega is None else (rim_speeds(0.0, omega, b), True)
+            held = self.trim.hold(heading, dt)  # turned back to the commanded heading, briefly
+            if held is None:
+                self.contacts.restore()  # parked: rigid contacts hold it
+                return rims, False
+            return rim_speeds(0.0, held, b), True
+        if omega != 0.0:
+            self.contacts.soften()  # its wheels slide sideways (`skid_contacts`)
+        else:
+            self.contacts.restore()
         return rim_speeds(v, self.trim.update(omega, heading, dt), b), True
 
     def wheel_speeds(self) -> tuple[list[float], list[float]]:

@@ -1,5 +1,6 @@
-"""A skid steer in a world. Its wheels (`converters.gazebo.skid_wheels`): driven at fixed speeds,
-the base turns as Coulomb friction says, ω/(1 + (a/c)²) for wheels run at the unicycle's speeds
+"""A skid steer in a world. Its wheels (`converters.gazebo.skid_wheels`, with the contacts the drive
+softens while it turns, `twin_cli.control.skid_contacts`): driven at fixed speeds, the base turns
+as Coulomb friction says, ω/(1 + (a/c)²) for wheels run at the unicycle's speeds
 (a half the wheel base, c half the track, equal loads). Its loops (`twin_cli.control.skid_trim`,
 the controller's side): a stopped base is left where it is put, and the loops' corrections obey
 the plugin's wheel acceleration. Robots the tests write (tests/drive_models.py)."""
@@ -14,6 +15,7 @@ import pytest
 
 from twin_cli.control import drive
 from twin_cli.control.drives import controller_of
+from twin_cli.control.skid_contacts import TURN_IMPEDANCE, WheelContacts
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 from twin_cli.world.engine import Pose
@@ -106,12 +108,10 @@ def test_wheels_at_the_unicycles_speeds_turn_the_base_as_coulomb_friction_does(
     world.step(300)
     v, omega, c, a = 0.3, 0.5, dm.TRACK / 2, wheelbase / 2
     left, right = (v - omega * c) / dm.R, (v + omega * c) / dm.R
-    world.command_joints(
-        "base",
-        {"left_front_joint": left, "left_rear_joint": left}
-        | {"right_front_joint": right, "right_rear_joint": right},
-        mode="velocity",
-    )
+    wheels = {"left_front_joint": left, "left_rear_joint": left}
+    wheels |= {"right_front_joint": right, "right_rear_joint": right}
+    WheelContacts(world, "base", tuple(wheels)).soften()  # as the drive does while it turns
+    world.command_joints("base", wheels, mode="velocity")
     world.step(1000)  # the turn set in
     turned, last = 0.0, world.get_pose("base").yaw
     for _ in range(30):
@@ -129,3 +129,52 @@ def test_the_loop_starts_from_coulombs_track_multiplier(tmp_path: Path) -> None:
     world = _skid_world(tmp_path)
     trim = controller_of(world, "base").trim
     assert trim is not None and trim.chi == pytest.approx(1 + (0.06 / 0.15) ** 2, rel=1e-6)
+
+
+def test_a_parked_skid_steer_holds_on_a_slope_and_its_wheels_soften_only_in_a_turn(
+    tmp_path: Path,
+) -> None:
+    """Soft contacts creep under a steady load ((1 - d)/B): a parked base's wheels are the
+    converter's rigid ones. Oracle: a base held by its wheels on a 10° slope below its friction
+    angle (μ 1) stays where it is."""
+    world = _skid_world(tmp_path)
+    rigid = _wheel_impedance(world)
+    drive(world, "base", 0.0, angular=0.5, duration=1.0)
+    world.step(500)
+    assert max(_wheel_impedance(world)) <= TURN_IMPEDANCE, "soft while it turns"
+    world.step(2500)  # the rest of the turn, its hold, then parked
+    assert _wheel_impedance(world) == rigid, "rigid again once parked"
+    slope = math.radians(10.0)
+    world.set_gravity((-9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
+    world.step(2000)
+    before = world.get_pose("base")
+    world.step(10000)
+    after = world.get_pose("base")
+    slid = math.hypot(after.x - before.x, after.y - before.y)
+    assert slid < 1e-3, f"slid {slid * 1e3:.3f} mm down a 10° slope in 10 s"
+
+
+def _wheel_impedance(world: World) -> list[float]:
+    m = world.model
+    bodies = {m.body(f"base/{w}").id for w in ("left_front", "left_rear")}
+    bodies |= {m.body(f"base/{w}").id for w in ("right_front", "right_rear")}
+    return [float(m.geom_solimp[g, 0]) for g in range(m.ngeom) if m.geom_bodyid[g] in bodies]
+
+
+def test_a_spawn_while_it_turns_keeps_its_wheels_soft_then_rigid(tmp_path: Path) -> None:
+    """A spawn recompiles the world's model from the robots' specs (rigid wheels)."""
+    world = _skid_world(tmp_path)
+    rigid = _wheel_impedance(world)
+    drive(world, "base", 0.0, angular=0.5, duration=1.0)
+    world.step(300)
+    box = tmp_path / "box.urdf"
+    box.write_text(
+        '<robot name="box"><link name="b"><inertial><mass value="1"/><inertia ixx="0.01" '
+        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
+        '<box size="0.1 0.1 0.1"/></geometry></collision></link></robot>'
+    )
+    world.spawn(SpawnRequest(str(box), on_ground=True), name="box", pose=Pose(x=2.0))
+    world.step(100)
+    assert max(_wheel_impedance(world)) <= TURN_IMPEDANCE, "softened again on the new model"
+    world.step(3000)
+    assert _wheel_impedance(world) == rigid
