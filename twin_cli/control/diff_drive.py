@@ -44,7 +44,7 @@ class DiffDriveController(DriveController):
         self.radius = plugin.wheel_diameter / 2.0
         self.rims = (0.0, 0.0)  # rim speeds [m/s] the ramp has reached
         self.written = (0.0, 0.0)  # rim speeds [m/s] written at the last update
-        skids = len(plugin.left_joints) > 1 or len(plugin.right_joints) > 1
+        skids = len(set(plugin.left_joints)) > 1 or len(set(plugin.right_joints)) > 1
         self.trim = SkidTrim(chi=_coulomb_chi(world, entity, plugin)) if skids else None
         self.contacts = WheelContacts(world, entity, plugin.left_joints + plugin.right_joints)
         super().__init__(world, entity, plugin)
@@ -55,6 +55,12 @@ class DiffDriveController(DriveController):
         v = _clip(self.twist.linear, p.max_linear_velocity)
         w = _clip(self.twist.angular, p.max_angular_velocity)
         return rim_speeds(v, w, p.wheel_separation)
+
+    def stop(self) -> None:
+        """Stops the controller; a turning skid steer's wheels get their rigid contacts back
+        (a replaced model has them already)."""
+        super().stop()
+        self.contacts.restore()
 
     @property
     def separation(self) -> float:
@@ -165,19 +171,32 @@ def _clip(value: float, limit: float) -> float:
 
 
 def _coulomb_chi(world: World, entity: str, plugin: DiffDrive) -> float:
-    """χ that Coulomb friction predicts for the wheels' layout, 1 + (a/c)² (a half the wheel
-    base, c half the track, measured at the wheel joints in the base's frame): the loop
-    starts there instead of learning it from 1."""
-    m, d = world.model, world.data
+    """χ that Coulomb friction predicts for the wheels' layout, 1 + (a/c)², so that the loop
+    starts there instead of learning it from 1. c is half the distance between the left and
+    right wheels, a the wheels' mean distance from their centre along the base (exact for two
+    axles of equal loads; a start for more). Measured at the wheel joints in the base's frame,
+    on kinematics of the world's current posture (a fresh recompile has none computed yet)."""
+    m = world.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = world.data.qpos
+    mujoco.mj_kinematics(m, d)
     root = world.index_of(entity).root
     rot = np.asarray(d.xmat[root]).reshape(3, 3)
-    points = []
-    for joint in plugin.left_joints + plugin.right_joints:
-        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{entity}/{joint}")
-        if j >= 0:
-            points.append(rot.T @ (np.asarray(d.xanchor[j]) - np.asarray(d.xpos[root])))
-    if len(points) < 3:
+
+    def local(joints: tuple[str, ...]) -> np.ndarray:
+        found = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{entity}/{j}") for j in joints]
+        return np.array(
+            [rot.T @ (np.asarray(d.xanchor[j]) - np.asarray(d.xpos[root])) for j in found if j >= 0]
+        ).reshape(-1, 3)
+
+    left, right = local(plugin.left_joints), local(plugin.right_joints)
+    if not len(left) or not len(right) or len(left) + len(right) < 3:
         return 1.0
-    xy = np.array(points)[:, :2]
-    a, c = np.abs(xy - xy.mean(axis=0)).mean(axis=0)
-    return min(max(1.0 + (a / c) ** 2, CHI_RANGE[0]), CHI_RANGE[1]) if c > 0 else 1.0
+    c = float(np.linalg.norm(left[:, :2].mean(axis=0) - right[:, :2].mean(axis=0))) / 2.0
+    both = np.vstack([left, right])[:, :2]
+    across = (right[:, :2].mean(axis=0) - left[:, :2].mean(axis=0)) / max(2.0 * c, 1e-12)
+    along = np.array([across[1], -across[0]])  # the base's forward axis, normal to the axles' span
+    a = float(np.abs((both - both.mean(axis=0)) @ along).mean())
+    if not c > 0:
+        return 1.0
+    return min(max(1.0 + (a / c) ** 2, CHI_RANGE[0]), CHI_RANGE[1])

@@ -64,7 +64,8 @@ class PageLook:
         """Makes the fast copy of the world's `model` if it will be needed, without the world's
         lock: a copy costs 4-27 ms for 24 MiB of meshes (three franka_panda), and the world
         replaces its model on a change rather than editing it (in place it changes only its
-        options, copied by `model_for`, and actuator gains, which the page does not draw)."""
+        options, copied by `model_for`, actuator gains and a turning skid steer's wheel contact
+        impedance, none of which the page draws)."""
         if self.fast and model is not self._source:
             self._shown, self._source = fast_copy(model), model
 

@@ -178,3 +178,35 @@ def test_a_spawn_while_it_turns_keeps_its_wheels_soft_then_rigid(tmp_path: Path)
     assert max(_wheel_impedance(world)) <= TURN_IMPEDANCE, "softened again on the new model"
     world.step(3000)
     assert _wheel_impedance(world) == rigid
+
+
+def test_straight_after_a_turn_is_rigid_and_a_delete_mid_turn_leaves_no_soft_contact(
+    tmp_path: Path,
+) -> None:
+    """Soft only while the command turns the base; a delete that shifts every geom id mid-turn
+    leaves the world's contacts exactly those of a world that never turned."""
+    box = tmp_path / "box.urdf"
+    box.write_text(
+        '<robot name="box"><link name="b"><inertial><mass value="1"/><inertia ixx="0.01" '
+        'iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><collision><geometry>'
+        '<box size="0.1 0.1 0.1"/></geometry></collision></link></robot>'
+    )
+    path = tmp_path / "skid.urdf"
+    path.write_text(dm.skid_steer_bot(SKID_ROS2))
+    world, fresh = World(), World()
+    world.spawn(SpawnRequest(str(box), on_ground=True), name="box", pose=Pose(x=-2.0))
+    for w in (world, fresh):
+        w.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+        w.step(300)
+    rigid = _wheel_impedance(world)
+    drive(world, "base", 0.2, angular=0.5)
+    world.step(500)
+    assert max(_wheel_impedance(world)) <= TURN_IMPEDANCE
+    drive(world, "base", 0.2, angular=0.0, duration=1.0)
+    world.step(100)
+    assert _wheel_impedance(world) == rigid, "rigid again on a straight line"
+    drive(world, "base", 0.0, angular=0.5, duration=1.0)
+    world.step(300)
+    world.delete("box")  # every geom of `base` moves down the model's arrays
+    world.step(3000)
+    assert (world.model.geom_solimp == fresh.model.geom_solimp).all()
