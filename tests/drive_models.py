@@ -63,6 +63,15 @@ def _caster(name: str, x: float) -> str:
     )
 
 
+SKID_STEER_ROS1 = (  # gazebo_ros' ROS 1 skid steer on skid_steer_bot's wheels, 5 N m a wheel
+    '<plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so"><leftFrontJoint>'
+    "left_front_joint</leftFrontJoint><rightFrontJoint>right_front_joint</rightFrontJoint>"
+    "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
+    "</rightRearJoint><wheelSeparation>0.3</wheelSeparation><wheelDiameter>0.1</wheelDiameter>"
+    "<torque>5</torque></plugin>"
+)
+
+
 def skid_steer_bot(plugin: str, wheelbase: float = 0.12) -> str:
     """Four wheels `left_front_joint` ... `right_rear_joint`, `wheelbase` apart front to rear."""
     half = wheelbase / 2

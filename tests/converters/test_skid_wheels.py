@@ -12,12 +12,6 @@ import pytest
 
 from converters.pipeline import convert
 
-SKID = (
-    '<plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so"><leftFrontJoint>'
-    "left_front_joint</leftFrontJoint><rightFrontJoint>right_front_joint</rightFrontJoint>"
-    "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
-    "</rightRearJoint><wheelSeparation>0.3</wheelSeparation>{diameter}</plugin>"
-)
 GZ_PAIRS = (  # the same wheels named again by a second drive
     '<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive"><left_joint>'
     "left_front_joint</left_joint><left_joint>left_rear_joint</left_joint><right_joint>"
@@ -43,9 +37,10 @@ def _converted(tmp_path: Path, text: str) -> tuple:
 @pytest.mark.parametrize(
     "plugins",
     [
-        SKID.format(diameter="<wheelDiameter>0.1</wheelDiameter>"),
-        SKID.format(diameter=""),  # the plugin's default diameter (0.15 m) is not the wheel's
-        SKID.format(diameter="<wheelDiameter>0.1</wheelDiameter>") + GZ_PAIRS,
+        dm.SKID_STEER_ROS1,
+        # the plugin's default diameter (0.15 m) is not the wheel's
+        dm.SKID_STEER_ROS1.replace("<wheelDiameter>0.1</wheelDiameter>", ""),
+        dm.SKID_STEER_ROS1 + GZ_PAIRS,
     ],
 )
 def test_each_skid_steer_wheel_carries_its_load_at_its_rim(tmp_path: Path, plugins: str) -> None:

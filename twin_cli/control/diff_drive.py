@@ -45,8 +45,11 @@ class DiffDriveController(DriveController):
         self.rims = (0.0, 0.0)  # rim speeds [m/s] the ramp has reached
         self.written = (0.0, 0.0)  # rim speeds [m/s] written at the last update
         skids = len(set(plugin.left_joints)) > 1 or len(set(plugin.right_joints)) > 1
-        self.trim = SkidTrim(chi=_coulomb_chi(world, entity, plugin)) if skids else None
-        self.contacts = WheelContacts(world, entity, plugin.left_joints + plugin.right_joints)
+        self.trim: SkidTrim | None = None
+        self.contacts: WheelContacts | None = None
+        if skids:
+            self.trim = SkidTrim(chi=_coulomb_chi(world, entity, plugin))
+            self.contacts = WheelContacts(world, entity, plugin.left_joints + plugin.right_joints)
         super().__init__(world, entity, plugin)
 
     def goals(self) -> tuple[float, float]:
@@ -60,7 +63,8 @@ class DiffDriveController(DriveController):
         """Stops the controller; a turning skid steer's wheels get their rigid contacts back
         (a replaced model has them already)."""
         super().stop()
-        self.contacts.restore()
+        if self.contacts:
+            self.contacts.restore()
 
     @property
     def separation(self) -> float:
@@ -71,7 +75,7 @@ class DiffDriveController(DriveController):
 
     def _reset_targets(self) -> None:
         self.rims = self.written = (0.0, 0.0)
-        if self.trim:
+        if self.trim and self.contacts:
             self.trim = SkidTrim(chi=_coulomb_chi(self.world, self.entity, self.plugin))
             self.contacts.restore()
 
@@ -102,7 +106,7 @@ class DiffDriveController(DriveController):
     def _trimmed(self, rims: tuple[float, float], dt: float) -> tuple[tuple[float, float], bool]:
         """The rim speeds to write for the ramped `rims`, and whether the heading loop runs (it
         then keeps the fast rate its gains are set for). Without a trim: `rims` as they are."""
-        if self.trim is None:
+        if self.trim is None or self.contacts is None:
             return rims, False
         b = self.plugin.wheel_separation
         v, omega = (rims[0] + rims[1]) / 2.0, (rims[1] - rims[0]) / b

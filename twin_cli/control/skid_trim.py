@@ -1,22 +1,21 @@
 """A skid steer's heading loop: the wheel differential trimmed until the base turns as asked.
 
-A base with several wheels a side must slide them sideways to turn. Gazebo's ODE holds each wheel
-at its commanded speed with a hard velocity constraint and bounds each friction direction on its
-own, so there the drive's moment wins and the base turns at the commanded rate. MuJoCo's rigid
-contacts lean a sliding wheel's friction sideways (towards the base's inertia, away from the
-wheel's light spin), and the same base turns at a third of the rate. So the drive measures the
-base's heading at each update and runs the wheels at the yaw rate that makes it follow the
-commanded one:
+A base with several wheels a side must slide them sideways to turn. Even with friction that acts
+along the slip (Coulomb's; twin's skid-steer wheels, `converters/gazebo/skid_wheels.py` and
+`skid_contacts`), wheels run at the unicycle's speeds turn it at ω/(1 + (a/c)²), a half the
+wheel base and c half the track: the drive's moment against the wheels' sideways friction. ROS
+users correct the track by hand for that; the drive here measures the base's heading at each
+update and runs the wheels at the yaw rate that makes it follow the commanded one:
 
     ω_wheels = χ·ω_ref + KP·e,      e = θ_ref − θ (the heading the base owes),
     χ' = KI·e / ω_ref               (only while |ω_ref| ≥ MIN_TURN)
 
 χ is the effective-track multiplier that ROS users set by hand for skid steers
-(`wheel_separation_multiplier`): learned online, kept across commands, used by the encoder
-odometry. For a constant ω_ref and a base that turns at ω_wheels/χ*, the heading error obeys
-e'' + (KP/χ*)·e' + (KI/χ*)·e = 0: it returns to zero, critically damped at χ* = 1 and with a
-damping ratio of 1/√χ* above, in about a second. Pure arithmetic on numbers; the controller
-calls it in sim time, at its update rate.
+(`wheel_separation_multiplier`): started at Coulomb's 1 + (a/c)² by the drive, learned online,
+kept across commands, used by the encoder odometry. For a constant ω_ref and a base that turns
+at ω_wheels/χ*, the heading error obeys e'' + (KP/χ*)·e' + (KI/χ*)·e = 0: it returns to zero,
+critically damped at χ* = 1 and with a damping ratio of 1/√χ* above, in about a second. Pure
+arithmetic on numbers; the controller calls it in sim time, at its update rate.
 """
 
 from __future__ import annotations

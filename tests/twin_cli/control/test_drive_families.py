@@ -37,13 +37,6 @@ DIFF_ROS2 = (
     "</wheel_separation><wheel_diameter>0.1</wheel_diameter><odometry_source>0</odometry_source>"
     "<odometry_frame>odom</odometry_frame><robot_base_frame>base_link</robot_base_frame></plugin>"
 )
-SKID = (
-    '<plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so"><leftFrontJoint>'
-    "left_front_joint</leftFrontJoint><rightFrontJoint>right_front_joint</rightFrontJoint>"
-    "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
-    "</rightRearJoint><wheelSeparation>0.3</wheelSeparation><wheelDiameter>0.1</wheelDiameter>"
-    "<torque>5</torque></plugin>"
-)
 DIFF_ROS2_PAIRS = (  # ROS 2's diff drive on four wheels: a skid steer with encoder odometry
     '<plugin name="dd4" filename="libgazebo_ros_diff_drive.so"><num_wheel_pairs>2'
     "</num_wheel_pairs><left_joint>left_front_joint</left_joint><right_joint>right_front_joint"
@@ -163,7 +156,10 @@ FAMILIES = {
         lambda: dm.two_wheel_base(DIFF_ROS2), "urdf", "unicycle", {"angular": 0.5}
     ),
     "gazebo_ros_skid_steer_drive": Family(
-        lambda: dm.skid_steer_bot(SKID, wheelbase=0.12), "urdf", "unicycle", {"angular": 0.5}
+        lambda: dm.skid_steer_bot(dm.SKID_STEER_ROS1, wheelbase=0.12),
+        "urdf",
+        "unicycle",
+        {"angular": 0.5},
     ),
     "gazebo_ros_diff_drive_two_pairs": Family(
         lambda: dm.skid_steer_bot(DIFF_ROS2_PAIRS), "urdf", "unicycle", {"angular": 0.5}

@@ -23,13 +23,6 @@ from twin_cli.world.engine import Pose
 ACCEL = 1.0  # [m/s² at the rim]
 COULOMB_TOLERANCE = 0.1  # of the predicted turn rate (measured -1.5 % to -7.4 %; -62 % to -79 %
 # with the rigid, light wheels before)
-SKID_ROS1 = (
-    '<plugin name="skid" filename="libgazebo_ros_skid_steer_drive.so"><leftFrontJoint>'
-    "left_front_joint</leftFrontJoint><rightFrontJoint>right_front_joint</rightFrontJoint>"
-    "<leftRearJoint>left_rear_joint</leftRearJoint><rightRearJoint>right_rear_joint"
-    "</rightRearJoint><wheelSeparation>0.3</wheelSeparation><wheelDiameter>0.1</wheelDiameter>"
-    "<torque>5</torque></plugin>"
-)
 SKID_ROS2 = (
     '<plugin name="dd4" filename="libgazebo_ros_diff_drive.so"><num_wheel_pairs>2'
     "</num_wheel_pairs><left_joint>left_front_joint</left_joint><right_joint>right_front_joint"
@@ -102,7 +95,7 @@ def test_wheels_at_the_unicycles_speeds_turn_the_base_as_coulomb_friction_does(
     tmp_path: Path, wheelbase: float
 ) -> None:
     path = tmp_path / "skid.urdf"
-    path.write_text(dm.skid_steer_bot(SKID_ROS1, wheelbase=wheelbase))
+    path.write_text(dm.skid_steer_bot(dm.SKID_STEER_ROS1, wheelbase=wheelbase))
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
     world.step(300)

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from twin_cli.control.skid_trim import CHI_RANGE, HOLD_S, MAX_LAG, SkidTrim
+from twin_cli.control.skid_trim import CHI_RANGE, HOLD_S, KP, MAX_LAG, SkidTrim
 
 RATE = 250.0  # [Hz] the drive's update rate while its targets move
 LAG_S = 0.02  # [s] the base's response time to a change of wheel speeds
@@ -47,7 +47,7 @@ def test_a_base_that_cannot_turn_does_not_wind_the_loop_up() -> None:
     wheels = [trim.update(0.5, 0.0, dt) for _ in range(round(10 * RATE))]
     assert trim.chi == CHI_RANGE[1]
     assert trim.reference is not None and trim.reference - trim.heading <= MAX_LAG + 1e-12
-    assert max(wheels) <= CHI_RANGE[1] * 0.5 + 32.0 * MAX_LAG + 1e-9
+    assert max(wheels) <= CHI_RANGE[1] * 0.5 + KP * MAX_LAG + 1e-9
 
 
 def test_a_straight_line_holds_the_heading_and_learns_nothing() -> None:
