@@ -267,3 +267,29 @@ class TrajectoryDrive(_Record):
 
 BaseDrive = DiffDrive | AckermannDrive | TricycleDrive | HolonomicDrive
 DriveRecord = BaseDrive | JointDrive | TrajectoryDrive
+
+
+def held_from_load(plugins: tuple) -> dict[str, tuple[str, float]]:
+    """What Gazebo's drive plugins command from their first step: joint → (mode, target).
+
+    A drive plugin sends its wheels the speeds of its last twist on every update, from load, with
+    the plugin's torque: zero until a first command, so a parked base holds on a slope (a
+    turtlebot3 whose wheels roll free runs 16 m down a 5° slope in 10 s). Steering joints are
+    held at the straight-ahead angle 0, and gz-sim's JointController sends its `initial`
+    velocity. Holonomic bases (their planar servo already holds a zero twist) and position
+    controllers are not listed. Targets are [rad/s or m/s] (velocity) and [rad] (position).
+    """
+    held: dict[str, tuple[str, float]] = {}
+    for plugin in plugins:
+        if isinstance(plugin, DiffDrive):
+            held.update(dict.fromkeys(plugin.wheel_joints(), ("velocity", 0.0)))
+        elif isinstance(plugin, AckermannDrive):
+            held.update(dict.fromkeys(plugin.left_joints + plugin.right_joints, ("velocity", 0.0)))
+            steering = plugin.left_steering_joints + plugin.right_steering_joints
+            held.update(dict.fromkeys(steering, ("position", 0.0)))
+        elif isinstance(plugin, TricycleDrive):
+            held[plugin.actuated_wheel_joint] = ("velocity", 0.0)
+            held[plugin.steering_joint] = ("position", 0.0)
+        elif isinstance(plugin, JointDrive) and plugin.mode == "velocity":
+            held.update(dict.fromkeys(plugin.joints, ("velocity", plugin.initial)))
+    return held

@@ -171,7 +171,10 @@ def _set_command(
     slope = min(slope, 0.5 * kp) if servos.has_reference(state.model, a) else 0.0  # stays stiff
     previous = state.commands.get(key)
     if reference and mode == "velocity" and previous and previous.mode == mode:
-        kp, kv, rule = previous.kp, previous.kv, previous.rule  # its integral stays what it was
+        if previous.rule == servos.HELD_FROM_LOAD:
+            _carry_integral(state, a, j, previous.kp, kp)
+        else:
+            kp, kv, rule = previous.kp, previous.kv, previous.rule  # its integral stays as it was
     cmd = control.JointCommand(
         key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
     )
@@ -186,6 +189,15 @@ def _set_command(
     if reference and mode != "effort":
         servo_watch.watch(state)
     return cmd
+
+
+def _carry_integral(state: WorldState, a: int, j: int, old_kp: float, new_kp: float) -> None:
+    """Rescales a velocity servo's integral r − q to new gains so that it carries the same force
+    (what a held wheel holds on a slope)."""
+    if old_kp > 0 and new_kp > 0:
+        q = float(state.data.qpos[state.model.jnt_qposadr[j]])
+        address = state.model.actuator_actadr[a]
+        state.data.act[address] = q + (state.data.act[address] - q) * old_kp / new_kp
 
 
 def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:

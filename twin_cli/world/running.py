@@ -22,6 +22,7 @@ from twin_cli.world.divergence import (
     warning_counts,
 )
 from twin_cli.world.entities import index_entities, write_state
+from twin_cli.world.plugin_holds import hold_from_load
 from twin_cli.world.recompile import commit
 from twin_cli.world.sensor_rings import align_sensor_ticks, shift_sensor_history
 from twin_cli.world.state import STATE, WorldState
@@ -46,7 +47,8 @@ def step(state: WorldState, n: int = 1) -> None:
 def reset(state: WorldState, loop: SteppingLoop, *, time_only: bool = False) -> None:
     """Puts every entity back to its spawn state and time to 0 (or only time and iterations).
 
-    A full reset also clears pushes and joint commands (motors back to zero effort).
+    A full reset also clears pushes and joint commands (motors back to zero effort), except the
+    holds robots' drive plugins keep from load (`plugin_holds`).
     """
     with state.lock:
         if time_only:
@@ -66,6 +68,7 @@ def reset(state: WorldState, loop: SteppingLoop, *, time_only: bool = False) -> 
             write_state(data, index[n], e.spawn_state)
         state.iterations = 0
         commit(state, state.spec, (model, data, index))
+        hold_from_load(state, state.entities)
         loop.reset_clock()
 
 

@@ -18,12 +18,16 @@ def watch(state: WorldState) -> None:
     """Starts the world's servo observer unless it runs (the lock is held)."""
     if state.servo_observer:
         return
+    memory = servos.WindupMemory()
     state.servo_observer = state.observers.add(
-        lambda: _tend(state), servos.WINDUP_RATE, float(state.data.time), state.model.opt.timestep
+        lambda: _tend(state, memory),
+        servos.WINDUP_RATE,
+        float(state.data.time),
+        state.model.opt.timestep,
     )
 
 
-def _tend(state: WorldState) -> None:
+def _tend(state: WorldState, memory: servos.WindupMemory) -> None:
     model, data = state.model, state.data
     windup, settled, moving = [], [], 0
     for key, cmd in state.commands.items():
@@ -41,7 +45,7 @@ def _tend(state: WorldState) -> None:
         else:
             settled.append(a)
     if windup:
-        servos.limit_windup(model, data, windup)
+        servos.limit_windup(model, data, windup, memory)
     if settled:
         sleeping.hold_awake(model, sleeping.actuator_trees(model, settled), False)
     if not moving:

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -68,9 +69,19 @@ LEAK_S = 0.5
 the lag of a speed change the damping could not follow (a light wheel dragged on by its
 robot while it brakes) and pays it back later: a turtlebot stopped after a drive turned its
 wheels back for a minute (1.1-1.7 mrad of yaw in 60 s). So while a servo commanded to 0 moves
-towards its reference (|q̇| > LEAK_SPEED, the sign of r − q), the integral decays; a load that
-pushes the joint away from its reference, or holds it still, keeps it."""
+towards its reference (mean |q̇| > LEAK_SPEED, the sign of r − q) within LEAK_WINDOW_S of its
+stop, the integral decays; a load that pushes the joint away from its reference, or holds it
+still, keeps it."""
 LEAK_SPEED = 1e-5  # [rad/s or m/s]
+LEAK_WINDOW_S = 3.0
+"""[s] how long after a servo is given speed 0 it may still forget its integral. A lag is paid
+back in the first seconds after a stop; later the integral holds a load (a wheel parked on a
+slope), and letting it leak whenever chatter swings the joint back made a held turtlebot3 creep
+0.08 mm/s down a 5° slope."""
+HELD_FROM_LOAD = "held from load"
+"""The rule of a drive plugin's hold from spawn (`twin_cli.world.plugin_holds`). Its gains were
+derived before the robot's contacts were known, so the next velocity command derives its own;
+it stored no lag, so its integral never leaks (a leak let a held base creep down a slope)."""
 WINDUP_RATE = 100.0  # [Hz] of sim time at which a velocity servo's reference is kept near q
 MARK_SLOT, MARK = 9, 1.0  # dynprm entry that marks a servo reference (integrators ignore dynprm)
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
@@ -257,8 +268,33 @@ def _joint_range(model: mujoco.MjModel, joint: int) -> tuple[float, float]:
     return -math.inf, math.inf
 
 
+@dataclass
+class WindupMemory:
+    """What `limit_windup` keeps between calls, per actuator id: the joint position at the
+    previous call, and the speed target with the sim time it was first seen."""
+
+    position: dict[int, float] = field(default_factory=dict)
+    target: dict[int, tuple[float, float]] = field(default_factory=dict)
+
+    def moved(self, a: int, q: float) -> float:
+        """How far the joint moved since the previous call (0 at the first)."""
+        step = q - self.position.get(a, q)
+        self.position[a] = q
+        return step
+
+    def held_for(self, a: int, target: float, now: float) -> float:
+        """[s] how long the servo has had this speed target."""
+        seen = self.target.get(a)
+        if seen is None or seen[0] != target:
+            seen = self.target[a] = (target, now)
+        return now - seen[1]
+
+
 def limit_windup(
-    model: mujoco.MjModel, data: mujoco.MjData, servos: Iterable[tuple[int, JointCommand]]
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    servos: Iterable[tuple[int, JointCommand]],
+    memory: WindupMemory,
 ) -> None:
     """Clamps each velocity servo's integral e = r − q so that kv·(v* − q̇) + kp·e stays within
     ±effort, and lets it grow only towards the side with room left: while the damping term alone
@@ -268,6 +304,10 @@ def limit_windup(
 
     Args:
         servos: (actuator id, its velocity command) with kp > 0.
+        memory: kept by the caller between calls. Whether a joint moves towards its
+            reference is read from its mean speed since the previous call, not from its speed
+            now, which contact chatter flips from step to step; and only within LEAK_WINDOW_S
+            of its stop.
     """
     keep = math.exp(-1.0 / (WINDUP_RATE * LEAK_S))
     for a, cmd in servos:
@@ -279,8 +319,11 @@ def limit_windup(
         low = min(0.0, (-effort - damping) / cmd.kp)
         high = max(0.0, (effort - damping) / cmd.kp)
         address = int(model.actuator_actadr[a])
-        error = float(np.clip(data.act[address] - q, low, high))
-        if cmd.target == 0.0 and abs(speed) > LEAK_SPEED and error * speed > 0.0:
+        error = min(max(float(data.act[address]) - q, low), high)
+        mean_speed = memory.moved(a, q) * WINDUP_RATE
+        stopping = memory.held_for(a, cmd.target, float(data.time)) < LEAK_WINDOW_S
+        back = abs(mean_speed) > LEAK_SPEED and error * mean_speed > 0.0
+        if cmd.target == 0.0 and stopping and back and cmd.rule != HELD_FROM_LOAD:
             error *= keep  # paying back a stored lag (LEAK_S)
         data.act[address] = q + error
 

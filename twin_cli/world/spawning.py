@@ -18,6 +18,7 @@ from twin_cli.errors import EntityExistsError, InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest, as_request
 from twin_cli.world import placement, posture, shared_meshes, spawn
 from twin_cli.world.entities import Entity, EntityState, index_entities, rest_state, write_state
+from twin_cli.world.plugin_holds import hold_from_load
 from twin_cli.world.pose import Pose, check_finite
 from twin_cli.world.recompile import Built, commit, ground, rebuild
 from twin_cli.world.respec import keep_spec
@@ -217,6 +218,7 @@ def _spawn_loaded(
             raise
         state.entities.update(records)  # nothing is recorded until everything succeeded
         commit(state, state.spec, (model, data, index))
+        hold_from_load(state, names)
         return results
 
 

@@ -158,7 +158,9 @@ def test_bad_drive_requests_leave_the_world_unchanged(
     _spawn(world)
     world.spawn(SpawnRequest(xml=BOX), pose=Pose(1.0, 0.0, 0.1))
     before = full_state(world)
+    held, watching = dict(world.commands()), set(world._state.observers._entries)
     with pytest.raises(error, match=needle):
         drive(world, entity, linear, 0.0, duration)
     assert (full_state(world) == before).all(), "state, controls and time unchanged"
-    assert not world.commands() and not world._state.observers, "no command and no controller added"
+    assert dict(world.commands()) == held, "no command but the plugin's hold from load"
+    assert set(world._state.observers._entries) == watching, "no command and no controller added"

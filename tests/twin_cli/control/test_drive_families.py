@@ -14,6 +14,7 @@ included).
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -305,7 +306,63 @@ def test_an_option_its_drive_does_not_take_leaves_the_world_unchanged(
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
     before = full_state(world)
+    held, watching = dict(world.commands()), set(world._state.observers._entries)
     with pytest.raises(InvalidRequestError, match=needle):
         drive(world, "base", 0.3, **command)
     assert (full_state(world) == before).all(), "state, controls and time unchanged"
-    assert not world.commands() and not world._state.observers, "no command, no controller"
+    assert dict(world.commands()) == held, "no command but the plugin's hold from load"
+    assert set(world._state.observers._entries) == watching, "no command, no controller"
+
+
+SLOPE = math.radians(5.0)  # gravity tilted along the base's forward axis: a 5° slope
+HOLD_SETTLE = 5.0  # [s] on the slope before the watch: a velocity servo learns its load
+HELD_M = 1e-3  # [m] a held base moves less than this in the 2 s watch
+
+
+def _watch_on_a_slope(world: World) -> float:
+    """Tilts gravity by SLOPE; how far the base moves in 2 s after HOLD_SETTLE [m]."""
+    world.step(300)
+    world.set_gravity((9.81 * math.sin(SLOPE), 0.0, -9.81 * math.cos(SLOPE)))
+    world.step(round(HOLD_SETTLE / world.model.opt.timestep))
+    p0 = world.get_pose("base")
+    world.step(2000)
+    p1 = world.get_pose("base")
+    return math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+
+
+def _spawned(tmp_path: Path, name: str, text: str) -> World:
+    family = FAMILIES[name]
+    path = tmp_path / f"{name}.{family.suffix}"
+    path.write_text(text)
+    for file_name, extra in family.files:
+        (tmp_path / file_name).write_text(extra)
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    return world
+
+
+@pytest.mark.parametrize("name", sorted(FAMILIES))
+def test_a_base_no_one_has_driven_holds_on_a_slope(tmp_path: Path, name: str) -> None:
+    """Gazebo's drive plugins command their wheels from load, so a parked base stands on a 5°
+    slope, also after a reset. Control: without its plugins the robot rolls down it (>5 cm)."""
+    world = _spawned(tmp_path, name, FAMILIES[name].robot())
+    moved = _watch_on_a_slope(world)
+    assert moved < HELD_M, f"{name}: moved {moved * 1e3:.3f} mm in 2 s on a 5° slope"
+    world.reset()
+    again = _watch_on_a_slope(world)
+    assert again < HELD_M, f"{name}: after a reset, moved {again * 1e3:.3f} mm in 2 s"
+    if 'type="continuous"' not in FAMILIES[name].robot():
+        return  # a base without wheels stands without its plugin too
+    free = re.sub(r"<plugin\b.*?</plugin>", "", FAMILIES[name].robot(), flags=re.S)
+    rolled = _watch_on_a_slope(_spawned(tmp_path, name, free))
+    assert rolled > 0.05, f"{name} without its plugins rolled only {rolled:.3f} m: no control"
+
+
+def test_the_first_drive_derives_its_own_gains_from_the_hold(tmp_path: Path) -> None:
+    """The hold's gains were set before the wheels touched the ground; the drive's are its own,
+    and the base still follows the unicycle (test_drive_follows_its_kinematic_model...)."""
+    from twin_cli.world.servos import HELD_FROM_LOAD
+
+    world, _, _, _ = _drive(tmp_path, "gazebo_ros_diff_drive", {"linear": V})
+    rules = {c.rule for c in world.commands().values()}
+    assert HELD_FROM_LOAD not in rules, rules

@@ -84,3 +84,23 @@ def test_turtlebot3_stands_still_after_a_drive() -> None:
     assert moved < MOVED_M and turned < TURNED_RAD, (moved, turned)
     speeds = [abs(j.velocity) for j in world.joint_states("tb3")]
     assert max(speeds) < 1e-4, f"wheels still turn at {speeds} rad/s"
+
+
+@pytest.mark.skipif("turtlebot3_burger" not in CORPUS, reason="corpus: no turtlebot3_burger")
+def test_turtlebot3_stopped_on_a_slope_holds() -> None:
+    """Driven, stopped, then on a 5° slope (gravity tilted along its heading): its wheels' zero
+    velocity servos hold it. They crept 0.64 mm in these 10 s while each chattering swing of a
+    light wheel back towards its reference leaked the integral that holds the load."""
+    world = World()
+    world.spawn(corpus_spawn_request("turtlebot3_burger"), name="tb3")
+    world.step(300)
+    drive(world, "tb3", 0.2, 0.0, 1.0)
+    world.step(2000)
+    slope = math.radians(5.0)
+    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
+    world.step(5000)
+    p0 = world.get_pose("tb3")
+    world.step(10000)
+    p1 = world.get_pose("tb3")
+    moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+    assert moved < 2e-4, f"moved {moved * 1e3:.3f} mm in 10 s on a 5° slope"
