@@ -5,6 +5,8 @@
   limbs are still folding after 2 s moves more, and the row says it is passive);
 - turtlebot3 after a 5 s drive (0.2 m/s, 0.5 rad/s) and a 2 s stop: the same 60 s figures, and
   how far its 5 s drive ends from the unicycle model (target < 2 % of the path);
+- turtlebot3 never driven, on a 5° slope: how far it moves in 10 s (its plugin holds its wheels
+  from load; they used to roll free, 16 m in 10 s);
 - a 3.85 kg box on the rigid default contact: the spread of its normal force over m·g
   (target < 5 %);
 - a wheel at 3 rad/s carrying half its effort limit (target within 1 %), and a 1 rad position
@@ -107,6 +109,26 @@ def _turtlebot_after_drive() -> dict:
     return {"unicycle_error": round(error, 4), **_drift(world, "tb3")}
 
 
+def _turtlebot_on_a_slope() -> dict:
+    """Never driven, then on a 5° slope (gravity tilted along its heading): how far it moves in
+    10 s after 5 s there, its wheels held by its drive plugin from load."""
+    from twin_cli.world import World
+
+    robot = _robots().get("turtlebot3_burger")
+    if robot is None:
+        return {"skipped": "no corpus"}
+    world = World()
+    _spawn(world, robot, "tb3")
+    world.step(300)
+    slope = math.radians(5.0)
+    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
+    world.step(5000)
+    p0 = world.get_pose("tb3")
+    world.step(10000)
+    p1 = world.get_pose("tb3")
+    return {"moved_mm": round(math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z)) * 1e3, 4)}
+
+
 def _unicycle(v: float, w: float, t: float, plugin, start: tuple) -> tuple:
     """The unicycle model driven by the plugin's rim-speed ramp, 0.1 ms Euler steps."""
     x, y, th = start
@@ -199,6 +221,7 @@ def run() -> dict:
         "resting_box_normal_force_spread": round(_box_force(), 6),
         "servos": _servos(),
         "turtlebot3_after_drive": _turtlebot_after_drive(),
+        "turtlebot3_never_driven_on_a_5_degree_slope": _turtlebot_on_a_slope(),
         "corpus_at_rest": _corpus_rest(),
     }
     out["wall_s"] = round(time.perf_counter() - start, 1)
