@@ -138,6 +138,7 @@ USED: dict[str, set[str]] = {
         "use_force_commands",
         "p_gain",
         "cmd_max",
+        "initial_velocity",  # held from load (twin_cli.world.plugin_holds)
     },
     "gz-sim-joint-position-controller-system": {
         "joint_name",

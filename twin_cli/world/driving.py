@@ -216,6 +216,18 @@ def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tupl
     return actuated[j], j
 
 
+def release_commands(model: mujoco.MjModel, data: mujoco.MjData, actuators: set[str]) -> None:
+    """Turns the motors of commands that no longer hold (a restore to a state without them) back
+    into motors at zero effort, as an uncommanded motor is: a servo written for a command stays
+    in the model until something else is written over it."""
+    for actuator in actuators:
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
+        if a >= 0:
+            effort = control.effort_limit(model, a)
+            limp = control.JointCommand(actuator, "effort", 0.0, 0.0, 0.0, effort)
+            control.apply_command(model, data, a, limp)
+
+
 def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
     """Writes every joint command into a (re)compiled model, by actuator name, and starts the
     servo observer for them (a loaded or restored world has none yet)."""

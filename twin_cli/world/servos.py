@@ -270,23 +270,26 @@ def _joint_range(model: mujoco.MjModel, joint: int) -> tuple[float, float]:
 
 @dataclass
 class WindupMemory:
-    """What `limit_windup` keeps between calls, per actuator id: the joint position at the
-    previous call, and the speed target with the sim time it was first seen."""
+    """What `limit_windup` keeps between calls, per actuator name (ids shift when an entity is
+    deleted): its joint's position with the sim time, and its speed target with the sim time it
+    was first seen. Time that went back (a reset, a restore) starts both afresh."""
 
-    position: dict[int, float] = field(default_factory=dict)
-    target: dict[int, tuple[float, float]] = field(default_factory=dict)
+    position: dict[str, tuple[float, float]] = field(default_factory=dict)
+    target: dict[str, tuple[float, float]] = field(default_factory=dict)
 
-    def moved(self, a: int, q: float) -> float:
-        """How far the joint moved since the previous call (0 at the first)."""
-        step = q - self.position.get(a, q)
-        self.position[a] = q
-        return step
+    def mean_speed(self, key: str, q: float, now: float) -> float:
+        """The joint's mean speed since the previous call [rad/s or m/s] (0 at the first)."""
+        before = self.position.get(key)
+        self.position[key] = (now, q)
+        if before is None or now <= before[0]:
+            return 0.0
+        return (q - before[1]) / (now - before[0])
 
-    def held_for(self, a: int, target: float, now: float) -> float:
+    def held_for(self, key: str, target: float, now: float) -> float:
         """[s] how long the servo has had this speed target."""
-        seen = self.target.get(a)
-        if seen is None or seen[0] != target:
-            seen = self.target[a] = (target, now)
+        seen = self.target.get(key)
+        if seen is None or seen[0] != target or now < seen[1]:
+            seen = self.target[key] = (target, now)
         return now - seen[1]
 
 
@@ -320,8 +323,9 @@ def limit_windup(
         high = max(0.0, (effort - damping) / cmd.kp)
         address = int(model.actuator_actadr[a])
         error = min(max(float(data.act[address]) - q, low), high)
-        mean_speed = memory.moved(a, q) * WINDUP_RATE
-        stopping = memory.held_for(a, cmd.target, float(data.time)) < LEAK_WINDOW_S
+        now = float(data.time)
+        mean_speed = memory.mean_speed(cmd.actuator, q, now)
+        stopping = memory.held_for(cmd.actuator, cmd.target, now) < LEAK_WINDOW_S
         back = abs(mean_speed) > LEAK_SPEED and error * mean_speed > 0.0
         if cmd.target == 0.0 and stopping and back and cmd.rule != HELD_FROM_LOAD:
             error *= keep  # paying back a stored lag (LEAK_S)

@@ -14,7 +14,7 @@ import numpy as np
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.world.actuation import JointCommand, Push
-from twin_cli.world.driving import reapply_commands
+from twin_cli.world.driving import reapply_commands, release_commands
 from twin_cli.world.entities import Entity, typed_like
 from twin_cli.world.state import STATE, WorldState
 from twin_cli.world.values import WorldSettings
@@ -111,6 +111,8 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
         mujoco.mj_setState(state.model, state.data, np.asarray(snapshot.state, float), STATE)
         state.iterations, state.divergences = snapshot.iterations, snapshot.divergences
         state.paused = snapshot.paused
+        released = set(state.commands) - {c.actuator for c in snapshot.commands}
         state.commands = {c.actuator: c for c in snapshot.commands}
+        release_commands(state.model, state.data, released)
         reapply_commands(state, state.model, state.data)
         state.pushes = list(snapshot.pushes)

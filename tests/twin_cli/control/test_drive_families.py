@@ -13,6 +13,7 @@ included).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from collections.abc import Callable
@@ -366,3 +367,25 @@ def test_the_first_drive_derives_its_own_gains_from_the_hold(tmp_path: Path) -> 
     world, _, _, _ = _drive(tmp_path, "gazebo_ros_diff_drive", {"linear": V})
     rules = {c.rule for c in world.commands().values()}
     assert HELD_FROM_LOAD not in rules, rules
+
+
+def test_the_first_drive_keeps_the_force_the_hold_carried(tmp_path: Path) -> None:
+    """Held on a slope, then a first drive command of zero speed: the new gains carry the held
+    load from their first step (the integral rescaled), so the base does not sag downhill."""
+    world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
+    assert _watch_on_a_slope(world) < HELD_M
+    p0 = world.get_pose("base")
+    drive(world, "base", 0.0, angular=0.0)
+    world.step(2000)
+    p1 = world.get_pose("base")
+    moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+    assert moved < HELD_M, f"sagged {moved * 1e3:.3f} mm when the drive took over the hold"
+
+
+def test_a_restored_world_without_commands_has_free_wheels(tmp_path: Path) -> None:
+    """A snapshot (or an older save file) that holds no commands is restored as it was: the
+    wheels the spawn held are released, so the base rolls down the slope as it would have."""
+    world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
+    world.restore(dataclasses.replace(world.snapshot(), commands=()))
+    assert not world.commands()
+    assert _watch_on_a_slope(world) > 0.05, "a restored world kept servos no command holds"

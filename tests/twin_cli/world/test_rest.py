@@ -104,3 +104,24 @@ def test_turtlebot3_stopped_on_a_slope_holds() -> None:
     p1 = world.get_pose("tb3")
     moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
     assert moved < 2e-4, f"moved {moved * 1e3:.3f} mm in 10 s on a 5° slope"
+
+
+@pytest.mark.skipif("turtlebot3_burger" not in CORPUS, reason="corpus: no turtlebot3_burger")
+def test_turtlebot3_driven_then_reset_holds_on_a_slope() -> None:
+    """A reset takes the clock back: the leak window of its stopped wheels restarts there instead
+    of staying open until the clock passes the old stop (0.64 mm in these 10 s)."""
+    world = World()
+    world.spawn(corpus_spawn_request("turtlebot3_burger"), name="tb3")
+    world.step(27000)  # a stop late on the clock: its window would stay open after the reset
+    drive(world, "tb3", 0.2, 0.0, 1.0)
+    world.step(3000)
+    world.reset()
+    world.step(300)
+    slope = math.radians(5.0)
+    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
+    world.step(5000)
+    p0 = world.get_pose("tb3")
+    world.step(10000)
+    p1 = world.get_pose("tb3")
+    moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+    assert moved < 2e-4, f"moved {moved * 1e3:.3f} mm in 10 s on a 5° slope after a reset"
