@@ -7,7 +7,7 @@ Functions of a world's state (`twin_cli.world.state`); the servo and push arithm
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
 import mujoco
@@ -216,15 +216,16 @@ def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tupl
     return actuated[j], j
 
 
-def release_commands(model: mujoco.MjModel, data: mujoco.MjData, actuators: set[str]) -> None:
-    """Turns the motors of commands that no longer hold (a restore to a state without them) back
-    into motors at zero effort, as an uncommanded motor is: a servo written for a command stays
-    in the model until something else is written over it."""
-    for actuator in actuators:
-        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
+def release_commands(
+    model: mujoco.MjModel, data: mujoco.MjData, dropped: Iterable[control.JointCommand]
+) -> None:
+    """Turns the motors of commands that no longer hold (a restore to a state without them) into
+    motors at zero effort within their joints' effort limits, as an uncommanded motor is: a
+    servo written for a command stays in the model until something else is written over it."""
+    for old in dropped:
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, old.actuator)
         if a >= 0:
-            effort = control.effort_limit(model, a)
-            limp = control.JointCommand(actuator, "effort", 0.0, 0.0, 0.0, effort)
+            limp = control.JointCommand(old.actuator, "effort", 0.0, 0.0, 0.0, old.effort)
             control.apply_command(model, data, a, limp)
 
 

@@ -27,6 +27,13 @@ def watch(state: WorldState) -> None:
     )
 
 
+def unwatch(state: WorldState) -> None:
+    """Stops the world's servo observer, forgetting what it remembered (the lock is held)."""
+    if state.servo_observer:
+        state.observers.remove(state.servo_observer)
+        state.servo_observer = 0
+
+
 def _tend(state: WorldState, memory: servos.WindupMemory) -> None:
     model, data = state.model, state.data
     windup, settled, moving = [], [], 0
@@ -49,5 +56,4 @@ def _tend(state: WorldState, memory: servos.WindupMemory) -> None:
     if settled:
         sleeping.hold_awake(model, sleeping.actuator_trees(model, settled), False)
     if not moving:
-        state.observers.remove(state.servo_observer)
-        state.servo_observer = 0
+        unwatch(state)

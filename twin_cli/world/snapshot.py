@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError
+from twin_cli.world import servo_watch
 from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.driving import reapply_commands, release_commands
 from twin_cli.world.entities import Entity, typed_like
@@ -111,8 +112,10 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
         mujoco.mj_setState(state.model, state.data, np.asarray(snapshot.state, float), STATE)
         state.iterations, state.divergences = snapshot.iterations, snapshot.divergences
         state.paused = snapshot.paused
-        released = set(state.commands) - {c.actuator for c in snapshot.commands}
+        kept = {c.actuator for c in snapshot.commands}
+        dropped = [c for key, c in state.commands.items() if key not in kept]
         state.commands = {c.actuator: c for c in snapshot.commands}
-        release_commands(state.model, state.data, released)
+        release_commands(state.model, state.data, dropped)
+        servo_watch.unwatch(state)  # what it remembered belongs to the state before
         reapply_commands(state, state.model, state.data)
         state.pushes = list(snapshot.pushes)

@@ -186,3 +186,23 @@ def test_corpus_franka_panda_offers_and_switches_every_mode_on_each_arm_joint(co
     for joint in PANDA_JOINTS:
         assert offered.get(joint) == ["position", "velocity", "effort"], (joint, offered)
     _switch_every_mode(world)
+
+
+@pytest.mark.parametrize("effort", [10.0, 0.0])
+def test_a_restore_gives_a_dropped_commands_motor_its_joints_full_effort(tmp_path, effort):
+    """A restore to a state without a command releases its motor within the joint's effort
+    limit, not the dropped command's (an effort command narrows the force range to its own u):
+    a later position move then has the joint's whole effort and arrives."""
+    world = _spawn_panda(tmp_path)
+    joint = "panda_joint1"
+    before = world.snapshot()
+    full = world.joint_commands("panda")[joint]["effort_limit"]
+    world.command_joints("panda", {joint: effort}, mode="effort")
+    world.step(10)
+    world.restore(before)
+    assert not world.commands()
+    assert world.joint_commands("panda")[joint]["effort_limit"] == full
+    world.command_joints("panda", {joint: 0.5}, mode="position")
+    assert world.commands()[f"panda/{joint}"].effort == full
+    world.step(SETTLE_STEPS)
+    assert abs(_state(world, joint).position - 0.5) < REACHED
