@@ -8,8 +8,6 @@ arrived sleep again (`sleeping.hold_awake`); when none moves it removes itself.
 
 from __future__ import annotations
 
-import mujoco
-
 from twin_cli.world import servos, sleeping
 from twin_cli.world.state import WorldState
 
@@ -40,8 +38,8 @@ def _tend(state: WorldState, memory: servos.WindupMemory) -> None:
     for key, cmd in state.commands.items():
         if cmd.mode == "effort":
             continue
-        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
-        if a < 0 or not servos.has_reference(model, a):
+        a = memory.servo(model, key)
+        if a < 0:
             continue
         if cmd.mode == "velocity":
             moving += 1

@@ -270,12 +270,25 @@ def _joint_range(model: mujoco.MjModel, joint: int) -> tuple[float, float]:
 
 @dataclass
 class WindupMemory:
-    """What `limit_windup` keeps between calls, per actuator name (ids shift when an entity is
-    deleted): its joint's position with the sim time, and its speed target with the sim time it
-    was first seen. Time that went back (a reset, a restore) starts both afresh."""
+    """What the servo observer keeps between calls, per actuator name (ids shift when an entity
+    is deleted): its joint's position with the sim time, its speed target with the sim time it
+    was first seen (time that went back, a reset, starts both afresh), and its id in the model."""
 
     position: dict[str, tuple[float, float]] = field(default_factory=dict)
     target: dict[str, tuple[float, float]] = field(default_factory=dict)
+    model: mujoco.MjModel | None = None
+    servo_ids: dict[str, int] = field(default_factory=dict)
+
+    def servo(self, model: mujoco.MjModel, key: str) -> int:
+        """The id of actuator `key` if it carries a reference activation, else -1; looked up
+        once per compiled model (the observer runs at WINDUP_RATE)."""
+        if model is not self.model:
+            self.model, self.servo_ids = model, {}
+        a = self.servo_ids.get(key)
+        if a is None:
+            a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
+            a = self.servo_ids[key] = a if a >= 0 and has_reference(model, a) else -1
+        return a
 
     def mean_speed(self, key: str, q: float, now: float) -> float:
         """The joint's mean speed since the previous call [rad/s or m/s] (0 at the first)."""
