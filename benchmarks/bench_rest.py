@@ -87,16 +87,25 @@ def _corpus_rest() -> dict:
     return rows
 
 
-def _turtlebot_after_drive() -> dict:
-    from twin_cli.control import controller_of, drive
+def _turtlebot3_settled():
+    """turtlebot3 spawned on the ground and settled for 0.3 s, or None without the corpus."""
     from twin_cli.world import World
 
     robot = _robots().get("turtlebot3_burger")
     if robot is None:
-        return {"skipped": "no corpus"}
+        return None
     world = World()
     _spawn(world, robot, "tb3")
     world.step(300)
+    return world
+
+
+def _turtlebot_after_drive() -> dict:
+    from twin_cli.control import controller_of, drive
+
+    world = _turtlebot3_settled()
+    if world is None:
+        return {"skipped": "no corpus"}
     start = world.get_pose("tb3")
     v, w, t = 0.2, 0.5, 5.0
     drive(world, "tb3", v, w, t)
@@ -112,14 +121,9 @@ def _turtlebot_after_drive() -> dict:
 def _turtlebot_on_a_slope() -> dict:
     """Never driven, then on a 5° slope (gravity tilted along its heading): how far it moves in
     10 s after 5 s there, its wheels held by its drive plugin from load."""
-    from twin_cli.world import World
-
-    robot = _robots().get("turtlebot3_burger")
-    if robot is None:
+    world = _turtlebot3_settled()
+    if world is None:
         return {"skipped": "no corpus"}
-    world = World()
-    _spawn(world, robot, "tb3")
-    world.step(300)
     slope = math.radians(5.0)
     world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
     world.step(5000)

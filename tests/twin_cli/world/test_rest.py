@@ -86,6 +86,18 @@ def test_turtlebot3_stands_still_after_a_drive() -> None:
     assert max(speeds) < 1e-4, f"wheels still turn at {speeds} rad/s"
 
 
+def _moved_on_a_slope(world: World, name: str) -> float:
+    """Tilts gravity 5° along +x (a slope down +x) and returns how far `name` moves [m] in the
+    10 s after 5 s on it."""
+    slope = math.radians(5.0)
+    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
+    world.step(5000)
+    p0 = world.get_pose(name)
+    world.step(10000)
+    p1 = world.get_pose(name)
+    return math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+
+
 @pytest.mark.skipif("turtlebot3_burger" not in CORPUS, reason="corpus: no turtlebot3_burger")
 def test_turtlebot3_stopped_on_a_slope_holds() -> None:
     """Driven, stopped, then on a 5° slope (gravity tilted along its heading): its wheels' zero
@@ -96,13 +108,7 @@ def test_turtlebot3_stopped_on_a_slope_holds() -> None:
     world.step(300)
     drive(world, "tb3", 0.2, 0.0, 1.0)
     world.step(2000)
-    slope = math.radians(5.0)
-    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
-    world.step(5000)
-    p0 = world.get_pose("tb3")
-    world.step(10000)
-    p1 = world.get_pose("tb3")
-    moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+    moved = _moved_on_a_slope(world, "tb3")
     assert moved < 2e-4, f"moved {moved * 1e3:.3f} mm in 10 s on a 5° slope"
 
 
@@ -117,11 +123,5 @@ def test_turtlebot3_driven_then_reset_holds_on_a_slope() -> None:
     world.step(3000)
     world.reset()
     world.step(300)
-    slope = math.radians(5.0)
-    world.set_gravity((9.81 * math.sin(slope), 0.0, -9.81 * math.cos(slope)))
-    world.step(5000)
-    p0 = world.get_pose("tb3")
-    world.step(10000)
-    p1 = world.get_pose("tb3")
-    moved = math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
+    moved = _moved_on_a_slope(world, "tb3")
     assert moved < 2e-4, f"moved {moved * 1e3:.3f} mm in 10 s on a 5° slope after a reset"
