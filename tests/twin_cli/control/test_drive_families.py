@@ -240,14 +240,22 @@ def _oracle(family: Family, start: tuple, applied: dict, command: dict) -> tuple
     return (x, y, th), path
 
 
-def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
+def _spawned(tmp_path: Path, name: str, text: str) -> World:
+    """A world with `text` (a FAMILIES robot, or a variant of one) spawned on the ground as
+    `base`, the files its family needs beside it."""
     family = FAMILIES[name]
     path = tmp_path / f"{name}.{family.suffix}"
-    path.write_text(family.robot())
-    for file_name, text in family.files:
-        (tmp_path / file_name).write_text(text)
+    path.write_text(text)
+    for file_name, extra in family.files:
+        (tmp_path / file_name).write_text(extra)
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    return world
+
+
+def _drive(tmp_path: Path, name: str, command: dict) -> tuple:
+    family = FAMILIES[name]
+    world = _spawned(tmp_path, name, family.robot())
     world.step(300)  # settle on the ground [ms]
     if family.model == "bicycle" and "angular" not in command:
         steer = {k: v for k, v in command.items() if k in ("steering", "curvature")}
@@ -329,17 +337,6 @@ def _watch_on_a_slope(world: World) -> float:
     world.step(2000)
     p1 = world.get_pose("base")
     return math.dist((p0.x, p0.y, p0.z), (p1.x, p1.y, p1.z))
-
-
-def _spawned(tmp_path: Path, name: str, text: str) -> World:
-    family = FAMILIES[name]
-    path = tmp_path / f"{name}.{family.suffix}"
-    path.write_text(text)
-    for file_name, extra in family.files:
-        (tmp_path / file_name).write_text(extra)
-    world = World()
-    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
-    return world
 
 
 @pytest.mark.parametrize("name", sorted(FAMILIES))
