@@ -200,14 +200,25 @@ def _carry_integral(state: WorldState, a: int, j: int, old_kp: float, new_kp: fl
         state.data.act[address] = q + (state.data.act[address] - q) * old_kp / new_kp
 
 
-def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:
-    m = state.model
-    j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{name}/{joint}")
-    actuated = {
+def _actuated(m: mujoco.MjModel, ix: EntityIndex) -> dict[int, int]:
+    """Joint id → id of the joint motor that drives it, for one entity."""
+    return {
         int(m.actuator_trnid[a][0]): int(a)
         for a in ix.actuators
         if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
     }
+
+
+def motor_joints(state: WorldState, name: str) -> set[str]:
+    """The entity's joints that a joint motor drives (names without the entity prefix)."""
+    m = state.model
+    return {m.joint(j).name.removeprefix(f"{name}/") for j in _actuated(m, state.require(name))}
+
+
+def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tuple[int, int]:
+    m = state.model
+    j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{name}/{joint}")
+    actuated = _actuated(m, ix)
     if j < 0 or j not in actuated:
         known = [
             n.removeprefix(f"{name}/") for n in element_names(m, m.name_jntadr[list(actuated)])

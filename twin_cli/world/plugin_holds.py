@@ -16,8 +16,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import replace
 
-import mujoco
-
 from converters.gazebo.drive_records import held_from_load
 from twin_cli.world import driving, joint_control
 from twin_cli.world.servos import HELD_FROM_LOAD
@@ -27,7 +25,7 @@ from twin_cli.world.state import WorldState
 def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
     """Commands each entity's plugin-held joints (the lock is held; entities are committed)."""
     for name in names:
-        motors = _motor_joints(state, name)
+        motors = driving.motor_joints(state, name)
         by_mode: dict[str, dict[str, float]] = {}
         for joint, (mode, target) in held_from_load(state.entities[name].plugins).items():
             if joint in motors and mode in joint_control.limits_of(state.model, name, joint).modes:
@@ -35,13 +33,3 @@ def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
         for mode, targets in by_mode.items():
             for cmd in driving.command_joints(state, name, targets, mode=mode, clip=True):
                 state.commands[cmd.actuator] = replace(cmd, rule=HELD_FROM_LOAD)
-
-
-def _motor_joints(state: WorldState, name: str) -> set[str]:
-    """The entity's joints that a joint motor drives (names without the entity prefix)."""
-    m, ix = state.model, state.require(name)
-    joints = (int(m.actuator_trnid[a][0]) for a in ix.actuators if m.actuator_trntype[a] == _JOINT)
-    return {m.joint(j).name.removeprefix(f"{name}/") for j in joints}
-
-
-_JOINT = mujoco.mjtTrn.mjTRN_JOINT
