@@ -88,10 +88,10 @@
   // second. State payloads still in flight for the model before then name a superseded model:
   // MuJoCo's page would load it again (the robot would vanish for a moment), so those reloads
   // are skipped; its payloads, sized for the other model, are dropped by the page meanwhile.
-  // The payload after them names the model already shown, and MuJoCo's page would load that
-  // one again too: rebuild its scene and upload every mesh a second time (measured: 34 MiB of
-  // vertex buffers and 0.2-0.5 s of the main thread for an arm of 136,000 triangles), so a
-  // reload of the model in place is skipped as well.
+  // A skipped reload leaves the page's client waiting for a model: it applies no state until
+  // one is parsed. The payload after the stale ones names the model already shown, and that
+  // reload runs (a cache hit: parsed at once, no download), or the page would show the world
+  // frozen at the new model's spawn poses under "Downloading model".
   let newest = 0;
   const superseded = new Set();
   const mujocoReload = reloadModel;
@@ -105,12 +105,6 @@
   reloadModel = function (crc) {
     const asked = (crc || 0) >>> 0;
     if (superseded.has(asked)) return Promise.resolve();
-    if (asked && asked === currentModelCrc) {
-      // As MuJoCo's own reload would: a load of another model still in flight is dropped, so
-      // a world that went back to the shown model (a spawn, then a delete) keeps showing it.
-      loadGeneration++;
-      return Promise.resolve();
-    }
     return mujocoReload(crc);
   };
 

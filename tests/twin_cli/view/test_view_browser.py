@@ -1,8 +1,9 @@
 """The web viewer in a real browser (Debian's headless chromium) on a real world server.
 
 One page (its first load takes ~12 s with WebGL in SwiftShader), checked in sequence by one
-test: the humanoid shows, a spawned red box appears without a page reload, the page's Pause
-pauses the world, the page's Reset puts entities back at their spawn poses.
+test: the humanoid shows, a spawned box appears without a page reload, the page still follows
+the world's state after that model change (a box the world moves moves on the page), the page's
+Pause pauses the world, the page's Reset puts entities back at their spawn poses.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing, pure_red, red_box, twin_in
+from view_helpers import CHROMIUM, CHROMIUM_FLAGS, chromium_missing, red_box, twin_in
 
 import scenarios
 
@@ -29,8 +30,14 @@ PAUSE_BUTTON = (60, 122)
 RESET_BUTTON = (48, 90)
 WAIT_S = 90.0  # [s] for a picture to change: SwiftShader renders a frame in ~0.1-5 s under load
 MIN_PIXELS = 150  # pixels of a colour that count as "shows"
-BOX_PIXELS = 2000  # red pixels the 0.4 m box adds (~15,000 at the default camera distance)
-SPAWN_Z = 1.0  # [m]
+# The box is magenta, a colour nothing else on the page has, so its pixels are its own whatever
+# the humanoid does meanwhile. The page's camera looks down at the humanoid (screen right is +x,
+# up is +y, ~220 px/m): at (0.25, 0.6) the box is in view and clear of the fallen humanoid.
+BOX_SIZE = 0.3  # [m]
+BOX_PIXELS = 2000  # magenta pixels that count as the box shown (~6,000 when all of it shows)
+SPAWN_X, SPAWN_Y, SPAWN_Z = 0.25, 0.6, 1.0  # [m]
+MOVED_X = -0.25  # [m] where `twin pose --set` puts the box: ~110 px left of where it landed
+MIN_SHIFT_PX = 50
 SCREENSHOT_TIMEOUT_MS = 120_000  # a screenshot waits for a rendered frame: slow on a loaded CPU
 
 
@@ -56,6 +63,19 @@ def shot(page, name: str, out: Path) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
 
 
+def magenta(pixels: np.ndarray) -> np.ndarray:
+    """Pixels lit from a (1, 0, 1) surface: red and blue alike, green under 15 % of them."""
+    rgb = pixels[..., :3].astype(float)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return (r > 40) & (b > 0.7 * r) & (r > 0.7 * b) & (g < 0.15 * np.minimum(r, b))
+
+
+def box_column(tab, name: str, out: Path) -> float | None:
+    """Mean screen column [px] of the box's pixels, or None while fewer than BOX_PIXELS show."""
+    rows_cols = np.nonzero(magenta(shot(tab, name, out)))
+    return float(rows_cols[1].mean()) if len(rows_cols[1]) > BOX_PIXELS else None
+
+
 def wait_for(what: str, test, timeout: float = WAIT_S):
     """Polls `test()` until it returns a truthy value; fails naming `what`."""
     deadline = time.monotonic() + timeout
@@ -75,7 +95,7 @@ def page(tmp_path_factory, serve_world):
     global SHOTS
     root = SHOTS = tmp_path_factory.mktemp("browser")
     with serve_world(root, WORLD):
-        spawned = twin("spawn", str(HUMANOID), "--name", "h", "-z", str(SPAWN_Z))
+        spawned = twin("spawn", str(HUMANOID), "--name", "h", "-z", "1.0")
         assert spawned.returncode == 0, spawned.stderr
         url = twin("view").stdout.strip()
         assert url.startswith("http://localhost:"), url
@@ -97,19 +117,32 @@ def _the_page_shows_the_humanoid(page):
     )
 
 
-def _a_spawned_red_box_appears_without_a_page_reload(page):
+def _a_spawned_box_appears_without_a_page_reload(page) -> float:
     tab, out = page
-    # The humanoid's shirt (0.8 0.2 0.2) renders as red as the box: count the red it adds.
-    before = int(pure_red(shot(tab, "before_box", out)).sum())
+    assert box_column(tab, "before_box", out) is None, "magenta on the page before the spawn"
     urdf = out / "box.urdf"
-    urdf.write_text(red_box(0.4))
-    spawned = twin("spawn", str(urdf), "--name", "box", "-x", "0.6", "-z", str(SPAWN_Z))
+    urdf.write_text(red_box(BOX_SIZE).replace('rgba="1 0 0 1"', 'rgba="1 0 1 1"'))
+    at = ("-x", str(SPAWN_X), "-y", str(SPAWN_Y), "-z", str(SPAWN_Z))
+    spawned = twin("spawn", str(urdf), "--name", "box", *at)
     assert spawned.returncode == 0, spawned.stderr
-    wait_for(
-        "the red box appears on the page",
-        lambda: int(pure_red(shot(tab, "box", out)).sum()) - before > BOX_PIXELS,
-    )
+    column = wait_for("the box appears on the page", lambda: box_column(tab, "box", out))
     assert tab.evaluate("window.twinLoaded") == "same page", "the page was reloaded"
+    return column
+
+
+def _the_page_follows_the_world_after_the_spawn(page, landed_column: float):
+    """A page that took the new model but stopped applying the world's state would keep
+    drawing the box where it first showed it."""
+    tab, out = page
+    resting_z = str(BOX_SIZE / 2 + 1e-3)
+    moved = twin("pose", "box", "--set", str(MOVED_X), str(SPAWN_Y), resting_z, "0", "0", "0")
+    assert moved.returncode == 0, moved.stderr
+
+    def shifted_left() -> bool:
+        column = box_column(tab, "moved", out)
+        return column is not None and landed_column - column > MIN_SHIFT_PX
+
+    wait_for(f"the box drawn {MIN_SHIFT_PX}+ px left of {landed_column:.0f} px", shifted_left)
 
 
 def _pause_in_the_page_pauses_the_world(page):
@@ -129,9 +162,10 @@ def _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page):
 
     def back() -> bool:
         pose = json.loads(twin("pose", "box", "--json").stdout)
-        return abs(pose["z"] - SPAWN_Z) < 1e-9 and abs(pose["x"] - 0.6) < 1e-9
+        spawn = (SPAWN_X, SPAWN_Y, SPAWN_Z)
+        return all(abs(pose[k] - v) < 1e-9 for k, v in zip("xyz", spawn, strict=True))
 
-    wait_for("`twin pose box` back at its spawn pose (0.6, 0, 1.0) m", back)
+    wait_for(f"`twin pose box` back at its spawn pose {(SPAWN_X, SPAWN_Y, SPAWN_Z)} m", back)
     stats = twin("stats", "-d", "0").stdout
     assert "SimTime[0.00]" in stats and "Paused[T]" in stats, stats
 
@@ -139,6 +173,7 @@ def _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page):
 def test_the_viewer_shows_and_drives_the_world(page):
     """One test (one page: pytest-xdist must not split the steps over workers), in order."""
     _the_page_shows_the_humanoid(page)
-    _a_spawned_red_box_appears_without_a_page_reload(page)
+    column = _a_spawned_box_appears_without_a_page_reload(page)
+    _the_page_follows_the_world_after_the_spawn(page, column)
     _pause_in_the_page_pauses_the_world(page)
     _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page)
