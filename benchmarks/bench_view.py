@@ -151,14 +151,25 @@ def measure(browser: Any | None) -> dict:
     }
 
 
-def _page_drawn(page: Any, after: float) -> dict:
-    """The page's record of the first model it drew that it began to parse at most 1 s before
-    `after` [s since the epoch: a spawn's reply], with its worker's record of that model; times
-    in s after `after`."""
+def _shown_crc(page: Any) -> int:
+    """The crc32 of the model the page drew last (0: none yet)."""
+    drawn = [x["crc"] for x in page.evaluate("window.twinPieces.loads") if x["presented"]]
+    return drawn[-1] if drawn else 0
+
+
+def _page_drawn(page: Any, after: float, old: int = 0) -> dict:
+    """The page's record of the first model other than `old` (shown before the spawn; the page
+    parses it once more after stale state payloads) that it drew and began to parse at most
+    1 s before `after` [s since the epoch: a spawn's reply], with its worker's record of that
+    model; times in s after `after`."""
     deadline = time.monotonic() + DRAWN_TIMEOUT_S
     while time.monotonic() < deadline:
         record = page.evaluate("window.twinPieces")
-        drawn = [x for x in record["loads"] if x["presented"] and x["started"] / 1e3 > after - 1.0]
+        drawn = [
+            x
+            for x in record["loads"]
+            if x["presented"] and x["started"] / 1e3 > after - 1.0 and x["crc"] != old
+        ]
         if drawn:
             load = drawn[0]
             got = next((r for r in record["received"] if r["crc"] == load["crc"]), {})
@@ -196,9 +207,10 @@ def spawn_to_drawn(browser: Any) -> dict:
             figures = []
             for i in range(SPAWNS):
                 request = SpawnRequest(source=path, args=args)
+                old = _shown_crc(page)
                 world.spawn(request, name=f"{condition}_{i}", pose=Pose(x=float(spawned)))
                 spawned += 1
-                figures.append(_page_drawn(page, time.time()))
+                figures.append(_page_drawn(page, time.time(), old))
             result[condition] = {"spawns": figures, "load_average": os.getloadavg()[0]}
         result["look"] = host.look.status()
         page.close()
