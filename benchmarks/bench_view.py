@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -242,16 +243,25 @@ def _in_browser(part: str) -> dict:
 def _in_child(part: str) -> dict:
     """`part` in a child process of its own: MuJoCo 4.0's web viewer crashes a process that
     starts a second one after closing the first (twin's server refuses that; a benchmark that
-    ran both parts in one process died with SIGSEGV)."""
-    proc = subprocess.run(
+    ran both parts in one process died with SIGSEGV). A child past PART_TIMEOUT_S is killed
+    with its process group (its busy loops and browser too)."""
+    child = subprocess.Popen(
         [sys.executable, "-m", "benchmarks.bench_view", part],
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
         text=True,
-        timeout=PART_TIMEOUT_S,
+        start_new_session=True,
+        cwd=Path(__file__).parents[1],
     )
-    lines = proc.stdout.strip().splitlines()
-    if proc.returncode != 0 or not lines:
-        return {"failed": f"exit {proc.returncode}: {proc.stderr.strip()[-800:]}"}
+    try:
+        out, err = child.communicate(timeout=PART_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        os.killpg(child.pid, signal.SIGKILL)
+        child.communicate()
+        return {"failed": f"not within {PART_TIMEOUT_S:.0f} s"}
+    lines = out.strip().splitlines()
+    if child.returncode != 0 or not lines:
+        return {"failed": f"exit {child.returncode}: {err.strip()[-800:]}"}
     return json.loads(lines[-1])
 
 

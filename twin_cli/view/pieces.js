@@ -65,6 +65,9 @@
     }
     if (error) {
       console.warn("[twin] pieces failed:", error);
+      // The state stream's reload of it then runs (MuJoCo's download), even for a model the
+      // world went back to after it was superseded: skipped, the page would wait for it.
+      superseded.delete(crc);
       settle(crc, null);
       release();
       return;
