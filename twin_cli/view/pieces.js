@@ -65,10 +65,8 @@
     }
     if (error) {
       console.warn("[twin] pieces failed:", error);
-      // The state stream's reload of it then runs (MuJoCo's download), even for a model the
-      // world went back to after it was superseded: skipped, the page would wait for it.
-      superseded.delete(crc);
       settle(crc, null);
+      recoverSkipped(crc);
       release();
       return;
     }
@@ -97,17 +95,34 @@
   // frozen at the new model's spawn poses under "Downloading model".
   let newest = 0;
   const superseded = new Set();
+  let skipped = 0; // the last reload skipped, until another runs
   const mujocoReload = reloadModel;
   function showPublished(crc) {
     if (newest && newest !== crc) superseded.add(newest);
     superseded.delete(crc);
     newest = crc;
-    if (currentModelCrc && currentModelCrc !== crc) mujocoReload(crc);
+    if (currentModelCrc && currentModelCrc !== crc) {
+      skipped = 0;
+      mujocoReload(crc);
+    }
+  }
+  // A model the world went back to after it was superseded (a spawn, then a delete) that the
+  // worker fails to fetch: the state stream's reload of it must run (MuJoCo's download), and
+  // if it came before the failure and was skipped, the page waits for it: it runs now.
+  function recoverSkipped(crc) {
+    superseded.delete(crc);
+    if (skipped !== crc) return;
+    skipped = 0;
+    mujocoReload(crc);
   }
   // eslint-disable-next-line no-global-assign
   reloadModel = function (crc) {
     const asked = (crc || 0) >>> 0;
-    if (superseded.has(asked)) return Promise.resolve();
+    if (superseded.has(asked)) {
+      skipped = asked;
+      return Promise.resolve();
+    }
+    skipped = 0;
     return mujocoReload(crc);
   };
 

@@ -8,6 +8,7 @@ Pause pauses the world, the page's Reset puts entities back at their spawn poses
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import subprocess
@@ -88,8 +89,10 @@ def wait_for(what: str, test, timeout: float = WAIT_S):
     pytest.fail(f"{what} within {timeout:.0f} s (last: {last}; screenshots in {SHOTS})")
 
 
-@pytest.fixture
-def page(tmp_path_factory, serve_world):
+@contextlib.contextmanager
+def _served_page(tmp_path_factory, serve_world, pieces: dict[str, bool]):
+    """A world with the humanoid and its page; the page's requests for model pieces fail
+    while `pieces["fail"]` is true (its worker then reports an error)."""
     from playwright.sync_api import sync_playwright
 
     global SHOTS
@@ -101,12 +104,23 @@ def page(tmp_path_factory, serve_world):
         assert url.startswith("http://localhost:"), url
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
-            tab = browser.new_page(viewport=VIEWPORT)
+            context = browser.new_context(viewport=VIEWPORT)
+            context.route(
+                lambda url: "/twin/pieces?" in url,
+                lambda route: route.abort() if pieces["fail"] else route.continue_(),
+            )
+            tab = context.new_page()
             tab.set_default_timeout(SCREENSHOT_TIMEOUT_MS)
             tab.goto(url)
             tab.evaluate("window.twinLoaded = 'same page'")
             yield tab, root
             browser.close()
+
+
+@pytest.fixture
+def page(tmp_path_factory, serve_world):
+    with _served_page(tmp_path_factory, serve_world, {"fail": False}) as served:
+        yield served
 
 
 def _the_page_shows_the_humanoid(page):
@@ -177,3 +191,19 @@ def test_the_viewer_shows_and_drives_the_world(page):
     _the_page_follows_the_world_after_the_spawn(page, column)
     _pause_in_the_page_pauses_the_world(page)
     _reset_in_the_page_puts_entities_back_at_their_spawn_pose(page)
+
+
+def test_a_model_the_world_goes_back_to_shows_when_its_pieces_fail(tmp_path_factory, serve_world):
+    """A spawn then a delete takes the world back to the model it had (same bytes, same crc32),
+    which the page had set aside as superseded. When its worker cannot fetch that model's
+    pieces, MuJoCo's own reload must still run: skipped, the page would keep drawing the box."""
+    pieces = {"fail": False}
+    with _served_page(tmp_path_factory, serve_world, pieces) as page:
+        _the_page_shows_the_humanoid(page)
+        _a_spawned_box_appears_without_a_page_reload(page)
+        pieces["fail"] = True
+        deleted = twin("delete", "box")
+        assert deleted.returncode == 0, deleted.stderr
+        tab, out = page
+        wait_for("the box gone from the page", lambda: box_column(tab, "deleted", out) is None)
+        assert tab.evaluate("window.twinLoaded") == "same page", "the page was reloaded"
