@@ -3,7 +3,9 @@
 One page (its first load takes ~12 s with WebGL in SwiftShader), checked in sequence by one
 test: the humanoid shows, a spawned box appears without a page reload, the page still follows
 the world's state after that model change (a box the world moves moves on the page), the page's
-Pause pauses the world, the page's Reset puts entities back at their spawn poses.
+Pause pauses the world, the page's Reset puts entities back at their spawn poses. A second page,
+whose requests for model pieces fail after the box appears, must still show the world's earlier
+model again once the box is deleted.
 """
 
 from __future__ import annotations
