@@ -19,6 +19,7 @@ from twin_cli.world.divergence import (
     Divergence,
     batch_healthy,
     find_divergent,
+    speed_bounds,
     warning_counts,
 )
 from twin_cli.world.entities import index_entities, write_state
@@ -97,7 +98,8 @@ def _step_chunk(state: WorldState, n: int) -> None:
 
     NaNs spread to other entities through collisions within a few steps, so a divergence
     found after a batch is traced back: the batch-start state is restored and stepped one
-    step at a time, and the entity that goes bad first is reset to its spawn state.
+    step at a time, and the entity that goes bad first is reset to its spawn state. The speed
+    bounds (`divergence.SpeedBounds`) are kept per compiled model in `state.speed_bounds`.
     """
     m, d = state.model, state.data
     if n > 1:
@@ -115,9 +117,12 @@ def _step_chunk(state: WorldState, n: int) -> None:
     finally:
         mujoco.set_mju_user_warning(previous)
     state.iterations += n
-    if batch_healthy(d, before):
+    bounds = state.speed_bounds
+    if bounds is None or bounds.model is not m:  # the first batch after a compile
+        bounds = state.speed_bounds = speed_bounds(m, state.index)
+    if batch_healthy(d, before, bounds.bound):
         return
-    bad = find_divergent(d, before, state.index)
+    bad = find_divergent(d, before, state.index, bounds)
     if bad and n == 1:
         _recover(state, bad)
     elif bad:

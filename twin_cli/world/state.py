@@ -21,7 +21,7 @@ from twin_cli.world.observers import Observers
 if TYPE_CHECKING:
     from converters.description import Light
     from twin_cli.world.actuation import Damping, JointCommand, Push
-    from twin_cli.world.divergence import Divergence
+    from twin_cli.world.divergence import Divergence, SpeedBounds
     from twin_cli.world.entities import Entity, EntityIndex
     from twin_cli.world.loop import WorldLock
     from twin_cli.world.values import WorldSettings
@@ -44,7 +44,9 @@ class WorldState:
         pushes: wrenches acting until a world iteration; perturbation: a viewer's drag, by body.
         damping: per-step velocity decay (Gazebo's `dampingFactor`), or None.
         iterations: steps taken since the last reset; stepping_time: [s] spent in `mj_step`.
-        paused: the loop's pause; divergences, divergence_log: entities reset after a NaN.
+        paused: the loop's pause; divergences, divergence_log: entities reset after a NaN or
+            a speed far past a joint's limit; speed_bounds: the per-dof bounds of `model`
+            (None until the first batch; renewed when the model is a new one).
         mujoco_warnings: MuJoCo's warning texts, the last `WARNINGS_KEPT`.
         scratch_state: a buffer for one `mj_getState` of `model` (a batch's start).
         observers: consumers called between steps (recorder, live stream, sensors).
@@ -74,6 +76,7 @@ class WorldState:
     paused: bool = False
     divergences: int = 0
     divergence_log: list[Divergence] = field(default_factory=list)
+    speed_bounds: SpeedBounds | None = None
     mujoco_warnings: deque[str] = field(default_factory=lambda: deque(maxlen=WARNINGS_KEPT))
     scratch_state: np.ndarray = field(default_factory=lambda: np.empty(0))
     observers: Observers = field(default_factory=Observers)
