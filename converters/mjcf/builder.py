@@ -18,6 +18,7 @@ from converters.mjcf import inertia as inr
 from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
 from converters.mjcf.bodies import body_inertias
 from converters.mjcf.control_data import add_control_data
+from converters.mjcf.fixed_base import weld_base
 from converters.mjcf.geometry import GeomPlan, plan_geoms
 from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joints
 from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
@@ -43,8 +44,9 @@ MODEL_SITE = "__model__"
 class ConvertOptions:
     """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan,
     `as_written`: apply what a URDF says where Gazebo's own parser drops it (inline `<surface>`,
-    link surface values on named collisions) instead of simulating what Gazebo simulates, and
+    link surface values on named collisions) instead of simulating what Gazebo simulates,
     `drop_dangling`: leave out tags that name a missing link or joint instead of refusing them,
+    `fixed_base`: weld the root link to the world (no free joint) as a `world` link does,
     and `xacro_budget`: expand xacro in a bounded child process (a server's conversions)."""
 
     keep_fixed: bool = False
@@ -52,6 +54,7 @@ class ConvertOptions:
     collision: CollisionSettings = field(default_factory=CollisionSettings)
     as_written: bool = False
     drop_dangling: bool = False
+    fixed_base: bool = False
     xacro_budget: XacroBudget | None = None  # None: xacro runs in this process, unbounded
 
 
@@ -93,7 +96,8 @@ def build_spec(
     """Build the robot's MjSpec (Gazebo tags are applied afterwards by the caller).
 
     Gazebo's model flags shape the bodies: `<static>` welds the base, preserveFixedJoint and
-    disableFixedJointLumping keep a fixed joint's child as its own body.
+    disableFixedJointLumping keep a fixed joint's child as its own body; `fixed_base` welds
+    the base as a `world` link would.
 
     Raises:
         InertiaError, MeshError, URDFStructureError (a mimic of a joint that cannot move).
@@ -104,6 +108,8 @@ def build_spec(
         keep_fixed=options.keep_fixed,
         static=robot.gazebo.static,
     )
+    if options.fixed_base:
+        plan = weld_base(plan, report)
     geoms = plan_geoms(robot, plan, report)
     inertias = body_inertias(robot, plan, geoms, options.repair_inertia, report)
     spec = new_spec(robot.name)

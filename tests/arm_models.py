@@ -1,0 +1,34 @@
+"""Arms without a `world` link, as vendors ship them, for the `--fixed-base` tests.
+
+Geometry [m, kg]: a 2 kg base box 0.2 × 0.2 × 0.1 m, and above it (0.1 m up) a 0.5 m
+horizontal link on hinge 'shoulder' about y, which gravity swings down.
+"""
+
+from __future__ import annotations
+
+INERTIA = 'ixx="0.001" iyy="0.02" izz="0.02" ixy="0" ixz="0" iyz="0"'  # [kg m^2]
+
+
+def floating_arm(link_mass: float = 1.0, world_link: bool = False) -> str:
+    """The arm as URDF, with a link of `link_mass` [kg]; `world_link` adds a `world` link and
+    a fixed joint to `base_link` (how Gazebo users fix it by hand)."""
+    world = (
+        '<link name="world"/><joint name="world_joint" type="fixed">'
+        '<parent link="world"/><child link="base_link"/></joint>'
+        if world_link
+        else ""
+    )
+    return f"""<robot name="arm">{world}
+  <link name="base_link">
+    <inertial><mass value="2"/><inertia {INERTIA}/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
+  </link>
+  <link name="upper">
+    <inertial><origin xyz="0.25 0 0"/><mass value="{link_mass}"/><inertia {INERTIA}/></inertial>
+    <collision><origin xyz="0.25 0 0" rpy="0 1.5707963 0"/>
+      <geometry><cylinder radius="0.03" length="0.5"/></geometry></collision>
+  </link>
+  <joint name="shoulder" type="revolute"><parent link="base_link"/><child link="upper"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="100" velocity="2"/></joint>
+</robot>"""
