@@ -38,6 +38,8 @@ class SpawnRequest:
         repair_inertia: bound non-physical inertias instead of refusing the file.
         drop_dangling: leave out Gazebo and control tags that name a missing link or joint
             (Gazebo's behaviour) instead of refusing the file.
+        fixed_base: weld the root link to the world at the spawn pose (no free joint), as a
+            `world` link and a fixed joint do; a robot already fixed is unchanged.
     """
 
     source: Any = None
@@ -50,6 +52,7 @@ class SpawnRequest:
     on_ground: bool = False
     repair_inertia: bool = False
     drop_dangling: bool = False
+    fixed_base: bool = False
 
     @property
     def label(self) -> str:
@@ -82,6 +85,7 @@ class SpawnRequest:
             "on_ground": self.on_ground,
             "repair_inertia": self.repair_inertia,
             "drop_dangling": self.drop_dangling,
+            "fixed_base": self.fixed_base,
         }
 
     def to_body(self) -> dict[str, Any]:
@@ -110,6 +114,7 @@ class SpawnRequest:
             on_ground=bool(body.get("on_ground", False)),
             repair_inertia=bool(body.get("repair_inertia", False)),
             drop_dangling=bool(body.get("drop_dangling", False)),
+            fixed_base=bool(body.get("fixed_base", False)),
         )
 
 

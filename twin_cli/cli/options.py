@@ -51,6 +51,7 @@ WorldOpt = annotation(table.WORLD)
 ArgOpt = annotation(table.ARG)
 PackageOpt = annotation(table.PACKAGE)
 JointOpt = annotation(table.JOINT)
+FixedBaseOpt = annotation(table.FIXED_BASE)
 
 
 def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:

@@ -45,6 +45,7 @@ def spawn_request(
     on_ground: bool,
     repair_inertia: bool,
     drop_dangling: bool = False,
+    fixed_base: bool = False,
 ) -> SpawnRequest:
     """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
 
@@ -66,6 +67,7 @@ def spawn_request(
         on_ground=on_ground,
         repair_inertia=repair_inertia,
         drop_dangling=drop_dangling,
+        fixed_base=fixed_base,
     )
 
 
@@ -92,6 +94,7 @@ def spawn(
     view: bool = False,
     repair_inertia: bool = False,
     drop_dangling: bool = False,
+    fixed_base: bool = False,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
@@ -111,7 +114,7 @@ def spawn(
     else:
         pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
     request = spawn_request(
-        file, xml, arg, package, joint, on_ground, repair_inertia, drop_dangling
+        file, xml, arg, package, joint, on_ground, repair_inertia, drop_dangling, fixed_base
     )
     with connect_world(world, start=True) as c, _progress(world, file, json):
         if many:

@@ -87,6 +87,12 @@ POSE = tuple(
         ("-Y", "yaw", "yaw [rad]"),
     )
 )
+FIXED_BASE = flag(
+    "--fixed-base",
+    dest="fixed_base",
+    help="Weld the root link to the world (no free joint), as a `world` link and a fixed "
+    "joint do; the robot's own joints still move.",
+)
 NAME = Arg("name", "Entity name (see `twin list`).", str)
 
 SPAWN = Command(
@@ -133,6 +139,7 @@ SPAWN = Command(
             help="Leave out tags naming a missing link or joint (as Gazebo does) instead of "
             "failing.",
         ),
+        FIXED_BASE,
     ),
 )
 

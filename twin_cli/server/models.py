@@ -96,6 +96,10 @@ class SpawnBody(Body):
         default=False,
         description="leave out tags that name a missing link or joint instead of refusing them",
     )
+    fixed_base: bool = Field(
+        default=False,
+        description="weld the root link to the world at the spawn pose (no free joint)",
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> SpawnBody:

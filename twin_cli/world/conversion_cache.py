@@ -117,6 +117,7 @@ def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> 
         tuple(lookup.get(name, "") for name in PACKAGE_ENVS),
         request.repair_inertia,
         request.drop_dangling,
+        request.fixed_base,
     )
 
 

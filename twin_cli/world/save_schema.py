@@ -81,6 +81,7 @@ class SavedEntity(Strict):
     on_ground: bool = False
     repair_inertia: bool = False
     drop_dangling: bool = False
+    fixed_base: bool = False
     spawn_state: Annotated[dict[str, FiniteArray], AfterValidator(_state_fields)]
 
 

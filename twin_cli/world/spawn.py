@@ -18,7 +18,7 @@ import numpy as np
 from converters.mjcf.world_rules import min_friction_priorities
 from twin_cli.errors import InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest
-from twin_cli.world import servos, shared_meshes
+from twin_cli.world import fixed_base, servos, shared_meshes
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate
 from twin_cli.world.scene import adopt_world_globals
@@ -33,7 +33,6 @@ SDF_SUFFIXES = (".sdf",)
 PENETRATION_TOL = 1e-4  # [m] overlap below this is contact, not a bad start
 HOME_KEY = "home"
 ROOT_DEFAULT = "main"  # MjSpec's root default class, "<entity>/main" once attached
-_QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # mjtJoint: free, ball, slide, hinge
 
 
 @dataclass(frozen=True)
@@ -72,12 +71,20 @@ def load_source(request: SpawnRequest) -> LoadedSource:
 
     The request's `env` (the caller's package search variables) goes over this process's. In a
     world server a description is read in a bounded child (`convert_bounded`); MJCF is
-    MuJoCo's own parser, in this process.
+    MuJoCo's own parser, in this process. With `fixed_base` the converter welds a description's
+    root, and `fixed_base.weld_loaded` an MJCF's.
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
         converters.ConversionError: the converter refused the description.
     """
+    loaded = _load(request)
+    if request.fixed_base and loaded.report is None:
+        return fixed_base.weld_loaded(loaded)
+    return loaded
+
+
+def _load(request: SpawnRequest) -> LoadedSource:
     if request.xml is not None:
         return _load_text(request)
     if isinstance(request.source, mujoco.MjSpec):
@@ -109,6 +116,7 @@ def convert_options(request: SpawnRequest) -> ConvertOptions:
     return ConvertOptions(
         repair_inertia=request.repair_inertia,
         drop_dangling=request.drop_dangling,
+        fixed_base=request.fixed_base,
         xacro_budget=XacroBudget.from_env(),  # a served xacro runs bounded, apart from the world
     )
 
@@ -292,7 +300,7 @@ def _key_qpos(child: mujoco.MjSpec, key: mujoco.MjsKey) -> np.ndarray:
 
     Compiling the child only for this costs about 1 ms for a humanoid, a quarter of a spawn.
     """
-    nq = sum(_QPOS_WIDTH[int(j.type)] for j in child.joints)
+    nq = sum(fixed_base.QPOS_WIDTH[int(j.type)] for j in child.joints)
     if len(key.qpos) == nq:
         return np.array(key.qpos, dtype=float)
     model = child.copy().compile()

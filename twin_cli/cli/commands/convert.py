@@ -7,7 +7,14 @@ from typing import Annotated, Any
 
 import typer
 
-from twin_cli.cli.options import ArgOpt, JsonOpt, PackageOpt, parse_pairs, source_inputs
+from twin_cli.cli.options import (
+    ArgOpt,
+    FixedBaseOpt,
+    JsonOpt,
+    PackageOpt,
+    parse_pairs,
+    source_inputs,
+)
 
 RobotArg = Annotated[
     Path, typer.Argument(help="Robot description: .urdf, .xacro or .sdf (SDF model) file.")
@@ -68,6 +75,7 @@ def _options(
     collision: dict[str, Any] | None = None,
     as_written: bool = False,
     drop_dangling: bool = False,
+    fixed_base: bool = False,
 ) -> Any:
     from converters.collision.plan import CollisionSettings
     from converters.mjcf.builder import ConvertOptions
@@ -78,6 +86,7 @@ def _options(
         CollisionSettings(**(collision or {})),
         as_written=as_written,
         drop_dangling=drop_dangling,
+        fixed_base=fixed_base,
     )
 
 
@@ -121,6 +130,7 @@ def convert_command(
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
     drop_dangling: DanglingOpt = False,
+    fixed_base: FixedBaseOpt = False,
     print_xml: Annotated[bool, typer.Option("--print", help="Write the MJCF to stdout.")] = False,
     json_mode: JsonOpt = False,
     collision: Annotated[
@@ -181,7 +191,9 @@ def convert_command(
         done = convert_full(
             robot,
             **source_inputs(arg, package),
-            options=_options(keep_fixed, repair_inertia, settings, as_written, drop_dangling),
+            options=_options(
+                keep_fixed, repair_inertia, settings, as_written, drop_dangling, fixed_base
+            ),
         )
     if print_xml:
         typer.echo(standalone_xml(done.spec), nl=False)
@@ -214,6 +226,7 @@ def inspect_command(
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
     drop_dangling: DanglingOpt = False,
+    fixed_base: FixedBaseOpt = False,
     json_mode: JsonOpt = False,
     as_written: AsWrittenOpt = False,
 ) -> None:
@@ -226,7 +239,9 @@ def inspect_command(
     done = convert_full(
         robot,
         **source_inputs(arg, package),
-        options=_options(keep_fixed, repair_inertia, {"mode": "mesh"}, as_written, drop_dangling),
+        options=_options(
+            keep_fixed, repair_inertia, {"mode": "mesh"}, as_written, drop_dangling, fixed_base
+        ),
     )
     stats = inertial_stats(done.spec, done.description)
     out = Output(json_mode)
