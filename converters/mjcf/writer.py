@@ -54,17 +54,20 @@ def msh_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 
 
 def exported_spec(spec: mujoco.MjSpec) -> tuple[mujoco.MjSpec, dict[str, str]]:
-    """A copy of `spec` as the exported file carries it: the world's contact rules and the
-    servos of what the robot's tags command by position or velocity.
+    """A copy of `spec` as the exported file carries it: the world's contact rules, a `home`
+    keyframe that stands a floating robot on the floor as `--on-ground` does, and the servos of
+    what the robot's tags command by position or velocity (the key's ctrl holds their posture).
 
     Returns:
         The copy, and each joint given a servo with its mode.
     """
     from converters.mjcf.export_servos import export_servos
+    from converters.mjcf.home_key import place_on_ground
     from converters.mjcf.world_rules import finish_robot_spec
 
     copy = spec.copy()
     finish_robot_spec(copy)  # priorities and solrefs as a world attaches the robot
+    place_on_ground(copy)
     return copy, export_servos(copy)
 
 

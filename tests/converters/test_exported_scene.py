@@ -12,6 +12,7 @@ import scenarios
 from converters.mjcf.world_rules import POSE_FREE_FIELDS
 from converters.mjcf.writer import write_model
 from converters.pipeline import convert
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 
 FALL_S = 1.0  # [s] of falling and landing (feet touch down after about 0.2 s)
@@ -139,3 +140,24 @@ def test_exported_scene_follows_the_world_through_a_push(exported_robot: Path) -
     gaps, travel = _root_gaps(world, exported_robot.parent / "scene.xml", push=True)
     assert np.hypot(travel[0], travel[1]) > 0.05, f"the push should move the root, {travel}"
     _assert_within(gaps, SAME_FILE_M, "pushed for 0.2 s")
+
+
+def test_exported_scene_from_home_steps_as_the_world_spawned_on_ground(
+    exported_robot: Path,
+) -> None:
+    """A MuJoCo user's start (`scene.xml` reset to its `home` keyframe, ctrl from the key) is a
+    World's `--on-ground` spawn of the source: the same state, and the same steps after it."""
+    model = mujoco.MjModel.from_xml_path(str(exported_robot.parent / "scene.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    world = World()
+    world.spawn(SpawnRequest(scenarios.HUMANOID, on_ground=True), name="humanoid")
+    assert np.array_equal(data.ctrl, world.data.ctrl), "the keyframe's ctrl is the world's"
+    assert np.array_equal(data.qpos, world.data.qpos), "the keyframe's qpos is the world's"
+    root, world_root = model.body("torso").id, world.model.body("humanoid/torso").id
+    gaps = []
+    for _ in range(round(FALL_S / model.opt.timestep)):
+        world.step(1)
+        mujoco.mj_step(model, data)
+        gaps.append(float(np.max(np.abs(world.data.xpos[world_root] - data.xpos[root]))))
+    _assert_within(gaps, SAME_FILE_M, "scene from home, world spawned on the ground")

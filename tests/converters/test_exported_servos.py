@@ -13,6 +13,7 @@ import pytest
 from corpus_registry import corpus_ids
 
 from converters.mjcf.writer import write_model
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 
 GATE_S = 10.0  # [s] of random control per robot, on the ground
@@ -106,8 +107,8 @@ def test_a_world_spawning_the_exported_file_has_the_sources_motors(
     done = converted_corpus(robot_id)
     robot_file = write_model(done.spec, done.report, tmp_path / robot_id)
     from_file, from_source = World(), World()
-    from_file.spawn(robot_file, name="r")
-    from_source.spawn(done.spec.copy(), name="r")
+    from_file.spawn(robot_file, name="r")  # the file's `home` key stands it on the ground
+    from_source.spawn(SpawnRequest(done.spec.copy(), on_ground=True), name="r")
     fields = ("actuator_gainprm", "actuator_biasprm", "actuator_ctrlrange", "actuator_forcerange")
     for field in ("actuator_dyntype", "actuator_gaintype", "actuator_biastype", *fields):
         ours, theirs = getattr(from_file.model, field), getattr(from_source.model, field)

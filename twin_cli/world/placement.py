@@ -1,4 +1,8 @@
-"""Where a spawned entity starts: its lowest point, and overlaps with the ground or others."""
+"""Where a spawned entity starts: its lowest point, and overlaps with the ground or others.
+
+The lowest point is the converter's (`converters.mjcf.lowest_point`), the rule the exported
+`home` keyframe stands a floating robot by; it is re-exported here for the world's callers.
+"""
 
 from __future__ import annotations
 
@@ -8,10 +12,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from converters.mjcf.lowest_point import collision_geoms
+from converters.mjcf.lowest_point import lowest_point as lowest_point  # re-exported
 from twin_cli.world.entities import EntityIndex
 
 PENETRATION_TOL = 1e-4  # [m] overlap below this is resting contact, not a bad start
-_G = mujoco.mjtGeom
 
 
 @dataclass(frozen=True)
@@ -36,39 +41,6 @@ def positioned(model: mujoco.MjModel, qpos: np.ndarray) -> mujoco.MjData:
     data.qpos[:] = qpos
     mujoco.mj_fwdPosition(model, data)
     return data
-
-
-def collision_geoms(model: mujoco.MjModel, geoms: np.ndarray) -> np.ndarray:
-    """The geoms among `geoms` that take part in collisions (contype or conaffinity set)."""
-    live = (model.geom_contype[geoms] != 0) | (model.geom_conaffinity[geoms] != 0)
-    return geoms[live]
-
-
-def lowest_point(model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray) -> float | None:
-    """The lowest world z [m] of the given geoms' surfaces (planes and height fields skipped)."""
-    lows = [_geom_low(model, data, int(g)) for g in geoms]
-    lows = [z for z in lows if z is not None]
-    return min(lows) if lows else None
-
-
-def _geom_low(model: mujoco.MjModel, data: mujoco.MjData, g: int) -> float | None:
-    kind, size = model.geom_type[g], model.geom_size[g]
-    z, rot_z = data.geom_xpos[g][2], data.geom_xmat[g].reshape(3, 3)[2]
-    if kind == _G.mjGEOM_SPHERE:
-        return z - size[0]
-    if kind == _G.mjGEOM_CAPSULE:
-        return z - abs(rot_z[2]) * size[1] - size[0]
-    if kind == _G.mjGEOM_CYLINDER:
-        return z - abs(rot_z[2]) * size[1] - size[0] * np.sqrt(max(0.0, 1.0 - rot_z[2] ** 2))
-    if kind == _G.mjGEOM_BOX:
-        return z - float(np.abs(rot_z) @ size)
-    if kind == _G.mjGEOM_ELLIPSOID:
-        return z - float(np.sqrt(np.sum((rot_z * size) ** 2)))
-    if kind == _G.mjGEOM_MESH:
-        mesh = model.geom_dataid[g]
-        start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
-        return z + float(np.min(model.mesh_vert[start : start + count] @ rot_z))
-    return None
 
 
 def overlaps(
