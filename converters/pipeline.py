@@ -187,7 +187,9 @@ def build_description(
     check_joints(robot)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
-    add_height_fields(spec, robot, report, keep_fixed=options.keep_fixed)  # SDF terrain
+    add_height_fields(
+        spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
+    )  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = add_sensors(spec, robot, provenance, report)
     base = Path(robot.base_dir) if robot.base_dir else Path(robot.source).parent

@@ -17,6 +17,7 @@ import numpy as np
 from converters.description import Collision, RobotDescription
 from converters.errors import InputFileError
 from converters.mjcf.builder import COLLISION_CLASS, pose
+from converters.mjcf.fixed_base import weld_base
 from converters.mjcf.geometry import HEIGHTMAP, static_bodies
 from converters.mjcf.lumping import WORLDBODY, LinkPlacement, plan_bodies
 from converters.replay import read_once
@@ -33,10 +34,17 @@ FLAT_RANGE = 1e-3
 
 
 def add_height_fields(
-    spec: mujoco.MjSpec, robot: RobotDescription, report: Report, *, keep_fixed: bool = False
+    spec: mujoco.MjSpec,
+    robot: RobotDescription,
+    report: Report,
+    *,
+    keep_fixed: bool = False,
+    fixed_base: bool = False,
 ) -> int:
     """Add a height field geom for every heightmap collision of `robot` (a built spec of it);
-    returns how many. Ones already in the spec are kept as they are."""
+    returns how many. Ones already in the spec are kept as they are. `keep_fixed` and
+    `fixed_base` are the build's options: the body plan must be the builder's, so that a
+    heightmap on a root welded by `--fixed-base` counts as static."""
     found = [
         (link.name, index, c)
         for link in robot.links
@@ -51,6 +59,8 @@ def add_height_fields(
         keep_fixed=keep_fixed,
         static=robot.gazebo.static,
     )
+    if fixed_base:  # reported once already, by the builder
+        plan = weld_base(plan, Report())
     static = static_bodies(plan)
     report.entries[:] = [e for e in report.entries if e.tag != HEIGHTMAP]
     added = 0

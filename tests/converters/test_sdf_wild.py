@@ -315,3 +315,31 @@ def test_a_heightmap_model_converts_on_its_own_to_a_height_field(tmp_path: Path)
 
     (geom,) = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD]
     assert model.geom_pos[geom][:2] == pytest.approx([1.0, 0.0]), "centred on <pos> x, y [m]"
+
+
+@pytest.mark.parametrize("fixed_base", [False, True])
+def test_a_heightmap_on_a_root_welded_by_fixed_base_is_kept(
+    tmp_path: Path, fixed_base: bool
+) -> None:
+    """A heightmap on a model that is not `<static>` rides a moving link and is left out
+    (MuJoCo's height fields are static); `--fixed-base` welds that link to the world, so the
+    terrain is kept, with no warning about a moving link."""
+    import mujoco
+    import numpy as np
+    from PIL import Image
+
+    from converters.mjcf.builder import ConvertOptions
+    from converters.pipeline import convert_full
+
+    Image.fromarray(np.zeros((9, 9), np.uint8)).save(tmp_path / "terrain.png")
+    (tmp_path / "terrain.sdf").write_text(
+        f'<sdf version="1.6"><model name="terrain"><link name="l">{INERTIAL.format(m=1)}'
+        '<collision name="c"><geometry><heightmap><uri>terrain.png</uri><size>4 4 2</size>'
+        "</heightmap></geometry></collision></link></model></sdf>"
+    )
+    done = convert_full(tmp_path / "terrain.sdf", options=ConvertOptions(fixed_base=fixed_base))
+    model = done.spec.compile()
+    fields = [g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD]
+    assert len(fields) == int(fixed_base), "a height field only on the welded root"
+    moving = "heightmap on a moving link" in _details(done.report, Outcome.WARNING)
+    assert moving is not fixed_base, "the warning only where the link moves"
