@@ -2,14 +2,14 @@
 
 A converted floating robot's free joint starts where its root link is in the description, most
 often the origin, so legs and feet reach below z = 0. A MuJoCo user who resets a scene to `home`
-then starts the robot inside the ground: measured on the bundled humanoid, 0.95 m deep, and the
-ground's contact threw it 179 m up within 10 s. A twin World spawned `--on-ground` lowers or
-raises the robot until its lowest collision point rests on z = 0 and keeps the key's joint
-values and orientation; `place_on_ground` gives the keyframe the same shift, on every free joint
-(the root and an SDF model's other unjoined links), with the same geometry
-(`converters.mjcf.lowest_point`). The key's ctrl is not changed here (`export_servos` writes the
-posture its position servos hold). A fixed-base robot keeps its pose: its base is where its
-description welds it.
+then starts the robot inside the ground: measured on the bundled humanoid, 0.95 m deep, and
+with ctrl 0 the ground's contact threw it 179 m up within 10 s. A twin World spawned
+`--on-ground` lowers or raises the robot until its lowest collision point rests on z = 0 and
+keeps the key's joint values and orientation; `place_on_ground` gives the keyframe the same
+shift, on every free joint (the root and an SDF model's other unjoined links), with the same
+geometry (`converters.mjcf.lowest_point`), so the key is that spawn's state to the bit. The
+key's ctrl is not changed here (`export_servos` writes the posture its position servos hold).
+A fixed-base robot keeps its pose: its base is where its description welds it.
 """
 
 from __future__ import annotations
