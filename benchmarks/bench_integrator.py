@@ -1,0 +1,204 @@
+"""The world's integrator against MuJoCo's `implicitfast`: step cost, rest and the random-ctrl gate.
+
+Every corpus robot (and the bundled humanoid, the only robot without ../shared) is spawned on
+the ground in a `World`, as `twin spawn` spawns it. `mj_step` then runs the world's own model
+(its integrator as configured) and a copy of it with `implicitfast`, each from a copy of the
+spawned state, island sleeping off in both so every step does the full work:
+- cost: from the state after COST_SETTLE_S, WINDOW_STEPS steps per window, the two models
+  alternating in REPEATS windows each; the best window of each gives its per-step time, and the
+  ratio is the world's over implicitfast's (target: a mean of at most MEAN_RATIO_TARGET);
+- rest: each integrator settles the robot for REST_SETTLE_S, then over REST_S: how far the root
+  (free joint) moves [mm] and turns [mrad], the largest hinge or slide joint drift [mrad or mm],
+  and the peak |qvel| (a light limb that its integrator keeps moving shows there);
+- gate: random ctrl within 10 % of each actuator's ctrlrange around its centre (±UNLIMITED_CTRL
+  without one), resampled every GATE_HOLD_S from `default_rng(0)`, for GATE_S from the spawn:
+  whether the state turns non-finite or MuJoCo raises a warning (the sim time it does), and the
+  peak |qvel|. The world's actuators integrate ctrl (an uncommanded motor's ctrl is its torque
+  rate), so the gate drives each joint with a slowly wandering torque.
+Rest and gate figures are sim-time physics, the same on any machine; the cost ratio is
+measured within one run.
+"""
+
+from __future__ import annotations
+
+import copy
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import tomllib
+
+CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
+PACKAGES = CORPUS / "packages"
+NON_PHYSICAL_INERTIA = ("abb_irb2400_12_155", "anymal_c", "hyq")
+# [s] sim time. A limp robot folds first: the bundled humanoid, symmetric, stands about 4 s on
+# its feet and has fallen by 6 s.
+COST_SETTLE_S, REST_SETTLE_S, REST_S = 1.0, 8.0, 5.0
+# Short windows, so that the best of each model is a window no other process disturbed: on 2
+# shared cores at load 3-4, the best of 4 windows of 2000 steps gave per-robot ratios 0.3 apart
+# in two runs (turtlebot3 1.08 and 1.39); 20 of 200 steps repeat within 0.05.
+WINDOW_STEPS, REPEATS = 200, 20
+GATE_S, GATE_HOLD_S, GATE_SCALE = 10.0, 0.5, 0.1  # [s], [s], share of each ctrlrange
+REST_SAMPLE_STEPS = 10  # |qvel| is sampled every 10 steps at rest
+UNLIMITED_CTRL = 10.0  # half-range for an actuator without ctrlrange (10 % of it: ±1 rad/s)
+MEAN_RATIO_TARGET = 1.15  # the project's goal for the world's step cost over implicitfast's
+
+
+def _spawn_requests() -> dict:
+    """Robot id → SpawnRequest: the corpus robots, then the bundled humanoid."""
+    from scenarios import HUMANOID
+    from twin_cli.spawn_request import SpawnRequest
+
+    requests = {}
+    if (CORPUS / "robots.toml").is_file():
+        packages = {p.name: str(p) for p in PACKAGES.iterdir()}
+        for robot in tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]:
+            requests[robot["id"]] = SpawnRequest(
+                str(PACKAGES / robot["entry"]),
+                package_paths=packages,
+                args=robot["xacro_args"],
+                repair_inertia=robot["id"] in NON_PHYSICAL_INERTIA,
+                drop_dangling=True,
+                on_ground=True,
+            )
+    requests["humanoid"] = SpawnRequest(str(HUMANOID), on_ground=True)
+    return requests
+
+
+def _models(request) -> tuple:  # noqa: ANN001
+    """(world's model, its implicitfast copy, spawned data), island sleeping off in both."""
+    import mujoco
+
+    from twin_cli.world import World
+
+    world = World()
+    world.spawn(request, name="r")
+    sleep = int(mujoco.mjtEnableBit.mjENBL_SLEEP)
+    ours, fast = copy.deepcopy(world.model), copy.deepcopy(world.model)
+    for model in (ours, fast):
+        model.opt.enableflags = int(model.opt.enableflags) & ~sleep
+    fast.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    return ours, fast, copy.copy(world.data)
+
+
+def _step_costs(models: tuple, data) -> list[float]:  # noqa: ANN001
+    """Best per-step time [s] of each model over REPEATS alternating windows from `data`."""
+    import mujoco
+
+    best = [float("inf")] * len(models)
+    for _ in range(REPEATS):
+        for i, model in enumerate(models):
+            work = copy.copy(data)
+            start = time.perf_counter()
+            mujoco.mj_step(model, work, nstep=WINDOW_STEPS)
+            best[i] = min(best[i], (time.perf_counter() - start) / WINDOW_STEPS)
+    return best
+
+
+def _diverged(data) -> bool:  # noqa: ANN001
+    finite = np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
+    return not finite or any(w.number for w in data.warning)
+
+
+def _rest(model, data) -> dict:  # noqa: ANN001
+    """Root motion, joint drift and peak |qvel| over REST_S after REST_SETTLE_S from `data`."""
+    import mujoco
+
+    work, h = copy.copy(data), model.opt.timestep
+    roots = [model.jnt_qposadr[j] for j in range(model.njnt) if model.jnt_type[j] == 0]
+    joints = [model.jnt_qposadr[j] for j in range(model.njnt) if model.jnt_type[j] in (2, 3)]
+    mujoco.mj_step(model, work, nstep=round(REST_SETTLE_S / h))
+    q0, peak = work.qpos.copy(), 0.0
+    for _ in range(round(REST_S / h) // REST_SAMPLE_STEPS):
+        mujoco.mj_step(model, work, nstep=REST_SAMPLE_STEPS)
+        peak = max(peak, float(np.abs(work.qvel).max(initial=0.0)))
+    row = {"peak_qvel": round(peak, 4), "diverged": _diverged(work)}
+    if roots:
+        a, turn = roots[0], np.zeros(3)
+        mujoco.mju_subQuat(turn, work.qpos[a + 3 : a + 7], q0[a + 3 : a + 7])
+        row["root_mm"] = round(float(np.linalg.norm(work.qpos[a : a + 3] - q0[a : a + 3])) * 1e3, 4)
+        row["root_mrad"] = round(float(np.linalg.norm(turn)) * 1e3, 4)
+    drift = np.abs(work.qpos[joints] - q0[joints]).max(initial=0.0)
+    row["joint_drift_milli"] = round(float(drift) * 1e3, 3)
+    return row
+
+
+def _gate(model, data) -> dict:  # noqa: ANN001
+    """Random ctrl within GATE_SCALE of each range for GATE_S: diverged at [s] and peak |qvel|."""
+    import mujoco
+
+    work = copy.copy(data)
+    low, high = model.actuator_ctrlrange.T.copy()
+    unlimited = ~model.actuator_ctrllimited.astype(bool)
+    low[unlimited], high[unlimited] = -UNLIMITED_CTRL, UNLIMITED_CTRL
+    centre, half = (low + high) / 2, (high - low) / 2 * GATE_SCALE
+    rng, hold = np.random.default_rng(0), round(GATE_HOLD_S / model.opt.timestep)
+    peak = 0.0
+    for _ in range(round(GATE_S / GATE_HOLD_S)):
+        work.ctrl[:] = rng.uniform(centre - half, centre + half)
+        mujoco.mj_step(model, work, nstep=hold)
+        if _diverged(work):
+            return {"diverged_at_s": round(work.time, 2), "peak_qvel": round(peak, 1)}
+        peak = max(peak, float(np.abs(work.qvel).max(initial=0.0)))
+    return {"diverged_at_s": None, "peak_qvel": round(peak, 1)}
+
+
+def _robot(request) -> dict:  # noqa: ANN001
+    import mujoco
+
+    ours, fast, data = _models(request)
+    settled = copy.copy(data)
+    mujoco.mj_step(ours, settled, nstep=round(COST_SETTLE_S / ours.opt.timestep))
+    cost_ours, cost_fast = _step_costs((ours, fast), settled)
+    name = mujoco.mjtIntegrator(int(ours.opt.integrator)).name.removeprefix("mjINT_").lower()
+    return {
+        "integrator": name,
+        "nv": int(ours.nv),
+        "step_us": round(cost_ours * 1e6, 2),
+        "implicitfast_step_us": round(cost_fast * 1e6, 2),
+        "ratio": round(cost_ours / cost_fast, 3),
+        "rest": {name: _rest(ours, data), "implicitfast": _rest(fast, data)},
+        "gate": {name: _gate(ours, data), "implicitfast": _gate(fast, data)},
+    }
+
+
+def _table(rows: dict) -> str:
+    """Robot → ratio, with rest drift and the gate's outcome for both integrators (world / fast)."""
+    lines = [
+        f"{'robot':19} {'ratio':>6} {'world µs':>9} {'fast µs':>8} {'rest root mm':>19} "
+        f"{'rest joint milli':>19} {'gate diverged s':>15}"
+    ]
+    for rid, row in rows.items():
+        if "skipped" in row:
+            lines.append(f"{rid:19} skipped: {row['skipped']}")
+            continue
+        rest, gate = list(row["rest"].values()), list(row["gate"].values())
+        root = "/".join(str(r.get("root_mm", "fixed")) for r in rest)
+        joint = "/".join(str(r["joint_drift_milli"]) for r in rest)
+        diverged = "/".join(str(g["diverged_at_s"] or "no") for g in gate)
+        lines.append(
+            f"{rid:19} {row['ratio']:6.3f} {row['step_us']:9.2f} "
+            f"{row['implicitfast_step_us']:8.2f} {root:>19} {joint:>19} {diverged:>15}"
+        )
+    return "\n".join(lines)
+
+
+def run() -> dict:
+    start = time.perf_counter()
+    rows: dict[str, dict] = {}
+    for rid, request in _spawn_requests().items():
+        try:
+            rows[rid] = _robot(request)
+        except Exception as exc:  # a robot that needs options the bench does not give
+            rows[rid] = {"skipped": f"{type(exc).__name__}: {exc}"[:160]}
+    ratios = [row["ratio"] for row in rows.values() if "ratio" in row]
+    mean = round(float(np.mean(ratios)), 3) if ratios else None
+    print(_table(rows), f"\nmean ratio {mean} (target ≤ {MEAN_RATIO_TARGET})", file=sys.stderr)
+    return {
+        "robots": rows,
+        "mean_ratio": mean,
+        "mean_ratio_target": MEAN_RATIO_TARGET,
+        "within_target": mean is not None and mean <= MEAN_RATIO_TARGET,
+        "wall_s": round(time.perf_counter() - start, 1),
+    }
