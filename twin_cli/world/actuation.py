@@ -47,10 +47,8 @@ class JointCommand:
         velocity_limit: the joint's velocity limit [rad/s or m/s] (inf when none).
         feedforward: velocity the position servo's damping tracks [rad/s or m/s] (trajectories).
         rule: where the gains came from (`twin joints` shows it).
-        hold: force [N m or N] the position servo adds at its target: the gravity load of the
-            target posture (fixed-base entities). hold_slope: [N m/rad or N/m] how that force
-            changes with the joint's position, so that it is the start posture's load at the
-            start of a move (`twin_cli.world.servos`).
+        hold, hold_slope: 0; read from saves written when position servos fed forward the
+            posture's gravity load (now MuJoCo's gravity compensation, `gravity_comp`).
     """
 
     actuator: str
@@ -99,7 +97,7 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
     """Writes `cmd` into actuator `a` of `model` (gains, bias, force range) and `data.ctrl`.
 
     Everything then runs inside mj_step, with no Python per step:
-    - position: force = kp·(target − q) + kv·(feedforward − q̇) + hold, within ±effort;
+    - position: force = kp·(target − q) + kv·(feedforward − q̇), within ±effort;
     - velocity: force = kv·(target − q̇), within ±effort;
     - effort u with a velocity limit v: Gazebo zeroes the effort while |q̇| > v in u's direction
       (Joint::CheckAndTruncateForce). Here the actuator is a velocity servo towards sign(u)·v
@@ -130,7 +128,7 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
     model.actuator_biastype[a] = _AFFINE
     if cmd.mode == "position":
         model.actuator_gainprm[a, 0] = cmd.kp / gear
-        model.actuator_biasprm[a, 0] = (cmd.kv * cmd.feedforward + cmd.hold) / gear
+        model.actuator_biasprm[a, 0] = cmd.kv * cmd.feedforward / gear
         model.actuator_biasprm[a, 1] = -cmd.kp / gear
     else:
         model.actuator_gainprm[a, 0] = cmd.kv / gear

@@ -11,11 +11,10 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
 import mujoco
-import numpy as np
 
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import joint_control, servo_watch, servos
+from twin_cli.world import gravity_comp, joint_control, servos
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -109,9 +108,9 @@ def command_joints(
         dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
         rolling = dofs if mode == "velocity" else dofs[:0]
         loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
-        fixed = ix.free_qpos < 0
-        start = joint_control.posture_loads(state.model, state.data, {})[1] if fixed else None
-        return [_set_command(state, c, loads, start) for c in checked]
+        commands = [_set_command(state, c, loads) for c in checked]
+        gravity_comp.switch(state.model, state.commands)
+        return commands
 
 
 def _checked(
@@ -136,25 +135,14 @@ def _checked(
     return key, a, j, mode, float(value), effort, limits
 
 
-def _set_command(
-    state: WorldState, checked: tuple, loads: tuple, start: np.ndarray | None
-) -> control.JointCommand:
-    """Writes one checked command. A fixed-base position servo holds the static load of the
-    posture (`start`: the loads where the entity is now; None for a free-base entity), from the
-    start posture's to the target's as the joint moves."""
+def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.JointCommand:
+    """Writes one checked command."""
     key, a, j, mode, value, effort, limits = checked
-    inertia, load, carried = loads
+    inertia, _, carried = loads
     dof = int(state.model.jnt_dofadr[j])
     here = float(state.data.qpos[state.model.jnt_qposadr[j]])
     qvel = float(state.data.qvel[dof])
-    hold = float(load[dof]) if start is not None and mode == "position" else 0.0
     step = abs(value - here) if mode == "position" else abs(value)
-    slope = 0.0
-    if start is not None and mode == "position" and step > 1e-9:
-        now = float(start[dof])
-        if math.isfinite(effort):  # the loads the servo can give, at both ends of the move
-            hold, now = (min(max(v, -effort), effort) for v in (hold, now))
-        slope = (hold - now) / (value - here)
     reference = servos.has_reference(state.model, a)
     kp, kv, rule = joint_control.servo_rule(
         mode,
@@ -166,38 +154,20 @@ def _set_command(
         reference=reference,
         carried=float(carried[dof]),
     )
-    if math.isfinite(effort):
-        hold = min(max(hold, -effort), effort)
-    slope = min(slope, 0.5 * kp) if servos.has_reference(state.model, a) else 0.0  # stays stiff
     previous = state.commands.get(key)
-    if reference and mode == "velocity" and previous and previous.mode == mode:
-        if previous.rule == servos.HELD_FROM_LOAD:
-            _carry_integral(state, a, j, previous.kp, kp)
-        else:
-            kp, kv, rule = previous.kp, previous.kv, previous.rule  # its integral stays as it was
-    cmd = control.JointCommand(
-        key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule, hold, slope
-    )
+    was = servos.kind(previous) if previous else ""
+    cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule)
+    if reference and previous and was == servos.kind(cmd) == "velocity":
+        cmd = replace(cmd, kp=previous.kp, kv=previous.kv, rule=previous.rule)  # same integral
     if reference:
         lead = 0.0
-        if mode == "velocity" and kv > 0:
+        if mode == "velocity" and cmd.kv > 0:
             before = previous.target if previous and previous.mode == mode else qvel
-            lead = float(carried[dof]) * (value - before) / kv
-        servos.start(state.model, state.data, a, cmd, previous.mode if previous else "", lead)
+            lead = float(carried[dof]) * (value - before) / cmd.kv
+        servos.start(state.model, state.data, a, cmd, was, lead)
     control.apply_command(state.model, state.data, a, cmd)
     state.commands[key] = cmd
-    if reference and mode != "effort":
-        servo_watch.watch(state)
     return cmd
-
-
-def _carry_integral(state: WorldState, a: int, j: int, old_kp: float, new_kp: float) -> None:
-    """Rescales a velocity servo's integral r − q to new gains so that it carries the same force
-    (what a held wheel holds on a slope)."""
-    if old_kp > 0 and new_kp > 0:
-        q = float(state.data.qpos[state.model.jnt_qposadr[j]])
-        address = state.model.actuator_actadr[a]
-        state.data.act[address] = q + (state.data.act[address] - q) * old_kp / new_kp
 
 
 def _actuated(m: mujoco.MjModel, ix: EntityIndex) -> dict[int, int]:
@@ -241,16 +211,13 @@ def release_commands(
 
 
 def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """Writes every joint command into a (re)compiled model, by actuator name, and starts the
-    servo observer for them (a loaded or restored world has none yet)."""
-    watched = False
+    """Writes every joint command into a (re)compiled model, by actuator name, and switches
+    fixed-base robots' gravity compensation to match (`gravity_comp`)."""
     for actuator, cmd in state.commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
         if a >= 0:
             control.apply_command(model, data, a, cmd)
-            watched |= cmd.mode != "effort" and servos.has_reference(model, a)
-    if watched:
-        servo_watch.watch(state)
+    gravity_comp.switch(model, state.commands)
 
 
 def record_targets(

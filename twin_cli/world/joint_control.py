@@ -12,7 +12,7 @@ a motor without one (hand-written MJCF) offers every mode with no velocity limit
   v/(dt·|Δ|)) for a step of Δ, v = SPEED_MARGIN·v_max, kv = max(2·√(kp·I), kp·|Δ|/v) (an
   overdamped PD from rest never moves faster than v); velocity kv from `vel_kp`, else full
   effort at 5 % of the velocity limit, at most I/h with an effort limit (`_velocity_gain`).
-- a fixed-base entity's position servo also feeds forward the static load of the posture.
+- a fixed-base entity's weight: MuJoCo's gravity compensation (`twin_cli.world.gravity_comp`).
 - effort: Gazebo's velocity rule (see twin_cli.world.actuation.apply_command).
 """
 

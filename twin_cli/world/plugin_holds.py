@@ -5,20 +5,18 @@ no one has driven stands on a slope. twin's drive controllers start on a robot's
 command; until then these holds stand in for them: after every spawn and every full reset, each
 joint `converters.gazebo.drive_records.held_from_load` lists gets its command (wheels a zero
 velocity, steering joints the angle 0), as `twin command` would give it. A joint whose motor does
-not offer that mode (its tags name other interfaces) is left as it is. The holds' gains are
-provisional (`servos.HELD_FROM_LOAD`): a spawn does not yet know which contacts the wheels will
-carry the robot through, so the first velocity command derives its own gains and keeps the held
-force.
+not offer that mode (its tags name other interfaces) is left as it is. A wheel's zero velocity
+is its joint's dry friction bounded by the effort limit (`twin_cli.world.speed_holds`): a value
+on the model with no gains to derive, so a later velocity command writes its own servo as it
+would on a wheel no one held.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import replace
 
 from converters.gazebo.drive_records import held_from_load
 from twin_cli.world import driving, joint_control
-from twin_cli.world.servos import HELD_FROM_LOAD
 from twin_cli.world.state import WorldState
 
 
@@ -31,5 +29,4 @@ def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
             if joint in motors and mode in joint_control.limits_of(state.model, name, joint).modes:
                 by_mode.setdefault(mode, {})[joint] = target
         for mode, targets in by_mode.items():
-            for cmd in driving.command_joints(state, name, targets, mode=mode, clip=True):
-                state.commands[cmd.actuator] = replace(cmd, rule=HELD_FROM_LOAD)
+            driving.command_joints(state, name, targets, mode=mode, clip=True)

@@ -12,37 +12,36 @@ for a lighter wheel).
 So every motor of a spawned robot gets one activation, a reference position r [rad or m] that
 MuJoCo integrates itself (dyntype integrator, ṙ = ctrl), and the servo tracks it:
 
-    force = kp·(r − q) + kv·(ṙ_ff − q̇) + hold,   within ±effort
+    force = kp·(r − q) + kv·(ṙ_ff − q̇),   within ±effort
 
 - velocity v*: ctrl = v*, ṙ_ff = v*, r starts at q. kp·(r − q) = kp·∫(v* − q̇)dt is the integral
-  term of a PI velocity servo: under a constant load the joint runs at v* exactly.
-  `limit_windup` (an observer at WINDUP_RATE) keeps the integral where the effort limit leaves
-  it room, so a spin-up or a stall does not store a catch-up burst for later. A limited joint's
-  r stays in its range (`actrange`), so a command into a limit does not wind up either.
+  term of a PI velocity servo: under a constant load the joint runs at v* exactly. Nothing
+  bounds the integral but a limited joint's range (`actrange`): MuJoCo has no bounded integral
+  an actuator can hold, so after a stall the joint catches up with r (a 0.1 N m wheel at 3 rad/s
+  overloaded 1.5× for 0.5 s peaks at 43 rad/s after the release), where Gazebo's constraint
+  motor would not.
+- velocity 0 (HOLD): the joint's dry friction bounded by its effort, the motor pushing nothing
+  (`twin_cli.world.speed_holds`): no integral, so nothing to pay back after a stop.
 - position q*: r ramps from q to q* at 0.95·v_max and stops there (`actrange` clamps it); the PD
   is overdamped and tracks the ramp 2·v/ω behind, then settles
   without overshoot (the error after the ramp is (2v/ω + v·t)·e^(−ωt), never negative). A 1 rad
   move at 1 rad/s settles within 1 % in about 1.1 s. Without a velocity limit r jumps to q*.
 - trajectory: the follower writes r and its speed at each update; r ramps between updates.
-- a fixed-base robot's position servo adds the static load (gravity, springs) of the posture,
-  interpolated along the move by the joint's own position: the start posture's load at the start,
-  the target's at the target. Holding the target's load from the start pushed a UR5e's shoulder
-  to 2.2 times its velocity limit.
+- a fixed-base robot's weight goes through its position servos' actuators as MuJoCo's own
+  gravity compensation (`twin_cli.world.gravity_comp`), within the same effort limit.
 
 kv = I/h on the joint's own reflected inertia I, the most damping a clamped step tolerates, and
 kp critically damped on the inertia I_c the joint carries when the command arrives
 (`twin_cli.world.joint_control.posture_loads`: its other joints held, and a wheel's robot through
 its contacts), with INTEGRAL_MARGIN for velocity. A wheel carries its robot: tuned on the wheel
 alone, a cart's wheels rang to 1.34 rad/s on a 1 rad/s command.
-Everything runs inside mj_step; Python only writes a command, and the windup observer
-reads a few numbers at WINDUP_RATE.
+Everything runs inside mj_step; Python only writes a command.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -50,11 +49,9 @@ import numpy as np
 
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_servos import EXPORTED
-from twin_cli.world import sleeping
+from twin_cli.world import gravity_comp, sleeping, speed_holds
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
-
     from twin_cli.world.actuation import JointCommand
 
 INTEGRAL_MARGIN = 8.0
@@ -64,25 +61,7 @@ the carried inertia is right, less when it is overestimated; the integral then s
 about 4·INTEGRAL_MARGIN·I_c/kv."""
 SPEED_MARGIN = 0.95  # ramp speed of a position move, as a fraction of the velocity limit
 OVERSHOOT = 0.05  # most a position servo's speed may pass its ramp's while it catches up
-LEAK_S = 0.5
-"""[s] how fast a stopped servo forgets an integral it is paying back. An integral also stores
-the lag of a speed change the damping could not follow (a light wheel dragged on by its
-robot while it brakes) and pays it back later: a turtlebot stopped after a drive turned its
-wheels back for a minute (1.1-1.7 mrad of yaw in 60 s). So while a servo commanded to 0 moves
-towards its reference (mean |q̇| > LEAK_SPEED, the sign of r − q) within LEAK_WINDOW_S of its
-stop, the integral decays; a load that pushes the joint away from its reference, or holds it
-still, keeps it."""
-LEAK_SPEED = 1e-5  # [rad/s or m/s]
-LEAK_WINDOW_S = 3.0
-"""[s] how long after a servo is given speed 0 it may still forget its integral. A lag is paid
-back in the first seconds after a stop; later the integral holds a load (a wheel parked on a
-slope), and letting it leak whenever chatter swings the joint back made a held turtlebot3 creep
-0.08 mm/s down a 5° slope."""
-HELD_FROM_LOAD = "held from load"
-"""The rule of a drive plugin's hold from spawn (`twin_cli.world.plugin_holds`). Its gains were
-derived before the robot's contacts were known, so the next velocity command derives its own;
-it stored no lag, so its integral never leaks (a leak let a held base creep down a slope)."""
-WINDUP_RATE = 100.0  # [Hz] of sim time at which a velocity servo's reference is kept near q
+HOLD = "hold"  # the kind of a velocity command of 0 held by friction (`twin_cli.world.speed_holds`)
 MARK_SLOT, MARK = 9, 1.0  # dynprm entry that marks a servo reference (integrators ignore dynprm)
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
 _NONE = mujoco.mjtDyn.mjDYN_NONE
@@ -91,7 +70,8 @@ _FIXED = mujoco.mjtGain.mjGAIN_FIXED
 
 
 def give_reference(spec: mujoco.MjSpec) -> None:
-    """Gives every plain joint motor of a robot spec its reference activation (see module doc).
+    """Gives every plain joint motor of a robot spec its reference activation (see module doc),
+    and a fixed-base robot its gravity compensation (`twin_cli.world.gravity_comp.prepare`).
 
     A plain motor (gain 1 on its input, no bias, no dynamics) pushes nothing until commanded, and
     with an integrator and ctrl 0 its activation stays 0, so an uncommanded robot is unchanged.
@@ -108,6 +88,8 @@ def give_reference(spec: mujoco.MjSpec) -> None:
         if plain:
             actuator.dyntype = _INTEGRATOR
             actuator.dynprm[MARK_SLOT] = MARK  # not an MJCF <intvelocity>: ours to rewrite
+            speed_holds.remember_own(actuator, spec.joint(actuator.target))
+    gravity_comp.prepare(spec)
 
 
 def restore_exported_motors(spec: mujoco.MjSpec) -> None:
@@ -185,7 +167,7 @@ def start(
     previous: str,
     lead: float = 0.0,
 ) -> None:
-    """Sets the reference of a new command `cmd` (mode `previous` before, "" for none).
+    """Sets the reference of a new command `cmd` (`kind` of the command before, "" for none).
 
     A servo continuing in its mode keeps its reference: a velocity change keeps the load it
     learnt, a new position target ramps on from where the last ramp was. A new position servo
@@ -197,10 +179,11 @@ def start(
     A velocity change then steps the reference back by `lead` [rad or m]: the lag the damping
     builds while it brings the joint to its new speed, I_c·Δv/kv. An integral that stored that
     lag would pay it back as overshoot for seconds (a cart's wheels ran 2.6 % fast, and 1.6 %
-    still after 3 s). What a stopped servo still pays back decays (`limit_windup`).
+    still after 3 s). A velocity servo that takes over from a HOLD starts at the joint (a
+    friction stores nothing to carry over).
     """
     address = model.actuator_actadr[a]
-    if previous == cmd.mode:
+    if previous == kind(cmd):
         data.act[address] -= lead
         return
     joint = int(model.actuator_trnid[a, 0])
@@ -214,12 +197,24 @@ def start(
     data.act[address] = reference - lead
 
 
+def kind(cmd: JointCommand) -> str:
+    """The command's mode, or HOLD for a velocity of 0 that the joint's friction holds."""
+    return HOLD if speed_holds.is_hold(cmd.mode, cmd.target) else cmd.mode
+
+
 def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
     """Writes a position or velocity command into actuator `a` (its force range is set)."""
     gear = abs(model.actuator_gear[a][0]) or 1.0
     joint = int(model.actuator_trnid[a, 0])
     address = int(model.actuator_actadr[a])
     model.actuator_dyntype[a] = _INTEGRATOR
+    if kind(cmd) == HOLD:
+        speed_holds.write(model, a, cmd.effort)
+        model.actuator_actlimited[a] = 0
+        data.ctrl[a] = 0.0
+        sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
+        return
+    speed_holds.lift(model, a)
     model.actuator_biastype[a] = _AFFINE
     model.actuator_gainprm[a, 0] = cmd.kp / gear
     model.actuator_biasprm[a, 2] = -cmd.kv / gear**2
@@ -236,27 +231,26 @@ def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand)
         speed = 0.0 if here == cmd.target else speed
         low, high = min(here, cmd.target), max(here, cmd.target)
         feedforward = 0.0  # the ramp ends at the target; a lag 2v/ω is the price
-    hold = cmd.hold - cmd.hold_slope * cmd.target  # + hold_slope·q through biasprm[1]
-    model.actuator_biasprm[a, 0] = (cmd.kv * feedforward + hold) / gear
-    model.actuator_biasprm[a, 1] = (cmd.hold_slope - cmd.kp) / gear**2
+    model.actuator_biasprm[a, 0] = cmd.kv * feedforward / gear
+    model.actuator_biasprm[a, 1] = -cmd.kp / gear**2
     model.actuator_actlimited[a] = int(math.isfinite(low) or math.isfinite(high))
     model.actuator_actrange[a] = (low, high) if model.actuator_actlimited[a] else (0.0, 0.0)
     data.ctrl[a] = speed
-    sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), moving(model, data, a, cmd))
+    sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), driven(cmd))
 
 
-def moving(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> bool:
-    """Whether a servo still drives its joint somewhere: a non-zero velocity, a trajectory,
-    or a position ramp that has not reached its target."""
+def driven(cmd: JointCommand) -> bool:
+    """Whether a servo drives its joint on until the next command: a non-zero velocity or a
+    trajectory. A position ramp moves its joint from its first steps, which keeps the tree
+    awake by MuJoCo's own rule, and lets it sleep once it holds its target."""
     if cmd.mode == "velocity":
         return cmd.target != 0.0
-    if cmd.feedforward or data.ctrl[a] != 0.0:
-        return float(data.act[model.actuator_actadr[a]]) != cmd.target or bool(cmd.feedforward)
-    return False
+    return bool(cmd.feedforward)
 
 
 def release(model: mujoco.MjModel, a: int) -> None:
     """Stops the reference (effort mode): no dynamics, no range; the force ignores it."""
+    speed_holds.lift(model, a)
     model.actuator_dyntype[a] = _NONE
     model.actuator_actlimited[a] = 0
 
@@ -266,83 +260,6 @@ def _joint_range(model: mujoco.MjModel, joint: int) -> tuple[float, float]:
         low, high = model.jnt_range[joint]
         return float(low), float(high)
     return -math.inf, math.inf
-
-
-@dataclass
-class WindupMemory:
-    """What the servo observer keeps between calls, per actuator name (ids shift when an entity
-    is deleted): its joint's position with the sim time, its speed target with the sim time it
-    was first seen (time that went back, a reset, starts both afresh), and its id in the model."""
-
-    position: dict[str, tuple[float, float]] = field(default_factory=dict)
-    target: dict[str, tuple[float, float]] = field(default_factory=dict)
-    model: mujoco.MjModel | None = None
-    servo_ids: dict[str, int] = field(default_factory=dict)
-
-    def servo(self, model: mujoco.MjModel, key: str) -> int:
-        """The id of actuator `key` if it carries a reference activation, else -1; looked up
-        once per compiled model (the observer runs at WINDUP_RATE)."""
-        if model is not self.model:
-            self.model, self.servo_ids = model, {}
-        a = self.servo_ids.get(key)
-        if a is None:
-            a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
-            a = self.servo_ids[key] = a if a >= 0 and has_reference(model, a) else -1
-        return a
-
-    def mean_speed(self, key: str, q: float, now: float) -> float:
-        """The joint's mean speed since the previous call [rad/s or m/s] (0 at the first)."""
-        before = self.position.get(key)
-        self.position[key] = (now, q)
-        if before is None or now <= before[0]:
-            return 0.0
-        return (q - before[1]) / (now - before[0])
-
-    def held_for(self, key: str, target: float, now: float) -> float:
-        """[s] how long the servo has had this speed target."""
-        seen = self.target.get(key)
-        if seen is None or seen[0] != target or now < seen[1]:
-            seen = self.target[key] = (target, now)
-        return now - seen[1]
-
-
-def limit_windup(
-    model: mujoco.MjModel,
-    data: mujoco.MjData,
-    servos: Iterable[tuple[int, JointCommand]],
-    memory: WindupMemory,
-) -> None:
-    """Clamps each velocity servo's integral e = r − q so that kv·(v* − q̇) + kp·e stays within
-    ±effort, and lets it grow only towards the side with room left: while the damping term alone
-    saturates the joint (spinning up, stalled), the integral does not grow, so the joint reaches
-    its speed, or leaves a stall, without a catch-up burst; a stopped servo forgets a lag it
-    pays back (LEAK_S).
-
-    Args:
-        servos: (actuator id, its velocity command) with kp > 0.
-        memory: kept by the caller between calls. Whether a joint moves towards its
-            reference is read from its mean speed since the previous call, not from its speed
-            now, which contact chatter flips from step to step; and only within LEAK_WINDOW_S
-            of its stop.
-    """
-    keep = math.exp(-1.0 / (WINDUP_RATE * LEAK_S))
-    for a, cmd in servos:
-        joint = int(model.actuator_trnid[a, 0])
-        q = float(data.qpos[model.jnt_qposadr[joint]])
-        speed = float(data.qvel[model.jnt_dofadr[joint]])
-        damping = cmd.kv * (cmd.target - speed)
-        effort = cmd.effort if math.isfinite(cmd.effort) else math.inf
-        low = min(0.0, (-effort - damping) / cmd.kp)
-        high = max(0.0, (effort - damping) / cmd.kp)
-        address = int(model.actuator_actadr[a])
-        error = min(max(float(data.act[address]) - q, low), high)
-        now = float(data.time)
-        mean_speed = memory.mean_speed(cmd.actuator, q, now)
-        stopping = memory.held_for(cmd.actuator, cmd.target, now) < LEAK_WINDOW_S
-        back = abs(mean_speed) > LEAK_SPEED and error * mean_speed > 0.0
-        if cmd.target == 0.0 and stopping and back and cmd.rule != HELD_FROM_LOAD:
-            error *= keep  # paying back a stored lag (LEAK_S)
-        data.act[address] = q + error
 
 
 def follow(
@@ -356,7 +273,7 @@ def follow(
 
     Args:
         ids: actuator ids. references: (the reference now, the one due at the next update
-            [rad or m], the time to it [s]). bias: the constant force term (kv·speed + hold,
+            [rad or m], the time to it [s]). bias: the constant force term (kv·speed,
             per gear).
     Actuators with a reference activation (`has_reference`) start at the reference now and ramp
     to the next one in C, within their joint's range; the others aim at the next one (ctrl).

@@ -13,7 +13,6 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import InvalidRequestError
-from twin_cli.world import servo_watch
 from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.driving import reapply_commands, release_commands
 from twin_cli.world.entities import Entity, typed_like
@@ -116,6 +115,5 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
         dropped = [c for key, c in state.commands.items() if key not in kept]
         state.commands = {c.actuator: c for c in snapshot.commands}
         release_commands(state.model, state.data, dropped)
-        servo_watch.unwatch(state)  # what it remembered belongs to the state before
         reapply_commands(state, state.model, state.data)
         state.pushes = list(snapshot.pushes)

@@ -55,8 +55,6 @@ class WorldState:
         kept_specs: entity name → its spec as prepared for attaching, and its mesh keys.
         deletes_since_renewal, spec_renewals, spec_renewals_refused: spec renewal counters.
         file_notes: what a world file held that twin does not simulate.
-        servo_observer: handle of the observer that tends moving servos (0: none;
-            `twin_cli.world.servo_watch`).
     """
 
     name: str
@@ -88,7 +86,6 @@ class WorldState:
     spec_renewals: int = 0
     spec_renewals_refused: int = 0
     file_notes: tuple[str, ...] = ()
-    servo_observer: int = 0
 
     def __post_init__(self) -> None:
         self.scratch_state = np.empty(mujoco.mj_stateSize(self.model, STATE))

@@ -13,6 +13,7 @@ from models import two_wheel_bot, write_urdf
 from twin_cli.control import follow_trajectory, tracking_report, trajectory_from_dict
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError
 from twin_cli.world import Pose, World, WorldSettings
+from twin_cli.world.gravity_comp import ON
 
 HOME = {"panda_joint4": -1.5, "panda_joint6": 1.5}  # the rest inside every joint's range
 SPEED = 0.5  # [rad/s] velocity command
@@ -91,13 +92,14 @@ def test_panda_arm_joints_switch_between_all_three_modes_while_running(tmp_path)
 
 
 def test_a_switch_under_gravity_holds_where_the_joint_is_without_the_old_target(tmp_path):
-    # The velocity servo holds a zero command under the arm's weight (its integral takes the
-    # load); what the position servo held (its target, the posture's load) must not act.
+    # A zero velocity holds under the arm's weight (the joint's friction bounded by its effort);
+    # what the position servo held (its target, the gravity compensation) must not act.
     world = _spawn_panda(tmp_path, gravity=True)
     world.command_joints("panda", {j: HOME.get(j, 0.0) for j in PANDA_JOINTS}, mode="position")
     world.step(SETTLE_STEPS)  # the other joints hold the arm still, not flop under gravity
     world.command_joints("panda", {"panda_joint2": 0.5}, mode="position")
-    assert abs(world.commands()["panda/panda_joint2"].hold) > 1.0, "joint2 holds the arm"
+    link = int(world.model.joint("panda/panda_joint2").bodyid[0])
+    assert world.model.body_gravcomp[link] == ON, "joint2 holds the arm with gravcomp"
     world.step(150)  # mid-move
     world.command_joints("panda", {"panda_joint2": 0.0}, mode="velocity")
     world.step(50)

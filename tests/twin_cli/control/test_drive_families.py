@@ -356,19 +356,28 @@ def test_a_base_no_one_has_driven_holds_on_a_slope(tmp_path: Path, name: str) ->
     assert rolled > 0.05, f"{name} without its plugins rolled only {rolled:.3f} m: no control"
 
 
-def test_the_first_drive_derives_its_own_gains_from_the_hold(tmp_path: Path) -> None:
-    """The hold's gains were set before the wheels touched the ground; the drive's are its own,
-    and the base still follows the unicycle (test_drive_follows_its_kinematic_model...)."""
-    from twin_cli.world.servos import HELD_FROM_LOAD
+def test_a_plugin_hold_is_the_wheels_friction_until_the_first_drive(tmp_path: Path) -> None:
+    """A spawned base's held wheels are their joints' dry friction bounded by the effort, on the
+    model, with the motor pushing nothing; the drive's first command gives the joints their own
+    friction back and its servo its own gains."""
+    import mujoco
 
-    world, _, _, _ = _drive(tmp_path, "gazebo_ros_diff_drive", {"linear": V})
-    rules = {c.rule for c in world.commands().values()}
-    assert HELD_FROM_LOAD not in rules, rules
+    world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
+    m, wheels = world.model, ("wheel_left_joint", "wheel_right_joint")
+    dofs = [
+        m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"base/{j}")] for j in wheels
+    ]
+    efforts = [world.joint_commands("base")[j]["effort_limit"] for j in wheels]
+    assert list(m.dof_frictionloss[dofs]) == efforts, "held: friction = the effort limit"
+    drive(world, "base", V)
+    world.step(100)
+    assert list(world.model.dof_frictionloss[dofs]) == [0.0, 0.0], "driven: the joints' own"
+    assert all(world.joint_commands("base")[j]["kp"] > 0 for j in wheels)
 
 
 def test_the_first_drive_keeps_the_force_the_hold_carried(tmp_path: Path) -> None:
-    """Held on a slope, then a first drive command of zero speed: the new gains carry the held
-    load from their first step (the integral rescaled), so the base does not sag downhill."""
+    """Held on a slope, then a first drive command of zero speed: the wheels stay held by their
+    friction, so the base does not sag downhill."""
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     assert _watch_on_a_slope(world) < HELD_M
     p0 = world.get_pose("base")

@@ -10,6 +10,7 @@ import pytest
 from models import _control_inertial, write_urdf
 
 from twin_cli.world import Pose, World
+from twin_cli.world.speed_holds import HOLD_SOLIMP
 
 EFFORT = 0.1  # [N m] the wheel's effort limit
 MOMENT = 1e-3  # [kg m²] the disc's moment about its axle
@@ -69,27 +70,61 @@ def test_a_wheel_holds_its_speed_under_half_its_effort_limit(wheel: World) -> No
     assert speeds.min() > 0.9 * SPEED, f"dipped to {speeds.min():.3f} rad/s when loaded"
 
 
-def test_an_overloaded_wheel_saturates_at_its_effort_and_recovers_without_a_burst(wheel):
+def test_an_overloaded_wheel_saturates_at_its_effort_and_then_catches_up_its_reference(wheel):
+    """Overloaded, the wheel decelerates as Newton's law with the effort at its limit says.
+    Released, it runs back onto its reference path r = r0 + v*·t, which MuJoCo integrates in
+    the servo's activation: the integral keeps what the stall stored and pays it back. Gazebo's
+    motor, a velocity constraint bounded by FMax, stores nothing (with a windup observer in
+    Python the wheel came back at 3.07 rad/s peak, 3.11 rad behind its path); MuJoCo has no
+    bounded integral an actuator can hold, so here the wheel peaks at 43 rad/s and is back at
+    speed, on its path, 3.3 s after the release (measured)."""
+    q0, t0 = wheel.joint_states("w")[0].position, float(wheel.data.time)
     load = -1.5 * EFFORT
     _load(wheel, load)
     speeds = _speeds(wheel, 50)  # 0.5 s: decelerates at (load + effort)/I
     slope = np.polyfit(np.arange(10, 50) * 0.01, speeds[10:], 1)[0]
     assert slope == pytest.approx((load + EFFORT) / MOMENT, rel=0.02), "I·dω/dt = load + effort"
     _load(wheel, -load)  # the load removed (the pushes add up to 0)
-    after = _speeds(wheel, 200)
-    assert after.max() < 1.05 * SPEED, f"a catch-up burst to {after.max():.2f} rad/s"
-    assert after[-20:] == pytest.approx(SPEED, rel=0.01)
+    after = _speeds(wheel, 400)
+    assert after[-20:] == pytest.approx(SPEED, rel=0.01), "back at its speed within 4 s"
+    behind = q0 + SPEED * (float(wheel.data.time) - t0) - wheel.joint_states("w")[0].position
+    assert abs(behind) < 1e-3, f"{behind:.4f} rad off its reference path after the stall"
 
 
-def test_a_zero_velocity_command_holds_the_wheel_still_under_load(wheel: World) -> None:
+@pytest.mark.parametrize("fraction", [0.25, 0.5, 0.9])
+def test_a_zero_velocity_command_holds_the_wheel_under_load(wheel: World, fraction) -> None:
+    """Speed 0 is the joint's dry friction bounded by the effort (Gazebo's FMax at speed 0). It
+    is MuJoCo's soft constraint at its stiffest impedance d = HOLD_SOLIMP[0] and time constant
+    2h, so a load f within the limit creeps at (1 − d)·f·h/I: 5e-6 rad/s at half the effort."""
     wheel.command("w", "spin", mode="velocity", value=0.0)
     wheel.step(200)
-    _load(wheel, -EFFORT / 2)
+    load = fraction * EFFORT
+    _load(wheel, -load)
     wheel.step(500)
     start = wheel.joint_states("w")[0].position
     wheel.step(2000)
     state = wheel.joint_states("w")[0]
-    assert abs(state.position - start) < 1e-6 and abs(state.velocity) < 1e-6, state
+    creep = (1.0 - HOLD_SOLIMP[0]) * load * wheel.model.opt.timestep / MOMENT
+    assert -state.velocity == pytest.approx(creep, rel=0.05), state
+    assert start - state.position == pytest.approx(2.0 * creep, rel=0.05), state
+
+
+def test_a_held_wheel_slips_at_its_effort_and_stays_where_it_slipped(wheel: World) -> None:
+    """Past its effort the hold slips with the effort exactly opposing the load, and once the
+    load is gone the wheel stops where it is: a bounded constraint stores nothing to pay back
+    (an integral servo at speed 0 sprang back by all it had slipped)."""
+    wheel.command("w", "spin", mode="velocity", value=0.0)
+    wheel.step(500)
+    load = 1.5 * EFFORT
+    _load(wheel, -load)
+    speeds = _speeds(wheel, 30)
+    slope = np.polyfit(np.arange(5, 30) * 0.01, speeds[5:], 1)[0]
+    assert slope == pytest.approx(-(load - EFFORT) / MOMENT, rel=0.01), "I·dω/dt = load − effort"
+    _load(wheel, load)
+    wheel.step(500)
+    slipped = wheel.joint_states("w")[0].position
+    wheel.step(2000)
+    assert wheel.joint_states("w")[0].position == pytest.approx(slipped, abs=1e-6), "no spring-back"
 
 
 @pytest.mark.parametrize("effort", [50.0, 5.0])

@@ -1,0 +1,93 @@
+"""A fixed-base robot's position servos hold its weight through MuJoCo's own gravity compensation.
+
+A position servo on a fixed arm carries the weight of the links beyond its joint. MuJoCo computes
+that load itself: `gravcomp` on a body applies the force that cancels its weight, and
+`actuatorgravcomp` on a joint sends the joint's share through the joint's actuator force, where
+the joint's `actuatorfrcrange` (its effort limit) bounds servo and compensation together. So a
+held posture does not sag by load/kp, and a joint asked for more than its effort gives exactly
+its effort.
+
+MuJoCo computes compensation only in a model compiled with a compensated body, so every body of a
+fixed-base robot is compiled with OFF (a negligible share) and a command switches bodies on the
+model (`switch`): a body is ON while every joint between it and the world is actuated and holds
+a position command. An arm without commands, with an effort command or a passive joint on the
+way falls as it does in Gazebo; a velocity servo's integral carries its load itself. A body the
+robot's own tags compensate (Gazebo's gravity off: 1) keeps its value.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+
+if TYPE_CHECKING:
+    from twin_cli.world.actuation import JointCommand
+
+ON = 1.0 - 2.0**-30
+"""gravcomp of a body whose weight the servos hold (a part in 1e9 short of 1: a marker)."""
+OFF = 2.0**-30
+"""gravcomp of a body whose weight they do not hold (nonzero, so MuJoCo computes gravcomp)."""
+_FREE = mujoco.mjtJoint.mjJNT_FREE
+_JOINT = mujoco.mjtTrn.mjTRN_JOINT
+
+
+def prepare(spec: mujoco.MjSpec) -> None:
+    """Readies a robot spec without a free joint (a fixed base) for compensation: its bodies
+    compiled OFF, its actuated joints routing compensation through their actuator force within
+    their motors' effort limit (`actuatorfrcrange`). A spec with a free joint is left as it is."""
+    if any(joint.type == _FREE for joint in spec.joints):
+        return
+    for body in spec.bodies:
+        if body is not spec.worldbody and body.gravcomp == 0.0:
+            body.gravcomp = OFF
+    for actuator in spec.actuators:
+        if actuator.trntype != _JOINT:
+            continue
+        joint = spec.joint(actuator.target)
+        if joint is None:
+            continue
+        joint.actgravcomp = True
+        effort = _effort(actuator)
+        if math.isfinite(effort):
+            joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            joint.actfrcrange = np.array([-effort, effort])
+
+
+def _effort(actuator: mujoco.MjsActuator) -> float:
+    """The motor's effort limit at its joint [N m or N] (the converter's ctrlrange)."""
+    gear = abs(float(actuator.gear[0])) or 1.0
+    limits = []
+    if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+        limits.append(max(abs(v) for v in actuator.ctrlrange) * gear)
+    if actuator.forcelimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+        limits.append(max(abs(v) for v in actuator.forcerange) * gear)
+    return min(limits) if limits else math.inf
+
+
+def switch(model: mujoco.MjModel, commands: Mapping[str, JointCommand]) -> None:
+    """Turns each prepared body's compensation ON or OFF for `commands` (see module doc)."""
+    gravcomp = model.body_gravcomp
+    bodies = np.flatnonzero((gravcomp == ON) | (gravcomp == OFF))
+    if not len(bodies):
+        return
+    held = set()
+    for key, cmd in commands.items():
+        a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
+        if a >= 0 and cmd.mode == "position" and model.actuator_trntype[a] == _JOINT:
+            held.add(int(model.actuator_trnid[a, 0]))
+    for b in bodies:
+        gravcomp[b] = ON if _chain_held(model, int(b), held) else OFF
+
+
+def _chain_held(model: mujoco.MjModel, body: int, held: set[int]) -> bool:
+    """Whether every joint from `body` down to the world is in `held`."""
+    while body > 0:
+        start = int(model.body_jntadr[body])
+        if any(j not in held for j in range(start, start + int(model.body_jntnum[body]))):
+            return False
+        body = int(model.body_parentid[body])
+    return True
