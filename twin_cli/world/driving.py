@@ -14,7 +14,7 @@ import mujoco
 
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import gravity_comp, joint_control, servos
+from twin_cli.world import gravity_comp, joint_control, servos, sleeping
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -110,6 +110,7 @@ def command_joints(
         loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
         commands = [_set_command(state, c, loads) for c in checked]
         gravity_comp.switch(state.model, state.commands)
+        servos.keep_awake(state.model, state.commands)
         return commands
 
 
@@ -208,16 +209,18 @@ def release_commands(
         if a >= 0:
             limp = control.JointCommand(old.actuator, "effort", 0.0, 0.0, 0.0, old.effort)
             control.apply_command(model, data, a, limp)
+            sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
 
 
 def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
     """Writes every joint command into a (re)compiled model, by actuator name, and switches
-    fixed-base robots' gravity compensation to match (`gravity_comp`)."""
+    fixed-base robots' gravity compensation and moving robots' sleep policy to match."""
     for actuator, cmd in state.commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
         if a >= 0:
             control.apply_command(model, data, a, cmd)
     gravity_comp.switch(model, state.commands)
+    servos.keep_awake(model, state.commands)
 
 
 def record_targets(

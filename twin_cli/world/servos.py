@@ -52,6 +52,8 @@ from converters.mjcf.export_servos import EXPORTED
 from twin_cli.world import gravity_comp, sleeping, speed_holds
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from twin_cli.world.actuation import JointCommand
 
 INTEGRAL_MARGIN = 8.0
@@ -212,7 +214,6 @@ def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand)
         speed_holds.write(model, a, cmd.effort)
         model.actuator_actlimited[a] = 0
         data.ctrl[a] = 0.0
-        sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
         return
     speed_holds.lift(model, a)
     model.actuator_biastype[a] = _AFFINE
@@ -236,7 +237,6 @@ def apply(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand)
     model.actuator_actlimited[a] = int(math.isfinite(low) or math.isfinite(high))
     model.actuator_actrange[a] = (low, high) if model.actuator_actlimited[a] else (0.0, 0.0)
     data.ctrl[a] = speed
-    sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), driven(cmd))
 
 
 def driven(cmd: JointCommand) -> bool:
@@ -246,6 +246,17 @@ def driven(cmd: JointCommand) -> bool:
     if cmd.mode == "velocity":
         return cmd.target != 0.0
     return bool(cmd.feedforward)
+
+
+def keep_awake(model: mujoco.MjModel, commands: Mapping[str, JointCommand]) -> None:
+    """Keeps the trees of `driven` commands from sleeping until their next command, and lets
+    every other commanded tree sleep (`sleeping.hold_awake`), decided when commands change."""
+    ids = {key: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key) for key in commands}
+    moving = [a for key, a in ids.items() if a >= 0 and driven(commands[key])]
+    awake = sleeping.actuator_trees(model, moving)
+    resting = sleeping.actuator_trees(model, [a for a in ids.values() if a >= 0]) - awake
+    sleeping.hold_awake(model, awake, True)
+    sleeping.hold_awake(model, resting, False)
 
 
 def release(model: mujoco.MjModel, a: int) -> None:

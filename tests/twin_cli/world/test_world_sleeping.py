@@ -4,6 +4,7 @@ own sleep state (`tree_asleep`, `ntree_awake`), and the same world stepped witho
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -93,3 +94,27 @@ def _tree(world: World, name: str) -> int:
         if model.body(b).name.startswith(f"{name}/")
     }
     return tree
+
+
+def test_a_base_with_one_wheel_driven_stays_awake_and_sleeps_once_both_stop(tmp_path):
+    """A velocity command other than 0 keeps its robot awake until the next command, even when
+    the other wheel on the same robot is told to stop after it (a zero velocity lets a robot
+    sleep: its joints' friction holds it); with both stopped the base falls asleep."""
+    import drive_models as dm
+
+    path = tmp_path / "base.urdf"
+    path.write_text(dm.two_wheel_base(""))
+    world = World()
+    world.set_engine(sleep=True, sleep_tolerance=TOLERANCE)
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    world.command("base", "wheel_left_joint", mode="velocity", value=2.0)
+    world.command("base", "wheel_right_joint", mode="velocity", value=0.0)
+    world.step(1000)
+    tree = _tree(world, "base")
+    assert world.data.tree_asleep[tree] < 0, "asleep while a wheel is driven"
+    never = int(mujoco.mjtSleepPolicy.mjSLEEP_AUTO_NEVER)
+    assert world.model.tree_sleep_policy[tree] == never, "may sleep while a wheel is driven"
+    assert world.get_pose("base").yaw != 0.0
+    world.command("base", "wheel_left_joint", mode="velocity", value=0.0)
+    world.step(round(SETTLE_S / world.model.opt.timestep))
+    assert world.data.tree_asleep[tree] >= 0, "still awake with both wheels stopped"
