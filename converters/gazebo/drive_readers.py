@@ -21,6 +21,7 @@ from converters.gazebo.drive_records import (
     DEFAULT_RATE,
     DEFAULT_SEPARATION,
     DEFAULT_TORQUE,
+    EVERY_STEP,
     AckermannDrive,
     DiffDrive,
     DriveRecord,
@@ -117,7 +118,7 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         max_wheel_torque=math.inf,
         max_wheel_acceleration=p.number(0.0, "max_linear_acceleration", "max_acceleration"),
         odometry_source="encoder",
-        update_rate=p.number(50.0, "odom_publish_frequency"),
+        update_rate=EVERY_STEP,
         family="gz_diff_drive",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
@@ -182,7 +183,7 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         steering_limit=p.number(0.5, "steering_limit"),
         max_velocity=p.number(math.inf, "max_velocity"),
         max_acceleration=p.number(0.0, "max_acceleration"),
-        update_rate=p.number(50.0, "odom_publish_frequency"),
+        update_rate=EVERY_STEP,
         odometry_source="encoder",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
@@ -226,12 +227,19 @@ def read_tricycle(p: Params, blob: Blob, ctx: ReadContext) -> TricycleDrive:
     )
 
 
+PLANAR_MOVE_RATE = 20.0  # [Hz] gazebo_ros_planar_move's (ROS 2) default update_rate
+
+
 def read_planar_move(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
-    """gazebo_ros_planar_move (ROS 2 names, then ROS 1's)."""
+    """gazebo_ros_planar_move (ROS 2 names, then ROS 1's). ROS 2's sets the base's velocity at
+    its `update_rate` (default 20 Hz); ROS 1's at every world update (its `odometryRate` only
+    paces the odometry it publishes), so a plugin with ROS 1's tags and no `update_rate` runs
+    every step."""
+    ros1 = p.names("odometryRate", "odometryFrame", "robotBaseFrame", "commandTopic") != ()
     return HolonomicDrive(
         name=blob.name or "planar_move",
         where=blob.where,
-        update_rate=p.number(20.0, "update_rate", "odometryRate"),
+        update_rate=p.number(EVERY_STEP if ros1 else PLANAR_MOVE_RATE, "update_rate"),
         odometry_frame=p.text("odom", "odometry_frame", "odometryFrame"),
         robot_base_frame=p.text("base_footprint", "robot_base_frame", "robotBaseFrame"),
     )
@@ -244,7 +252,7 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
         name=blob.name or "MecanumDrive",
         where=blob.where,
         family="gz_mecanum_drive",
-        update_rate=p.number(50.0, "odom_publish_frequency"),
+        update_rate=EVERY_STEP,
         wheel_joints_named=wheels,
         wheel_radius=p.number(0.2, "wheel_radius"),
         wheel_separation=p.number(1.0, "wheel_separation"),

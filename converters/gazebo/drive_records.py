@@ -25,6 +25,11 @@ DEFAULT_DIAMETER = 0.15  # [m]
 DEFAULT_TORQUE = 5.0  # [N m]
 DEFAULT_ACCELERATION = 0.0  # [m/s²] at the wheel rim; 0 = unlimited
 DEFAULT_RATE = 100.0  # [Hz]
+EVERY_STEP = 0.0
+"""[Hz] the update rate of a plugin that acts at every physics step: gz-sim's DiffDrive,
+AckermannSteering and MecanumDrive set their joints' velocities in every `PreUpdate` (their
+`odom_publish_frequency` only throttles the odometry messages), ROS 1's planar move sets the
+model's velocity at every world update."""
 
 
 def _plain(value: Any) -> Any:

@@ -104,6 +104,7 @@ ROWS = [
             "odometry_source": "encoder",
             "odometry_frame": "dd/odom",
             "robot_base_frame": "dd/base_link",
+            "update_rate": 0.0,  # every step: PreUpdate sets the wheels' speeds each step
         },
     ),
     (
@@ -136,6 +137,7 @@ ROWS = [
         {
             "kind": "AckermannDrive",
             "family": "gz_ackermann_steering",
+            "update_rate": 0.0,  # every step, as gz-sim's DiffDrive
             "wheel_base": 1.0,
             "kingpin_width": 0.8,
             "wheel_radius": 0.2,
@@ -165,6 +167,12 @@ ROWS = [
         dm.planar_base(PLANAR),
         "urdf",
         {"kind": "HolonomicDrive", "family": "gazebo_ros_planar_move", "update_rate": 20.0},
+    ),
+    (
+        "planar_move_ros1",  # its odometryRate paces odometry; the velocity is set every step
+        dm.planar_base(PLANAR.replace("/>", "><odometryRate>20</odometryRate></plugin>")),
+        "urdf",
+        {"kind": "HolonomicDrive", "family": "gazebo_ros_planar_move", "update_rate": 0.0},
     ),
     (
         "vendor_kobuki",

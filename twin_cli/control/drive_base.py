@@ -1,11 +1,12 @@
 """What every drive controller shares: a world observer in sim time, the command's duration,
 reset handling, encoder odometry integration and the nav_msgs/Odometry reply.
 
-A controller is a world observer (`World.add_observer`) at the plugin's update rate (at least
-MIN_RATE while its targets move), so the stepping loop calls it between batches, in simulated time,
-with the world's lock held: no Python per physics step. A subclass says how a command becomes
-joint targets (`_apply`, which returns whether the targets reached their goal) and, for encoder
-odometry, the body twist its wheels measure (`_encoder_twist`).
+A controller is a world observer (`World.add_observer`) at the rate its plugin declares
+(`update_rate`; 0, or a rate faster than the physics step: every step, as Gazebo runs a plugin
+whose period is shorter than its step), so the stepping loop calls it between batches, in
+simulated time, with the world's lock held, as often as Gazebo calls the plugin and no more. A
+subclass says how a command becomes joint targets (`_apply`) and, for encoder odometry, the body
+twist its wheels measure (`_encoder_twist`).
 """
 
 from __future__ import annotations
@@ -23,14 +24,12 @@ if TYPE_CHECKING:
     from twin_cli.world.engine import World
     from twin_cli.world.entities import Entity
 
-FALLBACK_RATE = 100.0  # [Hz] for update_rate 0 ("every step" in Gazebo): no per-step Python
-MIN_RATE = 250.0
-"""[Hz] slowest controller rate while targets move. The world's velocity servo reaches full effort
-at 1 rad/s of error, and a wheel of a light robot has tiny inertia (turtlebot3: 2e-5 kg m²):
-measured, at the plugin's 30 Hz each ramp step (1 rad/s) saturated the 10 N m motor and the wheels
-ran away to 175 rad/s; at 100 Hz they held their targets but the robot reared up on each step; at
-250 Hz the start is smooth (heading within 4 % of the unicycle's after 5 s). Limits are applied per
-elapsed sim time, so they are the plugin's at any rate."""
+
+def update_rate(declared: float, timestep: float) -> float:
+    """The rate [Hz] a plugin that declares `declared` [Hz] updates at in a world stepped every
+    `timestep` [s]: every step for 0 ("as fast as possible") or a period shorter than a step."""
+    every_step = 1.0 / timestep
+    return every_step if declared <= 0 else min(declared, every_step)
 
 
 @dataclass(frozen=True)
@@ -58,8 +57,7 @@ class DriveController:
 
     def __init__(self, world: World, entity: str, plugin: Any) -> None:
         self.world, self.entity, self.plugin = world, entity, plugin
-        self.plugin_rate = plugin.update_rate if plugin.update_rate > 0 else FALLBACK_RATE
-        self.rate = max(self.plugin_rate, MIN_RATE)
+        self.rate = update_rate(plugin.update_rate, float(world.model.opt.timestep))
         self.twist = STOP
         self.until = math.inf  # [s] sim time the command stops at
         self.updates = 0
@@ -73,9 +71,9 @@ class DriveController:
     def _reset_targets(self) -> None:
         """Forgets ramp state after a world reset (the world stopped the joints)."""
 
-    def _apply(self, dt: float, force: bool) -> bool:
+    def _apply(self, dt: float, force: bool) -> None:
         """Moves the targets towards the command by dt [s]; writes them when they changed (or
-        `force`); returns whether they reached the command's goal."""
+        `force`)."""
         raise NotImplementedError
 
     def _encoder_twist(self) -> tuple[float, float]:
@@ -105,7 +103,6 @@ class DriveController:
             self.twist = twist
             now = float(self.world.data.time)
             self.until = math.inf if duration is None else now + duration
-            self._observe_at(self.rate)  # targets move: the fast rate (see MIN_RATE)
 
     def _observe_at(self, rate: float) -> None:
         """Re-registers the update at `rate` [Hz] (no-op when already there)."""
@@ -121,7 +118,7 @@ class DriveController:
         self.observed_rate = 0.0
 
     def resume(self) -> None:
-        """Calls the controller again after `stop` (at the fast rate until targets settle)."""
+        """Calls the controller again after `stop`."""
         with self.world.lock:
             self.last_time = float(self.world.data.time)
             self._observe_at(self.rate)
@@ -146,10 +143,8 @@ class DriveController:
         if now >= self.until - 1e-9:
             self.twist, self.until = STOP, math.inf
         force = self.updates == 0 or self.world.commands() != self._written
-        settled = self._apply(dt, force)
+        self._apply(dt, force)
         self.updates += 1
-        # Targets at their goal: the plugin's own rate is enough for timeouts and odometry.
-        self._observe_at(self.plugin_rate if settled else self.rate)
 
     def _write(self, targets: dict[str, float], mode: str) -> None:
         """Writes joint targets through the world's joint command API (clipped to the joints'

@@ -29,7 +29,7 @@ ANGULAR_RAMP = 6.0  # [rad/s²]
 """Gazebo's planar move sets the new velocity in one step. A servo asked for 0.3 m/s at once
 pushes the base with M·0.3/dt (2.4 kN for 8 kg) against its feet's friction, which kicks it off
 the ground (measured: a 7 cm hop); ramped at 3 m/s² it reaches 0.3 m/s in 0.1 s without leaving
-the ground. The ramp is applied per elapsed sim time, at MIN_RATE while it lasts."""
+the ground. The ramp is applied per elapsed sim time, at the plugin's update rate."""
 
 
 class HolonomicController(DriveController):
@@ -47,7 +47,7 @@ class HolonomicController(DriveController):
     def _reset_targets(self) -> None:
         self.current = (0.0, 0.0, 0.0)
 
-    def _apply(self, dt: float, force: bool) -> bool:
+    def _apply(self, dt: float, force: bool) -> None:
         goals = self.goals()
         limits = (LINEAR_RAMP, LINEAR_RAMP, ANGULAR_RAMP)
         now = tuple(ramp(c, g, a, dt) for c, g, a in zip(self.current, goals, limits, strict=True))
@@ -60,14 +60,13 @@ class HolonomicController(DriveController):
             for a in ("vx", "vy", "wz")
         ]
         if any(a < 0 for a in ids):
-            return True  # a hand-written model without the servos: nothing to drive
+            return  # a hand-written model without the servos: nothing to drive
         if force or now != self.current:
             wake_actuated(m, d, ids)
             for a, value in zip(ids, now, strict=True):
                 d.ctrl[a] = value
             self.current = now  # type: ignore[assignment]
         self._written = dict(self.world.commands())
-        return now == goals
 
     def _encoder_twist(self) -> tuple[float, float]:
         return self.goals()[0], self.goals()[2]

@@ -87,7 +87,7 @@ class SteeredDriveController(DriveController):
     def _reset_targets(self) -> None:
         self.speed, self.phi = 0.0, 0.0
 
-    def _apply(self, dt: float, force: bool) -> bool:
+    def _apply(self, dt: float, force: bool) -> None:
         v_goal, phi_goal = self.goals()
         speed = ramp(self.speed, v_goal, self._acceleration(v_goal), dt)
         turn_rate = 0.0 if not self.tricycle else self.plugin.max_steering_speed
@@ -97,7 +97,6 @@ class SteeredDriveController(DriveController):
             wheels, steering = self._targets(speed, phi)
             self._write(wheels, "velocity")
             self._write(steering, "position")
-        return (speed, phi) == (v_goal, phi_goal)
 
     def _acceleration(self, goal: float) -> float:
         """The speed ramp's limit [m/s²] (0 = none)."""
