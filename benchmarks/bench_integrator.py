@@ -2,11 +2,13 @@
 
 Every corpus robot (and the bundled humanoid, the only robot without ../shared) is spawned on
 the ground in a `World`, as `twin spawn` spawns it. `mj_step` then runs the world's own model
-(its integrator as configured) and a copy of it with `implicitfast`, each from a copy of the
-spawned state, island sleeping off in both so every step does the full work:
-- cost: from the state after COST_SETTLE_S, WINDOW_STEPS steps per window, the two models
+(its integrator as configured) and copies of it under the other integrators of COMPARED
+(`implicit`, `implicitfast`), each from a copy of the spawned state, island sleeping off in all
+so every step does the full work:
+- cost: from the state after COST_SETTLE_S, WINDOW_STEPS steps per window, the models
   alternating in REPEATS windows each; the best window of each gives its per-step time, and the
-  ratio is the world's over implicitfast's (target: a mean of at most MEAN_RATIO_TARGET);
+  ratio is the world's over implicitfast's (target: a mean of at most MEAN_RATIO_TARGET), with
+  implicit's over implicitfast's beside it;
 - rest: each integrator settles the robot for REST_SETTLE_S, then over REST_S: how far the root
   (free joint) moves [mm] and turns [mrad], the largest hinge or slide joint drift [mrad or mm],
   and the peak |qvel| (a light limb that its integrator keeps moving shows there);
@@ -35,13 +37,15 @@ NON_PHYSICAL_INERTIA = ("abb_irb2400_12_155", "anymal_c", "hyq")
 # [s] sim time. A limp robot folds first: the bundled humanoid, symmetric, stands about 4 s on
 # its feet and has fallen by 6 s.
 COST_SETTLE_S, REST_SETTLE_S, REST_S = 1.0, 8.0, 5.0
-# Short windows, so that the best of each model is a window no other process disturbed: on 2
-# shared cores at load 3-4, the best of 4 windows of 2000 steps gave per-robot ratios 0.3 apart
-# in two runs (turtlebot3 1.08 and 1.39); 20 of 200 steps repeat within 0.05.
-WINDOW_STEPS, REPEATS = 200, 20
+# Many short windows, so that the best of each model is one no other process disturbed. On 2
+# shared cores at load 2.5-4, four runs of each: the best of 4 windows of 2000 steps put
+# turtlebot3's ratio anywhere in 1.08-1.39, the best of 20 of 200 steps in 0.92-1.61; the best
+# of 40 of 200 repeats within 0.04 (turtlebot3 1.24-1.25, solo12 1.10-1.12, booster_t1 1.68-1.72).
+WINDOW_STEPS, REPEATS = 200, 40
 GATE_S, GATE_HOLD_S, GATE_SCALE = 10.0, 0.5, 0.1  # [s], [s], share of each ctrlrange
 REST_SAMPLE_STEPS = 10  # |qvel| is sampled every 10 steps at rest
 UNLIMITED_CTRL = 10.0  # half-range for an actuator without ctrlrange (10 % of it: ±1 rad/s)
+COMPARED = ("implicit", "implicitfast")  # MuJoCo's integrators that treat damping implicitly
 MEAN_RATIO_TARGET = 1.15  # the project's goal for the world's step cost over implicitfast's
 
 
@@ -66,20 +70,24 @@ def _spawn_requests() -> dict:
     return requests
 
 
-def _models(request) -> tuple:  # noqa: ANN001
-    """(world's model, its implicitfast copy, spawned data), island sleeping off in both."""
+def _models(request) -> tuple[str, dict, object]:  # noqa: ANN001
+    """(the world's integrator, integrator → model, spawned data): the world's model as it is, and
+    a copy of it under each other integrator of COMPARED; island sleeping off in all."""
     import mujoco
 
+    from converters.mjcf.world_options import INTEGRATORS
     from twin_cli.world import World
 
     world = World()
     world.spawn(request, name="r")
+    own = next(k for k, v in INTEGRATORS.items() if int(v) == int(world.model.opt.integrator))
     sleep = int(mujoco.mjtEnableBit.mjENBL_SLEEP)
-    ours, fast = copy.deepcopy(world.model), copy.deepcopy(world.model)
-    for model in (ours, fast):
+    models = {}
+    for name in dict.fromkeys((own, *COMPARED)):
+        models[name] = model = copy.deepcopy(world.model)
         model.opt.enableflags = int(model.opt.enableflags) & ~sleep
-    fast.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    return ours, fast, copy.copy(world.data)
+        model.opt.integrator = INTEGRATORS[name]
+    return own, models, copy.copy(world.data)
 
 
 def _step_costs(models: tuple, data) -> list[float]:  # noqa: ANN001
@@ -147,39 +155,42 @@ def _gate(model, data) -> dict:  # noqa: ANN001
 def _robot(request) -> dict:  # noqa: ANN001
     import mujoco
 
-    ours, fast, data = _models(request)
+    own, models, data = _models(request)
     settled = copy.copy(data)
-    mujoco.mj_step(ours, settled, nstep=round(COST_SETTLE_S / ours.opt.timestep))
-    cost_ours, cost_fast = _step_costs((ours, fast), settled)
-    name = mujoco.mjtIntegrator(int(ours.opt.integrator)).name.removeprefix("mjINT_").lower()
+    mujoco.mj_step(models[own], settled, nstep=round(COST_SETTLE_S / models[own].opt.timestep))
+    costs = dict(zip(models, _step_costs(tuple(models.values()), settled), strict=True))
     return {
-        "integrator": name,
-        "nv": int(ours.nv),
-        "step_us": round(cost_ours * 1e6, 2),
-        "implicitfast_step_us": round(cost_fast * 1e6, 2),
-        "ratio": round(cost_ours / cost_fast, 3),
-        "rest": {name: _rest(ours, data), "implicitfast": _rest(fast, data)},
-        "gate": {name: _gate(ours, data), "implicitfast": _gate(fast, data)},
+        "integrator": own,
+        "nv": int(models[own].nv),
+        "step_us": {name: round(cost * 1e6, 2) for name, cost in costs.items()},
+        "ratio": round(costs[own] / costs["implicitfast"], 3),
+        "implicit_ratio": round(costs["implicit"] / costs["implicitfast"], 3),
+        "rest": {name: _rest(model, data) for name, model in models.items()},
+        "gate": {name: _gate(model, data) for name, model in models.items()},
     }
 
 
 def _table(rows: dict) -> str:
-    """Robot → ratio, with rest drift and the gate's outcome for both integrators (world / fast)."""
+    """Robot → ratio (the world's over implicitfast's step), with the two compared integrators'
+    step times, rest drift and gate outcome (implicit / implicitfast)."""
     lines = [
-        f"{'robot':19} {'ratio':>6} {'world µs':>9} {'fast µs':>8} {'rest root mm':>19} "
-        f"{'rest joint milli':>19} {'gate diverged s':>15}"
+        f"{'robot':19} {'ratio':>6} {'µs':>13} {'rest root mm':>19} {'rest joint milli':>19} "
+        f"{'gate diverged s':>15}"
     ]
     for rid, row in rows.items():
         if "skipped" in row:
             lines.append(f"{rid:19} skipped: {row['skipped']}")
             continue
-        rest, gate = list(row["rest"].values()), list(row["gate"].values())
-        root = "/".join(str(r.get("root_mm", "fixed")) for r in rest)
-        joint = "/".join(str(r["joint_drift_milli"]) for r in rest)
-        diverged = "/".join(str(g["diverged_at_s"] or "no") for g in gate)
+        rest, gate = [row["rest"][k] for k in COMPARED], [row["gate"][k] for k in COMPARED]
+        cells = (
+            "/".join(f"{row['step_us'][k]:.1f}" for k in COMPARED),
+            "/".join(str(r.get("root_mm", "fixed")) for r in rest),
+            "/".join(str(r["joint_drift_milli"]) for r in rest),
+            "/".join(str(g["diverged_at_s"] or "no") for g in gate),
+        )
         lines.append(
-            f"{rid:19} {row['ratio']:6.3f} {row['step_us']:9.2f} "
-            f"{row['implicitfast_step_us']:8.2f} {root:>19} {joint:>19} {diverged:>15}"
+            f"{rid:19} {row['ratio']:6.3f} {cells[0]:>13} {cells[1]:>19} {cells[2]:>19} "
+            f"{cells[3]:>15}"
         )
     return "\n".join(lines)
 
@@ -192,12 +203,18 @@ def run() -> dict:
             rows[rid] = _robot(request)
         except Exception as exc:  # a robot that needs options the bench does not give
             rows[rid] = {"skipped": f"{type(exc).__name__}: {exc}"[:160]}
-    ratios = [row["ratio"] for row in rows.values() if "ratio" in row]
-    mean = round(float(np.mean(ratios)), 3) if ratios else None
-    print(_table(rows), f"\nmean ratio {mean} (target ≤ {MEAN_RATIO_TARGET})", file=sys.stderr)
+    done = [row for row in rows.values() if "ratio" in row]
+    mean = round(float(np.mean([row["ratio"] for row in done])), 3) if done else None
+    implicit = round(float(np.mean([row["implicit_ratio"] for row in done])), 3) if done else None
+    print(
+        _table(rows),
+        f"\nmean ratio {mean} (target ≤ {MEAN_RATIO_TARGET}); implicit/implicitfast {implicit}",
+        file=sys.stderr,
+    )
     return {
         "robots": rows,
         "mean_ratio": mean,
+        "mean_implicit_ratio": implicit,
         "mean_ratio_target": MEAN_RATIO_TARGET,
         "within_target": mean is not None and mean <= MEAN_RATIO_TARGET,
         "wall_s": round(time.perf_counter() - start, 1),
