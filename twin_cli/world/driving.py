@@ -160,6 +160,8 @@ def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.Joi
     cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule)
     if reference and previous and was == servos.kind(cmd) == "velocity":
         cmd = replace(cmd, kp=previous.kp, kv=previous.kv, rule=previous.rule)  # same integral
+    elif reference and servos.kind(cmd) == servos.HOLD:
+        cmd = replace(cmd, kp=0.0, kv=0.0, rule=servos.HOLD_RULE)  # no servo: the joint's friction
     if reference:
         lead = 0.0
         if mode == "velocity" and cmd.kv > 0:

@@ -64,6 +64,7 @@ about 4·INTEGRAL_MARGIN·I_c/kv."""
 SPEED_MARGIN = 0.95  # ramp speed of a position move, as a fraction of the velocity limit
 OVERSHOOT = 0.05  # most a position servo's speed may pass its ramp's while it catches up
 HOLD = "hold"  # the kind of a velocity command of 0 held by friction (`twin_cli.world.speed_holds`)
+HOLD_RULE = "speed 0: joint friction up to the effort limit"  # what `twin joints` shows for HOLD
 MARK_SLOT, MARK = 9, 1.0  # dynprm entry that marks a servo reference (integrators ignore dynprm)
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
 _NONE = mujoco.mjtDyn.mjDYN_NONE

@@ -371,6 +371,8 @@ def test_a_plugin_hold_is_the_wheels_friction_until_the_first_drive(tmp_path: Pa
     friction back and its servo its own gains."""
     import mujoco
 
+    from twin_cli.world.servos import HOLD_RULE
+
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     m, wheels = world.model, ("wheel_left_joint", "wheel_right_joint")
     dofs = [
@@ -378,6 +380,8 @@ def test_a_plugin_hold_is_the_wheels_friction_until_the_first_drive(tmp_path: Pa
     ]
     efforts = [world.joint_commands("base")[j]["effort_limit"] for j in wheels]
     assert list(m.dof_frictionloss[dofs]) == efforts, "held: friction = the effort limit"
+    shown = {world.joint_commands("base")[j]["rule"] for j in wheels}
+    assert shown == {HOLD_RULE}, f"`twin joints` shows {shown}"
     drive(world, "base", V)
     world.step(100)
     assert list(world.model.dof_frictionloss[dofs]) == [0.0, 0.0], "driven: the joints' own"
