@@ -41,6 +41,8 @@ COST_SETTLE_S, REST_SETTLE_S, REST_S = 1.0, 8.0, 5.0
 # shared cores at load 2.5-4, four runs of each: the best of 4 windows of 2000 steps put
 # turtlebot3's ratio anywhere in 1.08-1.39, the best of 20 of 200 steps in 0.92-1.61; the best
 # of 40 of 200 repeats within 0.04 (turtlebot3 1.24-1.25, solo12 1.10-1.12, booster_t1 1.68-1.72).
+# A busy spell can still move one robot (r2d2_physics 1.40 and 1.81 in two whole runs); the mean
+# over the robots moved by 0.05 (1.34, 1.39).
 WINDOW_STEPS, REPEATS = 200, 40
 GATE_S, GATE_HOLD_S, GATE_SCALE = 10.0, 0.5, 0.1  # [s], [s], share of each ctrlrange
 REST_SAMPLE_STEPS = 10  # |qvel| is sampled every 10 steps at rest
