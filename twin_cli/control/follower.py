@@ -150,8 +150,7 @@ class TrajectoryFollower:
             gear = np.abs(world.model.actuator_gear[self._ids, 0])
             gear[gear == 0] = 1.0
             self._kv = np.array([c.kv for c in commands]) / gear
-            self._hold = np.array([c.hold for c in commands]) / gear
-        bias = self._kv * speeds + self._hold
+        bias = self._kv * speeds
         follow(world.model, world.data, self._ids, (reference, positions, self._period), bias)
         wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
         self._last = (positions, speeds)
@@ -173,7 +172,7 @@ class TrajectoryFollower:
             if servos.has_reference(world.model, a):
                 target = float(world.data.act[world.model.actuator_actadr[a]])
             world.data.ctrl[a] = 0.0 if servos.has_reference(world.model, a) else target
-            world.model.actuator_biasprm[a, 0] = self._hold[i]
+            world.model.actuator_biasprm[a, 0] = 0.0
             targets[key] = (target, 0.0)
         return targets
 

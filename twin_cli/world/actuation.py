@@ -47,8 +47,6 @@ class JointCommand:
         velocity_limit: the joint's velocity limit [rad/s or m/s] (inf when none).
         feedforward: velocity the position servo's damping tracks [rad/s or m/s] (trajectories).
         rule: where the gains came from (`twin joints` shows it).
-        hold, hold_slope: 0; read from saves written when position servos fed forward the
-            posture's gravity load (now MuJoCo's gravity compensation, `gravity_comp`).
     """
 
     actuator: str
@@ -60,8 +58,6 @@ class JointCommand:
     velocity_limit: float = math.inf
     feedforward: float = 0.0
     rule: str = ""
-    hold: float = 0.0
-    hold_slope: float = 0.0
 
 
 def effort_limit(model: mujoco.MjModel, actuator: int) -> float:

@@ -85,6 +85,11 @@ class SavedEntity(Strict):
     spawn_state: Annotated[dict[str, FiniteArray], AfterValidator(_state_fields)]
 
 
+OBSOLETE_COMMAND_FIELDS = {"hold", "hold_slope"}
+"""Command fields of saves written when fixed-base position servos fed the posture's gravity
+load forward themselves (now MuJoCo's gravity compensation): read, then left out."""
+
+
 class SavedCommand(Strict):
     actuator: str
     mode: Literal["position", "velocity", "effort"]
@@ -95,7 +100,7 @@ class SavedCommand(Strict):
     velocity_limit: Limit = math.inf
     feedforward: Finite = 0.0
     rule: str = ""
-    hold: Finite = 0.0
+    hold: Finite = 0.0  # OBSOLETE_COMMAND_FIELDS
     hold_slope: Finite = 0.0
 
 

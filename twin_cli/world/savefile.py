@@ -25,7 +25,7 @@ from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.engine import World
 from twin_cli.world.entities import Entity, EntityState
 from twin_cli.world.pose import Pose
-from twin_cli.world.save_schema import SaveDocument, checked_document
+from twin_cli.world.save_schema import OBSOLETE_COMMAND_FIELDS, SaveDocument, checked_document
 from twin_cli.world.snapshot import WorldSnapshot
 from twin_cli.world.values import WorldSettings
 
@@ -107,7 +107,7 @@ def load(path: str | os.PathLike) -> World:
         doc.iterations,
         doc.divergences,
         tuple(entities),
-        tuple(JointCommand(**c.model_dump()) for c in doc.commands),
+        tuple(JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands),
         tuple(Push(p.body, tuple(p.wrench), p.end_step) for p in doc.pushes),
         layout,
         state,
