@@ -1,6 +1,6 @@
 """Controllers that drive a running world over time, in sim time, as its observers.
 
-Each controller is a world observer at its own update rate (no Python per physics step) that acts
+Each controller is a world observer at its own update rate (a drive's: its plugin's) that acts
 only through the engine's API (joint commands). `trajectory` reads
 trajectory_msgs/JointTrajectory files and interpolates them as joint_trajectory_controller does;
 `follower` follows one on an entity at the controller manager's update rate and reports the
