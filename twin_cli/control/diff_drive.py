@@ -18,8 +18,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from twin_cli.control.drive_base import DriveController
 from twin_cli.control.kinematics import body_twist, ramp, rim_speeds
 
@@ -84,9 +82,9 @@ class DiffDriveController(DriveController):
     def wheel_angles(self) -> tuple[float, float]:
         """The mean left and right wheel joint angles [rad] now (world lock held)."""
         p = self.plugin
-        left = [self.joint_position(j) for j in p.left_joints]
-        right = [self.joint_position(j) for j in p.right_joints]
-        return float(np.mean(left)), float(np.mean(right))
+        left = sum(self.joint_position(j) for j in p.left_joints) / len(p.left_joints)
+        right = sum(self.joint_position(j) for j in p.right_joints) / len(p.right_joints)
+        return left, right  # plain sums: numpy's mean cost 4x a step at every update
 
     def _encoder_motion(self, dt: float) -> tuple[float, float]:
         """gz-sim's DiffDrive and ros2_control's diff_drive_controller measure how far the wheels
@@ -105,7 +103,8 @@ class DiffDriveController(DriveController):
 
     def _encoder_twist(self) -> tuple[float, float]:
         left, right = self.wheel_speeds()
-        return body_twist(float(np.mean(left)), float(np.mean(right)), self.radius, self.separation)
+        mean_left, mean_right = sum(left) / len(left), sum(right) / len(right)
+        return body_twist(mean_left, mean_right, self.radius, self.separation)
 
     def command_reply(self) -> dict[str, Any]:
         left, right = self.goals()

@@ -63,6 +63,8 @@ class DriveController:
         self.updates = 0
         self.entity_record: Entity | None = None  # the entity this controller was made for
         self._written: dict = {}  # the world's commands after our last write (reset clears them)
+        self._model: mujoco.MjModel | None = None  # the model `_joints` was looked up in
+        self._joints: dict[str, tuple[int, int]] = {}  # joint → (qpos, dof) address
         self._start()
         self.handle = world.add_observer(self._update, self.rate)
         self.observed_rate = self.rate
@@ -155,15 +157,26 @@ class DriveController:
 
     def joint_speed(self, joint: str) -> float:
         """A joint's speed [rad/s] now (world lock held); 0 for a joint the model lacks."""
-        m, d = self.world.model, self.world.data
-        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.entity}/{joint}")
-        return float(d.qvel[m.jnt_dofadr[j]]) if j >= 0 else 0.0
+        dof = self._addresses(joint)[1]
+        return float(self.world.data.qvel[dof]) if dof >= 0 else 0.0
 
     def joint_position(self, joint: str) -> float:
         """A hinge joint's angle [rad] now (world lock held); 0 for a joint the model lacks."""
-        m, d = self.world.model, self.world.data
-        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.entity}/{joint}")
-        return float(d.qpos[m.jnt_qposadr[j]]) if j >= 0 else 0.0
+        qpos = self._addresses(joint)[0]
+        return float(self.world.data.qpos[qpos]) if qpos >= 0 else 0.0
+
+    def _addresses(self, joint: str) -> tuple[int, int]:
+        """The joint's qpos and dof addresses in the world's model ((-1, -1): none), looked up
+        once per compiled model (an update may run at every step)."""
+        m = self.world.model
+        if m is not self._model:
+            self._model, self._joints = m, {}
+        found = self._joints.get(joint)
+        if found is None:
+            j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.entity}/{joint}")
+            found = (int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])) if j >= 0 else (-1, -1)
+            self._joints[joint] = found
+        return found
 
     # ------------------------------------------------------------------ odometry
     def odometry(self) -> dict[str, Any]:
