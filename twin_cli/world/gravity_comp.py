@@ -58,10 +58,16 @@ def prepare(spec: mujoco.MjSpec) -> None:
 
 
 def _effort(actuator: mujoco.MjsActuator) -> float:
-    """The motor's effort limit at its joint [N m or N] (the converter's ctrlrange)."""
+    """The actuator's force limit at its joint [N m or N]: its `forcerange`, and for a plain
+    motor its `ctrlrange` too (the converter's effort limit; an MJCF position servo's ctrlrange
+    is a position range)."""
     gear = abs(float(actuator.gear[0])) or 1.0
     limits = []
-    if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
+    motor = actuator.biastype == mujoco.mjtBias.mjBIAS_NONE and actuator.dyntype in (
+        mujoco.mjtDyn.mjDYN_NONE,
+        mujoco.mjtDyn.mjDYN_INTEGRATOR,  # `servos.give_reference` ran first: a motor still
+    )
+    if motor and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
         limits.append(max(abs(v) for v in actuator.ctrlrange) * gear)
     if actuator.forcelimited == mujoco.mjtLimited.mjLIMITED_TRUE:
         limits.append(max(abs(v) for v in actuator.forcerange) * gear)

@@ -109,3 +109,26 @@ def test_an_overloaded_joint_gives_exactly_its_effort(tmp_path, load):
         forces.append(float(world.data.actuator_force[0]))
     assert world.joint_states("a")[0].velocity > 0.0, "it falls"
     assert forces == pytest.approx([-EFFORT] * len(forces), abs=1e-9), f"{min(forces)}.."
+
+
+def test_an_mjcf_position_servo_is_not_bounded_by_its_position_range(tmp_path):
+    """A hand-written fixed arm whose `<position>` servo has ctrlrange ±1.5 rad (a range of
+    targets, not of force) holds a 2.45 N m weight at 0.3 rad: the compensation's bound is the
+    actuator's force range (none here), not its control range (bounded by it, the arm fell to
+    0.76 rad). The servo's own force stays within ±1.5, so the move takes about 4 s."""
+    path = tmp_path / "servo_arm.xml"
+    path.write_text(
+        """<mujoco model="servo_arm"><worldbody><body name="base" pos="0 0 1">
+  <geom type="box" size="0.05 0.05 0.05" mass="1" contype="0" conaffinity="0"/>
+  <body name="link"><joint name="shoulder" type="hinge" axis="0 1 0"/>
+    <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1" contype="0"
+      conaffinity="0"/></body></body></worldbody>
+  <actuator><position name="shoulder" joint="shoulder" kp="200" ctrlrange="-1.5 1.5"
+      ctrllimited="true"/></actuator></mujoco>"""
+    )
+    world = World()
+    world.spawn(path, name="servo_arm", pose=Pose())
+    world.command("servo_arm", "shoulder", mode="position", value=0.3)
+    world.step(6000)
+    angle = world.joint_states("servo_arm")[0].position
+    assert angle == pytest.approx(0.3, abs=HOLD_RAD), f"at {angle:.4f} rad"
