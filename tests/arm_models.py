@@ -32,3 +32,29 @@ def floating_arm(link_mass: float = 1.0, world_link: bool = False) -> str:
     <origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
     <limit lower="-3" upper="3" effort="100" velocity="2"/></joint>
 </robot>"""
+
+
+def panda_like_arm(world_link: bool = True) -> str:
+    """A Panda-like 7-joint arm (`interface_models`' kinematics, masses and limits: effort
+    87/87/87/87/12/12/12 N m, velocity 2.175-2.61 rad/s) whose joints ros2_control commands by
+    position alone; `world_link` fixes it to a `world` link, otherwise it floats (`--fixed-base`
+    welds it)."""
+    from interface_models import PANDA_JOINTS, PANDA_LINKS, _joint, _link
+
+    world = (
+        '<link name="world"/><joint name="world_joint" type="fixed">'
+        '<parent link="world"/><child link="panda_link0"/></joint>'
+        if world_link
+        else ""
+    )
+    links = "".join(_link(name) for name in PANDA_LINKS)
+    joints = "".join(_joint(name, i) for i, name in enumerate(PANDA_JOINTS, start=1))
+    interfaces = "".join(
+        f'<joint name="{j}"><command_interface name="position"/>'
+        f'<state_interface name="position"/></joint>'
+        for j in PANDA_JOINTS
+    )
+    return f"""<robot name="panda_like">{world}{links}{joints}
+  <ros2_control name="arm" type="system"><hardware><plugin>x</plugin></hardware>{interfaces}
+  </ros2_control>
+  <gazebo><plugin name="control" filename="libgazebo_ros2_control.so"/></gazebo></robot>"""

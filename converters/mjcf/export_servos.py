@@ -10,13 +10,17 @@ wheel (2e-5 kg m²) spins it past 1e5 rad/s within a second of random `ctrl`, an
 So each such joint is written as MuJoCo's own position or velocity actuator:
   - `ctrl` is the target (position within the joint's range, velocity within its limit), the
     force stays within ±effort (`forcerange`), as Menagerie's models do;
-  - kv = I/h on the joint's reflected inertia I at the home posture (the most damping an
-    explicit step tolerates, reached in one step like Gazebo's joint motor), and a position
-    servo's kp = kv²/(4I), critically damped on I;
+  - a position servo is stiff and damped so that a move at the effort limit stops on target
+    (`servo_gains`); a velocity servo's kv = I/h on the joint's reflected inertia I at the home
+    posture (the most damping an explicit step tolerates, reached in one step like Gazebo's
+    joint motor);
+  - on a fixed base, the position servos carry the weight of the bodies they hold through
+    MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
   - the `home` keyframe's ctrl holds the home posture.
 Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
-torque motor. The control record keeps the motor each servo replaced (`EXPORTED`), so a World
-that spawns the file restores it and commands it as it commands the robot's source.
+torque motor. The control record keeps the motor each servo replaced (`EXPORTED`) and the
+compensation it added, so a World that spawns the file restores them and commands the robot as
+it commands the robot's source.
 """
 
 from __future__ import annotations
@@ -27,6 +31,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from converters.control_text import CONTROL_TEXT
+from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
+from converters.mjcf.servo_gains import largest_inertia, position_gains
 from converters.mjcf.world_options import TIMESTEP_S
 
 if TYPE_CHECKING:
@@ -54,6 +60,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     if not chosen:
         return {}
     servoed: dict[str, str] = {}
+    held: dict[str, float] = {}  # each position servo's effort limit
     inertia, home = _home_inertia(spec)
     key = _home_key(spec)
     ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
@@ -61,7 +68,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         ctrl = np.zeros(len(spec.actuators))
     for i, actuator, record in chosen:
         joint = actuator.target
-        if not inertia.get(joint, 0.0) > 0.0:
+        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0:
             continue  # nothing to tune a servo on: the torque motor stays
         record[EXPORTED] = {
             "ctrlrange": [float(v) for v in actuator.ctrlrange],
@@ -71,10 +78,14 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         }
         _to_servo(spec, actuator, record, inertia[joint], timestep)
         servoed[joint] = record["modes"][0]
-        if key is not None and record["modes"][0] == "position":
-            ctrl[i] = home[joint]
+        if record["modes"][0] == "position":
+            held[joint] = _force_bound(actuator)
+            if key is not None:
+                ctrl[i] = home[joint]
     if key is not None:
         key.ctrl = ctrl
+    for joint, changed in compensate(spec, held).items():
+        records[joint][EXPORTED][GRAVCOMP] = changed
     text.data = json.dumps(records)
     return servoed
 
@@ -99,7 +110,7 @@ def _to_servo(
     spec: mujoco.MjSpec,
     actuator: mujoco.MjsActuator,
     record: dict,
-    inertia: float,
+    inertias: tuple[float, float],
     timestep: float,
 ) -> None:
     """One motor (gear 1) → MuJoCo's position or velocity actuator, its effort as the bound.
@@ -110,6 +121,7 @@ def _to_servo(
     import mujoco
 
     mode = record["modes"][0]
+    inertia, largest = inertias
     kv = inertia / timestep
     limited = actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
     effort = float(np.max(np.abs(actuator.ctrlrange))) if limited else np.inf
@@ -128,26 +140,19 @@ def _to_servo(
             damping = max(float(pid[2]), 2.0 * np.sqrt(max(kp, 0.0) * inertia))
             kv = min(damping, kv) if np.isfinite(effort) else damping
         else:
-            kp = _position_gain(inertia, kv, effort, record.get("velocity_limit"), high - low)
+            kp, kv = position_gains(inertia, largest, effort, timestep)
         actuator.set_to_position(kp=kp, kv=kv)
     else:
         actuator.set_to_velocity(kv=float(pid[0]) if pid else kv)
 
 
-def _position_gain(
-    inertia: float, kv: float, effort: float, speed: float | None, span: float
-) -> float:
-    """kp critically damped on the joint's inertia, and at most (effort + kv·v_max)/span.
+def _force_bound(actuator: mujoco.MjsActuator) -> float:
+    """A servo's force bound [N m or N]: its `forcerange`, inf without one."""
+    import mujoco
 
-    While the force is at its bound, kp·e − kv·q̇ > effort, so q̇ < (kp·span − effort)/kv: the
-    bound keeps a saturated move at or below the velocity limit. Without it a UR5e wrist
-    (1.3e-4 kg m², ±28 N m) crossed its 2π range at 2900 rad/s and MuJoCo diverged.
-    """
-    kp = kv * kv / (4.0 * inertia)
-    if speed is None or not np.isfinite(speed) or not np.isfinite(effort):
-        return kp
-    span = span if np.isfinite(span) else 2.0 * np.pi  # a continuous joint: one turn
-    return min(kp, (effort + kv * speed) / span)
+    if actuator.forcelimited != mujoco.mjtLimited.mjLIMITED_TRUE:
+        return float("inf")
+    return float(np.max(np.abs(actuator.forcerange)))
 
 
 def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[float, float]:
@@ -165,8 +170,11 @@ def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[f
     return -np.inf, np.inf
 
 
-def _home_inertia(spec: mujoco.MjSpec) -> tuple[dict[str, float], dict[str, float]]:
-    """Each joint's reflected inertia (mass-matrix diagonal) and position at the home posture."""
+def _home_inertia(
+    spec: mujoco.MjSpec,
+) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
+    """Each joint's reflected inertia (mass-matrix diagonal) at the home posture and the largest
+    over its range (`servo_gains.largest_inertia`) [kg m² or kg], and its home position."""
     import mujoco
 
     model = spec.copy().compile()
@@ -177,10 +185,12 @@ def _home_inertia(spec: mujoco.MjSpec) -> tuple[dict[str, float], dict[str, floa
     mujoco.mj_forward(model, data)
     full = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
+    largest = largest_inertia(model)
     inertia, home = {}, {}
     for j in range(model.njnt):
         dof, adr = model.jnt_dofadr[j], model.jnt_qposadr[j]
-        inertia[model.joint(j).name] = float(full[dof, dof])
+        at_home = float(full[dof, dof])
+        inertia[model.joint(j).name] = (at_home, max(at_home, float(largest[dof])))
         home[model.joint(j).name] = float(data.qpos[adr])
     return inertia, home
 

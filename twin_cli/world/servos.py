@@ -48,6 +48,7 @@ import mujoco
 import numpy as np
 
 from converters.control_text import CONTROL_TEXT
+from converters.mjcf.export_gravcomp import GRAVCOMP, restore_gravcomp
 from converters.mjcf.export_servos import EXPORTED
 from twin_cli.world import gravity_comp, sleeping, speed_holds
 
@@ -98,7 +99,8 @@ def give_reference(spec: mujoco.MjSpec) -> None:
 def restore_exported_motors(spec: mujoco.MjSpec) -> None:
     """Turns the servos an exported file carries for MuJoCo users back into the torque motors
     they replaced (`converters.mjcf.export_servos`), so a World commands a robot spawned from
-    `twin convert`'s file exactly as it commands the robot's source."""
+    `twin convert`'s file exactly as it commands the robot's source (gravity compensation
+    included: `gravity_comp` switches it at run time)."""
     text = spec.text(CONTROL_TEXT)
     if text is None:
         return
@@ -113,6 +115,7 @@ def restore_exported_motors(spec: mujoco.MjSpec) -> None:
         actuator.ctrllimited = mujoco.mjtLimited(motor["ctrllimited"])
         actuator.forcerange = np.array(motor["forcerange"], dtype=float)
         actuator.forcelimited = mujoco.mjtLimited(motor["forcelimited"])
+        restore_gravcomp(spec, actuator.target, motor.get(GRAVCOMP))
         restored = True
     if restored:
         text.data = json.dumps(records)
