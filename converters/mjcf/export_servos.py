@@ -140,7 +140,8 @@ def _to_servo(
             damping = max(float(pid[2]), 2.0 * np.sqrt(max(kp, 0.0) * inertia))
             kv = min(damping, kv) if np.isfinite(effort) else damping
         else:
-            kp, kv = position_gains(inertia, largest, effort, timestep)
+            speed = record.get("velocity_limit")
+            kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
         actuator.set_to_position(kp=kp, kv=kv)
     else:
         actuator.set_to_velocity(kv=float(pid[0]) if pid else kv)

@@ -3,16 +3,19 @@
 A position servo's law is f = clamp(kp·(target − q) − kv·q̇, ±effort). Two rules set it:
   - stiffness: kp = I·ω² on the joint's reflected inertia I at the home posture, with the natural
     frequency ω as high as the step h integrates well (ω·h = OMEGA_STEP). Menagerie's hand-tuned
-    arms are as stiff (its Panda: 4500 N m/rad on joint 1, here 4570).
-  - damping: kv = kp·τ with τ = max(2ζ/ω, √(2·BRAKE_RAD·I_max/effort)). The first term is
-    critical damping (ζ = DAMPING_RATIO, MuJoCo's `dampratio`) at home. The second keeps a move
-    that saturates the effort from overshooting where the joint is heaviest (I_max, the largest
-    reflected inertia over the joint's range): the force leaves its bound on the line
-    q̇ = (target − q)/τ and then brakes along it, which the effort can do only while
-    q̇/τ ≤ effort/I_max. τ is the time the effort takes to move I_max across BRAKE_RAD.
+    arms are as stiff (its Panda: 4500 N m/rad on joint 1, here 5020).
+  - damping: kv = kp·τ, τ the longest of three times. 2ζ/ω is critical damping at home
+    (ζ = DAMPING_RATIO, MuJoCo's `dampratio`). √(2·B·I_max/effort) keeps a move that saturates
+    the effort from overshooting where the joint is heaviest (I_max, the largest reflected
+    inertia over the joint's range): the force leaves its bound on the line q̇ = (target − q)/τ
+    and brakes along it, which the effort can do only while q̇/τ ≤ effort/I_max; it is the time
+    the effort takes to move I_max across B = BRAKE_RAD. B/v_max makes the servo ask for at most
+    the velocity limit within B of its target, so that light joints do not whirl (a UR5e wrist
+    of 1.3e-4 kg m² and ±28 N m reached 874 rad/s in the random-ctrl gate without it, 223 with).
 Critical damping alone (τ = 2/ω = 10 ms at the 1 ms step) overshot a 1 rad step of a Panda-like
-arm's first joint by 0.80 rad and settled in 2.6 s where the joint is extended (I 2.4 kg m²
-against 0.11 at home); with the braking term it settles in 0.46-0.80 s without overshoot.
+arm's first joint by 0.80 rad and settled in 2.6 s where the arm is extended (I 2.4 kg m²
+against 0.13 at home); these gains settle it in 0.61-0.69 s without overshoot, at most 3.6 times
+its velocity limit, under `implicit` and `implicitfast` alike.
 """
 
 from __future__ import annotations
@@ -29,30 +32,39 @@ if TYPE_CHECKING:
 # arm at the 1 ms step: 0.1 and 0.2 settle every step within 10 % of each other.
 OMEGA_STEP = 0.2
 DAMPING_RATIO = 1.0  # critical damping on the joint's reflected inertia at home
-# [rad] The move the effort must be able to stop within τ (module doc). Measured over 4 postures,
-# 7 joints and steps of 0.1-1 rad of a Panda-like arm: 0.1 rad overshot by up to 510 mrad, 0.15 by
-# 261 mrad, 0.25 by none, and every step settled within 1.3·Δ/v_max + 0.3 s (at most 0.95 of it).
+# [rad] B, the move the effort must be able to stop within τ (module doc). Measured over 4
+# postures, 7 joints and steps of 0.1-1 rad of a Panda-like arm (without the velocity term): 0.1
+# rad overshot by up to 510 mrad, 0.15 by 261 mrad, 0.25 by none, and every step settled within
+# 1.3·Δ/v_max + 0.3 s (at most 0.95 of it).
 BRAKE_RAD = 0.25
+RANGE_SHARE = (
+    0.25  # on a joint of a short range (a gripper's finger), BRAKE_RAD is this share of it
+)
 POSTURES = 64  # random postures sampled for the largest reflected inertia
 SEED = 0  # of those postures: the same file on every run
 
 
 def position_gains(
-    inertia: float, largest: float, effort: float, timestep: float
+    inertia: float, largest: float, effort: float, speed: float | None, span: float, timestep: float
 ) -> tuple[float, float]:
-    """(kp [N m/rad], kv [N m s/rad]) of a position servo (module doc).
+    """(kp [N m/rad], kv [N m s/rad]) of a position servo (module doc; [N/m], [N s/m] on a slide).
 
     Args:
         inertia: the joint's reflected inertia at home [kg m² or kg].
         largest: its largest reflected inertia over the joint's range (≥ `inertia`).
-        effort: its effort limit [N m or N]; inf: none (critical damping only).
+        effort: its effort limit [N m or N]; inf: none.
+        speed: its velocity limit [rad/s or m/s]; None or inf: none.
+        span: its range's width [rad or m]; inf: none.
         timestep: the model's step [s].
     """
     omega = OMEGA_STEP / timestep
     kp = inertia * omega * omega
+    brake = min(BRAKE_RAD, RANGE_SHARE * span)
     tau = 2.0 * DAMPING_RATIO / omega
     if np.isfinite(effort) and effort > 0.0:
-        tau = max(tau, float(np.sqrt(2.0 * BRAKE_RAD * max(largest, inertia) / effort)))
+        tau = max(tau, float(np.sqrt(2.0 * brake * max(largest, inertia) / effort)))
+    if speed is not None and np.isfinite(speed) and speed > 0.0:
+        tau = max(tau, brake / speed)
     return kp, kp * tau
 
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from corpus_registry import corpus_ids
 
-from converters.mjcf.servo_gains import DAMPING_RATIO, OMEGA_STEP
+from converters.mjcf.servo_gains import BRAKE_RAD, DAMPING_RATIO, OMEGA_STEP
 from converters.mjcf.writer import write_model
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
@@ -157,11 +157,13 @@ def test_servo_gains_follow_the_effort_bound_and_the_tags_pid(tmp_path: Path) ->
     model = mujoco.MjModel.from_xml_path(str(write_model(spec, report, tmp_path / "out")))
     inertia, h = 0.005, 0.001  # [kg m²] each disc about its hinge, [s] the world's step
     d0, d1 = model.actuator("d0"), model.actuator("d1")
-    # No effort limit: no force bound; kp = I·ω² with ω·h = OMEGA_STEP, critically damped on I.
-    omega = OMEGA_STEP / h
+    # No effort limit: no force bound; kp = I·ω² with ω·h = OMEGA_STEP, and kv = kp·τ where τ
+    # is the longer of critical damping's 2ζ/ω and BRAKE_RAD at the 1 rad/s velocity limit.
+    omega, speed = OMEGA_STEP / h, 1.0
+    tau = max(2 * DAMPING_RATIO / omega, BRAKE_RAD / speed)
     assert not model.actuator_forcelimited[d0.id]
     assert d0.gainprm[0] == pytest.approx(inertia * omega**2)
-    assert d0.biasprm[2] == pytest.approx(-2 * DAMPING_RATIO * np.sqrt(d0.gainprm[0] * inertia))
+    assert d0.biasprm[2] == pytest.approx(-d0.gainprm[0] * tau)
     # The tags' PID: kp = pos_kp, kv = max(pos_kd, 2√(kp·I)) within I/h (an effort limit).
     assert d1.gainprm[0] == pytest.approx(120.0)
     assert -d1.biasprm[2] == pytest.approx(min(max(4.0, 2 * np.sqrt(120 * inertia)), inertia / h))
