@@ -27,9 +27,9 @@ HOLD_STEPS = 50  # 50 ms per random ctrl at the 1 ms step
 # with the explicit Coriolis forces of implicitfast every seed diverged within 2.5 s at 2.7 N m.
 CTRL_SCALE = {"solo12": 0.001}
 DIVERGES: dict[str, str] = {}
-# [rad] a tagged arm joint's drift from home after 1 s in the scene. Measured: at most 0.027
-# (the wrists, whose kp is bounded by effort/range so a saturated move stays under the velocity
-# limit); limp, the same arm folds 0.2-5.6 rad.
+# [rad] a tagged arm joint's drift from home after 1 s in the scene. Measured: at most 0.011
+# (wrist 3: kp 5.3 N m/rad on 1.3e-4 kg m², and a floating base gets no gravity compensation);
+# limp, the same arm folds 0.2-5.6 rad.
 HOME_HELD_RAD = 0.05
 
 
