@@ -31,16 +31,16 @@ UPDATE_RATE_HZ = 1000.0  # [Hz]
 ITERATIONS = 50
 # twin's --earth preset [m/s²] (standard gravity, rounded; Gazebo's empty.world has 9.8).
 GRAVITY = (0.0, 0.0, -9.81)
-# implicit integrates joint damping and the PD gains of joint commands implicitly, so they stay
-# stable at the 1 ms step (Euler would need much smaller gains), and also the Coriolis and
-# centrifugal forces, which implicitfast leaves explicit (MuJoCo doc "Numerical integration").
-# Explicit, they pump energy into a light link that a heavy one spins: measured on a limp
-# 6-axis arm lying on the ground (repaired inertias, 0.5 kg wrist), implicitfast flicked the
-# wrist to 63 rad/s 3.8 s after it came to rest and turned the base 4.2 mrad in 10 s; implicit
-# keeps the wrist under 0.4 rad/s and the base within 0.0013 mrad. Legs of 7-150 g under random
-# torques of 2.7 N m: implicitfast diverged after 1.3 s, implicit runs 10 s. It costs 1.2-1.8x
-# the step time of implicitfast on 12-29 DoF robots.
-INTEGRATOR = "implicit"
+# implicitfast integrates joint damping and the actuators' velocity gains implicitly, so the
+# servos of joint commands stay stable at the 1 ms step, and leaves the Coriolis and centrifugal
+# forces explicit (MuJoCo doc "Numerical integration"). `implicit` also treats those implicitly
+# and costs 1.2-1.8 times the step (mean 1.34-1.39 over the corpus and the humanoid, measured by
+# benchmarks/bench_integrator.py). Neither integrator lets a corpus robot diverge in the
+# random-ctrl gates. At rest only limp robots whose heavy links swing a light one do worse: an
+# IRB 2400 lying limp on its free base moves 1.04 mm and turns 4.2 mrad in 60 s (implicit: 0.05
+# mm, 0.008 mrad); held by its motors both give the same. The server's PUT /physics takes
+# {"integrator": "implicit"} for a world that needs the other.
+INTEGRATOR = "implicitfast"
 SOLVER = "newton"
 # Solver convergence threshold, fixed in every world. MuJoCo 4 solves each constraint island on its
 # own, but an island's stopping point still shifts with what else is in the model: measured on a

@@ -23,8 +23,8 @@ HOLD_STEPS = 50  # 50 ms per random ctrl at the 1 ms step
 # motors: about 2.7 N m). Untagged joints stay torque motors in the file (Gazebo leaves them
 # passive, and the world keeps them limp until commanded, which the file must match); its random
 # torques are drawn within 1 N m. Measured over seeds 0-7 of `default_rng`: at its real motors'
-# 2.7 N m (which spin its legs to 700-1400 rad/s) seed 7 diverges at 4.2 s, at 1 N m none does;
-# with the explicit Coriolis forces of implicitfast every seed diverged within 2.5 s at 2.7 N m.
+# 2.7 N m (which spin its legs to 700-1400 rad/s) some seeds diverge under either integrator
+# (implicitfast 6 of 8, implicit 4 of 8), at 1 N m none does.
 CTRL_SCALE = {"solo12": 0.001}
 DIVERGES: dict[str, str] = {}
 # [rad] a tagged arm joint's drift from home after 1 s in the scene. Measured: at most 0.011

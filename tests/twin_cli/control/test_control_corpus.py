@@ -21,9 +21,8 @@ SECONDS = 10.0  # of sim time per robot and mode
 # of each range around its centre (measured, implicit integrator: peaks of 68 and 160 rad/s,
 # no warning in 10 s on seeds 0-4 of `default_rng`), its efforts within 1 N m (0.001 of the
 # range). At its real motors' 2.7 N m the efforts spin its legs to 400-750 rad/s and seeds 3
-# and 5 of 0-5 diverge (at 2.45 s and 1.35 s); at 1 N m all six run the 10 s. With
-# implicitfast, which leaves Coriolis forces explicit, 1 % of the ranges was the most it took,
-# and its efforts diverged after 1.3 s.
+# and 5 of 0-5 diverge (at 2.45 s and 1.35 s); at 1 N m all six run the 10 s, under the
+# world's implicitfast as under implicit.
 RANGE_SCALE = {"solo12": 0.1}
 EFFORT_SCALE = {"solo12": 0.001}
 

@@ -22,17 +22,21 @@ from twin_cli.world import World
 
 SETTLE_S, WATCH_S = 2.0, 60.0
 MOVED_M, TURNED_RAD = 1e-3, 1e-3
-# Robots whose limp limbs are still moving 2 s after they are set down (measured, 60 s watch).
-# Both creep where a contact rests on MuJoCo's pyramidal friction cone at |f_t1| + |f_t2| = μ·f_n,
-# with |f_t| between 0.71 and 0.94 of μ·f_n: the pyramid's four edges bound the friction force by
-# a square turned 45° to the contact's tangent axes, inscribed in the circle μ·f_n, whereas ODE's
-# friction box |f_t1|, |f_t2| ≤ μ·f_n, which Gazebo uses, would hold them still:
-# - solo12, untagged and limp, lies on its splayed legs: it sinks 0.35 mm and rolls 7.2 mrad
-#   in the 60 s (still 2.1 mrad in the 60 s after a 32 s settle);
-# - booster_t1 topples from standing until about 3.5 s, then creeps 0.72 mm and 2.5 mrad in 60 s.
-# MuJoCo's noslip pass (friction re-solved hard) stops both creeps, but it made one robot's motion
-# depend on another's spawn and held self-colliding links from pushing apart.
-STILL_FALLING = ("solo12", "booster_t1")
+# Robots that do not stand still when left limp, with what they do in the 60 s (measured under
+# the world's implicitfast integrator). solo12 and booster_t1 creep where a contact rests on
+# MuJoCo's pyramidal friction cone at |f_t1| + |f_t2| = μ·f_n, with |f_t| between 0.71 and 0.94
+# of μ·f_n: the pyramid's four edges bound the friction force by a square turned 45° to the
+# contact's tangent axes, inscribed in the circle μ·f_n, whereas ODE's friction box |f_t1|,
+# |f_t2| ≤ μ·f_n, which Gazebo uses, would hold them still. MuJoCo's noslip pass (friction
+# re-solved hard) stops both creeps, but it made one robot's motion depend on another's spawn and
+# held self-colliding links from pushing apart. The IRB 2400, limp on its free base, swings its
+# 0.5 kg wrist from its 257 kg links through the Coriolis forces implicitfast leaves explicit
+# (under `implicit`: 0.05 mm, 0.008 mrad; held by its motors it stands still under both).
+STILL_FALLING = {
+    "solo12": "lies limp on its splayed 7-150 g legs: 1.84 mm, 30.8 mrad",
+    "booster_t1": "topples from standing until about 3.5 s: 239 mm, 3.1 rad",
+    "abb_irb2400_12_155": "limp wrist swung by explicit Coriolis forces: 1.04 mm, 4.18 mrad",
+}
 
 
 def corpus_spawn_request(robot_id: str) -> SpawnRequest:
@@ -61,7 +65,15 @@ def _drift(world: World, name: str) -> tuple[float, float]:
     return moved, turned
 
 
-@pytest.mark.parametrize("robot_id", [r for r in corpus_ids() if r not in STILL_FALLING])
+@pytest.mark.parametrize(
+    "robot_id",
+    [
+        pytest.param(r, marks=pytest.mark.xfail(reason=STILL_FALLING[r], strict=True))
+        if isinstance(r, str) and r in STILL_FALLING
+        else r
+        for r in corpus_ids()
+    ],
+)
 def test_a_corpus_robot_left_on_the_ground_stays_put(robot_id: str) -> None:
     world = World()
     world.spawn(corpus_spawn_request(robot_id), name="r")
