@@ -33,6 +33,12 @@ from twin_cli.world import World
 PATH_TOLERANCE = 0.02  # fraction of the distance driven (position) and of the turn (heading)
 STRAIGHT_HEADING = 0.02  # [rad] heading error allowed on a straight line
 ODOM_TOLERANCE = 0.01  # [m] odometry against the world pose
+# [m] gz-sim AckermannSteering's encoder odometry on the 1.2 m turn: its driven rear wheels,
+# whose lag the velocity servos' integral pays back while the drive ramps down (Gazebo's velocity
+# constraint keeps none), read 10.0 mm (implicit) and 11.0 mm (implicitfast) off the world pose;
+# gz-sim's own formula (first wheel of each side, mean steering angle) read 14 mm off on the same
+# drive, so the bound is that plugin's own accuracy here, not 1 cm.
+ACKERMANN_ODOM_TOLERANCE = 0.015
 SETTLE = 0.5  # [s] stepped after the command's duration (the ramp down)
 
 DIFF_ROS2 = (
@@ -154,6 +160,7 @@ class Family:
     turn: dict  # drive() keywords of the turn
     files: tuple[tuple[str, str], ...] = ()  # (name, text) written beside the robot
     skid: bool = False  # two wheels a side (skid_steer_bot, a/c = 0.4): it turns by friction
+    odom_tolerance: float = ODOM_TOLERANCE  # [m] its odometry against the world pose after the drive
 
 
 FAMILIES = {
@@ -202,7 +209,11 @@ FAMILIES = {
         lambda: dm.ackermann_car(ROS_ACKERMANN), "urdf", "bicycle", {"steering": 0.4}
     ),
     "gz_ackermann_steering_sdf": Family(
-        lambda: dm.sdf_ackermann(GZ_ACKERMANN), "sdf", "bicycle", {"curvature": 1.0}
+        lambda: dm.sdf_ackermann(GZ_ACKERMANN),
+        "sdf",
+        "bicycle",
+        {"curvature": 1.0},
+        odom_tolerance=ACKERMANN_ODOM_TOLERANCE,
     ),
     "gazebo_ros_tricycle_drive": Family(
         lambda: dm.tricycle(TRICYCLE), "urdf", "bicycle", {"steering": 0.4}
@@ -297,7 +308,7 @@ def test_drive_follows_its_kinematic_model_and_odometry_the_world_pose(
     assert heading <= allowed, f"{name}: heading {heading:.4f} rad off of a {turned:.3f} rad turn"
     odom = odometry(world, "base")
     ox, oy = odom["pose"]["position"][:2]
-    assert math.hypot(ox - end.x, oy - end.y) <= ODOM_TOLERANCE, (
+    assert math.hypot(ox - end.x, oy - end.y) <= family.odom_tolerance, (
         f"{name}: {odom['source']} odometry ({ox:.4f}, {oy:.4f}) vs world ({end.x:.4f}, "
         f"{end.y:.4f})"
     )
