@@ -6,9 +6,9 @@ by a force. So a velocity servo commanded to 0 (a stopped wheel, a drive plugin'
 becomes the joint's own dry friction plus its effort limit, with the actuator pushing nothing: it
 holds a load within the limit, slips at exactly the limit beyond it, and remembers nothing, so a
 wheel stopped after a drive does not turn back and one pushed past its limit does not spring
-back. A joint without an effort limit holds up to UNLIMITED. Measured on a 7 kg two-wheel base parked on 5° for 10 s (wheels 5 N m): 0.041 mm of creep
-with HOLD_SOLIMP (the integral servo it replaces: 0.023 mm; MuJoCo's default friction impedance:
-190 mm).
+back. A joint without an effort limit holds up to UNLIMITED. Measured on a 7 kg two-wheel base
+parked on 5° for 10 s (wheels 5 N m): 0.041 mm of creep with HOLD_SOLIMP (the integral servo
+it replaces: 0.023 mm; MuJoCo's default friction impedance: 190 mm).
 
 The joint's own friction and its impedance are kept in its motor's `dynprm` (an integrator
 ignores them; `servos.MARK_SLOT` marks the motor as twin's), so lifting a hold restores them on

@@ -160,7 +160,7 @@ class Family:
     turn: dict  # drive() keywords of the turn
     files: tuple[tuple[str, str], ...] = ()  # (name, text) written beside the robot
     skid: bool = False  # two wheels a side (skid_steer_bot, a/c = 0.4): it turns by friction
-    odom_tolerance: float = ODOM_TOLERANCE  # [m] its odometry against the world pose after the drive
+    odom_tolerance: float = ODOM_TOLERANCE  # [m] its odometry against the world pose
 
 
 FAMILIES = {
