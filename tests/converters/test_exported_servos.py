@@ -10,7 +10,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from corpus_registry import corpus_ids
+from corpus_registry import corpus_ids, corpus_ids_expecting
 
 from converters.mjcf.servo_gains import BRAKE_RAD, DAMPING_RATIO, OMEGA_STEP
 from converters.mjcf.writer import write_model
@@ -40,12 +40,7 @@ def _scene(tmp_path: Path, converted_corpus, robot_id: str) -> Path:
 
 @pytest.mark.parametrize(
     "robot_id",
-    [
-        pytest.param(r, marks=pytest.mark.xfail(reason=DIVERGES[r], strict=True))
-        if isinstance(r, str) and r in DIVERGES
-        else r
-        for r in corpus_ids()
-    ],
+    corpus_ids_expecting(DIVERGES),
 )
 def test_exported_scene_takes_random_ctrl_for_ten_seconds_on_the_ground(
     tmp_path: Path, converted_corpus, robot_id: str

@@ -15,7 +15,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from corpus_registry import corpus_ids
+from corpus_registry import corpus_ids, corpus_ids_expecting
 
 import scenarios
 from converters.gazebo.drive_records import held_from_load
@@ -234,12 +234,7 @@ def _home_ctrl(model: mujoco.MjModel, data: mujoco.MjData, a: int) -> float:
 
 @pytest.mark.parametrize(
     "robot_id",
-    [
-        pytest.param(r, marks=pytest.mark.xfail(reason=DIVERGES[r], strict=True))
-        if isinstance(r, str) and r in DIVERGES
-        else r
-        for r in corpus_ids()
-    ],
+    corpus_ids_expecting(DIVERGES),
 )
 def test_corpus_takes_random_ctrl_from_home(
     tmp_path: Path, converted_corpus, robot_id: str

@@ -12,7 +12,7 @@ from corpus_registry import (
     DANGLING,
     NON_PHYSICAL_INERTIA,
     PACKAGES_ROOT,
-    corpus_ids,
+    corpus_ids_expecting,
     package_paths,
 )
 
@@ -67,12 +67,7 @@ def _drift(world: World, name: str) -> tuple[float, float]:
 
 @pytest.mark.parametrize(
     "robot_id",
-    [
-        pytest.param(r, marks=pytest.mark.xfail(reason=STILL_FALLING[r], strict=True))
-        if isinstance(r, str) and r in STILL_FALLING
-        else r
-        for r in corpus_ids()
-    ],
+    corpus_ids_expecting(STILL_FALLING),
 )
 def test_a_corpus_robot_left_on_the_ground_stays_put(robot_id: str) -> None:
     world = World()
