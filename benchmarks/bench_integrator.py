@@ -26,14 +26,11 @@ from __future__ import annotations
 import copy
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
-import tomllib
 
-CORPUS = Path(__file__).resolve().parents[1].parent / "shared" / "corpus"
-PACKAGES = CORPUS / "packages"
-NON_PHYSICAL_INERTIA = ("abb_irb2400_12_155", "anymal_c", "hyq")
+from benchmarks.bench_rest import corpus_request, corpus_robots
+
 # [s] sim time. A limp robot folds first: the bundled humanoid, symmetric, stands about 4 s on
 # its feet and has fallen by 6 s.
 COST_SETTLE_S, REST_SETTLE_S, REST_S = 1.0, 8.0, 5.0
@@ -56,18 +53,7 @@ def _spawn_requests() -> dict:
     from scenarios import HUMANOID
     from twin_cli.spawn_request import SpawnRequest
 
-    requests = {}
-    if (CORPUS / "robots.toml").is_file():
-        packages = {p.name: str(p) for p in PACKAGES.iterdir()}
-        for robot in tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]:
-            requests[robot["id"]] = SpawnRequest(
-                str(PACKAGES / robot["entry"]),
-                package_paths=packages,
-                args=robot["xacro_args"],
-                repair_inertia=robot["id"] in NON_PHYSICAL_INERTIA,
-                drop_dangling=True,
-                on_ground=True,
-            )
+    requests = {rid: corpus_request(robot) for rid, robot in corpus_robots().items()}
     requests["humanoid"] = SpawnRequest(str(HUMANOID), on_ground=True)
     return requests
 

@@ -31,17 +31,19 @@ SETTLE_S, WATCH_S = 2.0, 60.0
 TARGETS = {"moved_mm": 1.0, "turned_mrad": 1.0, "normal_force_spread": 0.05, "speed_error": 0.01}
 
 
-def _robots() -> dict[str, dict]:
+def corpus_robots() -> dict[str, dict]:
+    """robots.toml's entries by id (none without ../shared)."""
     if not (CORPUS / "robots.toml").is_file():
         return {}
     return {r["id"]: r for r in tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]}
 
 
-def _spawn(world, robot: dict, name: str) -> None:
+def corpus_request(robot: dict):  # noqa: ANN201 (SpawnRequest, imported lazily)
+    """A corpus robot as `twin spawn --on-ground` takes it (the options its files need)."""
     from twin_cli.spawn_request import SpawnRequest
 
     packages = {p.name: str(p) for p in PACKAGES.iterdir()}
-    request = SpawnRequest(
+    return SpawnRequest(
         str(PACKAGES / robot["entry"]),
         package_paths=packages,
         args=robot["xacro_args"],
@@ -49,7 +51,10 @@ def _spawn(world, robot: dict, name: str) -> None:
         drop_dangling=True,
         on_ground=True,
     )
-    world.spawn(request, name=name)
+
+
+def _spawn(world, robot: dict, name: str) -> None:
+    world.spawn(corpus_request(robot), name=name)
 
 
 def _drift(world, name: str) -> dict:
@@ -70,7 +75,7 @@ def _corpus_rest() -> dict:
     from twin_cli.world import World
 
     rows = {}
-    for rid, robot in _robots().items():
+    for rid, robot in corpus_robots().items():
         world = World()
         try:
             _spawn(world, robot, "r")
@@ -91,7 +96,7 @@ def _turtlebot3_settled():
     """turtlebot3 spawned on the ground and settled for 0.3 s, or None without the corpus."""
     from twin_cli.world import World
 
-    robot = _robots().get("turtlebot3_burger")
+    robot = corpus_robots().get("turtlebot3_burger")
     if robot is None:
         return None
     world = World()
