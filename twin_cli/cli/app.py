@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 if TYPE_CHECKING:
     import typer
 
+DISTRIBUTION = "twin"  # pyproject.toml's [project] name, the one importlib.metadata knows
 HELP = "A MuJoCo digital twin for robots described for Gazebo: convert, spawn, run, validate."
 
 
@@ -33,20 +34,16 @@ def build_app() -> typer.Typer:
         pretty_exceptions_enable=False,
     )
     commands.register_all(app)
-    app.callback()(_root)
+    app.callback()(commands.root)
     app.command("version")(version)
     return app
 
 
-def _root() -> None:
-    """twin: convert, spawn, run and validate robots described for Gazebo, on MuJoCo."""
-
-
 def version() -> None:
-    """Print twin's version."""
+    """Print twin's version (the installed distribution's, as `twin --version` does)."""
     from importlib.metadata import version as _version
 
-    print(f"twin {_version('twin')}")
+    print(f"twin {_version(DISTRIBUTION)}")
 
 
 def __getattr__(name: str) -> Any:
