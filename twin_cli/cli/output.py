@@ -21,7 +21,8 @@ class Output:
     """Chosen once per command: `Output(json_mode)`; every printing call goes through it.
 
     Human mode on a terminal uses rich; human mode into a pipe prints tab-separated plain text,
-    so `twin list | cut -f1` works. JSON mode prints exactly one JSON document per `data` call.
+    so `twin list | cut -f1` works. Either prints a missing value (None) as `-`. JSON mode
+    prints exactly one JSON document per `data` call.
     """
 
     def __init__(self, json_mode: bool = False, stream: Any = None) -> None:
@@ -61,7 +62,13 @@ class Output:
             self.stream.flush()
 
 
+MISSING = "-"  # a cell without a value, as `gz` and `ros2` tables print one (JSON keeps null)
+
+
 def _cell(value: Any) -> str:
+    """A table cell: floats to 6 significant digits, a missing value (None) as MISSING."""
+    if value is None:
+        return MISSING
     if isinstance(value, float):
         return f"{value:.6g}"
     return str(value)
