@@ -53,19 +53,19 @@ class Output:
             for col in columns:
                 table.add_column(str(col))
             for row in rows:
-                table.add_row(*(_cell(v) for v in row))
+                table.add_row(*(cell(v) for v in row))
             Console(file=self.stream).print(table)
         else:
             self.stream.write("\t".join(str(c) for c in columns) + "\n")
             for row in rows:
-                self.stream.write("\t".join(_cell(v) for v in row) + "\n")
+                self.stream.write("\t".join(cell(v) for v in row) + "\n")
             self.stream.flush()
 
 
 MISSING = "-"  # a cell without a value, as `gz` and `ros2` tables print one (JSON keeps null)
 
 
-def _cell(value: Any) -> str:
+def cell(value: Any) -> str:
     """A table cell: floats to 6 significant digits, a missing value (None) as MISSING."""
     if value is None:
         return MISSING

@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from twin_cli.cli import pairs
-from twin_cli.cli.output import Output
+from twin_cli.cli.output import Output, cell
 from twin_cli.cli.spawn_action import POSE_KEYS, Vec3
 from twin_cli.cli.spawn_action import spawn as spawn  # the table names it here
 from twin_cli.cli.world_client import connect_world, not_running
@@ -199,7 +199,21 @@ def physics(
     if json:
         out.data(result)
         return
-    out.table("physics", ["setting", "value"], [[k, v] for k, v in result.items()])
+    out.table("physics", ["setting", "value"], physics_rows(result))
+
+
+def physics_rows(result: dict) -> list[list]:
+    """`twin physics` for people: each setting once. A field the world file carries that MuJoCo
+    has no counterpart for (listed in `not_applicable`) is not a setting in force: it shows
+    only in that last row, with the file's value (`contact_max_correcting_vel=100`)."""
+    unused = result.get("not_applicable") or []
+    rows = [
+        [key, " ".join(f"{v:g}" for v in value) if key == "gravity" else value]
+        for key, value in result.items()
+        if key != "not_applicable" and key not in unused
+    ]
+    shown = [f"{name}={cell(result[name])}" if name in result else name for name in unused]
+    return [*rows, ["not_applicable", ", ".join(shown) or None]]
 
 
 def pause(*, world: str) -> None:

@@ -39,3 +39,15 @@ def test_joints_print_a_missing_target_as_a_dash_and_json_as_null(world):
     assert not any("None" in value for r in rows for value in r.values()), rows
     data = json.loads(twin_ok(world, WORLD, "joints", "pendulums", "--json"))
     assert [j["target"] for j in data] == [None, None], "JSON keeps null"
+
+
+def test_physics_shows_each_setting_once_and_a_field_without_effect_as_not_applicable(world):
+    data = json.loads(twin_ok(world, WORLD, "physics", "--json"))
+    rows = {r["setting"]: r["value"] for r in _table(twin_ok(world, WORLD, "physics"))}
+    unused = rows.pop("not_applicable").split(", ")
+    assert "contact_max_correcting_vel=100" in unused, "ODE's default [m/s], not applied"
+    names = {item.partition("=")[0] for item in unused}
+    assert names == set(data["not_applicable"]), unused
+    assert not names & set(rows), f"shown as a setting and as not applicable: {names & set(rows)}"
+    assert rows["gravity"] == "0 0 -9.81", "as `twin gravity` prints it [m/s²]"
+    assert rows["timestep"] == f"{data['timestep']:g}"
