@@ -2,12 +2,14 @@
 
 Nested messages indent by two spaces; sequences of numbers or strings are one `- item` per line
 at the key's indentation, sequences of messages `- field: ...` blocks; an empty string is `''`
-and an empty sequence `[]`. A non-finite float, which JSON cannot carry, arrives as None and
-prints as `null`. Pure Python: the client imports no numpy.
+and an empty sequence `[]`. A non-finite float prints as YAML spells it, as `ros2 topic echo`
+does: `.inf`, `-.inf`, `.nan` (a lidar's ray with no return is `.inf`). JSON has no such numbers:
+`json_safe` makes them null for `--json`. Pure Python: the client imports no numpy.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 
@@ -41,9 +43,22 @@ def _items(values: list[Any], depth: int) -> list[str]:
     return out
 
 
+def json_safe(value: Any) -> Any:
+    """`value` with every non-finite float replaced by None (JSON's null), for strict JSON."""
+    if isinstance(value, dict):
+        return {key: json_safe(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [json_safe(item) for item in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
 def _scalar(value: Any) -> str:
     if value is None:
         return "null"
+    if isinstance(value, float) and not math.isfinite(value):
+        return ".nan" if math.isnan(value) else (".inf" if value > 0 else "-.inf")
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, str):

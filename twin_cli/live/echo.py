@@ -44,9 +44,11 @@ DEFAULT_TRUNCATE = 128  # items of an array or characters of a string shown (ros
 
 
 def plain(value: Any, truncate: int = DEFAULT_TRUNCATE) -> Any:
-    """A rosbags message as JSON-ready values: fields by name, arrays as lists, non-finite
-    floats as None. Arrays and strings longer than `truncate` (0: never) keep their first
-    `truncate` items and end in "...", as `ros2 topic echo` shows them."""
+    """A rosbags message as JSON-ready values: fields by name, arrays as lists, floats as
+    Python floats, non-finite ones kept (`json.dumps` writes them `Infinity`, `-Infinity`,
+    `NaN`, which `json.loads` reads back: the echo's client prints them as ROS does, `.inf`).
+    Arrays and strings longer than `truncate` (0: never) keep their first `truncate` items and
+    end in "...", as `ros2 topic echo` shows them."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {
             f.name: plain(getattr(value, f.name), truncate)
@@ -59,7 +61,7 @@ def plain(value: Any, truncate: int = DEFAULT_TRUNCATE) -> Any:
         items = head.tolist() if isinstance(head, np.ndarray) else list(head)
         return [plain(v, truncate) for v in items] + (["..."] if cut else [])
     if isinstance(value, float | np.floating):
-        return float(value) if math.isfinite(value) else None
+        return float(value)
     if isinstance(value, np.integer):
         return int(value)
     if isinstance(value, str) and truncate and len(value) > truncate:

@@ -1,28 +1,41 @@
 """Output for people follows gz and ROS conventions; `--json` keeps every value machine-readable.
 
 One served world, `twin` run as a user runs it (a subprocess with `--world`, output piped):
-a missing value prints as `-` (JSON: null).
+a missing value prints as `-` (JSON: null), a lidar ray without a return as `.inf` (JSON: null).
 """
 
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 from cli_world import twin_ok
-from models import pendulum_pair
+from models import block, pendulum_pair
+from sensor_models import lidar_post
 
 WORLD = "conventions"
+POST_Y = 5.0  # [m] the lidar post's y, away from the pendulums (farther than its 3.5 m range)
+WALL_X = 1.0  # [m] centre of the wall in front of the post, on its +x ray
+WALL_SIZE = 0.4  # [m] the wall's depth and width (1 m high: every ray at 0.3 m meets it)
+RANGE_TOLERANCE = 0.02  # [m] the lidar's 0.015 m resolution and float32 rounding
 
 
 @pytest.fixture(scope="module")
 def world(tmp_path_factory, serve_world):
-    """A served world with a pair of passive pendulums (no joint has a command target)."""
+    """A served world: passive pendulums (no joint has a command target), and a lidar post
+    facing a wall that fills a few of its rays; the others see nothing within range."""
     runtime_dir = tmp_path_factory.mktemp("rt")
     with serve_world(runtime_dir, WORLD) as (client, _proc):
         path = runtime_dir / "pendulums.urdf"
         path.write_text(pendulum_pair())
         client.spawn(str(path), name="pendulums", pose={"z": 1.0})
+        (runtime_dir / "post.urdf").write_text(lidar_post())
+        client.spawn(str(runtime_dir / "post.urdf"), name="post", pose={"y": POST_Y})
+        (runtime_dir / "wall.urdf").write_text(block(size=WALL_SIZE, height=1.0, name="wall"))
+        client.spawn(
+            str(runtime_dir / "wall.urdf"), name="wall", pose={"x": WALL_X, "y": POST_Y, "z": 0.5}
+        )
         yield runtime_dir
 
 
@@ -51,3 +64,39 @@ def test_physics_shows_each_setting_once_and_a_field_without_effect_as_not_appli
     assert not names & set(rows), f"shown as a setting and as not applicable: {names & set(rows)}"
     assert rows["gravity"] == "0 0 -9.81", "as `twin gravity` prints it [m/s²]"
     assert rows["timestep"] == f"{data['timestep']:g}"
+
+
+def _strict(constant: str) -> None:
+    raise AssertionError(f"{constant} is not JSON")
+
+
+def _ranges(text: str) -> list[str]:
+    """The `- value` items under `ranges:` in `ros2 topic echo`'s text of a LaserScan."""
+    lines = text.splitlines()
+    start = lines.index("ranges:") + 1
+    items = []
+    for line in lines[start:]:
+        if not line.startswith("- "):
+            break
+        items.append(line[2:])
+    return items
+
+
+def test_echo_prints_a_ray_without_return_as_inf_and_json_as_null(world):
+    text = twin_ok(world, WORLD, "topics", "echo", "/post/scan", "-n", "1")
+    ranges = _ranges(text)
+    assert len(ranges) == 128 + 1 and ranges[-1] == "'...'", "ros2 topic echo's 128 items"
+    ranges = ranges[:-1]
+    hits = [float(r) for r in ranges if r != ".inf"]
+    assert "null" not in text and "None" not in text
+    assert 10 <= len(hits) < len(ranges), f"{len(hits)} rays meet the wall: {ranges}"
+    near = WALL_X - WALL_SIZE / 2  # [m] the wall's face, straight ahead
+    assert min(hits) == pytest.approx(near, abs=RANGE_TOLERANCE)
+    line = twin_ok(world, WORLD, "topics", "echo", "/post/scan", "-n", "1", "--json")
+    message = json.loads(line, parse_constant=_strict)["message"]
+    as_json = message["ranges"][:128]
+    assert [r is None for r in as_json] == [r == ".inf" for r in ranges], "inf: null in JSON"
+    assert [r for r in as_json if r is not None] == pytest.approx(hits, abs=RANGE_TOLERANCE)
+    help_text = twin_ok(world, WORLD, "topics", "echo", "--help")
+    words = " ".join(help_text.replace("│", " ").split())
+    assert re.search(r"non-finite number \(.*\) is null", words), help_text

@@ -23,13 +23,13 @@ def _scan(ranges: list[float]) -> object:
     )  # fmt: skip
 
 
-def test_plain_keeps_every_field_and_makes_infinity_null():
+def test_plain_keeps_every_field_and_infinity():
     values = plain(_scan([1.0, math.inf, 2.5]))
     assert values["header"] == {
         "stamp": {"sec": 1, "nanosec": 500_000_000},
         "frame_id": "post/scan",
     }
-    assert values["ranges"] == [1.0, None, 2.5], "+inf (no return) has no JSON form: null"
+    assert values["ranges"] == [1.0, math.inf, 2.5], "+inf (no return): the client prints .inf"
     assert values["intensities"] == [] and values["range_max"] == 3.5
     assert not any(key.startswith("__") for key in values), "rosbags' type tag is not a field"
 
@@ -66,5 +66,5 @@ def test_text_is_ros2_topic_echos_yaml():
         "      w: 1.0",
     ]
     scan = message_text(plain(_scan([1.0, math.inf]))).splitlines()
-    assert "  frame_id: post/scan" in scan and scan[scan.index("ranges:") + 2] == "- null"
+    assert "  frame_id: post/scan" in scan and scan[scan.index("ranges:") + 2] == "- .inf"
     assert "intensities: []" in scan

@@ -17,6 +17,15 @@ from twin_cli.cli.options import JsonOpt, WorldOpt
 from twin_cli.cli.output import Output
 
 TRUNCATE = 128  # items of an array, characters of a string (ros2 topic echo's default)
+EchoJsonOpt = Annotated[
+    bool,
+    typer.Option(
+        "--json",
+        help="Print one JSON object a line per message, streamed until -n N or Ctrl-C (without "
+        "-n it never ends); a non-finite number (a lidar ray without a return, `.inf` in the "
+        "text) is null.",
+    ),
+]
 
 app = typer.Typer(
     help="List the running world's topics with type and rate (like `gz topic -l`); "
@@ -59,7 +68,7 @@ def echo(
         bool, typer.Option("--full-length", help="Print whole arrays and strings.")
     ] = False,
     world: WorldOpt = "default",
-    json: JsonOpt = False,
+    json: EchoJsonOpt = False,
 ) -> None:
     """Print a topic's messages as they arrive (like `gz topic -e`); `---` between messages."""
     from urllib.parse import urlencode
@@ -80,11 +89,11 @@ def echo(
 
 
 def _print(messages: Any, count: int, out: Output) -> None:
-    from twin_cli.cli.message_text import message_text
+    from twin_cli.cli.message_text import json_safe, message_text
 
     for n, item in enumerate(messages, start=1):
         if out.json_mode:  # one compact object per line, as a stream of messages
-            out.stream.write(jsonlib.dumps(item) + "\n")
+            out.stream.write(jsonlib.dumps(json_safe(item), allow_nan=False) + "\n")
         else:
             out.stream.write(message_text(item["message"]) + "\n---\n")
         out.stream.flush()
