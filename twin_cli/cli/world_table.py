@@ -194,12 +194,18 @@ PHYSICS = Command(
 
 STATS = Command(
     "stats",
-    "Print `Factor[..] SimTime[..] RealTime[..] Paused[..]` about five times a second.",
+    "Print `Factor[..] SimTime[..] RealTime[..] Paused[..]` about five times a second, until "
+    "--duration ends or Ctrl-C.",
     (
         Opt(("-d", "--duration"), "duration", "Seconds to run (default: forever).", float),
         flag("-p", "--plot", dest="plot", help="Comma-separated values."),
         WORLD,
-        JSON,
+        flag(
+            "--json",
+            dest="json",
+            help="Print one JSON object a line, about five a second, streamed until --duration "
+            "ends or Ctrl-C (without -d it never ends).",
+        ),
     ),
 )
 

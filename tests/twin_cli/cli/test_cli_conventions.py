@@ -1,7 +1,8 @@
 """Output for people follows gz and ROS conventions; `--json` keeps every value machine-readable.
 
 One served world, `twin` run as a user runs it (a subprocess with `--world`, output piped):
-a missing value prints as `-` (JSON: null), a lidar ray without a return as `.inf` (JSON: null).
+a missing value prints as `-` (JSON: null), a lidar ray without a return as `.inf` (JSON: null),
+and every `--json` stream says in its help when it ends.
 """
 
 from __future__ import annotations
@@ -100,3 +101,33 @@ def test_echo_prints_a_ray_without_return_as_inf_and_json_as_null(world):
     help_text = twin_ok(world, WORLD, "topics", "echo", "--help")
     words = " ".join(help_text.replace("│", " ").split())
     assert re.search(r"non-finite number \(.*\) is null", words), help_text
+
+
+def _json_help(runtime, *command: str) -> str:
+    """The words of the --json option's help in `twin COMMAND --help`."""
+    text = twin_ok(runtime, WORLD, *command, "--help").replace("│", " ")
+    words = " ".join(text.split())
+    found = re.search(r"--json (.*?) --help Show this message", words)
+    assert found, words
+    return found.group(1)
+
+
+@pytest.mark.parametrize(
+    ("command", "ends"),
+    [
+        (("stats",), r"streamed until --duration ends or Ctrl-C \(without -d it never ends\)"),
+        (("topics", "echo"), r"streamed until -n N or Ctrl-C \(without -n it never ends\)"),
+        (("sensors",), r"streamed until --duration ends"),
+        (("record",), r"when it ends .*Ctrl-C"),
+    ],
+    ids=["stats", "topics echo", "sensors", "record"],
+)
+def test_every_json_stream_says_in_its_help_when_it_ends(world, command, ends):
+    assert re.search(ends, _json_help(world, *command)), _json_help(world, *command)
+
+
+def test_stats_json_streams_one_object_a_line_until_its_duration(world):
+    lines = twin_ok(world, WORLD, "stats", "--json", "-d", "0.5").splitlines()
+    stats = [json.loads(line) for line in lines]
+    assert 2 <= len(stats) <= 4, f"0.5 s at 0.2 s a line: {len(stats)} lines"
+    assert all({"factor", "sim_time", "real_time", "paused"} <= set(s) for s in stats)

@@ -29,7 +29,14 @@ def record(
         list[str] | None, typer.Option(help="Record only this entity (repeat); default: all.")
     ] = None,
     world: WorldOpt = "default",
-    json: JsonOpt = False,
+    json: Annotated[
+        bool,
+        typer.Option(
+            "--json",
+            help="Print the recording's summary as one JSON object when it ends (at --duration "
+            "or Ctrl-C: without --duration it records until stopped).",
+        ),
+    ] = False,
 ) -> None:
     """Record /clock, /tf, /tf_static and each entity's joint_states, odom and
     robot_description into a rosbag2 MCAP file, until --duration or Ctrl-C."""

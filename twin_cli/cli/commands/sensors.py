@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
-from twin_cli.cli.options import JsonOpt, WorldOpt
+from twin_cli.cli.options import WorldOpt
 from twin_cli.cli.output import Output
 
 MAX_POLL_HZ = 50.0  # [Hz] of wall time: a human reads; a recording samples in the server
@@ -29,7 +29,14 @@ def sensors(
         typer.Option("-d", "--duration", help="Print readings for this many seconds (wall)."),
     ] = None,
     world: WorldOpt = "default",
-    json: JsonOpt = False,
+    json: Annotated[
+        bool,
+        typer.Option(
+            "--json",
+            help="Print one JSON object a line per reading, streamed until --duration ends "
+            "(once without -d).",
+        ),
+    ] = False,
 ) -> None:
     """Print the readings of an entity's sensors (IMU, lidar, contact, force/torque, camera)."""
     from twin_cli.server.connection import connect
