@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Any, NoReturn
 if TYPE_CHECKING:
     import typer
 
-DISTRIBUTION = "twin"  # pyproject.toml's [project] name, the one importlib.metadata knows
 HELP = "A MuJoCo digital twin for robots described for Gazebo: convert, spawn, run, validate."
 
 
@@ -41,9 +40,9 @@ def build_app() -> typer.Typer:
 
 def version() -> None:
     """Print twin's version (the installed distribution's, as `twin --version` does)."""
-    from importlib.metadata import version as _version
+    from twin_cli.cli.output import print_version
 
-    print(f"twin {_version(DISTRIBUTION)}")
+    print_version()
 
 
 def __getattr__(name: str) -> Any:

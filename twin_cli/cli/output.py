@@ -74,6 +74,16 @@ def cell(value: Any) -> str:
     return str(value)
 
 
+DISTRIBUTION = "twin"  # pyproject.toml's [project] name, the one importlib.metadata knows
+
+
+def print_version() -> None:
+    """Print `twin VERSION`: the installed distribution's version (`twin --version`)."""
+    from importlib.metadata import version
+
+    sys.stdout.write(f"twin {version(DISTRIBUTION)}\n")
+
+
 def error(message: str) -> None:
     """Print one error message to stderr (the CLI boundary's only printer of errors)."""
     sys.stderr.write(f"Error: {message}\n")

@@ -17,7 +17,8 @@ from importlib.metadata import version
 import pytest
 import typer
 
-from twin_cli.cli.app import DISTRIBUTION, build_app
+from twin_cli.cli.app import build_app
+from twin_cli.cli.output import DISTRIBUTION
 
 COLUMNS = 80  # the terminal width the help is rendered for
 PROSE_WIDTH = COLUMNS - 2  # rich's help prose: one space of margin on each side

@@ -63,9 +63,9 @@ def unwrap_app(app: typer.Typer) -> None:
 def _print_version(given: bool) -> None:
     """`--version` where Typer reads the line (`twin --version --help`): the version, exit 0."""
     if given:
-        from twin_cli.cli.app import version
+        from twin_cli.cli.output import print_version
 
-        version()
+        print_version()
         raise typer.Exit()
 
 
