@@ -20,7 +20,8 @@ from converters.mjcf.bodies import body_inertias
 from converters.mjcf.control_data import add_control_data
 from converters.mjcf.fixed_base import weld_base
 from converters.mjcf.geometry import GeomPlan, plan_geoms
-from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joints
+from converters.mjcf.joints import MjJointPlan, add_free_joint, add_joint_locks, add_joints
+from converters.mjcf.loops import add_loop_equalities
 from converters.mjcf.lumping import WORLDBODY, BodyPlan, plan_bodies
 from converters.provenance import GeomOrigin, Provenance
 from converters.report import Report
@@ -120,14 +121,17 @@ def build_spec(
     add_motors(spec, actuated, report, frozenset(robot.actuated))
     add_control_data(spec, actuated, {a.name for a in spec.actuators}, robot, report)
     add_mimics(spec, robot, report)
+    locked = add_joint_locks(spec, robot)
     spec.add_key(name=HOME_KEY, qpos=_home(joints, robot))
     _summarise(plan, inertias, geoms, report)
     report.summary.update(
         joints=len(robot.joints),
         mujoco_joints=len(joints),
         actuators=len(spec.actuators),
-        mimic_equalities=len(spec.equalities),
+        mimic_equalities=len(spec.equalities) - locked,
+        locked_joints=locked,
     )
+    report.summary.update(loop_equalities=add_loop_equalities(spec, robot, plan, report))
     return spec
 
 
