@@ -189,6 +189,8 @@ class RobotDescription:
         controls: the command interfaces each `<ros2_control>`/`<transmission>` joint declares.
         base_dir: where the file's relative paths start (its folder; for a text description,
             the folder it was sent from); empty: the folder of `source`.
+        loop_joints: joints into a link that already has a parent joint (closed chains);
+            kept out of `joints` so the links stay a tree, closed by equality constraints.
     """
 
     name: str
@@ -204,6 +206,7 @@ class RobotDescription:
     model_frame_site: bool = False
     controls: tuple[JointControl, ...] = ()
     base_dir: str = ""
+    loop_joints: tuple[Joint, ...] = ()
 
     def link(self, name: str) -> Link:
         """The link called `name` (KeyError when there is none)."""

@@ -58,10 +58,12 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         surfaces.extend(inline)
     if not links:
         raise ctx.error(model, "has no <link>", "add at least one link")
-    joints, ext_joints, parent_of = [], {}, {}
+    joints, loops, ext_joints, parent_of = [], [], {}, {}
     for element, prefix in ((el, p) for m, p in scopes for el in m.findall("joint")):
         joint, extension = read_joint(ctx, graph, element, prefix)
-        _check_edge(ctx, element, joint, parent_of)
+        if not _tree_edge(ctx, element, joint, parent_of):
+            loops.append(joint)
+            continue
         joints.append(joint)
         if _has_values(extension):
             ext_joints[joint.name] = extension
@@ -94,32 +96,29 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
         base_pose=base_pose,
         frames=_frames(graph),
         model_frame_site=True,
+        loop_joints=tuple(loops),
     )
 
 
-def _check_edge(ctx: SdfContext, element: Any, joint: Joint, parent_of: dict[str, str]) -> None:
-    """The joints must keep the links a tree (MuJoCo's bodies are one): no link moved by two
-    joints, none its own parent, no cycle.
+def _tree_edge(ctx: SdfContext, element: Any, joint: Joint, parent_of: dict[str, str]) -> bool:
+    """Whether the joint is an edge of the link tree (MuJoCo's bodies are one); False for a
+    joint that closes a loop (its child already has a parent joint, or is an ancestor of its
+    parent): the body tree keeps the first joint and equalities close the loop.
 
     Raises:
-        SDFError: naming the joint and the links.
+        SDFError: a joint from a link to itself.
     """
     if joint.child == joint.parent:
         raise ctx.error(element, f"joins link '{joint.child}' to itself", "name two links")
     if joint.child in parent_of:
-        raise ctx.error(
-            element,
-            f"link '{joint.child}' already has a parent joint (from '{parent_of[joint.child]}')",
-            "a link can be the child of one joint only; remove one of the joints",
-        )
+        return False
     link = joint.parent
     while link in parent_of:
         link = parent_of[link]
         if link == joint.child:
-            raise ctx.error(
-                element, f"closes a loop through link '{joint.child}'", "remove one joint"
-            )
+            return False
     parent_of[joint.child] = joint.parent
+    return True
 
 
 def _scopes(model: Any, prefix: str):
