@@ -145,6 +145,13 @@ class Observers:
         entries = self._entries.values()
         self._due = min((e.due for e in entries), default=math.inf)
 
+    def replaying(self, time: float) -> None:
+        """The state of sim `time` [s] was restored to step a batch again (the divergence
+        watchdog's replay). Not a reset: each observer keeps its origin and next due time, so
+        its calls stay on its k·period grid and the span already observed is not observed
+        twice (its sim time would go back)."""
+        self._time = time
+
     def _reanchor(self, time: float) -> None:
         """The clock went back (reset, load): every observer starts over from `time`."""
         for entry in self._entries.values():

@@ -127,6 +127,7 @@ def _step_chunk(state: WorldState, n: int) -> None:
         _recover(state, bad)
     elif bad:
         mujoco.mj_setState(m, d, state.scratch_state, STATE)
+        state.observers.replaying(float(d.time))
         state.iterations -= n
         for _ in range(n):
             _step_chunk(state, 1)
