@@ -59,7 +59,9 @@ class Follows:
             self._follow_sensors(self._world)
 
     def _follow_sensors(self, world: World) -> None:
-        """Observes `world` at each of its sensors' rates (no sensors: not at all)."""
+        """Observes `world` at each of its sensors' rates (no sensors: not at all), reading them
+        all once now: a sensor spawned into a paused world has a reading at once. The
+        observers then go on at the clock's k/rate grid, the same as before a model change."""
         self._stop_sensors()
         with world.lock:
             self._sensor_model = world.model
@@ -71,11 +73,15 @@ class Follows:
                 self._sensor_handles = self._observe_sensors(world, rates)
 
     def _observe_sensors(self, world: World, rates: list[float]) -> list[int]:
-        """Registers one observer per sensor rate [Hz] (lock held); their handles."""
+        """Registers one observer per sensor rate [Hz] (lock held); their handles. Each is on
+        the clock's k/rate grid, so a sensor registered again after a spawn (or at another
+        stride) keeps its stamps' grid."""
         self._sensor_rates = list(rates)
         return [
             world.add_observer(
-                lambda rate=rate: self._capture_sensors(rate), self._observer_rate(rate)
+                lambda rate=rate: self._capture_sensors(rate),
+                self._observer_rate(rate),
+                aligned=True,
             )
             for rate in rates
         ]

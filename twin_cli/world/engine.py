@@ -306,17 +306,24 @@ class World:
     def running(self) -> bool:
         return self._loop.running
 
-    def add_observer(self, callback: Callable[[], None], rate: float) -> int:
+    def add_observer(
+        self, callback: Callable[[], None], rate: float, *, aligned: bool = False
+    ) -> int:
         """Calls `callback()` every 1/`rate` [Hz] of sim time, between steps, lock held.
 
         For consumers of the world (recorder, live stream, sensors): the stepping splits its
         `mj_step(nstep)` calls where an observer is due, so there is no Python per physics step.
-        The callback must only copy what it needs. Returns a handle for `remove_observer`.
+        The callback must only copy what it needs. `aligned`: at sim times k/`rate` rather than
+        from now (`Observers.add`). Returns a handle for `remove_observer`.
         """
         state = self._state
         with self.lock:
             return state.observers.add(
-                callback, rate, float(state.data.time), state.model.opt.timestep
+                callback,
+                rate,
+                float(state.data.time),
+                state.model.opt.timestep,
+                aligned=aligned,
             )
 
     def remove_observer(self, handle: int) -> None:

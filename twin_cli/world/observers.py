@@ -71,11 +71,29 @@ class Observers:
     def __bool__(self) -> bool:
         return bool(self._entries)
 
-    def add(self, callback: Callable[[], None], rate: float, time: float, timestep: float) -> int:
-        """Registers `callback` every 1/`rate` [Hz] of sim time after `time` [s]; a handle."""
+    def add(
+        self,
+        callback: Callable[[], None],
+        rate: float,
+        time: float,
+        timestep: float,
+        *,
+        aligned: bool = False,
+    ) -> int:
+        """Registers `callback` every 1/`rate` [Hz] of sim time after `time` [s]; a handle.
+
+        `aligned`: on the clock's own k/`rate` grid instead of a grid from `time`, so that an
+        observer registered again (a sensor's, after a spawn changed the model or a live view
+        changed its stride) keeps the stamps it had, as a Gazebo sensor keeps its update grid.
+        """
         period = 1.0 / rate
+        origin = time
+        if aligned:
+            origin = math.floor(time / period + DUE_TOLERANCE * timestep / period) * period
         handle = next(self._handles)
-        self._entries[handle] = _Entry(callback, period, time, time + period)
+        self._entries[handle] = _Entry(
+            callback, period, origin, next_due(time, origin, period, timestep)
+        )
         self._summarize()
         return handle
 

@@ -103,3 +103,29 @@ def test_the_live_streams_worker_publishes_sensor_topics_too(tmp_path):
     a = bag["/imu/imu"][-1][1].linear_acceleration
     assert (a.x, a.y, a.z) == tuple(last.linear_acceleration)
     assert "/imu/joint_states" in bag, "the world's topics stay announced"
+
+
+@pytest.mark.parametrize("spawned_at", [37, 137, 251])
+def test_a_spawn_mid_recording_keeps_every_sensor_on_its_rate_grid(tmp_path, spawned_at):
+    """A spawn changes the model, and the recording reads every sensor once after it (a sensor
+    spawned into a paused world has a reading at once) and registers its sensor observers
+    again; apart from that reading the lidar's scans stay at k/rate of sim time, before and
+    after (as a Gazebo sensor keeps its update grid), and the spawned lidar's join that grid."""
+    world = _world(tmp_path)
+    path = tmp_path / "spawn.mcap"
+    recording = BagRecording(world, path).start()
+    world.step(spawned_at)
+    lidar = write_urdf(tmp_path, lidar_post(rate=SCAN_RATE, samples=31), "second.urdf")
+    world.spawn(lidar, name="second", pose=Pose(x=-2))
+    world.step(600 - spawned_at)
+    assert recording.stop().error is None
+    bag = read_bag(path)
+    for topic in ("/lidar/scan", "/second/scan"):
+        stamps = np.array([seconds(m.header.stamp) for _, m in bag[topic]])
+        # The reading the model change brings: the first at or after the spawn (taken at the
+        # recording's next state sample, which notices the new model).
+        stamps = np.delete(stamps, np.flatnonzero(stamps >= spawned_at * 1e-3 - 1e-9)[:1])
+        assert len(stamps) >= 3, f"{topic}: {len(stamps)} scans"
+        grid = stamps * SCAN_RATE
+        assert np.allclose(grid, np.round(grid), atol=1e-6), f"{topic} off its grid: {stamps}"
+        assert len(set(np.round(grid))) == len(grid), f"{topic} scanned twice: {stamps}"
