@@ -1,8 +1,6 @@
-"""Where a spawned entity starts: its lowest point, and overlaps with the ground or others.
-
-The lowest point is the converter's (`converters.mjcf.lowest_point`), the rule the exported
-`home` keyframe stands a floating robot by; it is re-exported here for the world's callers.
-"""
+"""Where a spawned entity starts: overlaps with the ground or others. Its lowest point is the
+converter's rule (`converters.mjcf.lowest_point`), which the exported `home` keyframe stands a
+floating robot by too."""
 
 from __future__ import annotations
 
@@ -13,7 +11,6 @@ import mujoco
 import numpy as np
 
 from converters.mjcf.lowest_point import collision_geoms
-from converters.mjcf.lowest_point import lowest_point as lowest_point  # re-exported
 from twin_cli.world.entities import EntityIndex
 
 PENETRATION_TOL = 1e-4  # [m] overlap below this is resting contact, not a bad start

@@ -14,6 +14,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
+from converters.mjcf.lowest_point import collision_geoms, lowest_point
 from twin_cli.errors import SpawnError
 from twin_cli.world import actuation, placement, spawn
 from twin_cli.world.contacts import cap_contact_stiffness
@@ -84,7 +85,7 @@ def ground(
     full = data.qpos.copy()
     full[ix.qpos] = q
     scratch = placement.positioned(model, full)
-    low = placement.lowest_point(model, scratch, placement.collision_geoms(model, ix.geoms))
+    low = lowest_point(model, scratch, collision_geoms(model, ix.geoms))
     if low is None:
         return pose, q, built
     pose = replace(pose, z=pose.z - low)
