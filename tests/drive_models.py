@@ -9,6 +9,12 @@ rolls forward), a chassis box above them; steering joints turn about z (positive
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from twin_cli.world import World
+
 R = 0.05  # wheel radius [m]
 TRACK = 0.30  # left-right wheel spacing [m]
 WHEEL_BASE = 0.40  # fixed axle to steered axle [m]
@@ -112,6 +118,36 @@ def with_ros2_control(robot: str, joints: tuple[str, ...]) -> str:
         f"gazebo_ros2_control/GazeboSystem</plugin></hardware>{interfaces}</ros2_control>"
     )
     return robot.replace("</robot>", f"{block}</robot>")
+
+
+def with_diff_drive_controller(
+    robot: str,
+    left: tuple[str, ...],
+    right: tuple[str, ...],
+    folder: Path,
+    multiplier: float = 1.0,
+    rate: float = 100.0,
+) -> str:
+    """`robot` with velocity interfaces on its wheels, and the diff_drive_controller's
+    controllers.yaml (`diff_drive_controller_yaml`) written in `folder` beside it."""
+    (folder / "controllers.yaml").write_text(
+        diff_drive_controller_yaml(left, right, multiplier, rate)
+    )
+    return with_ros2_control(robot, left + right)
+
+
+def settled_base(folder: Path, robot: str, file_name: str = "base.urdf") -> World:
+    """A world with `robot` written to `folder`/`file_name`, spawned on the ground as `base` and
+    stepped 0.3 s so that it rests on its wheels."""
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    path = folder / file_name
+    path.write_text(robot)
+    world = World()
+    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
+    world.step(300)
+    return world
 
 
 def diff_drive_controller_yaml(

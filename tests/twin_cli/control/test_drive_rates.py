@@ -14,7 +14,6 @@ import drive_models as dm
 import pytest
 
 from twin_cli.control import controller_of, drive
-from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 
 PATH_TOLERANCE = 0.02  # fraction of the distance driven
@@ -42,15 +41,9 @@ WHEELS = ("wheel_left_joint", "wheel_right_joint")
 def _world(tmp_path: Path, plugin: str, controller_rate: float = 100.0) -> World:
     robot = dm.two_wheel_base(plugin)
     if plugin == dm.ROS2_CONTROL:
-        robot = dm.with_ros2_control(robot, WHEELS)
-        yaml = dm.diff_drive_controller_yaml(WHEELS[:1], WHEELS[1:], rate=controller_rate)
-        (tmp_path / "controllers.yaml").write_text(yaml)
-    path = tmp_path / "base.urdf"
-    path.write_text(robot)
-    world = World()
-    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
-    world.step(300)
-    return world
+        left, right = WHEELS[:1], WHEELS[1:]
+        robot = dm.with_diff_drive_controller(robot, left, right, tmp_path, rate=controller_rate)
+    return dm.settled_base(tmp_path, robot)
 
 
 @pytest.mark.parametrize(
@@ -69,25 +62,34 @@ def _world(tmp_path: Path, plugin: str, controller_rate: float = 100.0) -> World
 def test_a_drive_updates_at_its_plugins_rate(
     tmp_path: Path, plugin: str, controller_rate: float, per_second: int
 ) -> None:
-    """Counted over the first and second second of a turn (gazebo_ros' wheels ramp at
-    0.2 m/s² all that time)."""
+    """Counted over the first and second second of a turn, on the controller and, for gazebo_ros'
+    drive, whose right wheel ramps at 0.2 m/s² towards its 0.45 m/s for 2.25 s (a new target at
+    every update), as the targets the world receives for that wheel, step by step."""
     world = _world(tmp_path, plugin, controller_rate)
     assert world.model.opt.timestep == pytest.approx(1e-3), "the counts assume 1 ms steps"
-    drive(world, "base", 0.3, angular=0.5)
+    drive(world, "base", 0.3, angular=1.0)
     controller = controller_of(world, "base")
+    wheel = next(key for key in world.commands() if key.endswith(WHEELS[1]))
+    ramped = "libgazebo_ros_diff_drive" in plugin
     for _ in range(2):
-        before = controller.updates
-        world.step(1000)
+        before, changes, target = controller.updates, 0, world.commands()[wheel].target
+        for _ in range(1000):
+            world.step(1)
+            changes += world.commands()[wheel].target != target
+            target = world.commands()[wheel].target
         assert controller.updates - before == per_second
+        if ramped:
+            assert changes == per_second, f"{changes} new wheel targets in 1 s"
 
 
 def test_a_gz_diff_drive_with_slow_odometry_drives_its_path(tmp_path: Path) -> None:
     """gz-sim's DiffDrive sets its wheels' speeds at every step whatever its odometry rate: at
-    0.3 m/s for 4 s it drives 1.2 m (2 %), not what 1 Hz updates would make of it."""
+    0.3 m/s for 3.5 s it drives 1.05 m (2 %); updates at the odometry's 1 Hz would stop it at a
+    whole second, 0.9 or 1.2 m."""
     world = _world(tmp_path, GZ_DIFF_SLOW_ODOM)
     start = world.get_pose("base")
-    drive(world, "base", 0.3, duration=4.0)
-    world.step(4500)
+    drive(world, "base", 0.3, duration=3.5)
+    world.step(4000)
     end = world.get_pose("base")
     driven = math.hypot(end.x - start.x, end.y - start.y)
-    assert driven == pytest.approx(1.2, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 1.2"
+    assert driven == pytest.approx(1.05, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 1.05"

@@ -20,7 +20,6 @@ import drive_models as dm
 import pytest
 
 from twin_cli.control import controller_of, drive, odometry
-from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 from twin_cli.world.engine import Pose
 
@@ -48,20 +47,13 @@ GZ_PAIRS = (  # gz-sim's DiffDrive with two joints a side
 )
 
 
-def _world(tmp_path: Path, plugin: str, multiplier: float = 1.0) -> World:
-    """A skid_steer_bot with `plugin` (ROS2_CONTROL: a diff_drive_controller with
-    `multiplier`), spawned on the ground as `base` and settled."""
-    robot = dm.skid_steer_bot(plugin)
+def _world(tmp_path: Path, plugin: str, multiplier: float = 1.0, wheelbase: float = 2 * A) -> World:
+    """A skid_steer_bot `wheelbase` long with `plugin` (ROS2_CONTROL: a diff_drive_controller
+    with `multiplier`), spawned on the ground as `base` and settled."""
+    robot = dm.skid_steer_bot(plugin, wheelbase=wheelbase)
     if plugin == dm.ROS2_CONTROL:
-        robot = dm.with_ros2_control(robot, LEFT + RIGHT)
-        yaml = dm.diff_drive_controller_yaml(LEFT, RIGHT, multiplier)
-        (tmp_path / "controllers.yaml").write_text(yaml)
-    path = tmp_path / "skid.urdf"
-    path.write_text(robot)
-    world = World()
-    world.spawn(SpawnRequest(str(path), on_ground=True), name="base")
-    world.step(300)
-    return world
+        robot = dm.with_diff_drive_controller(robot, LEFT, RIGHT, tmp_path, multiplier)
+    return dm.settled_base(tmp_path, robot, "skid.urdf")
 
 
 def _mean_turn_rate(world: World, linear: float, angular: float) -> float:
@@ -95,6 +87,40 @@ def test_a_skid_steer_turns_as_coulomb_friction_lets_it(
     assert 1.0 - COULOMB_SHORT <= ratio <= 1.0, (
         f"turns at {rate:.4f} rad/s for {angular} rad/s: {ratio:.3f} of Coulomb's "
         f"{angular * COULOMB_FACTOR:.4f}"
+    )
+
+
+# Longer wheel bases (a/c 0.67 and 1.0) turn further below Coulomb's rate than COULOMB_SHORT
+# (measured, ROS 1's skid steer at 0.3 m/s and 0.5 rad/s, mean over half a turn of heading). The
+# wheels' armature is not the cause: at a/c 1.0 none from 0.5 to 10 times the converter's raised
+# the turn above 0.62 of Coulomb's rate.
+LONG_BASES = {
+    0.2: "a/c 0.67: 0.762 of Coulomb's rate",
+    0.3: "a/c 1.0: 0.546 of Coulomb's rate",
+}
+
+
+@pytest.mark.parametrize(
+    "wheelbase",
+    [
+        pytest.param(w, marks=pytest.mark.xfail(reason=LONG_BASES[w], strict=True))
+        if w in LONG_BASES
+        else w
+        for w in (2 * A, 0.2, 0.3)
+    ],
+)
+def test_a_skid_steer_of_any_wheel_base_turns_as_coulomb_friction_lets_it(
+    tmp_path: Path, wheelbase: float
+) -> None:
+    """Coulomb's 1/(1 + (a/c)²) for a = wheelbase/2: the law's dependence on the layout."""
+    linear, angular = 0.3, 0.5
+    world = _world(tmp_path, dm.SKID_STEER_ROS1, wheelbase=wheelbase)
+    rate = _mean_turn_rate(world, linear, angular)
+    coulomb = angular / (1.0 + (wheelbase / 2 / C) ** 2)
+    ratio = rate / coulomb
+    assert 1.0 - COULOMB_SHORT <= ratio <= 1.0, (
+        f"a/c {wheelbase / 2 / C:.2f}: turns at {rate:.4f} rad/s, {ratio:.3f} of Coulomb's "
+        f"{coulomb:.4f}"
     )
 
 
