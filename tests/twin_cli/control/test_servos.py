@@ -91,6 +91,21 @@ def test_an_overloaded_wheel_saturates_at_its_effort_and_then_catches_up_its_ref
     assert abs(behind) < 1e-3, f"{behind:.4f} rad off its reference path after the stall"
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="the stall's stored integral comes back as a burst: 43 rad/s peak (Gazebo's FMax "
+    "constraint stores nothing; MuJoCo has no bounded integral an actuator can hold)",
+)
+def test_an_overloaded_wheel_recovers_without_a_burst(wheel: World) -> None:
+    """Gazebo's joint motor, a velocity constraint bounded by FMax, comes back from a stall at
+    its command: the speed after the release never passes it by more than 5 %."""
+    _load(wheel, -1.5 * EFFORT)
+    wheel.step(500)
+    _load(wheel, 1.5 * EFFORT)
+    after = _speeds(wheel, 200)
+    assert after.max() < 1.05 * SPEED, f"a catch-up burst to {after.max():.2f} rad/s"
+
+
 @pytest.mark.parametrize("fraction", [0.25, 0.5, 0.9])
 def test_a_zero_velocity_command_holds_the_wheel_under_load(wheel: World, fraction) -> None:
     """Speed 0 is the joint's dry friction bounded by the effort (Gazebo's FMax at speed 0). It
@@ -107,6 +122,26 @@ def test_a_zero_velocity_command_holds_the_wheel_under_load(wheel: World, fracti
     creep = (1.0 - HOLD_SOLIMP[0]) * load * wheel.model.opt.timestep / MOMENT
     assert -state.velocity == pytest.approx(creep, rel=0.05), state
     assert start - state.position == pytest.approx(2.0 * creep, rel=0.05), state
+    # Whatever the impedance: at most 1e-5 rad/s and 2e-5 rad in 2 s up to 0.9 of the effort.
+    assert abs(state.velocity) < 1e-5 and abs(start - state.position) < 2e-5, state
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the friction hold is MuJoCo's soft constraint: 1e-5 rad in 2 s at half the effort "
+    "(the integral servo it replaced held within 1e-6)",
+)
+def test_a_zero_velocity_command_holds_the_wheel_still_under_load(wheel: World) -> None:
+    """Gazebo's FMax constraint at speed 0 (ODE, CFM about 1e-9) holds a load within its limit
+    still: within 1e-6 rad and 1e-6 rad/s over 2 s at half the effort."""
+    wheel.command("w", "spin", mode="velocity", value=0.0)
+    wheel.step(200)
+    _load(wheel, -EFFORT / 2)
+    wheel.step(500)
+    start = wheel.joint_states("w")[0].position
+    wheel.step(2000)
+    state = wheel.joint_states("w")[0]
+    assert abs(state.position - start) < 1e-6 and abs(state.velocity) < 1e-6, state
 
 
 def test_a_held_wheel_slips_at_its_effort_and_stays_where_it_slipped(wheel: World) -> None:
