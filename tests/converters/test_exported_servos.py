@@ -163,3 +163,36 @@ def test_servo_gains_follow_the_effort_bound_and_the_tags_pid(tmp_path: Path) ->
     assert d1.gainprm[0] == pytest.approx(120.0)
     assert -d1.biasprm[2] == pytest.approx(min(max(4.0, 2 * np.sqrt(120 * inertia)), inertia / h))
     assert list(d1.forcerange) == [-5.0, 5.0]
+
+
+def test_a_position_step_without_an_effort_limit_settles_and_slows_to_its_limit(
+    tmp_path: Path,
+) -> None:
+    """d0 (no effort limit, 1 rad/s velocity limit) stepped 1 rad from home in the exported
+    scene: it settles within 0.01 rad by 1.3·Δ/v + 0.3 s, passes its target by at most 1 mrad,
+    and within BRAKE_RAD of the target it asks no more than its velocity limit (5 % slack)."""
+    from converters.pipeline import convert
+
+    source = tmp_path / "discs.urdf"
+    source.write_text(TWO_DISCS)
+    spec, report = convert(source)
+    robot = write_model(spec, report, tmp_path / "out")
+    model = mujoco.MjModel.from_xml_path(str(robot.parent / "scene.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    a, j = model.actuator("d0").id, model.joint("d0")
+    q0, step, speed = float(data.qpos[j.qposadr[0]]), 1.0, 1.0
+    data.ctrl[a] = q0 + step
+    times, errors, speeds = [], [], []
+    while data.time < 2.0:
+        mujoco.mj_step(model, data)
+        times.append(data.time)
+        errors.append(q0 + step - float(data.qpos[j.qposadr[0]]))
+        speeds.append(float(data.qvel[j.dofadr[0]]))
+    errors, speeds = np.array(errors), np.array(speeds)
+    far = np.flatnonzero(np.abs(errors) > 0.01)
+    settled = times[far[-1] + 1] if far.size else times[0]
+    assert settled <= 1.3 * step / speed + 0.3, f"settled at {settled:.3f} s"
+    assert errors.min() >= -1e-3, f"passed its target by {-errors.min():.4f} rad"
+    near = np.abs(errors) <= BRAKE_RAD
+    assert np.abs(speeds[near]).max() <= 1.05 * speed, "faster than its limit near the target"
