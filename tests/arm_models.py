@@ -1,7 +1,8 @@
-"""Arms without a `world` link, as vendors ship them, for the `--fixed-base` tests.
+"""Arms for the servo and `--fixed-base` tests.
 
-Geometry [m, kg]: a 2 kg base box 0.2 × 0.2 × 0.1 m, and above it (0.1 m up) a 0.5 m
-horizontal link on hinge 'shoulder' about y, which gravity swings down.
+`floating_arm` [m, kg]: without a `world` link, as vendors ship arms: a 2 kg base box
+0.2 × 0.2 × 0.1 m, and above it (0.1 m up) a 0.5 m horizontal link on hinge 'shoulder' about y,
+which gravity swings down. `bob_arm`: one hinge fixed to the world, its mass at one point.
 """
 
 from __future__ import annotations
@@ -58,3 +59,16 @@ def panda_like_arm(world_link: bool = True) -> str:
   <ros2_control name="arm" type="system"><hardware><plugin>x</plugin></hardware>{interfaces}
   </ros2_control>
   <gazebo><plugin name="control" filename="libgazebo_ros2_control.so"/></gazebo></robot>"""
+
+
+def bob_arm(effort: float, mass: float = 1.0, reach: float = 0.2) -> str:
+    """`mass` [kg] `reach` [m] out on hinge 'j' about y (±3 rad, `effort` [N m], 1 rad/s), on a
+    1 kg base fixed to a `world` link: a load m·g·reach·cos q at the hinge."""
+    return f"""<robot name="a"><link name="world"/>
+<link name="base"><inertial><mass value="1"/>
+  <inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<link name="arm"><inertial><origin xyz="{reach} 0 0"/><mass value="{mass}"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+  <limit lower="-3" upper="3" effort="{effort}" velocity="1"/></joint></robot>"""

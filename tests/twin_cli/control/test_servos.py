@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from arm_models import bob_arm
 from models import _control_inertial, write_urdf
 
 from twin_cli.world import Pose, World
@@ -28,17 +29,6 @@ def _wheel(moment: float = MOMENT) -> str:
 <ros2_control name="r" type="system"><joint name="spin">
   <command_interface name="velocity"/><command_interface name="position"/>
 </joint></ros2_control></robot>"""
-
-
-def _arm(effort: float) -> str:
-    """A 1 kg bob 0.2 m out on hinge 'j' about y (±3 rad, `effort`, 1 rad/s), under gravity."""
-    return f"""<robot name="a"><link name="world"/>
-<link name="base">{_control_inertial(1, 1)}</link>
-<link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
-  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
-<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
-  <limit lower="-3" upper="3" effort="{effort}" velocity="1"/></joint></robot>"""
 
 
 def _speeds(world: World, n: int, every: int = 10) -> np.ndarray:
@@ -167,7 +157,7 @@ def test_a_position_move_runs_at_the_velocity_limit_and_settles_without_overshoo
     tmp_path, effort
 ) -> None:
     world = World()
-    world.spawn(write_urdf(tmp_path, _arm(effort)), name="a", pose=Pose(z=1.0))
+    world.spawn(write_urdf(tmp_path, bob_arm(effort)), name="a", pose=Pose(z=1.0))
     world.command("a", "j", mode="position", value=0.0)
     world.step(1000)
     world.command("a", "j", mode="position", value=1.0)

@@ -14,11 +14,11 @@ import re
 import mujoco
 import numpy as np
 import pytest
-from models import mjcf_ball, write_urdf
+from models import _control_inertial, mjcf_ball, write_urdf
 from world_helpers import spec_of
 
 from twin_cli.world import Pose, World
-from twin_cli.world.divergence import SPEED_FACTOR, UNLIMITED_SPEED, speed_bounds
+from twin_cli.world.divergence import speed_bounds
 
 EFFORT = 1000.0  # [N m] every joint's effort limit
 LINK_MASS, LINK_MOMENT = 1e-3, 1e-4  # [kg], [kg m²] each leg link
@@ -32,13 +32,13 @@ LEGS = {"FL": (0.2, 0.1), "FR": (0.2, -0.1), "HL": (-0.2, 0.1), "HR": (-0.2, -0.
 def quadruped(velocity: float, travel: float = 10.0) -> str:
     """The placeholder's URDF: joints `<leg>_HAA/HFE/KFE` of ±`travel` [rad] (solo12's: 10)
     and `velocity` [rad/s]."""
-    links = [f'<link name="base">{_inertial(1.0, 0.01)}</link>']
+    links = [f'<link name="base">{_control_inertial(1.0, 0.01)}</link>']
     joints = []
     for leg, (x, y) in LEGS.items():
         parent = "base"
         for k, (joint, axis) in enumerate((("HAA", "1 0 0"), ("HFE", "0 1 0"), ("KFE", "0 1 0"))):
             child = f"{leg}_{joint}_link"
-            links.append(f'<link name="{child}">{_inertial(LINK_MASS, LINK_MOMENT)}</link>')
+            links.append(f'<link name="{child}">{_control_inertial(LINK_MASS, LINK_MOMENT)}</link>')
             origin = f"{x} {y} 0" if k == 0 else "0 0 -0.1"
             joints.append(
                 f'<joint name="{leg}_{joint}" type="revolute"><parent link="{parent}"/>'
@@ -48,13 +48,6 @@ def quadruped(velocity: float, travel: float = 10.0) -> str:
             )
             parent = child
     return f'<robot name="quad">{"".join(links)}{"".join(joints)}</robot>'
-
-
-def _inertial(mass: float, moment: float) -> str:
-    return (
-        f'<inertial><mass value="{mass}"/><inertia ixx="{moment}" iyy="{moment}" '
-        f'izz="{moment}" ixy="0" ixz="0" iyz="0"/></inertial>'
-    )
 
 
 def _world(tmp_path, velocity: float, travel: float = 10.0) -> World:
@@ -88,7 +81,7 @@ def _knee_speed(world: World) -> float:
 @pytest.mark.parametrize("velocity", LIMITS)
 def test_knee_kicked_past_100x_its_limit_is_reset_to_spawn_and_counted(tmp_path, velocity):
     world = _world(tmp_path, velocity)
-    bound = SPEED_FACTOR * velocity
+    bound = 100.0 * velocity  # the watchdog's bound: 100 × the velocity limit
     kick = _kick_speed(world, EFFORT)
     assert bound < kick < 1e6, f"premise: kick {kick:.3g} rad/s over the bound {bound} rad/s"
     ball = world.index_of("ball")
@@ -124,7 +117,7 @@ def test_kick_found_at_a_batch_end_is_traced_to_its_first_step(tmp_path, velocit
 @pytest.mark.parametrize("velocity", LIMITS)
 def test_fast_but_legal_kick_below_the_bound_is_not_reset(tmp_path, velocity):
     world = _world(tmp_path, velocity)
-    bound = SPEED_FACTOR * velocity
+    bound = 100.0 * velocity  # the watchdog's bound: 100 × the velocity limit
     effort = LEGAL_FRACTION * bound / _kick_speed(world, 1.0)  # [N m] kicks to half the bound
     world.command("quad", KNEE, mode="effort", value=effort)
     peak = 0.0
@@ -144,16 +137,16 @@ def test_speed_bounds_are_100x_each_limit_and_1e4_on_free_and_unlimited_dofs(tmp
     quad, ball = world.index_of("quad"), world.index_of("ball")
     free = model.jnt_dofadr[quad.joints[0]] + np.arange(6)
     legs = np.setdiff1d(quad.dofs, free)
-    assert len(legs) == 12 and np.all(bounds.bound[legs] == SPEED_FACTOR * 2.0), "legs: 200"
-    assert np.all(bounds.bound[free] == UNLIMITED_SPEED), "quad's free joint: 1e4"
-    assert np.all(bounds.bound[ball.dofs] == UNLIMITED_SPEED), "ball's free joint: 1e4"
+    assert len(legs) == 12 and np.all(bounds.bound[legs] == 200.0), "legs: 100 × 2 rad/s"
+    assert np.all(bounds.bound[free] == 1e4), "quad's free joint: 1e4"
+    assert np.all(bounds.bound[ball.dofs] == 1e4), "ball's free joint: 1e4"
 
 
 @pytest.mark.parametrize(("dof", "unit"), [(0, "m/s"), (4, "rad/s")])
 def test_free_joint_over_1e4_is_reset_and_named_with_its_unit(tmp_path, dof, unit):
     world = _world(tmp_path, 2.0)
     ball = world.index_of("ball")
-    world.data.qvel[ball.dofs[dof]] = 2.0 * UNLIMITED_SPEED
+    world.data.qvel[ball.dofs[dof]] = 2.0 * 1e4
     world.step(1)
     assert world.divergences == 1, "one divergence"
     assert world.divergence_log[0].entity == "ball", world.divergence_log
