@@ -59,6 +59,8 @@ def corpus_ids_expecting(failures: Mapping[str, str]) -> list[Any]:
     """`corpus_ids()` with each robot of `failures` a strict xfail whose reason is its measured
     figure: a robot that does not meet a test's bound is reported, never dropped from the list,
     and a robot that starts to meet it fails the test until the entry goes."""
+    unknown = set(failures) - set(CORPUS) if CORPUS else set()
+    assert not unknown, f"expected failures name robots the corpus lacks: {sorted(unknown)}"
     return [
         pytest.param(r, marks=pytest.mark.xfail(reason=failures[r], strict=True))
         if isinstance(r, str) and r in failures

@@ -324,12 +324,10 @@ def test_a_heightmap_on_a_root_welded_by_fixed_base_is_kept(
     """A heightmap on a model that is not `<static>` rides a moving link and is left out
     (MuJoCo's height fields are static); `--fixed-base` welds that link to the world, so the
     terrain is kept, with no warning about a moving link."""
-    import mujoco
     import numpy as np
     from PIL import Image
 
     from converters.mjcf.builder import ConvertOptions
-    from converters.pipeline import convert_full
 
     Image.fromarray(np.zeros((9, 9), np.uint8)).save(tmp_path / "terrain.png")
     (tmp_path / "terrain.sdf").write_text(
