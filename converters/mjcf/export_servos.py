@@ -7,13 +7,19 @@ by velocity, that user expects what Gazebo's controller does: a servo bounded by
 A raw torque within ±effort means nothing there and breaks the model: 10 N m on a turtlebot3
 wheel (2e-5 kg m²) spins it past 1e5 rad/s within a second of random `ctrl`, and MuJoCo diverges.
 
-So each such joint is written as MuJoCo's own position or velocity actuator:
+So each such joint is written as MuJoCo's own position or integrated-velocity actuator:
   - `ctrl` is the target (position within the joint's range, velocity within its limit), the
     force stays within ±effort (`forcerange`), as Menagerie's models do;
   - a position servo is stiff and damped so that a move at the effort limit stops on target
-    (`servo_gains`); a velocity servo's kv = I/h on the joint's reflected inertia I at the home
-    posture (the most damping an explicit step tolerates, reached in one step like Gazebo's
-    joint motor);
+    (`servo_gains`);
+  - a velocity servo is MuJoCo's `intvelocity`: its activation integrates the commanded speed
+    into a position the servo tracks, so a loaded joint keeps its speed and `ctrl` 0 holds it
+    where it is, as Gazebo's joint motor (a velocity constraint bounded by the effort) does. A
+    damper alone let a parked turtlebot3 roll 227 mm down 5° in 10 s; this holds it within
+    0.03 mm. kv = I/h on the joint's reflected inertia I at the home posture, the integral
+    kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it gives them). The
+    price of the integral without a World's feed-forward: a speed step overshoots (19 % on
+    turtlebot3's wheels, whose robot they carry) before it settles on the command;
   - on a fixed base, the position servos carry the weight of the bodies they hold through
     MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
   - the `home` keyframe's ctrl holds the home posture.
@@ -34,6 +40,8 @@ from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
 from converters.mjcf.servo_gains import largest_inertia, position_gains
 from converters.mjcf.world_options import TIMESTEP_S
+
+INTEGRAL_MARGIN = 8.0  # a velocity servo's integral gain, as the world's (twin_cli servos)
 
 if TYPE_CHECKING:
     import mujoco
@@ -75,6 +83,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
             "ctrllimited": int(actuator.ctrllimited),
             "forcerange": [float(v) for v in actuator.forcerange],
             "forcelimited": int(actuator.forcelimited),
+            "actlimited": int(actuator.actlimited),
+            "actrange": [float(v) for v in actuator.actrange],
         }
         _to_servo(spec, actuator, record, inertia[joint], timestep)
         servoed[joint] = record["modes"][0]
@@ -144,7 +154,31 @@ def _to_servo(
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
         actuator.set_to_position(kp=kp, kv=kv)
     else:
-        actuator.set_to_velocity(kv=float(pid[0]) if pid else kv)
+        _to_intvelocity(spec, actuator, pid, inertia, kv)
+
+
+def _to_intvelocity(
+    spec: mujoco.MjSpec,
+    actuator: mujoco.MjsActuator,
+    pid: tuple | None,
+    inertia: float,
+    kv: float,
+) -> None:
+    """A velocity servo with an integral: MuJoCo's `intvelocity`, whose activation is the
+    position the velocity command integrates to and which a position servo tracks, so `ctrl`
+    0 holds a loaded joint where it is (a parked base on a slope) and a loaded joint keeps its
+    speed. kv = I/h (or the tag's vel_kp); the integral gain kp = kv²/(4·INTEGRAL_MARGIN·I) (or
+    the tag's vel_ki), as a World's velocity servo on the joint's own inertia. A limited joint's
+    reference stays in its range."""
+    import mujoco
+
+    damping = float(pid[0]) if pid else kv
+    integral = float(pid[1]) if pid and pid[1] > 0 else damping**2 / (4 * INTEGRAL_MARGIN * inertia)
+    actuator.set_to_intvelocity(kp=integral, kv=damping)
+    joint = spec.joint(actuator.target)
+    if joint is not None and joint.limited == mujoco.mjtLimited.mjLIMITED_TRUE:
+        actuator.actlimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        actuator.actrange = np.asarray(joint.range, dtype=float)
 
 
 def _force_bound(actuator: mujoco.MjsActuator) -> float:

@@ -196,3 +196,69 @@ def test_a_position_step_without_an_effort_limit_settles_and_slows_to_its_limit(
     assert errors.min() >= -1e-3, f"passed its target by {-errors.min():.4f} rad"
     near = np.abs(errors) <= BRAKE_RAD
     assert np.abs(speeds[near]).max() <= 1.05 * speed, "faster than its limit near the target"
+
+
+@pytest.mark.parametrize("slope_deg", [3.0, 5.0, 8.0])
+def test_an_exported_base_parked_on_a_slope_holds_where_it_stands(
+    tmp_path: Path, slope_deg: float
+) -> None:
+    """A two-wheel base whose drive plugin commands its wheels by velocity, exported and reset to
+    `home` with ctrl 0 on a slope (gravity tilted along its wheels' rolling direction): its
+    wheels' `intvelocity` servos hold it as Gazebo's joint motors do (a velocity constraint at
+    speed 0 within their effort), under 1 mm in 10 s; it does not roll off (a damper let a
+    turtlebot3 roll 227 mm down 5°)."""
+    import drive_models as dm
+
+    from converters.pipeline import convert
+
+    plugin = (
+        '<plugin name="dd" filename="libgazebo_ros_diff_drive.so"><left_joint>wheel_left_joint'
+        "</left_joint><right_joint>wheel_right_joint</right_joint><wheel_separation>0.3"
+        "</wheel_separation><wheel_diameter>0.1</wheel_diameter><max_wheel_torque>5"
+        "</max_wheel_torque></plugin>"
+    )
+    source = tmp_path / "base.urdf"
+    source.write_text(dm.two_wheel_base(plugin))
+    spec, report = convert(source)
+    robot = write_model(spec, report, tmp_path / "out")
+    model = mujoco.MjModel.from_xml_path(str(robot.parent / "scene.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    theta = np.radians(slope_deg)
+    model.opt.gravity[:] = (9.81 * np.sin(theta), 0.0, -9.81 * np.cos(theta))
+    mujoco.mj_step(model, data, 1000)  # settle on the tilted ground
+    start = data.qpos[:3].copy()
+    mujoco.mj_step(model, data, 10000)
+    moved = float(np.linalg.norm(data.qpos[:3] - start))
+    assert moved < 1e-3, f"rolled {moved * 1e3:.3f} mm down {slope_deg}° in 10 s"
+
+
+def test_an_exported_velocity_servo_driven_into_its_limit_leaves_it_at_once(
+    tmp_path: Path,
+) -> None:
+    """A velocity-commanded hinge (±3 rad, 2 N m) driven at 1 rad/s into its limit for 3 s, then
+    back at -1 rad/s: it leaves the limit within 0.2 s, as Gazebo's joint motor (which stores
+    nothing) does, because its `intvelocity` reference stops at the joint's range instead of
+    winding on past it (3 s past would hold it at the limit for about 3 s more)."""
+    from converters.pipeline import convert
+
+    source = tmp_path / "hinge.urdf"
+    source.write_text(
+        TWO_DISCS.replace('effort="0" velocity="1"', 'effort="2" velocity="1"').replace(
+            '<joint name="d0"><command_interface name="position"/>',
+            '<joint name="d0"><command_interface name="velocity"/>',
+        )
+    )
+    spec, report = convert(source)
+    model = mujoco.MjModel.from_xml_path(str(write_model(spec, report, tmp_path / "out")))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    a, q = model.actuator("d0").id, model.joint("d0").qposadr[0]
+    data.ctrl[a] = 1.0
+    mujoco.mj_step(model, data, 6000)  # 3 s to the limit at 3 rad, 3 s against it
+    assert data.qpos[q] == pytest.approx(3.0, abs=0.01), "at its limit"
+    data.ctrl[a] = -1.0
+    start = data.time
+    while data.qpos[q] > 2.9 and data.time - start < 5.0:
+        mujoco.mj_step(model, data)
+    assert data.time - start < 0.2, f"left its limit after {data.time - start:.2f} s"

@@ -115,6 +115,8 @@ def restore_exported_motors(spec: mujoco.MjSpec) -> None:
         actuator.ctrllimited = mujoco.mjtLimited(motor["ctrllimited"])
         actuator.forcerange = np.array(motor["forcerange"], dtype=float)
         actuator.forcelimited = mujoco.mjtLimited(motor["forcelimited"])
+        actuator.actlimited = mujoco.mjtLimited(motor.get("actlimited", 0))  # an intvelocity's
+        actuator.actrange = np.array(motor.get("actrange", [0.0, 0.0]), dtype=float)
         restore_gravcomp(spec, actuator.target, motor.get(GRAVCOMP))
         restored = True
     if restored:
