@@ -49,7 +49,7 @@ import numpy as np
 
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, restore_gravcomp
-from converters.mjcf.export_servos import EXPORTED
+from converters.mjcf.export_servos import EXPORTED, INTEGRAL_MARGIN
 from twin_cli.world import gravity_comp, sleeping, speed_holds
 
 if TYPE_CHECKING:
@@ -57,11 +57,6 @@ if TYPE_CHECKING:
 
     from twin_cli.world.actuation import JointCommand
 
-INTEGRAL_MARGIN = 8.0
-"""A velocity servo's kp is its integral gain. A velocity step makes it store the lag of the
-damping term and give it back as overshoot, about 1/(4·INTEGRAL_MARGIN) of the step (3 %) when
-the carried inertia is right, less when it is overestimated; the integral then settles a load in
-about 4·INTEGRAL_MARGIN·I_c/kv."""
 SPEED_MARGIN = 0.95  # ramp speed of a position move, as a fraction of the velocity limit
 OVERSHOOT = 0.05  # most a position servo's speed may pass its ramp's while it catches up
 HOLD = "hold"  # the kind of a velocity command of 0 held by friction (`twin_cli.world.speed_holds`)
