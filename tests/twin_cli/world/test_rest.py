@@ -79,6 +79,21 @@ def test_a_corpus_robot_left_on_the_ground_stays_put(robot_id: str) -> None:
     )
 
 
+@pytest.mark.skipif("abb_irb2400_12_155" not in CORPUS, reason="corpus: no abb_irb2400_12_155")
+def test_the_limp_irb2400_stands_still_when_its_motors_hold_it() -> None:
+    """The IRB 2400 that creeps limp (STILL_FALLING) stands still with every joint held at
+    speed 0 from its spawn posture (its six motors; its passive lever joints stay limp): the
+    creep is its swinging wrist, not its contacts."""
+    world = World()
+    world.spawn(corpus_spawn_request("abb_irb2400_12_155"), name="r")
+    world.command_joints("r", {f"joint_{k}": 0.0 for k in range(1, 7)}, mode="velocity")
+    world.step(round(SETTLE_S / world.model.opt.timestep))
+    moved, turned = _drift(world, "r")
+    assert moved < MOVED_M and turned < TURNED_RAD, (
+        f"held: moved {moved * 1e3:.4f} mm, turned {turned * 1e3:.4f} mrad in {WATCH_S} s"
+    )
+
+
 @pytest.mark.skipif("turtlebot3_burger" not in CORPUS, reason="corpus: no turtlebot3_burger")
 def test_turtlebot3_stands_still_after_a_drive() -> None:
     """Its wheels commanded back to 0 hold it: before, they kept turning at ±0.023 rad/s."""
