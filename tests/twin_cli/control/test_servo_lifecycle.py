@@ -76,16 +76,22 @@ def _overload_peak(world: World) -> float:
     return peak
 
 
-def test_a_loaded_world_overloads_and_recovers_as_the_saved_one(tmp_path):
-    """The servo's reference is MuJoCo state (its activation), so a save carries what the
-    integral holds: the same overload peaks alike in both worlds (a loaded world whose servos
-    lost their reference once peaked at 43 rad/s against 2.3 rad/s)."""
+def _saved_and_loaded(tmp_path) -> tuple[World, World]:
+    """The rig's wheel at 2 rad/s for 0.5 s, and a world loaded from its save."""
     world = World()
     world.spawn(write_urdf(tmp_path, CONTROL_RIG), name="wheel", pose=Pose(z=1.0))
     world.command("wheel", "spin", mode="velocity", value=2.0)
     world.step(500)
     save(world, tmp_path / "w.json")
     loaded = load(tmp_path / "w.json")
+    return world, loaded
+
+
+def test_a_loaded_world_overloads_and_recovers_as_the_saved_one(tmp_path):
+    """The servo's reference is MuJoCo state (its activation), so a save carries what the
+    integral holds: the same overload peaks alike in both worlds (a loaded world whose servos
+    lost their reference once peaked at 43 rad/s against 2.3 rad/s)."""
+    world, loaded = _saved_and_loaded(tmp_path)
     peaks = [_overload_peak(w) for w in (world, loaded)]
     assert peaks[1] == pytest.approx(peaks[0], rel=1e-3), f"saved, loaded: {peaks} rad/s"
 
@@ -98,12 +104,7 @@ def test_a_loaded_world_overloads_and_recovers_as_the_saved_one(tmp_path):
 def test_an_overloaded_wheel_recovers_without_a_burst_in_a_loaded_world(tmp_path):
     """Gazebo's constraint motor stores nothing during a stall, so no world, saved or loaded,
     shows a catch-up burst: the peak after the overload stays within 15 % of the command."""
-    world = World()
-    world.spawn(write_urdf(tmp_path, CONTROL_RIG), name="wheel", pose=Pose(z=1.0))
-    world.command("wheel", "spin", mode="velocity", value=2.0)
-    world.step(500)
-    save(world, tmp_path / "w.json")
-    loaded = load(tmp_path / "w.json")
+    world, loaded = _saved_and_loaded(tmp_path)
     for label, w in (("saved", world), ("loaded", loaded)):
         assert _overload_peak(w) < 1.15 * 2.0, f"{label}: a catch-up burst after the overload"
 
