@@ -25,8 +25,8 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
   - the `home` keyframe's ctrl holds the home posture.
 Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
 torque motor. The control record keeps the motor each servo replaced (`EXPORTED`) and the
-compensation it added, so a World that spawns the file restores them and commands the robot as
-it commands the robot's source.
+compensation it added. A World gives a description the same servos when it spawns it and runs
+them by ctrl (`twin_cli.world.native_servos`), so the file and the world are one model.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import numpy as np
 
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
-from converters.mjcf.servo_gains import largest_inertia, position_gains
+from converters.mjcf.servo_gains import largest_inertia, position_gains, reflected_inertia
 from converters.mjcf.world_options import TIMESTEP_S
 
 INTEGRAL_MARGIN = 8.0
@@ -213,8 +213,9 @@ def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[f
 def _home_inertia(
     spec: mujoco.MjSpec,
 ) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
-    """Each joint's reflected inertia (mass-matrix diagonal) at the home posture and the largest
-    over its range (`servo_gains.largest_inertia`) [kg m² or kg], and its home position."""
+    """Each joint's reflected inertia (`servo_gains.reflected_inertia`: the other joints held,
+    a floating base free) at the home posture and the largest over its range
+    (`servo_gains.largest_inertia`) [kg m² or kg], and its home position."""
     import mujoco
 
     model = spec.copy().compile()
@@ -226,10 +227,11 @@ def _home_inertia(
     full = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
     largest = largest_inertia(model)
+    reflected = reflected_inertia(model, full)
     inertia, home = {}, {}
     for j in range(model.njnt):
         dof, adr = model.jnt_dofadr[j], model.jnt_qposadr[j]
-        at_home = float(full[dof, dof])
+        at_home = float(reflected[dof])
         inertia[model.joint(j).name] = (at_home, max(at_home, float(largest[dof])))
         home[model.joint(j).name] = float(data.qpos[adr])
     return inertia, home

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin_cli.world import servos, sleeping
+from twin_cli.world import native_servos, servos, sleeping
 
 MODES = ("position", "velocity", "effort")
 ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
@@ -32,6 +32,8 @@ GAZEBO_STEP = 0.001  # [s] dampingFactor is the velocity fraction lost per Gazeb
 _AFFINE = mujoco.mjtBias.mjBIAS_AFFINE
 _NONE = mujoco.mjtBias.mjBIAS_NONE
 _FIXED = mujoco.mjtGain.mjGAIN_FIXED
+_INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
+_NO_DYN = mujoco.mjtDyn.mjDYN_NONE
 
 
 @dataclass(frozen=True)
@@ -47,6 +49,8 @@ class JointCommand:
         velocity_limit: the joint's velocity limit [rad/s or m/s] (inf when none).
         feedforward: velocity the position servo's damping tracks [rad/s or m/s] (trajectories).
         rule: where the gains came from (`twin joints` shows it).
+        native: run by the model's own servo law, its ctrl the target
+            (`twin_cli.world.native_servos`).
     """
 
     actuator: str
@@ -58,13 +62,16 @@ class JointCommand:
     velocity_limit: float = math.inf
     feedforward: float = 0.0
     rule: str = ""
+    native: bool = False
 
 
 def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
-    """The most force [N m or N] the motor can apply at its joint (inf when unlimited)."""
+    """The most force [N m or N] the motor can apply at its joint (inf when unlimited): its
+    force range, and a motor's control range (a servo's control range holds targets)."""
     gear = abs(model.actuator_gear[actuator][0]) or 1.0
     limits = []
-    if model.actuator_ctrllimited[actuator]:
+    motor = model.actuator_biastype[actuator] == _NONE
+    if model.actuator_ctrllimited[actuator] and motor:
         limits.append(np.max(np.abs(model.actuator_ctrlrange[actuator])) * gear)
     if model.actuator_forcelimited[actuator]:
         limits.append(np.max(np.abs(model.actuator_forcerange[actuator])) * gear)
@@ -89,10 +96,19 @@ def clip_target(model: mujoco.MjModel, joint: int, mode: str, value: float, effo
     return float(value)
 
 
-def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:
+def apply_command(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    a: int,
+    cmd: JointCommand,
+    law: native_servos.Law | None = None,
+) -> None:
     """Writes `cmd` into actuator `a` of `model` (gains, bias, force range) and `data.ctrl`.
 
-    Everything then runs inside mj_step, with no Python per step:
+    A command in the mode of the actuator's own servo (`law`, `cmd.native`) writes that law
+    back and the target as ctrl, nothing else; a velocity of 0 on a joint whose own servo is a
+    position servo is the joint's friction (`native_servos.hold`). Otherwise everything runs
+    inside mj_step, with no Python per step:
     - position: force = kp·(target − q) + kv·(feedforward − q̇), within ±effort;
     - velocity: force = kv·(target − q̇), within ±effort;
     - effort u with a velocity limit v: Gazebo zeroes the effort while |q̇| > v in u's direction
@@ -104,6 +120,19 @@ def apply_command(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: Joint
       any gain.
     """
     sleeping.wake_actuated(model, data, (a,))  # a sleeping robot must feel its new command
+    if law is not None and cmd.native:
+        native_servos.restore(model, a, law)
+        data.ctrl[a] = cmd.target
+        return
+    if law is not None and servos.kind(cmd) == servos.HOLD:
+        native_servos.hold(model, a, law, cmd.effort)
+        data.ctrl[a] = 0.0
+        return
+    if law is not None:
+        native_servos.lift(model, a, law)
+    if model.actuator_dyntype[a] == _INTEGRATOR and not servos.has_reference(model, a):
+        model.actuator_dyntype[a] = _NO_DYN  # a model's intvelocity in another mode: no integral
+        model.actuator_actlimited[a] = 0
     gear = abs(model.actuator_gear[a][0]) or 1.0
     limit = cmd.effort / gear
     model.actuator_gaintype[a] = _FIXED

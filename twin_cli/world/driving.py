@@ -14,7 +14,7 @@ import mujoco
 
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import gravity_comp, joint_control, servos, sleeping
+from twin_cli.world import gravity_comp, joint_control, native_servos, servos, sleeping
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -156,11 +156,14 @@ def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.Joi
         carried=float(carried[dof]),
     )
     previous = state.commands.get(key)
+    law = state.native.get(key)
+    if law is not None and law.mode == mode:
+        return _set_native(state, (key, a, j, value, effort, limits), law, previous)
     was = servos.kind(previous) if previous else ""
     cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule)
     if reference and previous and was == servos.kind(cmd) == "velocity":
         cmd = replace(cmd, kp=previous.kp, kv=previous.kv, rule=previous.rule)  # same integral
-    elif reference and servos.kind(cmd) == servos.HOLD:
+    elif (reference or law is not None) and servos.kind(cmd) == servos.HOLD:
         cmd = replace(cmd, kp=0.0, kv=0.0, rule=servos.HOLD_RULE)  # no servo: the joint's friction
     if reference:
         lead = 0.0
@@ -168,9 +171,59 @@ def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.Joi
             before = previous.target if previous and previous.mode == mode else qvel
             lead = float(carried[dof]) * (value - before) / cmd.kv
         servos.start(state.model, state.data, a, cmd, was, lead)
-    control.apply_command(state.model, state.data, a, cmd)
+    control.apply_command(state.model, state.data, a, cmd, law)
     state.commands[key] = cmd
     return cmd
+
+
+def _set_native(
+    state: WorldState,
+    target: tuple,
+    law: native_servos.Law,
+    previous: control.JointCommand | None,
+) -> control.JointCommand:
+    """Writes a command in the mode of the model's own servo: its law and ctrl, nothing else.
+    An intvelocity taking over from another mode starts its integral at the joint, so the joint
+    is not pulled back to where the integral was left."""
+    key, a, j, value, effort, limits = target
+    model, data = state.model, state.data
+    if law.integrates and not (previous is not None and previous.native):
+        data.act[model.actuator_actadr[a]] = data.qpos[model.jnt_qposadr[j]]
+    cmd = control.JointCommand(
+        key,
+        law.mode,
+        value,
+        law.kp,
+        law.kv,
+        effort,
+        limits.velocity,
+        0.0,
+        native_servos.rule(law),
+        native=True,
+    )
+    control.apply_command(model, data, a, cmd, law)
+    state.commands[key] = cmd
+    return cmd
+
+
+def start_commands(state: WorldState, names: Iterable[str]) -> None:
+    """Holds the joints of each entity's own servos where they are, as from load (the lock is
+    held): a position servo's target is its joint's position, a velocity servo's 0
+    (`native_servos`). Gains come from the model: no posture is solved."""
+    model, data = state.model, state.data
+    for name in names:
+        for a in state.require(name).actuators:
+            key = model.actuator(int(a)).name
+            law = state.native.get(key)
+            if law is None:
+                continue
+            j = int(model.actuator_trnid[a, 0])
+            limits = joint_control.limits_of(model, name, key.removeprefix(f"{name}/"))
+            value = native_servos.start_value(model, data, int(a), law)
+            effort = control.effort_limit(model, int(a))
+            _set_native(state, (key, int(a), j, value, effort, limits), law, None)
+    gravity_comp.switch(model, state.commands)
+    servos.keep_awake(model, state.commands)
 
 
 def _actuated(m: mujoco.MjModel, ix: EntityIndex) -> dict[int, int]:
@@ -201,26 +254,38 @@ def _motor_of(state: WorldState, name: str, ix: EntityIndex, joint: str) -> tupl
 
 
 def release_commands(
-    model: mujoco.MjModel, data: mujoco.MjData, dropped: Iterable[control.JointCommand]
+    state: WorldState,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    dropped: Iterable[control.JointCommand],
 ) -> None:
     """Turns the motors of commands that no longer hold (a restore to a state without them) into
     motors at zero effort within their joints' effort limits, as an uncommanded motor is: a
-    servo written for a command stays in the model until something else is written over it."""
+    servo written for a command stays in the model until something else is written over it.
+    An actuator with a servo law of its own gets that law back (its ctrl is the state's)."""
     for old in dropped:
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, old.actuator)
-        if a >= 0:
+        law = state.native.get(old.actuator)
+        if a >= 0 and law is not None:
+            native_servos.restore(model, a, law)
+        elif a >= 0:
             limp = control.JointCommand(old.actuator, "effort", 0.0, 0.0, 0.0, old.effort)
             control.apply_command(model, data, a, limp)
             sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
 
 
-def reapply_commands(state: WorldState, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+def reapply_commands(
+    state: WorldState, model: mujoco.MjModel, data: mujoco.MjData, *, fresh: bool
+) -> None:
     """Writes every joint command into a (re)compiled model, by actuator name, and switches
-    fixed-base robots' gravity compensation and moving robots' sleep policy to match."""
+    fixed-base robots' gravity compensation and moving robots' sleep policy to match. A `fresh`
+    model (just compiled) first gives the world its actuators' own servo laws."""
+    if fresh:
+        state.native = native_servos.capture(model)
     for actuator, cmd in state.commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
         if a >= 0:
-            control.apply_command(model, data, a, cmd)
+            control.apply_command(model, data, a, cmd, state.native.get(actuator))
     gravity_comp.switch(model, state.commands)
     servos.keep_awake(model, state.commands)
 

@@ -1,4 +1,4 @@
-"""What a robot's drive plugins command from load: its wheels held at zero speed.
+"""What holds a robot from load: its own servos, and its drive plugins' wheels at zero speed.
 
 Gazebo's drive plugins command their wheels on every update from the moment they load, so a base
 no one has driven stands on a slope. twin's drive controllers start on a robot's first drive
@@ -21,7 +21,10 @@ from twin_cli.world.state import WorldState
 
 
 def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
-    """Commands each entity's plugin-held joints (the lock is held; entities are committed)."""
+    """Commands each entity's joints as from load (the lock is held; entities are committed):
+    its own servos where they are (`driving.start_commands`), then its plugin-held joints."""
+    names = list(names)
+    driving.start_commands(state, names)
     for name in names:
         motors = driving.motor_joints(state, name)
         by_mode: dict[str, dict[str, float]] = {}

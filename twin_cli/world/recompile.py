@@ -48,7 +48,7 @@ def rebuild(state: WorldState, trial: mujoco.MjSpec, new: Sequence[str], source:
     index = index_entities(model, kept + list(new))
     move_states(state.data, state.index, data, index, [n for n in kept if n in index])
     data.time = state.data.time
-    reapply_commands(state, model, data)
+    reapply_commands(state, model, data, fresh=True)
     return model, data, index
 
 

@@ -97,7 +97,7 @@ def _compiles_to_model(state: WorldState, spec: mujoco.MjSpec) -> bool:
     data = mujoco.MjData(candidate)
     if candidate.na == state.model.na:
         data.act[:] = state.data.act  # position servos size their ramps from their reference
-    reapply_commands(state, candidate, data)
+    reapply_commands(state, candidate, data, fresh=True)
     if candidate.nu == state.model.nu:  # a ramp's range is where it started: command state
         candidate.actuator_actrange[:] = state.model.actuator_actrange
     cap_contact_stiffness(candidate)

@@ -15,6 +15,7 @@ import mujoco
 
 from twin_cli.errors import InvalidRequestError
 from twin_cli.world import actuation as control
+from twin_cli.world import native_servos
 from twin_cli.world.divergence import (
     Divergence,
     batch_healthy,
@@ -63,6 +64,7 @@ def reset(state: WorldState, loop: SteppingLoop, *, time_only: bool = False) -> 
             return
         state.commands, state.pushes, state.perturbation = {}, [], {}
         model = state.spec.compile()
+        state.native = native_servos.capture(model)
         data = mujoco.MjData(model)
         index = index_entities(model, list(state.entities))
         for n, e in state.entities.items():

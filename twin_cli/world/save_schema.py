@@ -100,6 +100,7 @@ class SavedCommand(Strict):
     velocity_limit: Limit = math.inf
     feedforward: Finite = 0.0
     rule: str = ""
+    native: bool = False
     hold: Finite = 0.0  # OBSOLETE_COMMAND_FIELDS
     hold_slope: Finite = 0.0
 

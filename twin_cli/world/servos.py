@@ -49,7 +49,7 @@ import numpy as np
 
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, restore_gravcomp
-from converters.mjcf.export_servos import EXPORTED, INTEGRAL_MARGIN
+from converters.mjcf.export_servos import EXPORTED, INTEGRAL_MARGIN, export_servos
 from twin_cli.world import gravity_comp, sleeping, speed_holds
 
 if TYPE_CHECKING:
@@ -91,30 +91,26 @@ def give_reference(spec: mujoco.MjSpec) -> None:
     gravity_comp.prepare(spec)
 
 
-def restore_exported_motors(spec: mujoco.MjSpec) -> None:
-    """Turns the servos an exported file carries for MuJoCo users back into the torque motors
-    they replaced (`converters.mjcf.export_servos`), so a World commands a robot spawned from
-    `twin convert`'s file exactly as it commands the robot's source (gravity compensation
-    included: `gravity_comp` switches it at run time)."""
+def carry_exported_servos(spec: mujoco.MjSpec) -> None:
+    """Gives a robot spec the servos its exported file carries (`converters.mjcf.export_servos`):
+    the joints its tags command by position or velocity get MuJoCo's own servos, which the
+    World then runs by ctrl (`twin_cli.world.native_servos`). A spec read from `twin convert`'s
+    file has them already. The file's gravity compensation is handed to `gravity_comp`, which
+    switches it with the commands, so an effort command lets an arm fall as in Gazebo."""
     text = spec.text(CONTROL_TEXT)
     if text is None:
         return
     records = json.loads(text.data)
-    restored = False
-    for actuator in spec.actuators:
-        motor = records.get(actuator.target, {}).pop(EXPORTED, None)
-        if motor is None:
-            continue
-        actuator.set_to_motor()
-        actuator.ctrlrange = np.array(motor["ctrlrange"], dtype=float)
-        actuator.ctrllimited = mujoco.mjtLimited(motor["ctrllimited"])
-        actuator.forcerange = np.array(motor["forcerange"], dtype=float)
-        actuator.forcelimited = mujoco.mjtLimited(motor["forcelimited"])
-        actuator.actlimited = mujoco.mjtLimited(motor.get("actlimited", 0))  # an intvelocity's
-        actuator.actrange = np.array(motor.get("actrange", [0.0, 0.0]), dtype=float)
-        restore_gravcomp(spec, actuator.target, motor.get(GRAVCOMP))
-        restored = True
-    if restored:
+    if not any(isinstance(r, dict) and EXPORTED in r for r in records.values()):
+        export_servos(spec)
+        records = json.loads(text.data)
+    handed = False
+    for joint, record in records.items():
+        motor = record.get(EXPORTED) if isinstance(record, dict) else None
+        if motor and GRAVCOMP in motor:
+            restore_gravcomp(spec, joint, motor.pop(GRAVCOMP))
+            handed = True
+    if handed:
         text.data = json.dumps(records)
 
 

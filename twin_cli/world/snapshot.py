@@ -114,6 +114,6 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
         kept = {c.actuator for c in snapshot.commands}
         dropped = [c for key, c in state.commands.items() if key not in kept]
         state.commands = {c.actuator: c for c in snapshot.commands}
-        release_commands(state.model, state.data, dropped)
-        reapply_commands(state, state.model, state.data)
+        release_commands(state, state.model, state.data, dropped)
+        reapply_commands(state, state.model, state.data, fresh=False)
         state.pushes = list(snapshot.pushes)

@@ -283,7 +283,7 @@ def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | No
     """
     _name_unnamed(child)
     min_friction_priorities(child)  # Gazebo's min-μ rule, as the exported scene has it
-    servos.restore_exported_motors(child)  # an exported file's servos: the motors they were
+    servos.carry_exported_servos(child)  # the servos the exported file has (native_servos)
     servos.give_reference(child)  # motors hold their targets under load (servos module)
     adopt_world_globals(child, world)
     if len(child.keys) == 0:

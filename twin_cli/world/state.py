@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from twin_cli.world.divergence import Divergence, SpeedBounds
     from twin_cli.world.entities import Entity, EntityIndex
     from twin_cli.world.loop import WorldLock
+    from twin_cli.world.native_servos import Law
     from twin_cli.world.values import WorldSettings
 
 WARNINGS_KEPT = 100  # MuJoCo warning texts kept in `mujoco_warnings`
@@ -41,6 +42,7 @@ class WorldState:
         entities: entity name → its record, in spawn order.
         index: entity name → where it lives in `model` (renewed at every compile).
         commands: actuator name → the joint command it holds.
+        native: actuator name → its own servo law as compiled (`native_servos.capture`).
         pushes: wrenches acting until a world iteration; perturbation: a viewer's drag, by body.
         damping: per-step velocity decay (Gazebo's `dampingFactor`), or None.
         iterations: steps taken since the last reset; stepping_time: [s] spent in `mj_step`.
@@ -66,6 +68,7 @@ class WorldState:
     entities: dict[str, Entity] = field(default_factory=dict)
     index: dict[str, EntityIndex] = field(default_factory=dict)
     commands: dict[str, JointCommand] = field(default_factory=dict)
+    native: dict[str, Law] = field(default_factory=dict)
     pushes: list[Push] = field(default_factory=list)
     perturbation: dict[str, tuple[float, ...]] = field(default_factory=dict)
     damping: Damping | None = None

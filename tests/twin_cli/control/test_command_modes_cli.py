@@ -38,14 +38,14 @@ def served(tmp_path_factory, serve_world):
 def test_joints_shows_each_joints_active_mode_and_the_modes_it_offers(served: Path) -> None:
     joints = _joints(served)
     offered = {name: (j["mode"], j["modes"]) for name, j in joints.items()}
-    assert offered == {
-        "d0": ("none", ["position", "velocity", "effort"]),
-        "d1": ("none", ["position"]),
-        "d2": ("none", ["velocity", "effort"]),
+    assert offered == {  # each joint's own servo holds it from load, in its first mode
+        "d0": ("position", ["position", "velocity", "effort"]),
+        "d1": ("position", ["position"]),
+        "d2": ("velocity", ["velocity", "effort"]),
     }, offered
     table = _ok(served, "joints", "discs").splitlines()  # piped: tab-separated
     assert table[0].split("\t")[:3] == ["joint", "mode", "offers"], table[0]
-    assert table[1].split("\t")[:3] == ["d0", "none", "position,velocity,effort"], table[1]
+    assert table[1].split("\t")[:3] == ["d0", "position", "position,velocity,effort"], table[1]
 
 
 def test_command_mode_switches_a_live_joint_and_the_new_mode_acts_at_once(served: Path) -> None:

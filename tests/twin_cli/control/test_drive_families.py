@@ -369,34 +369,35 @@ def test_a_base_no_one_has_driven_holds_on_a_slope(tmp_path: Path, name: str) ->
     world.reset()
     again = _watch_on_a_slope(world)
     assert again < HELD_M, f"{name}: after a reset, moved {again * 1e3:.3f} mm in 2 s"
-    if 'type="continuous"' not in FAMILIES[name].robot():
-        return  # a base without wheels stands without its plugin too
+    if (
+        'type="continuous"' not in FAMILIES[name].robot()
+        or "<ros2_control" in FAMILIES[name].robot()
+    ):
+        return  # a base without wheels stands without its plugin too; tagged wheels are servos
     free = re.sub(r"<plugin\b.*?</plugin>", "", FAMILIES[name].robot(), flags=re.S)
     rolled = _watch_on_a_slope(_spawned(tmp_path, name, free))
     assert rolled > 0.05, f"{name} without its plugins rolled only {rolled:.3f} m: no control"
 
 
-def test_a_plugin_hold_is_the_wheels_friction_until_the_first_drive(tmp_path: Path) -> None:
-    """A spawned base's held wheels are their joints' dry friction bounded by the effort, on the
-    model, with the motor pushing nothing; the drive's first command gives the joints their own
-    friction back and its servo its own gains."""
-    import mujoco
-
-    from twin_cli.world.servos import HOLD_RULE
+def test_a_plugin_hold_is_the_wheels_own_servo_at_zero_until_the_first_drive(
+    tmp_path: Path,
+) -> None:
+    """A spawned base's held wheels are their own servos (the exported file's `intvelocity`) at
+    ctrl 0; the drive's commands then write ctrl and nothing else on the model."""
+    import numpy as np
 
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     m, wheels = world.model, ("wheel_left_joint", "wheel_right_joint")
-    dofs = [
-        m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"base/{j}")] for j in wheels
-    ]
-    efforts = [world.joint_commands("base")[j]["effort_limit"] for j in wheels]
-    assert list(m.dof_frictionloss[dofs]) == efforts, "held: friction = the effort limit"
+    ids = [m.actuator(f"base/{j}").id for j in wheels]
     shown = {world.joint_commands("base")[j]["rule"] for j in wheels}
-    assert shown == {HOLD_RULE}, f"`twin joints` shows {shown}"
+    assert shown == {"the model's own intvelocity servo: ctrl = target"}, shown
+    assert list(world.data.ctrl[ids]) == [0.0, 0.0], "held: speed 0"
+    law = m.actuator_gainprm[ids].copy(), m.actuator_biasprm[ids].copy()
     drive(world, "base", V)
     world.step(100)
-    assert list(world.model.dof_frictionloss[dofs]) == [0.0, 0.0], "driven: the joints' own"
-    assert all(world.joint_commands("base")[j]["kp"] > 0 for j in wheels)
+    assert all(world.data.ctrl[ids] > 0), "driven: the wheels' speeds are their ctrl"
+    assert np.array_equal(m.actuator_gainprm[ids], law[0]), "gains unchanged"
+    assert np.array_equal(m.actuator_biasprm[ids], law[1]), "gains unchanged"
 
 
 def test_the_first_drive_keeps_the_force_the_hold_carried(tmp_path: Path) -> None:
@@ -412,10 +413,11 @@ def test_the_first_drive_keeps_the_force_the_hold_carried(tmp_path: Path) -> Non
     assert moved < HELD_M, f"sagged {moved * 1e3:.3f} mm when the drive took over the hold"
 
 
-def test_a_restored_world_without_commands_has_free_wheels(tmp_path: Path) -> None:
-    """A snapshot (or an older save file) that holds no commands is restored as it was: the
-    wheels the spawn held are released, so the base rolls down the slope as it would have."""
+def test_a_restored_world_without_commands_keeps_the_wheels_own_servos(tmp_path: Path) -> None:
+    """A snapshot (or an older save file) that holds no commands is restored as it was: no
+    command, and the wheels' own servos, which are the model, hold the base on the slope at
+    the ctrl the snapshot kept."""
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     world.restore(dataclasses.replace(world.snapshot(), commands=()))
     assert not world.commands()
-    assert _watch_on_a_slope(world) > 0.05, "a restored world kept servos no command holds"
+    assert _watch_on_a_slope(world) < HELD_M, "the model's servos hold the base"

@@ -107,7 +107,8 @@ def test_an_mjcf_position_servo_is_not_bounded_by_its_position_range(tmp_path):
     """A hand-written fixed arm whose `<position>` servo has ctrlrange ±1.5 rad (a range of
     targets, not of force) holds a 2.45 N m weight at 0.3 rad: the compensation's bound is the
     actuator's force range (none here), not its control range (bounded by it, the arm fell to
-    0.76 rad). The servo's own force stays within ±1.5, so the move takes about 4 s."""
+    0.76 rad). The World runs the file's own servo (kp 200, kv 10): uncompensated, it would sag
+    2.45/200 = 12 mrad."""
     path = tmp_path / "servo_arm.xml"
     path.write_text(
         """<mujoco model="servo_arm"><worldbody><body name="base" pos="0 0 1">
@@ -115,7 +116,7 @@ def test_an_mjcf_position_servo_is_not_bounded_by_its_position_range(tmp_path):
   <body name="link"><joint name="shoulder" type="hinge" axis="0 1 0"/>
     <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.03" mass="1" contype="0"
       conaffinity="0"/></body></body></worldbody>
-  <actuator><position name="shoulder" joint="shoulder" kp="200" ctrlrange="-1.5 1.5"
+  <actuator><position name="shoulder" joint="shoulder" kp="200" kv="10" ctrlrange="-1.5 1.5"
       ctrllimited="true"/></actuator></mujoco>"""
     )
     world = World()
