@@ -70,7 +70,7 @@ def position_gains(
 
 
 def largest_inertia(model: mujoco.MjModel) -> np.ndarray:
-    """Each DoF's largest reflected inertia (mass-matrix diagonal) over POSTURES random postures
+    """Each DoF's largest reflected inertia (`reflected_inertia`) over POSTURES random postures
     of the hinge and slide joints within their ranges (a hinge without one: a turn), and qpos0."""
     import mujoco
 
@@ -105,7 +105,7 @@ def _sample_range(model: mujoco.MjModel, joint: int) -> tuple[float, float]:
 
 
 def _diagonal(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
-    """The mass matrix's diagonal at `data.qpos` [kg m² or kg]."""
+    """`reflected_inertia` of every dof at `data.qpos` [kg m² or kg]."""
     import mujoco
 
     mujoco.mj_kinematics(model, data)
@@ -113,4 +113,32 @@ def _diagonal(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     mujoco.mj_makeM(model, data)
     full = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data, full)  # MuJoCo 4 signature: (m, d, dst)
-    return np.diag(full).copy()
+    return reflected_inertia(model, full)
+
+
+def reflected_inertia(model: mujoco.MjModel, full: np.ndarray) -> np.ndarray:
+    """Each dof's inertia as its servo's step sees it [kg m² or kg]: the robot's other joints
+    held (their servos are stiff), its floating base free. On a fixed base that is the
+    mass-matrix diagonal Mᵢᵢ; a floating base turns against the joint, so a hinge's inertia is
+    1/((M_S)⁻¹)ᵢᵢ over S = the hinge and the base's dofs. A UR5e standing free on its base has
+    3.4 kg m² on its shoulder pan as Mᵢᵢ and 0.007 with its 4 kg base turning: a servo tuned on
+    Mᵢᵢ chattered at ±150 N m, spinning the base, where the base's floor friction holds ~10 N m.
+    """
+    import mujoco
+
+    diagonal = np.diag(full).copy()
+    free = [
+        int(model.jnt_dofadr[j]) + k
+        for j in range(model.njnt)
+        if int(model.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_FREE)
+        for k in range(6)
+    ]
+    if not free:
+        return diagonal
+    for dof in range(model.nv):
+        if dof in free:
+            continue
+        rows = [dof, *free]
+        sub = full[np.ix_(rows, rows)]
+        diagonal[dof] = 1.0 / np.linalg.inv(sub)[0, 0]
+    return diagonal
