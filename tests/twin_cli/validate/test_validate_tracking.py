@@ -26,7 +26,10 @@ def test_corpus_robot_tracks_a_step_and_a_sine_within_its_limits(
         converted_corpus(robot_id), CORPUS[robot_id]["entry"], repair_inertia=True
     )
     outcome = run_check(robot, tracking, debug=True)
-    assert outcome.status is Status.PASS, f"{robot_id}: {outcome.measured}; {outcome.hints}"
+    others = [h for h in outcome.hints if "has no speed limit" not in h]
+    assert outcome.status in (Status.PASS, Status.WARN) and not others, (
+        f"{robot_id}: {outcome.status}, {outcome.measured}; {outcome.hints}"
+    )
     assert outcome.value < 0.2, f"{robot_id}: sine error {outcome.value:.1%} of its amplitude"
 
 

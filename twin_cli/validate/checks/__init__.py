@@ -145,6 +145,7 @@ CHECKS: dict[str, Check] = {
             max_settle_s=1.0,
             max_sine_error_fraction=0.2,
             max_speed_ratio=1.05,
+            max_runaway_ratio=4.0,
         ),
     )
 }
