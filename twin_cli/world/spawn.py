@@ -80,7 +80,8 @@ def load_source(request: SpawnRequest) -> LoadedSource:
     """
     loaded = _load(request)
     if request.fixed_base and loaded.report is None:
-        return fixed_base.weld_loaded(loaded)
+        loaded = fixed_base.weld_loaded(loaded)
+    servos.carry_exported_servos(loaded.spec)  # once per load, not per instance of a batch
     return loaded
 
 
@@ -230,6 +231,7 @@ def _load_description(path: Path, request: SpawnRequest) -> LoadedSource:
 def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
     done = convert_bounded(request, source=str(path), path=str(path))
     spec, report = done.spec, done.report
+    servos.carry_exported_servos(spec)  # cached with its servos: a later spawn pays nothing
     name = report.robot or spec.modelname or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
     return LoadedSource(
@@ -283,7 +285,7 @@ def prepare_child(child: mujoco.MjSpec, world: mujoco.MjSpec) -> np.ndarray | No
     """
     _name_unnamed(child)
     min_friction_priorities(child)  # Gazebo's min-μ rule, as the exported scene has it
-    servos.carry_exported_servos(child)  # the servos the exported file has (native_servos)
+    servos.carry_exported_servos(child)  # the file's servos (native_servos); a no-op once loaded
     servos.give_reference(child)  # motors hold their targets under load (servos module)
     adopt_world_globals(child, world)
     if len(child.keys) == 0:
