@@ -210,8 +210,49 @@ def validate(
     )
     check_start_postures(robot, todo, joints or {})
     with recording_into(record):
-        results = tuple(run_check(robot, sc, debug=debug) for sc in todo)
+        results = tuple(run_from_start(robot, sc, debug=debug) for sc in todo)
     return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)
+
+
+STARTS_FROM_POSTURE = frozenset(
+    {
+        "stability",
+        "zero_gravity",
+        "tracking",
+        "joint_limits",
+        "friction_standing",
+        "friction_incline",
+        "ground_contact",
+        "collision",
+        "sensor_contact",
+        "sensor_imu",
+        "sensor_lidar",
+    }
+)
+"""Physics checks that measure the robot at rest or moving part against part: from a start
+posture whose links overlap or whose joints are outside their ranges they would measure the
+push apart. (Free fall, the Moon preset and the inertia check read the whole robot's motion,
+which internal pushes do not change; the real-time check its cost.)"""
+
+
+def run_from_start(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> CheckResult:
+    """`run_check`, unless the scenario's start posture is one `initial_overlap` fails: then
+    the check is not run, and says why (a verdict on the posture, not on twin)."""
+    from twin_cli.validate.checks.model_collision import start_posture_problems
+
+    if sc.check not in STARTS_FROM_POSTURE:
+        return run_check(robot, sc, debug=debug)
+    tolerance = CHECKS["initial_overlap"].defaults["tolerance_m"]
+    problems = start_posture_problems(robot, sc, tolerance)
+    if not problems:
+        return run_check(robot, sc, debug=debug)
+    check = CHECKS[sc.check]
+    reason = (
+        f"not run because of initial_overlap: in this scenario's start posture "
+        f"{'; '.join(problems)}, so the check would measure the robot pushing itself apart; "
+        "start it in a valid posture (-J, or the scenario's [robot] joints) or fix the model"
+    )
+    return _stamp(not_applicable(check.name, check.kind, "not run: start posture", reason), sc, 0.0)
 
 
 def check_start_postures(

@@ -1,5 +1,11 @@
 """Model checks on collision geometry: mesh complexity and overlaps in the initial pose.
 
+The start posture check (`initial_overlap`) also fails a hinge or slide that starts outside its
+range: its limit throws it in at startup, as an overlap throws links apart. Physics checks that
+measure the robot at rest or moving part against part are not run from such a posture
+(`start_posture_problems`, used by the runner): their readings would be that push, not the
+robot, and blaming twin for them misleads.
+
 Overlap rule (Gazebo semantics): a pair that the model collides and that already penetrates at
 spawn (the start posture, `-J` included) makes the robot "vibrate or explode at startup", so
 it fails. A robot with selfCollide
@@ -16,6 +22,7 @@ from twin_cli.validate.checks.posture import start_data
 from twin_cli.validate.scenario import Scenario
 
 MESH = 7  # mjtGeom mjGEOM_MESH
+HINGE, SLIDE = 3, 2  # mjtJoint codes
 
 
 def _mesh_sources(robot: RobotUnderTest) -> dict[str, dict]:
@@ -104,8 +111,40 @@ def latent_overlaps(robot: RobotUnderTest, data, tol: float, skip) -> dict[tuple
     return pairs
 
 
+def outside_limits(
+    robot: RobotUnderTest, data, tol: float
+) -> list[tuple[str, float, float, float]]:
+    """(joint, position, low, high) of each limited hinge or slide of `data` that is more than
+    `tol` [rad or m] outside its range."""
+    model, out = robot.model, []
+    for j in range(model.njnt):
+        if int(model.jnt_type[j]) not in (HINGE, SLIDE) or not model.jnt_limited[j]:
+            continue
+        q = float(data.qpos[model.jnt_qposadr[j]])
+        low, high = (float(v) for v in model.jnt_range[j])
+        if q < low - tol or q > high + tol:
+            out.append((model.joint(j).name, q, low, high))
+    return out
+
+
+def start_posture_problems(robot: RobotUnderTest, scenario: Scenario, tol: float) -> list[str]:
+    """What is wrong with the scenario's start posture: colliding pairs that overlap deeper than
+    `tol` [m] and joints outside their ranges (empty: nothing)."""
+    data = start_data(robot, scenario)
+    overlaps = sorted(colliding_overlaps(robot, data, tol).items(), key=lambda kv: kv[1])
+    problems = [
+        f"links {_pair_name(robot, b1, b2)} overlap by {fmt_len(-d)}" for (b1, b2), d in overlaps
+    ]
+    problems += [
+        f"joint '{name}' starts at {q:.4g}, outside its range [{low:.4g}, {high:.4g}]"
+        for name, q, low, high in outside_limits(robot, data, tol)
+    ]
+    return problems
+
+
 def check_initial_overlap(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
-    """Collision geometry that overlaps in the start posture (`-J` included), pair by pair."""
+    """Collision geometry that overlaps in the start posture (`-J` included), pair by pair, and
+    joints that start outside their ranges."""
     data = start_data(robot, scenario)
     tol = th["tolerance_m"]
     live = colliding_overlaps(robot, data, tol)
@@ -115,18 +154,27 @@ def check_initial_overlap(robot: RobotUnderTest, scenario: Scenario, th: dict[st
         f"robot will jump or vibrate at startup; {_separation_fix(robot, b1, b2)}"
         for (b1, b2), d in sorted(live.items(), key=lambda kv: kv[1])
     ]
+    outside = outside_limits(robot, data, tol)
+    hints += [
+        f"joint '{name}' starts at {q:.4g}, outside its range [{low:.4g}, {high:.4g}]: its "
+        f"limit throws it in at startup; start it inside, e.g. -J {name}={(low + high) / 2:.4g}"
+        for name, q, low, high in outside
+    ]
     details = [
         f"links {_pair_name(robot, b1, b2)} overlap by {fmt_len(-d)} but do not collide "
         "(selfCollide off, as in Gazebo); they would fight if selfCollide were turned on"
         for (b1, b2), d in sorted(latent.items(), key=lambda kv: kv[1])
     ]
     deepest = -min(list(live.values()) + [0.0])
-    status = Status.FAIL if live else (Status.WARN if latent else Status.PASS)
+    status = Status.FAIL if hints else (Status.WARN if latent else Status.PASS)
+    measured = f"{len(live)} colliding pair(s) overlap" + (
+        f", {fmt_len(deepest)} deep" if live else ""
+    )
     return result(
         "initial_overlap",
         "model",
         status,
-        f"{len(live)} colliding pair(s) overlap" + (f", {fmt_len(deepest)} deep" if live else ""),
+        measured + (f"; {len(outside)} joint(s) outside their range" if outside else ""),
         f"0 pairs deeper than {fmt_len(tol)}",
         hints=hints,
         details=details,
