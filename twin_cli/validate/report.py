@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from twin_cli.validate.checks.base import CheckResult, Series, Status
+from twin_cli.validate.markdown_text import cell, inline
 from twin_cli.validate.runner import ValidationRun
 
 if TYPE_CHECKING:
@@ -84,13 +85,14 @@ def markdown(run: ValidationRun, plots: str | None = None) -> str:
         "|---|---|---|---|",
     ]
     for r in run.results:
-        lines.append(f"| {MD_MARK[r.status]} | {label(r)} | {r.measured} | {r.threshold} |")
+        cells = (MD_MARK[r.status], label(r), r.measured, r.threshold)
+        lines.append("| " + " | ".join(cell(c) for c in cells) + " |")
     problems = [r for r in run.results if r.status in TO_FIX]
     if problems:
         lines += ["", "### What to fix", ""]
         for r in problems:
             for hint in r.hints or r.details:
-                lines.append(f"- **{r.check}** ({r.status.value}): {hint}")
+                lines.append(f"- **{r.check}** ({r.status.value}): {inline(hint)}")
     if plots is not None:
         pictures = [(r, s) for r in run.results for s in r.series]
         if pictures:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from twin_cli.validate.checks.base import Status
 from twin_cli.validate.margins import MARGINS, margin
+from twin_cli.validate.markdown_text import cell
 from twin_cli.validate.report import MD_MARK, junit_case, label
 from twin_cli.validate.sweep import SweepRun, VariantRun
 
@@ -48,13 +49,14 @@ def markdown(sweep: SweepRun) -> str:
         f"{len(sweep.runs)} variants ({failed} failing) on {sweep.executor} "
         f"in {sweep.seconds:.1f} s.",
         "",
-        "| robot | variant | " + " | ".join(checks) + " |",
+        "| robot | variant | " + " | ".join(cell(c) for c in checks) + " |",
         "|---|---|" + "---|" * len(checks),
     ]
     for run in sweep.runs:
         by_check = {label(r): r for r in run.results}
         cells = [MD_MARK[by_check[c].status] if c in by_check else "" for c in checks]
-        lines.append(f"| {run.robot} | {variant_name(run)} | " + " | ".join(cells) + " |")
+        row = [run.robot, variant_name(run), *cells]
+        lines.append("| " + " | ".join(cell(c) for c in row) + " |")
     return "\n".join(lines) + "\n"
 
 
