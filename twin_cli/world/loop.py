@@ -135,7 +135,7 @@ class SteppingLoop:
             now = time.perf_counter()
             state = self._state
             rate, paused, sim = state.settings.rate, state.paused, float(state.data.time)
-            self._meter = rt.observe(self._meter, now - self._origin, sim)
+            self._meter = rt.observe_running(self._meter, now - self._origin, sim, paused)
             if paused:
                 self._stop.wait(PAUSED_POLL_S)
                 epoch = -1

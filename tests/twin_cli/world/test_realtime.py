@@ -92,6 +92,26 @@ def test_observe_samples_at_most_every_interval():
     assert rt.factor(rt.RtfMeter(((1.0, 1.0),))) == 0.0, "one sample has no factor"
 
 
+def test_a_pause_leaves_no_paused_seconds_in_the_factor_after_resume():
+    """5 s at factor 0.5, paused 3 s, then 1 s at 0.5: the factor reads 0.5, not the 0.125 the
+    last 4 s of wall time give when they span the pause (0.5 s of sim time in 4 s)."""
+    meter = rt.RtfMeter()
+    for k in range(46):  # 0-9 s of wall time
+        real = 0.2 * k
+        paused = 5.0 < real < 8.0
+        sim = 0.5 * min(real, 5.0) + 0.5 * max(0.0, real - 8.0)
+        meter = rt.observe_running(meter, real, sim, paused)
+        if paused:
+            assert rt.factor(meter) == 0.0, "no factor while paused"
+    assert rt.factor(meter) == pytest.approx(0.5), [s for s in meter.samples]
+    spanning = rt.RtfMeter()
+    for k in range(46):
+        real = 0.2 * k
+        sim = 0.5 * min(real, 5.0) + 0.5 * max(0.0, real - 8.0)
+        spanning = rt.observe(spanning, real, sim)
+    assert rt.factor(spanning) == pytest.approx(0.125), "the window that spans the pause"
+
+
 def test_lateness_accounts_mean_worst_and_late_batches():
     log = rt.Lateness()
     for late in (0.0, 2e-4, 5e-3, -1e-5):
