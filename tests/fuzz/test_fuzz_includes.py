@@ -33,7 +33,10 @@ from converters.errors import (
 from converters.mjcf.builder import ConvertOptions
 from converters.served import ConversionJob, convert_served
 
-BUDGET = XacroBudget(timeout_s=2.0, memory_mib=2048)
+# 5 s: the bounded child's own start (Python, xacro, the converter) is part of the budget, and
+# on a runner with two busy loops per core it alone passed 2 s, so that every attack, refused in
+# well under a second when quiet, came back as a budget refusal instead of its own.
+BUDGET = XacroBudget(timeout_s=5.0, memory_mib=2048)
 SLACK_S = 5.0  # [s] past the budget: the child's start and the caller's own work
 SECRET_TEXT, SECRET_VALUE, SECRET_VAR = "hunter2", "server-secret", "TWIN_FUZZ_SECRET"
 # Each case starts a child (and a xacro grandchild): fewer cases than the file fuzzers.
