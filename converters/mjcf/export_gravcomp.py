@@ -12,7 +12,8 @@ In the file a body is compensated when every joint between it and the world is a
 servo: a body below a passive, effort or velocity joint falls as it does in Gazebo. A body the
 robot's own tags already compensate (Gazebo's gravity off) keeps its value. A floating robot
 (a free joint) gets none: compensating its bodies would make the whole robot weightless. The
-control record keeps what each change replaced, so a World spawning the file restores it.
+control record keeps what each change replaced, so a World spawning the file hands the
+compensation to `twin_cli.world.gravity_comp`, which switches it with the commands.
 """
 
 from __future__ import annotations

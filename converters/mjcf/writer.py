@@ -161,8 +161,8 @@ def _report_servos(report: Report, servoed: dict[str, str]) -> None:
         report.mapped(
             f"exported {mode} servos",
             f"{len(joints)} joint(s) {names}: ctrl is the {mode} target, force within ±effort, "
-            "gains from the reflected inertia at home (a world that spawns the file restores "
-            "the torque motors)",
+            "gains from the reflected inertia at home (a twin world runs the same servos by "
+            "ctrl)",
             tag="ros2_control",
         )
 

@@ -10,9 +10,10 @@ its effort.
 MuJoCo computes compensation only in a model compiled with a compensated body, so every body of a
 fixed-base robot is compiled with OFF (a negligible share) and a command switches bodies on the
 model (`switch`): a body is ON while every joint between it and the world is actuated and holds
-a position command. An arm without commands, with an effort command or a passive joint on the
-way falls as it does in Gazebo; a velocity servo's integral carries its load itself. A body the
-robot's own tags compensate (Gazebo's gravity off: 1) keeps its value.
+a position command (a joint's own servo holds one from load, `native_servos`). An arm with an
+effort command or a passive joint on the way falls as it does in Gazebo; a velocity servo's
+integral carries its load itself. A body the robot's own tags compensate (Gazebo's gravity
+off: 1) keeps its value.
 """
 
 from __future__ import annotations
