@@ -210,7 +210,7 @@ def validate(
     )
     check_start_postures(robot, todo, joints or {})
     with recording_into(record):
-        results = tuple(run_from_start(robot, sc, debug=debug) for sc in todo)
+        results = run_all(robot, todo, debug=debug)
     return ValidationRun(robot.name, robot.source, results, time.perf_counter() - start)
 
 
@@ -235,9 +235,25 @@ push apart. (Free fall, the Moon preset and the inertia check read the whole rob
 which internal pushes do not change; the real-time check its cost.)"""
 
 
-def run_from_start(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) -> CheckResult:
+def run_all(
+    robot: RobotUnderTest, todo: list[Scenario], *, debug: bool = False
+) -> tuple[CheckResult, ...]:
+    """Each scenario's result in order (`run_from_start`), each told whether a failed
+    `initial_overlap` is already in the run (model checks come first)."""
+    results: list[CheckResult] = []
+    for sc in todo:
+        reported = any(r.check == "initial_overlap" and r.failed for r in results)
+        results.append(run_from_start(robot, sc, debug=debug, reported=reported))
+    return tuple(results)
+
+
+def run_from_start(
+    robot: RobotUnderTest, sc: Scenario, *, debug: bool = False, reported: bool = False
+) -> CheckResult:
     """`run_check`, unless the scenario's start posture is one `initial_overlap` fails: then
-    the check is not run, and says why (a verdict on the posture, not on twin)."""
+    the check is not run, and says why (a verdict on the posture, not on twin). Not run is a
+    skip when the run's failed `initial_overlap` already fails it (`reported`), and a failure
+    otherwise (`--only`, `--skip initial_overlap`), so a run never passes on checks it held."""
     from twin_cli.validate.checks.model_collision import start_posture_problems
 
     if sc.check not in STARTS_FROM_POSTURE:
@@ -252,6 +268,10 @@ def run_from_start(robot: RobotUnderTest, sc: Scenario, *, debug: bool = False) 
         f"{'; '.join(problems)}, so the check would measure the robot pushing itself apart; "
         "start it in a valid posture (-J, or the scenario's [robot] joints) or fix the model"
     )
+    if not reported:
+        held = result(check.name, check.kind, Status.FAIL, "not run: start posture", "runs",
+                      hints=[reason])  # fmt: skip
+        return _stamp(held, sc, 0.0)
     return _stamp(not_applicable(check.name, check.kind, "not run: start posture", reason), sc, 0.0)
 
 

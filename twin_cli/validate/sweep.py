@@ -162,7 +162,7 @@ def run_task(task: Task) -> VariantRun:
 
 
 def _run_task(task: Task) -> VariantRun:
-    from twin_cli.validate.runner import check_start_postures, plan, run_from_start
+    from twin_cli.validate.runner import check_start_postures, plan, run_all
     from twin_cli.validate.scenario import with_joints
     from twin_cli.validate.variants import apply_to_scenario, ground_friction
 
@@ -176,7 +176,7 @@ def _run_task(task: Task) -> VariantRun:
     robot = load_variant(task.robot, task.values, opts)
     check_start_postures(robot, todo, joints)
     with ground_friction(task.values):
-        results = tuple(replace(run_from_start(robot, sc), series=()) for sc in todo)
+        results = tuple(replace(r, series=()) for r in run_all(robot, todo))
     seconds = time.perf_counter() - start
     return VariantRun(robot.name, task.robot, dict(task.values), results, seconds, _limits(todo))
 

@@ -100,3 +100,13 @@ def test_a_home_key_outside_a_joints_range_fails_and_holds_back_its_dependents(t
     held = results["stability"]
     assert held.status is Status.NOT_APPLICABLE, (held.status, held.measured)
     assert "outside its range [0.6, 2.5]" in held.details[0], held.details
+
+
+def test_without_initial_overlap_in_the_run_a_held_check_fails(arm):
+    """`--only stability` from the folding pose: nothing else would fail the run, so the held
+    check does, with the same reason (never a pass on a check that did not run)."""
+    run = validate(arm, only=["stability"])
+    (held,) = run.results
+    assert held.status is Status.FAIL, (held.status, held.measured)
+    assert "not run because of initial_overlap" in held.hints[0], held.hints
+    assert run.exit_code == 1
