@@ -54,7 +54,7 @@ class JointLimits:
 
 def limits_of(model: mujoco.MjModel, entity: str, joint: str) -> JointLimits:
     """`joint`'s record in the `<entity>/control` text of `model`, or every mode unbounded."""
-    record = _record(model, entity, joint)
+    record = record_of(model, entity, joint)
     if record is None:
         return JointLimits()
     velocity = record.get("velocity_limit")
@@ -67,7 +67,7 @@ def limits_of(model: mujoco.MjModel, entity: str, joint: str) -> JointLimits:
     )
 
 
-def _record(model: mujoco.MjModel, entity: str, joint: str) -> dict | None:
+def record_of(model: mujoco.MjModel, entity: str, joint: str) -> dict | None:
     """The joint's JSON record; MJCF converted before the records were merged (one
     `control:<joint>` text per motor) is read too."""
     records = _text_json(model, f"{entity}/control")

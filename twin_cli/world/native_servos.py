@@ -161,3 +161,11 @@ def rule(law: Law) -> str:
     """What `twin joints` shows for a command run by `law`."""
     kind = "intvelocity" if law.integrates else law.mode
     return RULE.format(kind)
+
+
+def velocity_limit(model: mujoco.MjModel, actuator: str) -> float:
+    """The velocity limit [rad/s or m/s] the joint's control record gives (inf: none)."""
+    from twin_cli.world.joint_control import limits_of
+
+    entity, _, joint = actuator.rpartition("/")
+    return limits_of(model, entity, joint).velocity

@@ -100,6 +100,7 @@ def load(path: str | os.PathLike) -> World:
     world = _new_world(path, doc)
     entities = [_respawn(path, world, item.model_dump()) for item in doc.entities]
     layout, state = _servo_references(world, dict(doc.layout), np.array(doc.state, dtype=float))
+    layout, state = _own_servos(world, layout, state)
     snapshot = WorldSnapshot(
         doc.name,
         world.settings,
@@ -107,7 +108,11 @@ def load(path: str | os.PathLike) -> World:
         doc.iterations,
         doc.divergences,
         tuple(entities),
-        tuple(JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands),
+        _natives(
+            world,
+            [JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands],
+            state,
+        ),
         tuple(Push(p.body, tuple(p.wrench), p.end_step) for p in doc.pushes),
         layout,
         state,
@@ -119,6 +124,85 @@ def load(path: str | os.PathLike) -> World:
             path, str(exc), "restore the robot files as they were when saved, or spawn afresh"
         ) from exc
     return world
+
+
+def _exported_positions(model) -> list[int]:
+    """Actuators that are a description's exported position servos (`native_servos`): before
+    a World ran them by ctrl they were torque motors with a servo reference each."""
+    from twin_cli.world import native_servos
+
+    laws = native_servos.capture(model)
+    return [
+        a
+        for a in range(model.nu)
+        if (law := laws.get(model.actuator(a).name)) is not None
+        and law.mode == "position"
+        and model.actuator_actnum[a] == 0
+        and _exported(model, a)
+    ]
+
+
+def _exported(model, a: int) -> bool:
+    """Whether actuator `a`'s joint's control record says the export gave it its servo."""
+    from converters.mjcf.export_servos import EXPORTED
+    from twin_cli.world.joint_control import record_of
+
+    entity, _, joint = model.actuator(a).name.rpartition("/")
+    return EXPORTED in (record_of(model, entity, joint) or {})
+
+
+def _own_servos(
+    world: World, layout: dict[str, int], state: np.ndarray
+) -> tuple[dict[str, int], np.ndarray]:
+    """A file saved when a description's tagged position joints were torque motors with a
+    servo reference (one activation each) loads into their own servos (none): those
+    activations are dropped from the state. Other files pass unchanged."""
+    model = world.model
+    gone = _exported_positions(model)
+    rest = {k: v for k, v in layout.items() if k != "na"}
+    fits = rest == {k: int(getattr(model, k)) for k in rest}
+    if not gone or not fits or layout.get("na") != model.na + len(gone):
+        return layout, state
+    slots, k = [], 0
+    for a in range(model.nu):
+        width = 1 if a in gone else int(model.actuator_actnum[a])
+        if a in gone:
+            slots.append(k)
+        k += width
+    at = 1 + model.nq + model.nv
+    return {**layout, "na": int(model.na)}, np.delete(state, [at + s for s in slots])
+
+
+def _natives(world: World, commands: list[JointCommand], state: np.ndarray) -> tuple:
+    """Saved commands in the mode of a joint's own servo, as commands of that servo; a servo
+    the file has no command for holds its joint where it was saved, as from load (a file
+    saved when such joints were limp motors would otherwise have them pulled to ctrl 0)."""
+    from dataclasses import replace as renew
+
+    from twin_cli.world import native_servos
+    from twin_cli.world.actuation import effort_limit
+
+    model = world.model
+    laws = native_servos.capture(model)
+    out = {}
+    for cmd in commands:
+        law = laws.get(cmd.actuator)
+        if law is not None and law.mode == cmd.mode and not cmd.native:
+            rule = native_servos.rule(law)
+            cmd = renew(cmd, kp=law.kp, kv=law.kv, feedforward=0.0, rule=rule, native=True)
+        out[cmd.actuator] = cmd
+    for name, law in laws.items():
+        if name in out:
+            continue
+        a = model.actuator(name).id
+        joint = int(model.actuator_trnid[a, 0])
+        value = float(state[1 + model.jnt_qposadr[joint]]) if law.mode == "position" else 0.0
+        limit = native_servos.velocity_limit(model, name)
+        out[name] = JointCommand(
+            name, law.mode, value, law.kp, law.kv, effort_limit(model, a), limit, 0.0,
+            native_servos.rule(law), native=True,
+        )  # fmt: skip
+    return tuple(out.values())
 
 
 def _servo_references(
@@ -204,6 +288,8 @@ def _respawn(path: str | os.PathLike, world: World, item: dict[str, Any]) -> Ent
         raise WorldFileError(path, problem, "restore its source file, or spawn afresh") from exc
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world.entity(item["name"])
-    if spawn_state.act.size == 0 and entity.spawn_state.act.size:  # saved before servo refs
-        spawn_state = replace(spawn_state, act=np.zeros(entity.spawn_state.act.size))
+    if spawn_state.act.size != entity.spawn_state.act.size:
+        # saved before its motors carried servo references, or before its tagged position
+        # joints ran their own servos (no activation): the spawn's activations as spawned now
+        spawn_state = replace(spawn_state, act=entity.spawn_state.act.copy())
     return replace(entity, source=item["source"], request=request, spawn_state=spawn_state)
