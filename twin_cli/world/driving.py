@@ -279,13 +279,19 @@ def reapply_commands(
 ) -> None:
     """Writes every joint command into a (re)compiled model, by actuator name, and switches
     fixed-base robots' gravity compensation and moving robots' sleep policy to match. A `fresh`
-    model (just compiled) first gives the world its actuators' own servo laws."""
+    model (just compiled) first gives the world its actuators' own servo laws. A command of a
+    joint's own servo keeps the ctrl `data` carries: a trajectory moves that ctrl between its
+    updates, and writing the command's first target back threw a Panda joint halfway along a
+    1.5 rad move back towards its start at 6.3 rad/s when another entity was spawned."""
     if fresh:
         state.native = native_servos.capture(model)
     for actuator, cmd in state.commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
-        if a >= 0:
-            control.apply_command(model, data, a, cmd, state.native.get(actuator))
+        law = state.native.get(actuator)
+        if a >= 0 and cmd.native and law is not None and law.mode == cmd.mode:
+            native_servos.restore(model, a, law)
+        elif a >= 0:
+            control.apply_command(model, data, a, cmd, law)
     gravity_comp.switch(model, state.commands)
     servos.keep_awake(model, state.commands)
 
