@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from twin_cli.world import speed_holds
 from twin_cli.world.servos import has_reference
-from twin_cli.world.speed_holds import HOLD_SOLIMP, HOLD_TIME_CONSTANTS, UNLIMITED
 
 FIELDS = (
     "gaintype",
@@ -137,12 +137,7 @@ def hold(model: mujoco.MjModel, a: int, law: Law, effort: float) -> None:
     plus `effort` [N m or N] (`twin_cli.world.speed_holds`), the actuator pushing nothing."""
     restore(model, a, law)
     model.actuator_dyntype[a] = _NONE
-    model.actuator_gainprm[a, 0] = 0.0
-    model.actuator_biasprm[a, :3] = 0.0
-    dof = _dof(model, a)
-    model.dof_frictionloss[dof] = law.friction[0] + (effort if np.isfinite(effort) else UNLIMITED)
-    model.dof_solref[dof] = (HOLD_TIME_CONSTANTS * model.opt.timestep, 1.0)
-    model.dof_solimp[dof] = HOLD_SOLIMP
+    speed_holds.hold(model, a, law.friction[0], effort)
 
 
 def _dof(model: mujoco.MjModel, a: int) -> int:

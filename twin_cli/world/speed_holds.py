@@ -46,10 +46,16 @@ def is_hold(mode: str, target: float) -> bool:
 
 def write(model: mujoco.MjModel, a: int, effort: float) -> None:
     """Makes the joint of motor `a` hold at speed 0 with `effort` [N m or N] on top of its own
-    friction; the motor itself pushes nothing (gain and bias 0)."""
+    friction (kept in its `dynprm`); the motor itself pushes nothing (gain and bias 0)."""
+    hold(model, a, float(model.actuator_dynprm[a, OWN_LOSS]), effort)
+
+
+def hold(model: mujoco.MjModel, a: int, own_loss: float, effort: float) -> None:
+    """The hold of actuator `a`'s joint: its dry friction `own_loss` plus `effort` [N m or N],
+    at the stiffest impedance, the actuator's gain and bias 0."""
     dof = _dof(model, a)
     bound = effort if math.isfinite(effort) else UNLIMITED
-    model.dof_frictionloss[dof] = model.actuator_dynprm[a, OWN_LOSS] + bound
+    model.dof_frictionloss[dof] = own_loss + bound
     model.dof_solref[dof] = (HOLD_TIME_CONSTANTS * model.opt.timestep, 1.0)
     model.dof_solimp[dof] = HOLD_SOLIMP
     model.actuator_gainprm[a, 0] = 0.0
