@@ -218,7 +218,8 @@ def start_commands(state: WorldState, names: Iterable[str]) -> None:
             if law is None:
                 continue
             j = int(model.actuator_trnid[a, 0])
-            limits = joint_control.limits_of(model, name, key.removeprefix(f"{name}/"))
+            joint = model.joint(j).name.removeprefix(f"{name}/")
+            limits = joint_control.limits_of(model, name, joint)
             value = native_servos.start_value(model, data, int(a), law)
             effort = control.effort_limit(model, int(a))
             _set_native(state, (key, int(a), j, value, effort, limits), law, None)
