@@ -100,7 +100,9 @@ def load(path: str | os.PathLike) -> World:
     world = _new_world(path, doc)
     entities = [_respawn(path, world, item.model_dump()) for item in doc.entities]
     layout, state = _servo_references(world, dict(doc.layout), np.array(doc.state, dtype=float))
-    layout, state = _own_servos(world, layout, state)
+    laws = _laws(world)
+    layout, state = _own_servos(world, laws, layout, state)
+    saved = [JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands]
     snapshot = WorldSnapshot(
         doc.name,
         world.settings,
@@ -108,11 +110,7 @@ def load(path: str | os.PathLike) -> World:
         doc.iterations,
         doc.divergences,
         tuple(entities),
-        _natives(
-            world,
-            [JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands],
-            state,
-        ),
+        _natives(world, laws, saved, state),
         tuple(Push(p.body, tuple(p.wrench), p.end_step) for p in doc.pushes),
         layout,
         state,
@@ -123,15 +121,29 @@ def load(path: str | os.PathLike) -> World:
         raise WorldFileError(
             path, str(exc), "restore the robot files as they were when saved, or spawn afresh"
         ) from exc
+    _write_targets(world, snapshot.commands, {c.actuator for c in saved if c.native})
     return world
 
 
-def _exported_positions(model) -> list[int]:
-    """Actuators that are a description's exported position servos (`native_servos`): before
-    a World ran them by ctrl they were torque motors with a servo reference each."""
+def _write_targets(world: World, commands: tuple, native: set[str]) -> None:
+    """Commands made a servo's own on loading (`_natives`) write their targets as ctrl: the
+    state saved with them holds the ctrl of the torque motors they were (0)."""
+    for cmd in commands:
+        if cmd.native and cmd.actuator not in native:
+            entity, joint = cmd.actuator.split("/", 1)
+            world.command(entity, joint, mode=cmd.mode, value=cmd.target)
+
+
+def _laws(world: World) -> dict:
+    """The servo laws of the respawned world's model (`native_servos.capture`)."""
     from twin_cli.world import native_servos
 
-    laws = native_servos.capture(model)
+    return native_servos.capture(world.model)
+
+
+def _exported_positions(model, laws: dict) -> list[int]:
+    """Actuators that are a description's exported position servos (`native_servos`): before
+    a World ran them by ctrl they were torque motors with a servo reference each."""
     return [
         a
         for a in range(model.nu)
@@ -152,13 +164,13 @@ def _exported(model, a: int) -> bool:
 
 
 def _own_servos(
-    world: World, layout: dict[str, int], state: np.ndarray
+    world: World, laws: dict, layout: dict[str, int], state: np.ndarray
 ) -> tuple[dict[str, int], np.ndarray]:
     """A file saved when a description's tagged position joints were torque motors with a
     servo reference (one activation each) loads into their own servos (none): those
     activations are dropped from the state. Other files pass unchanged."""
     model = world.model
-    gone = _exported_positions(model)
+    gone = _exported_positions(model, laws)
     rest = {k: v for k, v in layout.items() if k != "na"}
     fits = rest == {k: int(getattr(model, k)) for k in rest}
     if not gone or not fits or layout.get("na") != model.na + len(gone):
@@ -173,7 +185,7 @@ def _own_servos(
     return {**layout, "na": int(model.na)}, np.delete(state, [at + s for s in slots])
 
 
-def _natives(world: World, commands: list[JointCommand], state: np.ndarray) -> tuple:
+def _natives(world: World, laws: dict, commands: list[JointCommand], state: np.ndarray) -> tuple:
     """Saved commands in the mode of a joint's own servo, as commands of that servo; a servo
     the file has no command for holds its joint where it was saved, as from load (a file
     saved when such joints were limp motors would otherwise have them pulled to ctrl 0)."""
@@ -183,7 +195,6 @@ def _natives(world: World, commands: list[JointCommand], state: np.ndarray) -> t
     from twin_cli.world.actuation import effort_limit
 
     model = world.model
-    laws = native_servos.capture(model)
     out = {}
     for cmd in commands:
         law = laws.get(cmd.actuator)
