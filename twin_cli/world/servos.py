@@ -169,11 +169,9 @@ def start(
     """Sets the reference of a new command `cmd` (`kind` of the command before, "" for none).
 
     A servo continuing in its mode keeps its reference: a velocity change keeps the load it
-    learnt, a new position target ramps on from where the last ramp was. A new position servo
-    starts its ramp at the joint's position. A velocity servo that takes over from a position
-    servo starts with its integral carrying the force that servo applied (bumpless transfer):
-    it holds an arm's weight from its first step instead of letting the arm sag until its
-    integral has learnt the load again. (An effort command's force is a command, not a load.)
+    learnt, a new position target ramps on from where the last ramp was. A servo new to its
+    mode starts its reference at the joint's position, as an `intvelocity` whose activation is
+    set to it: the load a position servo held before is left for the integral to take up.
 
     A velocity change then steps the reference back by `lead` [rad or m]: the lag the damping
     builds while it brings the joint to its new speed, I_c·Δv/kv. An integral that stored that
@@ -186,14 +184,7 @@ def start(
         data.act[address] -= lead
         return
     joint = int(model.actuator_trnid[a, 0])
-    reference = float(data.qpos[model.jnt_qposadr[joint]])
-    if cmd.mode == "velocity" and previous == "position" and cmd.kp > 0:
-        gear = abs(model.actuator_gear[a][0]) or 1.0
-        carried = float(data.actuator_force[a]) * gear
-        if math.isfinite(cmd.effort):
-            carried = min(max(carried, -cmd.effort), cmd.effort)
-        reference += carried / cmd.kp
-    data.act[address] = reference - lead
+    data.act[address] = float(data.qpos[model.jnt_qposadr[joint]]) - lead
 
 
 def kind(cmd: JointCommand) -> str:
