@@ -39,15 +39,18 @@ def _gazebo(reference: str, **tags: object) -> str:
     return f'<gazebo reference="{reference}">{body}</gazebo>' if body else ""
 
 
-def ball_on_plane(mass: float, kp: float | None = None, kd: float | None = None) -> str:
-    """A free ball (radius 0.1 m, `mass` [kg]) with Gazebo kp [N/m] and kd [N s/m] on 'ball'."""
+def ball_on_plane(
+    mass: float, kp: float | None = None, kd: float | None = None, mu: float | None = None
+) -> str:
+    """A free ball (radius 0.1 m, `mass` [kg]) with Gazebo kp [N/m], kd [N s/m] and mu1 = mu2 =
+    `mu` on 'ball'."""
     return f"""<robot name="ball">
   <link name="ball">
     {_sphere_inertial(mass, 0.1)}
     <collision><geometry><sphere radius="0.1"/></geometry></collision>
     <visual><geometry><sphere radius="0.1"/></geometry></visual>
   </link>
-  {_gazebo("ball", kp=kp, kd=kd)}
+  {_gazebo("ball", kp=kp, kd=kd, mu1=mu, mu2=mu)}
 </robot>"""
 
 

@@ -114,15 +114,22 @@ def _apply_surface(
         geom.condim = 1
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
-    softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))
+    softness = contact_softness(
+        surface.kp, surface.kd, masses.of(origin.body), mu=mu, condim=int(geom.condim)
+    )
     geom.solref = np.array(softness.solref)
     geom.solimp = np.array(softness.solimp)
     if surface.kp is not None or surface.kd is not None:
-        _report_softness(origin, surface, softness, masses.of(origin.body), report)
+        _report_softness(origin, surface, softness, masses.of(origin.body), mu, report)
 
 
 def _report_softness(
-    origin: GeomOrigin, surface: Surface, softness: ContactSoftness, mass: float, report: Report
+    origin: GeomOrigin,
+    surface: Surface,
+    softness: ContactSoftness,
+    mass: float,
+    geom_mu: float,
+    report: Report,
 ) -> None:
     subject = f"link '{origin.link}' geom '{origin.geom}'"
     figures = (
@@ -130,7 +137,15 @@ def _report_softness(
         f"solref={softness.solref[0]:.6g} {softness.solref[1]:.6g}; rest sinkage "
         f"{softness.sinkage * 1e3:.4g} mm (Gazebo {softness.sinkage_gazebo * 1e3:.4g} mm)"
     )
-    if softness.clamped:
+    if abs(softness.pyramid_softening - 1.0) > 0.01:
+        report.approximated(
+            subject,
+            figures + f"; at μ {geom_mu:g} MuJoCo's pyramidal friction cone makes the rest "
+            f"sinkage {softness.pyramid_softening:.3g} times the single contact's "
+            "(docs/contacts.md)",
+            tag="kp",
+        )
+    elif softness.clamped:
         report.approximated(
             subject,
             figures + "; stiffer than MuJoCo's rigid contact reproduces: clamped (sinks microns)",

@@ -100,10 +100,10 @@ def test_gazebo_ground_is_named_plane_with_mu_100():
     assert ground.priority[0] == friction_priority(100.0), "ground priority"
 
 
-def _settle_ball(kp: float, kd: float, mass: float, seconds: float = 1.0):
-    soft = contact_softness(kp, kd, mass)
+def _settle_ball(kp: float, kd: float, mass: float, seconds: float = 1.0, mu: float = 1.0):
+    soft = contact_softness(kp, kd, mass, mu=mu)
     spec = _world()
-    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.1, mass, 1.0, soft)
+    _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.1, mass, mu, soft)
     model = spec.compile()
     data = mujoco.MjData(model)
     mujoco.mj_step(model, data, nstep=int(seconds / STEP))
@@ -115,6 +115,18 @@ def test_resting_ball_sinks_mg_over_kp(kp, mass):
     sinkage, _, _, _ = _settle_ball(kp, 2 * math.sqrt(kp * mass), mass)
     expected = mass * G / kp
     assert sinkage == pytest.approx(expected, rel=0.02), f"sinkage {sinkage} m vs m·g/kp"
+
+
+@pytest.mark.parametrize("mu", [0.05, 0.2, 0.7, 1.3, 2.0])
+@pytest.mark.parametrize("kp", [3e3, 1e6])
+def test_resting_ball_sinks_as_mujocos_pyramid_softens_it_and_the_report_says_so(kp, mu):
+    """MuJoCo's pyramidal edges act along the normal as one row of regulariser
+    μ²(1 + μ²)/2 times the single row's: the ball rests there, and the settings report it."""
+    assert _world().option.cone == mujoco.mjtCone.mjCONE_PYRAMIDAL, "the cone twin's worlds use"
+    sinkage, soft, _, _ = _settle_ball(kp, 1.0, 1.5, seconds=3.0, mu=mu)
+    softening = mu**2 * (1 + mu**2) / 2
+    assert sinkage == pytest.approx(softening * 1.5 * G / kp, rel=0.02), f"μ {mu}: {sinkage} m"
+    assert soft.sinkage == pytest.approx(sinkage, rel=0.02), "reported sinkage"
 
 
 def test_resting_box_sinks_a_quarter_on_four_contacts():
