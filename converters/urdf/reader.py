@@ -71,7 +71,7 @@ def parse_urdf(
             "give a URDF file (or a xacro that expands to one)",
         )
     check_numbers(root, source)
-    base_link = check_tree(root, source)
+    base_link, loops = check_tree(root, source)
     check_kinds(root, source)
     # Tag errors first, as Gazebo reads the <gazebo> blocks before any mesh.
     gazebo = parse_gazebo(root, source, as_written=as_written)
@@ -82,7 +82,8 @@ def parse_urdf(
         source=source,
         base_link=base_link,
         links=tuple(reading.link(link) for link in root.findall("link")),
-        joints=tuple(_joint(joint) for joint in root.findall("joint")),
+        joints=tuple(_joint(j) for j in root.findall("joint") if j.get("name", "") not in loops),
+        loop_joints=tuple(_joint(j) for j in root.findall("joint") if j.get("name", "") in loops),
         gazebo=gazebo,
         actuated=_named_joints(root, ("transmission", "ros2_control")),
         text=text,

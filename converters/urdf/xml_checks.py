@@ -84,38 +84,72 @@ def _unique_names(root: ET.Element, tag: str, source: str) -> list[str]:
     return names
 
 
-def check_tree(root: ET.Element, source: str) -> str:
-    """Links and joints form one tree; returns its root link.
+def check_tree(root: ET.Element, source: str) -> tuple[str, tuple[str, ...]]:
+    """Links and joints form one tree, closed chains aside; returns its root link and the
+    joints that close loops.
+
+    As for SDF (`converters.sdf.model`), the first joint into a link is the tree's edge; a later
+    joint into a link that already has a parent, or into an ancestor of its own parent, closes
+    a loop (a four-bar's last bar, a parallel gripper's second link), which MuJoCo closes with
+    equality constraints. urdfdom would keep one of the two joints and drop the other.
 
     Raises:
-        URDFStructureError: duplicate names, unknown parent/child, a link with two parents,
-            a cycle, several roots, or no links.
+        URDFStructureError: duplicate names, unknown parent/child, several roots (a second
+            parent that joins a link to nothing else names both joints), or no links.
     """
     links = _unique_names(root, "link", source)
     _unique_names(root, "joint", source)
     if not links:
         raise URDFStructureError(source, "<robot>", "has no <link>", "add at least one link")
     parent_of: dict[str, str] = {}
+    loops: list[tuple[str, str, str]] = []  # (joint, parent, child)
     for joint in root.findall("joint"):
         parent, child = _joint_links(joint, links, source)
-        if child in parent_of:
+        if child == parent:
             raise URDFStructureError(
                 source,
-                f"link '{child}'",
-                f"is the child of two joints (parents '{parent_of[child]}' and '{parent}')",
-                "a URDF must be a tree: remove one joint",
+                f"joint '{joint.get('name')}'",
+                f"joins link '{child}' to itself",
+                "name two links",
             )
-        parent_of[child] = parent
-    _check_acyclic(parent_of, source)
+        if child in parent_of or _is_ancestor(child, parent, parent_of):
+            loops.append((joint.get("name", ""), parent, child))
+        else:
+            parent_of[child] = parent
     roots = [link for link in links if link not in parent_of]
     if len(roots) != 1:
+        _refuse_loose_loop(loops, parent_of, source)
         raise URDFStructureError(
             source,
             "links " + ", ".join(roots),
             f"the model has {len(roots)} root links (links with no parent joint)",
             "connect them with joints so exactly one root remains",
         )
-    return roots[0]
+    return roots[0], tuple(name for name, _, _ in loops)
+
+
+def _is_ancestor(link: str, of: str, parent_of: dict[str, str]) -> bool:
+    while of in parent_of:
+        of = parent_of[of]
+        if of == link:
+            return True
+    return False
+
+
+def _refuse_loose_loop(
+    loops: list[tuple[str, str, str]], parent_of: dict[str, str], source: str
+) -> None:
+    """A second joint into a link whose parent the tree does not reach leaves two trees, not a
+    loop: the likely slip is a joint with the wrong child, so say which."""
+    for name, parent, child in loops:
+        if child in parent_of:
+            raise URDFStructureError(
+                source,
+                f"link '{child}'",
+                f"is the child of two joints (parents '{parent_of[child]}' and '{parent}'), and "
+                f"joint '{name}' does not close a loop: link '{parent}' is not joined to the rest",
+                f"join link '{parent}' to the robot, or give joint '{name}' another child",
+            )
 
 
 def _joint_links(joint: ET.Element, links: list[str], source: str) -> tuple[str, str]:
@@ -137,23 +171,6 @@ def _joint_links(joint: ET.Element, links: list[str], source: str) -> tuple[str,
             )
         found.append(link)
     return found[0], found[1]
-
-
-def _check_acyclic(parent_of: dict[str, str], source: str) -> None:
-    for start in parent_of:
-        path = [start]
-        link = start
-        while link in parent_of:
-            link = parent_of[link]
-            if link in path:
-                cycle = " → ".join(reversed(path[path.index(link) :] + [link]))  # parent → child
-                raise URDFStructureError(
-                    source,
-                    f"links {cycle}",
-                    "form a cycle",
-                    "a URDF must be a tree: remove one joint of the cycle",
-                )
-            path.append(link)
 
 
 # URDF joint types (and `spherical`, which several parsers accept); anything else is refused.

@@ -196,3 +196,62 @@ def test_fixed_and_ball_loop_joints(tmp_path: Path, kind: str, eq_type: int, mob
     model, data = _settled(_four_bar(tmp_path, closing))
     assert list(model.eq_type) == [eq_type]
     assert _mobility(model, data) == mobility
+
+
+def _urdf_link(name: str) -> str:
+    return (
+        f'<link name="{name}"><inertial><mass value="0.1"/>'
+        '<inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    )
+
+
+def _urdf_joint(name: str, kind: str, parent: str, child: str, x: float, y: float) -> str:
+    return (
+        f'<joint name="{name}" type="{kind}"><origin xyz="{x} {y} 0"/>'
+        f'<parent link="{parent}"/><child link="{child}"/><axis xyz="0 0 1"/></joint>'
+    )
+
+
+def test_urdf_four_bar_closed_by_a_second_parent_follows_freudenstein(tmp_path: Path) -> None:
+    """A URDF closes a loop as users write it for Gazebo: a joint into a link that already has
+    a parent. A URDF joint turns about its child's origin, so the rocker carries a tip link
+    (fixed, at the coupler pin C) that the closing joint takes as its child."""
+    bx, by = A * math.cos(THETA0), A * math.sin(THETA0)
+    cx, cy = _coupler_pin(THETA0)
+    text = (
+        '<robot name="fourbar">'
+        + "".join(_urdf_link(n) for n in ("world", "ground", "crank", "coupler", "rocker", "tip"))
+        + _urdf_joint("anchor", "fixed", "world", "ground", 0, 0)
+        + _urdf_joint("crank_j", "continuous", "ground", "crank", 0, 0)
+        + _urdf_joint("coupler_j", "continuous", "crank", "coupler", bx, by)
+        + _urdf_joint("rocker_j", "continuous", "ground", "rocker", D, 0)
+        + _urdf_joint("tip_j", "fixed", "rocker", "tip", cx - D, cy)
+        + _urdf_joint("close", "continuous", "coupler", "tip", cx - bx, cy - by)
+        + "</robot>"
+    )
+    path = tmp_path / "fourbar.urdf"
+    path.write_text(text)
+    model, data = _settled(path)
+    assert (model.nv, model.neq) == (3, 2)
+    assert _mobility(model, data) == 1
+    phi0 = _rocker_angle(THETA0)
+    for step in range(1, 13):
+        theta = THETA0 + math.radians(30 * step)
+        _hold(model, data, "crank_j", theta - THETA0)
+        measured = phi0 + data.qpos[model.joint("rocker_j").qposadr[0]]
+        error = math.remainder(measured - _rocker_angle(theta), 2 * math.pi)
+        assert abs(error) < TOL_RAD, (math.degrees(theta), measured)
+
+
+def test_urdf_second_parent_that_joins_nothing_else_is_refused_naming_both(tmp_path: Path) -> None:
+    text = (
+        '<robot name="r">'
+        + "".join(_urdf_link(n) for n in "abc")
+        + _urdf_joint("j1", "continuous", "a", "b", 0, 0)
+        + _urdf_joint("j2", "continuous", "c", "b", 0, 0)
+        + "</robot>"
+    )
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    with pytest.raises(ConversionError, match="link 'b'.*two joints.*joint 'j2'"):
+        convert(path)

@@ -49,14 +49,13 @@ BAD_INPUTS = {
         f'<robot name="r">{GOOD_LINK.format(n="a")}{_joint("j", "a", "ghost")}</robot>',
         ["joint 'j'", "'ghost'"],
     ),
-    "cycle": (
+    "self_joint": (
         '<robot name="r">'
-        + "".join(GOOD_LINK.format(n=n) for n in "abc")
+        + "".join(GOOD_LINK.format(n=n) for n in "ab")
         + _joint("j1", "a", "b")
-        + _joint("j2", "b", "c")
-        + _joint("j3", "c", "a")
+        + _joint("j2", "b", "b")
         + "</robot>",
-        ["form a cycle", "c → a → b"],
+        ["joint 'j2'", "link 'b' to itself"],
     ),
     "two_parents": (
         '<robot name="r">'
@@ -64,7 +63,7 @@ BAD_INPUTS = {
         + _joint("j1", "a", "b")
         + _joint("j2", "c", "b")
         + "</robot>",
-        ["link 'b'", "two joints"],
+        ["link 'b'", "two joints", "link 'c' is not joined"],
     ),
     "several_roots": (
         '<robot name="r">' + "".join(GOOD_LINK.format(n=n) for n in "ab") + "</robot>",
