@@ -32,6 +32,23 @@ EntityName = Annotated[
 ]
 
 
+def _absolute(path: str) -> str:
+    """A path the client resolved: the server's working folder is not the user's, so a relative
+    path (`../../etc/passwd`) would land wherever the server happened to start."""
+    if "\x00" in path:
+        raise ValueError("a path cannot hold a NUL character")
+    if not path.startswith("/"):
+        raise ValueError(f"{path!r} is relative: send an absolute path (the twin CLI does)")
+    return path
+
+
+HostPath = Annotated[
+    str,
+    AfterValidator(_absolute),
+    Field(min_length=1, max_length=4096, description="absolute path on the server host"),
+]
+
+
 class Body(BaseModel):
     """Request bodies reject unknown fields, so a typo is an error rather than a no-op."""
 
@@ -168,15 +185,15 @@ class ResetBody(Body):
 
 
 class PathBody(Body):
-    """A file on the server host (absolute, or relative to the server's working directory)."""
+    """A file on the server host, by its absolute path."""
 
-    path: Annotated[str, Field(min_length=1)]
+    path: HostPath
 
 
 class RecordBody(Body):
     """`twin record`: a rosbag2 MCAP file on the server host, sampled in sim time."""
 
-    path: Annotated[str, Field(min_length=1)]
+    path: HostPath
     rate: Annotated[Finite, Field(gt=0, le=1000)] = 100.0
     entities: list[EntityName] = []
     duration: Annotated[Finite, Field(gt=0)] | None = None
@@ -217,7 +234,7 @@ class ViewBody(Body):
 class SnapshotBody(Body):
     """`twin snapshot`: a PNG of the world rendered offscreen, written on the server's host."""
 
-    path: str
+    path: HostPath
     entity: str | None = None
     width: Annotated[int, Field(ge=1, le=4096)] = 640
     height: Annotated[int, Field(ge=1, le=4096)] = 480

@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from converters.errors import ConversionError
+from twin_cli import input_files
 from twin_cli.errors import InvalidRequestError, TwinError, WorldFileError
 from twin_cli.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
@@ -255,7 +256,9 @@ def _read(path: Path) -> SaveDocument:
         WorldFileError: unreadable, not JSON, too deeply nested, or a field that is wrong.
     """
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        data = json.loads(input_files.read_text(path))
+    except input_files.InputFileError as exc:
+        raise WorldFileError(path, str(exc.strerror), "give a file written by `twin save`") from exc
     except OSError as exc:
         raise WorldFileError(path, f"cannot read ({exc.strerror})", "check the path") from exc
     except json.JSONDecodeError as exc:

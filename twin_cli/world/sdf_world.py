@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from twin_cli import input_files
 from twin_cli.world.engine import World
 from twin_cli.world.pose import Pose
 from twin_cli.world.values import WorldSettings
@@ -53,7 +54,7 @@ def world_from_sdf(
     path = Path(path).resolve()
     resolver = PackageResolver.create(path, package_paths)
     try:
-        text = path.read_text()
+        text = input_files.read_text(path)
     except (OSError, UnicodeDecodeError) as exc:
         problem = "no such file" if isinstance(exc, FileNotFoundError) else f"unreadable ({exc})"
         raise InputFileError(str(path), problem, "give the path of an SDF world file") from exc
