@@ -19,6 +19,16 @@ class InputFileError(ConversionError):
         self.path = path
 
 
+class OutputDirError(ConversionError):
+    """The model's output folder cannot be written (read-only, full, a mount point, ...)."""
+
+    def __init__(self, path: str, problem: str) -> None:
+        super().__init__(
+            f"{path}: cannot write the model there ({problem}); choose another folder with -o"
+        )
+        self.path = path
+
+
 class GazeboTagError(ConversionError):
     """A `<gazebo>` tag (or inline `<surface>` value) that cannot be read."""
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import glob
 import os
 import re
 import shutil
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from converters.errors import OutputDirError
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -133,9 +135,47 @@ def write_model(spec: mujoco.MjSpec, report: Report, out_dir: str | Path) -> Pat
         The path of `<robot>.xml`.
     """
     out = Path(out_dir).resolve()
-    out.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        _remove_abandoned_staging(out)
+        staging = Path(tempfile.mkdtemp(prefix=_staging_prefix(out), dir=out.parent))
+    except OSError as exc:
+        raise OutputDirError(str(out), exc.strerror or str(exc)) from exc
+    try:
+        return _fill_and_replace(spec, report, staging, out)
+    except OSError as exc:
+        raise OutputDirError(str(out), exc.strerror or str(exc)) from exc
+
+
+def _staging_prefix(out: Path) -> str:
+    """`.<out>.<pid>.`: the writing process is in the name, so a later run can tell a folder
+    whose writer was killed from one being written now."""
+    return f".{out.name}.{os.getpid()}."
+
+
+def _remove_abandoned_staging(out: Path) -> None:
+    """Removes staging folders of `out` whose writing process is gone (a killed `twin convert`
+    leaves its half-written model beside the target)."""
+    head = f".{out.name}."
+    for path in out.parent.glob(f"{glob.escape(head)}*"):
+        pid = path.name[len(head) :].split(".", 1)[0]
+        if path.is_dir() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(path, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def _fill_and_replace(spec: mujoco.MjSpec, report: Report, staging: Path, out: Path) -> Path:
+    """Writes the model into `staging` and swaps it into `out`; `staging` is gone after."""
     name = safe_name(spec.modelname or report.robot)
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
         (staging / ASSETS).mkdir()
         robot_file = f"{name}.xml"
@@ -172,8 +212,12 @@ def _replace(staging: Path, out: Path) -> None:
     if not out.exists():
         staging.rename(out)
         return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old.", dir=out.parent))
+    old = Path(tempfile.mkdtemp(prefix=f"{_staging_prefix(out)}old.", dir=out.parent))
     old.rmdir()
     out.rename(old)
-    staging.rename(out)
+    try:
+        staging.rename(out)
+    except OSError:
+        old.rename(out)  # the previous model stays where it was
+        raise
     shutil.rmtree(old, ignore_errors=True)
