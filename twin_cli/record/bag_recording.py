@@ -204,7 +204,9 @@ class BagRecording(Follows):
         if world.model is not self._model:  # a spawn or delete: new layout, maybe new sensors
             self._watch_sensors()
             self._send_layout()
-        if not self._writer.put(world.data):
+        # The ring notices a dead encoder only once it is full, minutes later for a small
+        # robot; its exit (a full disk) is noticed at the next sample instead.
+        if not self._alive() or not self._writer.put(world.data):
             self._error = "the encoder process ended; the recording stopped"
             self._finish_sampling()
             return

@@ -16,7 +16,7 @@ import typer
 from twin_cli.cli.options import JsonOpt, WorldOpt
 from twin_cli.cli.output import Output
 
-POLL_S = 0.2  # [s] how often `twin record --duration` asks whether the recording ended
+POLL_S = 0.2  # [s] how often `twin record` asks whether the recording ended
 
 
 def record(
@@ -49,32 +49,38 @@ def record(
         client.request("POST", "/record", body=body)
         sys.stderr.write(f"twin: recording to {body['path']}; Ctrl-C stops\n")
         try:
-            _wait(client, duration)
+            _wait(client)
         except KeyboardInterrupt:
             pass
         status = client.request("DELETE", "/record")
     _report(status, json)
 
 
-def _wait(client: Any, duration: float | None) -> None:
-    """Until the server says the duration is over (forever without one)."""
+def _wait(client: Any) -> None:
+    """Until the server's recording ends: its duration is over, or it stopped early (a full
+    disk), which without a duration would otherwise go unnoticed until Ctrl-C."""
     while True:
         time.sleep(POLL_S)
-        if duration is not None and not client.request("GET", "/record")["active"]:
+        if not client.request("GET", "/record")["active"]:
             return
 
 
 def _report(status: dict, json: bool) -> None:
+    """The summary; a recording cut short (a full disk) also says why on stderr and exits 2,
+    so a script does not take a partial bag for a whole one."""
     out = Output(json)
     if json:
         out.data(status)
-        return
+    else:
+        span = (
+            ""
+            if status["start"] is None
+            else (f", sim time {status['start']:.3f}-{status['end']:.3f} s")
+        )
+        out.line(f"{status['path']}: {status['samples']} samples{span}")
     if status.get("error"):
-        sys.stderr.write(f"twin: recording stopped early: {status['error']}\n")
-    span = (
-        "" if status["start"] is None else f", sim time {status['start']:.3f}-{status['end']:.3f} s"
-    )
-    out.line(f"{status['path']}: {status['samples']} samples{span}")
+        sys.stderr.write(f"twin: {status['path']}: recording stopped early: {status['error']}\n")
+        raise typer.Exit(code=2)
 
 
 def foxglove(
