@@ -13,8 +13,9 @@ from typing import Annotated, Literal
 from fastapi import APIRouter
 from pydantic import BaseModel, Field
 
+from twin_cli.physical_ranges import CommandValue
 from twin_cli.server.holder import WorldDep
-from twin_cli.server.models import Body, Finite
+from twin_cli.server.models import Body
 
 router = APIRouter()
 
@@ -23,16 +24,16 @@ class CommandsBody(Body):
     """Targets by joint name, in one mode; refused as a whole if any is outside its limits."""
 
     mode: Literal["position", "velocity", "effort"] = "position"
-    targets: dict[str, Finite]
+    targets: dict[str, CommandValue]
 
 
 class PointBody(Body):
     """One trajectory_msgs/JointTrajectoryPoint; time_from_start in seconds."""
 
-    positions: list[Finite]
-    velocities: list[Finite] | None = None
-    accelerations: list[Finite] | None = None
-    time_from_start: Finite | None = None
+    positions: list[CommandValue]
+    velocities: list[CommandValue] | None = None
+    accelerations: list[CommandValue] | None = None
+    time_from_start: Annotated[float, Field(ge=0.0, le=1e7, allow_inf_nan=False)] | None = None
 
 
 class TrajectoryBody(Body):
@@ -108,11 +109,13 @@ class DriveRequest(BaseModel):
     """geometry_msgs/Twist's speeds (or a steered base's angle or curvature), held for
     `duration` [s] of sim time."""
 
-    linear: float = Field(0.0, description="forward speed [m/s] (Twist linear.x)")
-    angular: float = Field(0.0, description="yaw rate [rad/s] (Twist angular.z)")
-    lateral: float = Field(0.0, description="sideways speed [m/s] (holonomic bases)")
-    steering: float | None = Field(None, description="bicycle steering angle [rad] (steered)")
-    curvature: float | None = Field(None, description="path curvature [1/m] (steered bases)")
+    linear: CommandValue = Field(0.0, description="forward speed [m/s] (Twist linear.x)")
+    angular: CommandValue = Field(0.0, description="yaw rate [rad/s] (Twist angular.z)")
+    lateral: CommandValue = Field(0.0, description="sideways speed [m/s] (holonomic bases)")
+    steering: CommandValue | None = Field(
+        None, description="bicycle steering angle [rad] (steered)"
+    )
+    curvature: CommandValue | None = Field(None, description="path curvature [1/m] (steered bases)")
     duration: float | None = Field(
         None, description="sim seconds before the wheels stop (default: until replaced)"
     )

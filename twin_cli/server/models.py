@@ -11,11 +11,20 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from twin_cli.names import name_message, name_problem
+from twin_cli.physical_ranges import (
+    Acceleration,
+    Angle,
+    CommandValue,
+    Force,
+    Iterations,
+    Position,
+    Rate,
+    Timestep,
+)
 from twin_cli.server.body_limit import MAX_BODY_BYTES
 from twin_cli.spawn_request import SpawnRequest
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
-Vector = tuple[Finite, Finite, Finite]
 
 
 def _entity_name(name: str) -> str:
@@ -59,13 +68,13 @@ class PoseBody(Body):
     """A pose: position [m] and extrinsic roll-pitch-yaw [rad] (Gazebo's -x..-Y), or instead of
     roll-pitch-yaw a quaternion `quat` (x, y, z, w) as geometry_msgs/Pose and SpawnEntity give."""
 
-    x: Finite = 0.0
-    y: Finite = 0.0
-    z: Finite = 0.0
-    roll: Finite = 0.0
-    pitch: Finite = 0.0
-    yaw: Finite = 0.0
-    quat: tuple[Finite, Finite, Finite, Finite] | None = Field(
+    x: Position = 0.0
+    y: Position = 0.0
+    z: Position = 0.0
+    roll: Angle = 0.0
+    pitch: Angle = 0.0
+    yaw: Angle = 0.0
+    quat: tuple[Position, Position, Position, Position] | None = Field(
         default=None, description="orientation (x, y, z, w); replaces roll, pitch, yaw"
     )
 
@@ -98,7 +107,7 @@ class SpawnBody(Body):
     args: dict[str, str] = {}
     package_paths: dict[str, str] = {}
     on_ground: bool = False
-    joints: dict[str, Finite] = Field(
+    joints: dict[str, Position] = Field(
         default={}, description="initial joint positions [rad] or [m] by URDF joint name (-J)"
     )
     env: dict[str, str] | None = Field(
@@ -132,8 +141,8 @@ class SpawnBody(Body):
 class PushBody(Body):
     """A world-frame force [N] and torque [N m] on a link for `duration` seconds of sim time."""
 
-    force: Vector = (0.0, 0.0, 0.0)
-    torque: Vector = (0.0, 0.0, 0.0)
+    force: tuple[Force, Force, Force] = (0.0, 0.0, 0.0)
+    torque: tuple[Force, Force, Force] = (0.0, 0.0, 0.0)
     link: str | None = None
     duration: Annotated[float, Field(gt=0.0, le=3600.0, description="[s] of sim time")] = 0.1
 
@@ -143,14 +152,14 @@ class CommandBody(Body):
 
     joint: str
     mode: Literal["position", "velocity", "effort"]
-    value: Finite
+    value: CommandValue
 
 
 class GravityBody(Body):
     """Gravity from a named preset or an explicit vector [m/s^2], exactly one of them."""
 
     preset: Literal["earth", "moon", "mars", "zero"] | None = None
-    vector: Vector | None = None
+    vector: tuple[Acceleration, Acceleration, Acceleration] | None = None
 
     @model_validator(mode="after")
     def _exactly_one(self) -> GravityBody:
@@ -162,9 +171,9 @@ class GravityBody(Body):
 class PhysicsBody(Body):
     """Physics settings to change; fields left out keep their value."""
 
-    timestep: Annotated[float, Field(ge=1e-6, le=0.1, description="[s]")] | None = None
-    rate: Annotated[float, Field(ge=0.0, le=1e7, description="[Hz]; 0 = unthrottled")] | None = None
-    iterations: Annotated[int, Field(ge=1, le=100_000)] | None = None
+    timestep: Timestep | None = None
+    rate: Rate | None = Field(default=None, description="[Hz]; 0 = unthrottled")
+    iterations: Iterations | None = None
     solver: str | None = None
     integrator: str | None = None
     threads: Annotated[int, Field(ge=1, le=64, description="engine threads")] | None = None

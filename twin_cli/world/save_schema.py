@@ -1,9 +1,10 @@
 """The save file's schema: what `twin load` accepts, checked before any of it reaches a world.
 
 A save file is input like any other: it may be truncated, edited or hostile. Every field is
-checked for its type, every number for being finite (limits may be infinite, never NaN), and
-counters for their range, so a bad file gets one message with the path of the bad field and the
-world it would replace stays as it was.
+checked for its type, every number for being finite (limits may be infinite, never NaN) and
+within its physical range (`twin_cli.physical_ranges`), and counters for their range, so a bad
+file gets one message with the path of the bad field and the world it would replace stays as
+it was.
 """
 
 from __future__ import annotations
@@ -15,6 +16,18 @@ import numpy as np
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 
 from twin_cli.names import name_message, name_problem
+from twin_cli.physical_ranges import (
+    MAX_VALUE,
+    Acceleration,
+    Angle,
+    CommandValue,
+    Force,
+    Gain,
+    Iterations,
+    Position,
+    Rate,
+    Timestep,
+)
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Count = Annotated[int, Field(ge=0, le=2**53)]  # exactly representable in a JSON double
@@ -34,6 +47,8 @@ def _finite_array(value: Any) -> Any:
         raise ValueError("not an array of numbers") from exc
     if not np.all(np.isfinite(array)):
         raise ValueError("holds NaN or infinity")
+    if array.size and float(np.max(np.abs(array))) > MAX_VALUE:
+        raise ValueError(f"holds a value beyond ±{MAX_VALUE:g}, which MuJoCo treats as bad")
     return value
 
 
@@ -61,12 +76,12 @@ class Strict(BaseModel):
 
 
 class SavedPose(Strict):
-    x: Finite
-    y: Finite
-    z: Finite
-    roll: Finite
-    pitch: Finite
-    yaw: Finite
+    x: Position
+    y: Position
+    z: Position
+    roll: Angle
+    pitch: Angle
+    yaw: Angle
 
 
 class SavedEntity(Strict):
@@ -77,7 +92,7 @@ class SavedEntity(Strict):
     args: dict[str, str] = {}
     package_paths: dict[str, str] = {}
     env: dict[str, str] | None = None
-    joints: dict[str, Finite] = {}
+    joints: dict[str, Position] = {}
     on_ground: bool = False
     repair_inertia: bool = False
     drop_dangling: bool = False
@@ -93,12 +108,12 @@ load forward themselves (now MuJoCo's gravity compensation): read, then left out
 class SavedCommand(Strict):
     actuator: str
     mode: Literal["position", "velocity", "effort"]
-    target: Finite
-    kp: Finite
-    kv: Finite
+    target: CommandValue
+    kp: Gain
+    kv: Gain
     effort: Limit
     velocity_limit: Limit = math.inf
-    feedforward: Finite = 0.0
+    feedforward: Force = 0.0
     rule: str = ""
     native: bool = False
     hold: Finite = 0.0  # OBSOLETE_COMMAND_FIELDS
@@ -107,15 +122,15 @@ class SavedCommand(Strict):
 
 class SavedPush(Strict):
     body: str
-    wrench: Annotated[list[Finite], Field(min_length=6, max_length=6)]
+    wrench: Annotated[list[Force], Field(min_length=6, max_length=6)]
     end_step: Count
 
 
 class SavedSettings(Strict):
-    timestep: Finite
-    rate: Finite
-    gravity: Annotated[list[Finite], Field(min_length=3, max_length=3)]
-    iterations: Count
+    timestep: Timestep
+    rate: Rate
+    gravity: Annotated[list[Acceleration], Field(min_length=3, max_length=3)]
+    iterations: Iterations
     ground: bool
     solver: str
     integrator: str
