@@ -265,9 +265,9 @@ def stats(*, duration: float | None, plot: bool, world: str, json: bool) -> None
         return
 
 
-def save(*, file: Path, world: str) -> None:
+def save(*, file: Path, world: str, force: bool = False) -> None:
     with connect_world(world) as c:
-        c.save(file)
+        c.save(file, force=force)
 
 
 def load(*, file: Path | None, world: str, last: bool = False) -> None:

@@ -250,7 +250,11 @@ COMMANDS: dict[str, Command] = {
     "save": Command(
         "save",
         "Save the world (entities, state, physics) to a file `twin load` reads.",
-        (Arg("file", "Where to write the world.", Path), WORLD),
+        (
+            Arg("file", "Where to write the world.", Path),
+            WORLD,
+            flag("--force", dest="force", help="Replace FILE even if twin did not write it."),
+        ),
     ),
     "load": Command(
         "load",

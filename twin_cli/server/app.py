@@ -33,6 +33,7 @@ from twin_cli.server.models import (
     PoseBody,
     PushBody,
     ResetBody,
+    SaveBody,
     SpawnBatchBody,
     SpawnBody,
     StepBody,
@@ -218,10 +219,10 @@ def reset(body: ResetBody, world: WorldDep) -> dict:
 
 
 @router.post("/save")
-def save(body: PathBody, world: WorldDep) -> dict:
+def save(body: SaveBody, world: WorldDep) -> dict:
     from twin_cli.world import savefile
 
-    savefile.save(world, body.path)
+    savefile.save(world, body.path, force=body.force)
     return {"saved": body.path}
 
 

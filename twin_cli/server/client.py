@@ -332,8 +332,9 @@ class Client:
     def reset(self, *, time_only: bool = False) -> dict:
         return self.request("POST", "/reset", body={"time_only": time_only})
 
-    def save(self, path: str | os.PathLike) -> dict:
-        return self.request("POST", "/save", body={"path": str(Path(path).absolute())})
+    def save(self, path: str | os.PathLike, *, force: bool = False) -> dict:
+        body = {"path": str(Path(path).absolute()), "force": force}
+        return self.request("POST", "/save", body=body)
 
     def load(self, path: str | os.PathLike) -> dict:
         body = {"path": str(Path(path).absolute())}

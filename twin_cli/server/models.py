@@ -199,6 +199,12 @@ class PathBody(Body):
     path: HostPath
 
 
+class SaveBody(PathBody):
+    """`twin save`: the file; an existing file that is not a twin save needs `force`."""
+
+    force: bool = False
+
+
 class RecordBody(Body):
     """`twin record`: a rosbag2 MCAP file on the server host, sampled in sim time."""
 
@@ -244,6 +250,7 @@ class SnapshotBody(Body):
     """`twin snapshot`: a PNG of the world rendered offscreen, written on the server's host."""
 
     path: HostPath
+    force: bool = False  # replace an existing file that is not a PNG twin wrote
     entity: str | None = None
     width: Annotated[int, Field(ge=1, le=4096)] = 640
     height: Annotated[int, Field(ge=1, le=4096)] = 480

@@ -76,12 +76,13 @@ def snapshot(body: SnapshotBody, world: WorldDep) -> dict:
     """Render the world offscreen into a PNG at `path` (atomically); reply with the camera."""
     from twin_cli.errors import RequestError
     from twin_cli.output_files import OutputFileError, checked_target, write_atomically
-    from twin_cli.view.offscreen import snapshot_png
+    from twin_cli.view.offscreen import is_twin_png, snapshot_png
 
     try:
-        checked_target(body.path)  # before rendering: a bad target costs no frame
+        # before rendering: a bad target costs no frame
+        checked_target(body.path, ours=is_twin_png, force=body.force)
         png, camera = snapshot_png(world, entity=body.entity, width=body.width, height=body.height)
-        write_atomically(body.path, png, mode=PICTURE_MODE)
+        write_atomically(body.path, png, mode=PICTURE_MODE, ours=is_twin_png, force=body.force)
     except OutputFileError as exc:
         raise RequestError(f"snapshot {exc.filename}", exc.problem, exc.fix) from exc
     return {"path": body.path, "bytes": len(png), "camera": camera}

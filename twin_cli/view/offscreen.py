@@ -124,13 +124,24 @@ def render(
             r.close()
 
 
+PNG_SOFTWARE = "twin"
+"""The PNG's `Software` text chunk: how a later snapshot to the same path knows the file is
+twin's to replace (`is_twin_png`)."""
+
+
 def png_bytes(pixels: np.ndarray) -> bytes:
     """PNG encoding of an RGB array (matplotlib's writer: already a dependency)."""
     from matplotlib import image
 
     buffer = io.BytesIO()
-    image.imsave(buffer, pixels, format="png")
+    image.imsave(buffer, pixels, format="png", metadata={"Software": PNG_SOFTWARE})
     return buffer.getvalue()
+
+
+def is_twin_png(head: bytes) -> bool:
+    """Whether a file's first bytes are a PNG that twin wrote (its `Software` chunk, which the
+    writer puts before the pixels)."""
+    return head.startswith(b"\x89PNG\r\n\x1a\n") and b"Software\x00" + PNG_SOFTWARE.encode() in head
 
 
 def entity_view(

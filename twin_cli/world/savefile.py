@@ -35,12 +35,13 @@ VERSION = 1
 SAVED_BY_TWIN = "give a file written by `twin save`"
 
 
-def save(world: World, path: str | os.PathLike) -> None:
-    """Writes `world`'s snapshot to `path` atomically.
+def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
+    """Writes `world`'s snapshot to `path` atomically; an existing file that is not a twin save
+    is replaced only with `force`.
 
     Raises:
-        WorldFileError: an entity spawned from an MjSpec cannot be written as MJCF, or the
-            folder is not writable.
+        WorldFileError: an entity spawned from an MjSpec cannot be written as MJCF, the folder
+            is not writable, or the file is someone else's.
     """
     snap = world.snapshot()
     document = {
@@ -57,7 +58,7 @@ def save(world: World, path: str | os.PathLike) -> None:
         "layout": snap.layout,
         "state": snap.state.tolist(),
     }
-    _write_atomically(Path(path), json.dumps(document))
+    _write_atomically(Path(path), json.dumps(document), force)
 
 
 def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
@@ -78,10 +79,16 @@ def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:
     }
 
 
-def _write_atomically(path: Path, text: str) -> None:
+def is_save(head: bytes) -> bool:
+    """Whether a file's first bytes are those of a twin save (`json.dumps` writes "format"
+    first)."""
+    return head.startswith(b'{"format": "' + FORMAT.encode() + b'"')
+
+
+def _write_atomically(path: Path, text: str, force: bool) -> None:
     """Atomically, to a regular file only, 0600 (`twin_cli.output_files`)."""
     try:
-        write_atomically(path, text.encode("utf-8"))
+        write_atomically(path, text.encode("utf-8"), ours=is_save, force=force)
     except OutputFileError as exc:
         raise WorldFileError(exc.filename, exc.problem, exc.fix) from exc
     except OSError as exc:

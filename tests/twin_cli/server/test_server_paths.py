@@ -8,6 +8,7 @@ naming the file, the API answers 422 for a relative path, and the world is uncha
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -108,3 +109,58 @@ def test_load_in_process_names_a_device(tmp_path):
 
     with pytest.raises(WorldFileError, match="not a regular file \\(a character device\\)"):
         savefile.load("/dev/zero")
+
+
+def test_save_replaces_a_twin_save_and_an_empty_file_but_not_someone_elses(server, tmp_path):
+    client, _ = server
+    theirs = tmp_path / "notes.txt"
+    theirs.write_text("my notes")
+    refused = _twin_in(client, tmp_path, "save", "notes.txt")
+    assert refused.returncode == 2, refused.stderr
+    assert "notes.txt: exists and is not a file twin wrote" in refused.stderr, refused.stderr
+    assert "--force" in refused.stderr and theirs.read_text() == "my notes"
+    assert _twin_in(client, tmp_path, "save", "notes.txt", "--force").returncode == 0
+    assert json.loads(theirs.read_text())["format"] == "twin-world"
+    assert _twin_in(client, tmp_path, "save", "notes.txt").returncode == 0, "a save over a save"
+    (tmp_path / "empty.json").write_text("")
+    assert _twin_in(client, tmp_path, "save", "empty.json").returncode == 0, "nothing to lose"
+
+
+def test_a_snapshot_does_not_replace_someone_elses_picture(server, tmp_path):
+    client, _ = server
+    theirs = tmp_path / "holiday.png"
+    theirs.write_bytes(_png_without_software())
+    reply = client._http.request("POST", "/snapshot", json={"path": str(theirs)})
+    assert reply.status_code == 400 and "not a file twin wrote" in reply.text, reply.text
+    assert theirs.read_bytes() == _png_without_software()
+
+
+def test_twins_pictures_say_who_wrote_them():
+    import numpy as np
+
+    from twin_cli.view.offscreen import is_twin_png, png_bytes
+
+    assert is_twin_png(png_bytes(np.zeros((8, 8, 3), dtype=np.uint8))[:4096])
+    assert not is_twin_png(_png_without_software())
+
+
+def _png_without_software() -> bytes:
+    import io
+
+    import numpy as np
+    from matplotlib import image
+
+    buffer = io.BytesIO()
+    image.imsave(buffer, np.ones((8, 8, 3)), format="png", metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def _twin_in(client: Client, folder: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "twin_cli.cli.app", *args, "--world", WORLD],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "TWIN_RUNTIME_DIR": str(client.paths.directory)},
+        cwd=folder,
+        timeout=60,
+    )

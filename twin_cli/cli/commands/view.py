@@ -90,6 +90,9 @@ def snapshot(
     ] = None,
     width: Annotated[int, typer.Option(help="Width in pixels.")] = 640,
     height: Annotated[int, typer.Option(help="Height in pixels.")] = 480,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace OUT even if twin did not write it.")
+    ] = False,
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
@@ -101,6 +104,7 @@ def snapshot(
         "entity": entity,
         "width": width,
         "height": height,
+        "force": force,
     }
     with connect(world) as client:  # a first render starts GL: wait while the server lives
         reply = client.long_request(
