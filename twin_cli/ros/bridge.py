@@ -41,9 +41,18 @@ class RosBridge:
     """`world`'s topics published in `scope` at `rate` [Hz] of sim time, and its cmd_vel read."""
 
     def __init__(
-        self, world: World, scope: Scope, *, rate: float = RATE, frame_prefix: str | None = None
+        self,
+        world: World,
+        scope: Scope,
+        *,
+        rate: float = RATE,
+        frame_prefix: str | None = None,
+        services: bool = False,
     ) -> None:
-        """Raises: RequestError: Cyclone DDS cannot start in that scope."""
+        """`services`: answer gazebo_ros' entity services, which let any DDS peer in the scope
+        spawn and delete entities (ROS 2 without SROS2 has no access control); off unless asked.
+
+        Raises: RequestError: Cyclone DDS cannot start in that scope."""
         # rosbags' types (the node's announcement), built here rather than by the command
         # thread beside a running loop: the build holds the interpreter for ~0.1 s
         ros_messages.typestore()
@@ -55,7 +64,7 @@ class RosBridge:
                 frame_prefix=frame_prefix,
             )  # fmt: skip
             self.commands = CommandListener(world, self.participant)
-            self.services = ServiceServer(world, self.participant)
+            self.services = ServiceServer(world, self.participant) if services else None
         except BaseException:
             self.participant.close()
             raise
@@ -74,20 +83,23 @@ class RosBridge:
                 "see the server log (`twin logs`)",
             )
         self.commands.start()
-        self.services.start()
+        if self.services is not None:
+            self.services.start()
         return self
 
     def retarget(self, world: World) -> None:
         """Follows the world the server loaded (its entities' topics and drives)."""
         self.recording.retarget(world)
         self.commands.retarget(world)
-        self.services.retarget(world)
+        if self.services is not None:
+            self.services.retarget(world)
 
     def stop(self) -> dict[str, Any]:
         """Stops listening and publishing; both participants leave the graph."""
         status = self.status()
         self.commands.stop()
-        self.services.stop()
+        if self.services is not None:
+            self.services.stop()
         self.recording.stop(patience=STOP_PATIENCE_S)
         self.participant.close()
         return status
@@ -106,8 +118,8 @@ class RosBridge:
             "error": recording.error,
             "inputs": self.commands.topics,
             "commands": self.commands.commands,
-            "services": self.services.names,
-            "service_calls": self.services.calls,
+            "services": [] if self.services is None else self.services.names,
+            "service_calls": 0 if self.services is None else self.services.calls,
         }
 
 
@@ -124,6 +136,7 @@ class RosService:
         *,
         interface: str | None = None,
         environment: dict[str, str] | None = None,
+        services: bool = False,
     ) -> dict[str, Any]:
         """Joins the ROS 2 graph in the scope ROS's variables and `interface` ask (the variables
         of `environment`, the client's, else this process's).
@@ -140,7 +153,7 @@ class RosService:
                     "stop it first with `twin ros stop`",
                 )
             scope = scope_from(environment, interface)
-            self.bridge = RosBridge(world, scope).start()
+            self.bridge = RosBridge(world, scope, services=services).start()
             return self.bridge.status()
 
     def status(self) -> dict[str, Any]:

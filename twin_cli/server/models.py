@@ -228,6 +228,8 @@ class RosBody(Body):
     interface: Annotated[str, Field(min_length=1, max_length=64)] | None = None
     # the client's ROS_DOMAIN_ID and discovery variables (None: the server's own)
     environment: dict[Annotated[str, Field(pattern=r"^ROS_[A-Z_]+$")], str] | None = None
+    # gazebo_ros' /spawn_entity and /delete_entity: any DDS peer in the scope may call them
+    services: bool = False
 
 
 class SpawnBatchBody(SpawnBody):

@@ -41,6 +41,7 @@ class ServeOptions:
         foxglove: a port for a live Foxglove WebSocket stream (127.0.0.1), or None.
         ros: publish on the ROS 2 graph over DDS from the start (`twin_cli.ros`).
         ros_interface: the network interface the ROS 2 participant uses (None: loopback).
+        ros_services: answer gazebo_ros' entity services (spawn, delete) over DDS too.
         autosave: seconds between autosaves to `<world>.autosave.json`; 0 turns it off.
         view: serve MuJoCo's web viewer on 127.0.0.1 from the start.
         package_paths: package or model name → directory for an SDF world's `model://` and
@@ -61,6 +62,7 @@ class ServeOptions:
     package_paths: dict[str, str] | None = None
     ros: bool = False
     ros_interface: str | None = None
+    ros_services: bool = False
 
 
 def parse_tcp(text: str) -> tuple[str, int]:
@@ -302,8 +304,8 @@ def _start_consumers(app: Any, world: Any, opts: ServeOptions) -> Any:
         if opts.foxglove is not None:
             url = consumers.stream(world, port=opts.foxglove)["url"]
             sys.stderr.write(f"twin: Foxglove stream on {url}\n")
-        if opts.ros or opts.ros_interface is not None:
-            _start_ros(app, world, opts.ros_interface)
+        if opts.ros or opts.ros_interface is not None or opts.ros_services:
+            _start_ros(app, world, opts.ros_interface, opts.ros_services)
     except BaseException:
         _close_ros(app)
         consumers.close()
@@ -311,12 +313,20 @@ def _start_consumers(app: Any, world: Any, opts: ServeOptions) -> Any:
     return consumers
 
 
-def _start_ros(app: Any, world: Any, interface: str | None) -> None:
-    """`--ros`: the world on the ROS 2 graph; its scope on stderr."""
+SERVICES_OPEN = (
+    "gazebo_ros' /spawn_entity and /delete_entity answer every DDS peer in this scope (ROS 2 "
+    "has no access control without SROS2)"
+)
+
+
+def _start_ros(app: Any, world: Any, interface: str | None, services: bool) -> None:
+    """`--ros`: the world on the ROS 2 graph; its scope (and open services) on stderr."""
     from twin_cli.server.ros_routes import ros_service
 
-    status = ros_service(app.state).start(world, interface=interface)
+    status = ros_service(app.state).start(world, interface=interface, services=services)
     sys.stderr.write(f"twin: on the ROS 2 graph: {status['scope']}\n")
+    if services:
+        sys.stderr.write(f"twin: {SERVICES_OPEN}\n")
 
 
 def _close_ros(app: Any) -> None:

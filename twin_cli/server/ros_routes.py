@@ -31,7 +31,9 @@ def ros_service(state: Any) -> Any:
 def start_ros(body: RosBody, request: Request, world: WorldDep) -> dict:
     """Publish the world's topics on the ROS 2 graph and take its cmd_vel (`twin ros start`)."""
     service = ros_service(request.app.state)
-    status = service.start(world, interface=body.interface, environment=body.environment)
+    status = service.start(
+        world, interface=body.interface, environment=body.environment, services=body.services
+    )
     log.info("ROS 2 bridge started: %s", status["scope"])
     return status
 

@@ -79,7 +79,7 @@ def served(tmp_path_factory, serve_world):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("ROS_DOMAIN_ID", DOMAIN_ID)
         patch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
-        with serve_world(root, WORLD, "--ros") as (_, proc):
+        with serve_world(root, WORLD, "--ros", "--ros-services") as (_, proc):
             for name, y in (("bot", 0.0), ("twin_bot", 2.0)):
                 _twin(root, "spawn", str(path), "--name", name, "-y", str(y), "--on-ground")
             post = root / "post.urdf"
@@ -360,7 +360,7 @@ def test_a_widened_interface_leaves_the_sockets_unbound_from_loopback_and_still_
         assert _peer(root, "listen", "1", "bot")["messages"]["/clock"], "no /clock (widened)"
     finally:
         _twin(root, "ros", "stop")
-        _twin(root, "ros", "start")
+        _twin(root, "ros", "start", "--services")
     loopback = socket.if_nametoindex("lo")
     wildcard = [s for s in _server_sockets(proc.pid) if s.local[0] == "0.0.0.0"]
     assert wildcard and all(s.device == loopback for s in wildcard), wildcard
@@ -430,8 +430,12 @@ def test_ros_start_and_stop_on_a_running_world_and_their_errors(served) -> None:
     assert "Traceback" not in bad.stderr
     started = json.loads(_twin(root, "ros", "start", "--json"))
     assert started["domain_id"] == int(DOMAIN_ID) and started["local_only"] is True
+    assert started["services"] == [], "entity services are offered only when asked for"
     got = _peer(root, "listen", "1", "bot")
     assert got["messages"]["/clock"], "no /clock after twin ros stop and start"
+    _twin(root, "ros", "stop")
+    opened = json.loads(_twin(root, "ros", "start", "--services", "--json"))
+    assert opened["services"] == ["/spawn_entity", "/delete_entity", "/get_model_list"], opened
 
 
 def test_twin_ros_imports_no_physics_and_no_dds(served) -> None:

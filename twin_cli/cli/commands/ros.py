@@ -34,12 +34,20 @@ def start(
         str | None,
         typer.Option(help="Use this network interface (address or name), not loopback only."),
     ] = None,
+    services: Annotated[
+        bool,
+        typer.Option(
+            "--services",
+            help="Also answer gazebo_ros' /spawn_entity and /delete_entity: every DDS peer in "
+            "the scope may then change the world (ROS 2 has no access control without SROS2).",
+        ),
+    ] = False,
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
-    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel,
-    controller commands and gazebo_ros' entity services in."""
-    body: dict[str, Any] = {"environment": ros_environment()}
+    """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel and
+    controller commands in (gazebo_ros' entity services with --services)."""
+    body: dict[str, Any] = {"environment": ros_environment(), "services": services}
     if interface is not None:
         body["interface"] = interface
     _show(_ask(world, "POST", body), json, "publishing")
@@ -77,7 +85,12 @@ def _show(reply: dict[str, Any], json: bool, verb: str) -> None:
         out.line(f"reading: {', '.join(reply['inputs'])} ({reply['commands']} commands taken)")
     if reply.get("services"):
         calls = reply.get("service_calls", 0)
-        out.line(f"services: {', '.join(reply['services'])} ({calls} calls answered)")
+        out.line(
+            f"services: {', '.join(reply['services'])} ({calls} calls answered; any DDS peer "
+            "in this scope may call them)"
+        )
+    else:
+        out.line("services: none (entity services only with `twin ros start --services`)")
 
 
 def register(parent: typer.Typer) -> None:

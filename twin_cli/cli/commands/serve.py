@@ -61,6 +61,13 @@ def serve(
         str | None,
         typer.Option(help="With --ros: use this interface (address or name), not loopback."),
     ] = None,
+    ros_services: Annotated[
+        bool,
+        typer.Option(
+            "--ros-services",
+            help="With --ros: answer /spawn_entity and /delete_entity (any DDS peer may call).",
+        ),
+    ] = False,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it.
 
@@ -88,6 +95,7 @@ def serve(
         package_paths=packages or None,
         ros=ros,
         ros_interface=ros_interface,
+        ros_services=ros_services,
     )
     run_server(opts)
 
