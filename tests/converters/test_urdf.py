@@ -73,7 +73,7 @@ def test_transmissions_choose_the_actuated_joints(tmp_path: Path) -> None:
             '<robot name="r"><link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
             '<child link="a"/></joint></robot>',
             URDFStructureError,
-            "cycle",
+            "joins link 'a' to itself",
         ),
         (
             '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixed">'
