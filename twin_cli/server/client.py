@@ -23,6 +23,7 @@ from twin_cli.spawn_request import SpawnRequest, as_request, body_key
 
 # Seconds: most requests are a lock and a copy; spawn, delete and load wait in `long_request`.
 DEFAULT_TIMEOUT_S = 10.0
+HEALTH_TIMEOUT_S = 2.0  # [s] one look at /health; a live server is looked at again until it answers
 
 
 def _error_class(name: str) -> type[Exception] | None:
@@ -95,21 +96,39 @@ class Client:
         self.close()
 
     def request(
-        self, method: str, path: str, *, body: Any = None, timeout: float = DEFAULT_TIMEOUT_S
+        self, method: str, path: str, *, body: Any = None, timeout: float | None = None
     ) -> Any:
         """Send one request and return the decoded JSON reply.
 
+        Without `timeout`, a client on the world's socket waits as long as the server process
+        lives (a loaded machine may answer late) and `$TWIN_TIMEOUT` allows
+        (`twin_cli.server.patience`); over TCP, whose server's process cannot be seen, it waits
+        DEFAULT_TIMEOUT_S.
+
         Raises:
-            NotRunningError: no server listens for this world.
-            NoReplyError: no reply within `timeout` seconds; the outcome is unknown (exit 75).
+            NotRunningError: no server listens for this world, or it ended before replying.
+            NoReplyError: no reply within `timeout` or the user's limit [s]; the outcome is
+                unknown (exit 75).
             TwinError | ConversionError: the server's error, as the same class.
         """
+        from twin_cli.server import patience
+
+        waiter = None
+        if timeout is None and self._url is None:
+            waiter = patience.Waiter(self.paths, f"{method} {path}", patience.limit())
+        fixed = timeout if timeout is not None else DEFAULT_TIMEOUT_S
         try:
-            reply = self._http.request(method, path, json=body, timeout=timeout)
+            reply = self._http.request(
+                method, path, json=body, timeout=None if waiter else fixed, patience=waiter
+            )
         except TimeoutError as exc:
-            raise NoReplyError(self.world, f"{method} {path}", timeout) from exc
+            waited = fixed if waiter is None else (waiter.limit_s or 0.0)
+            raise NoReplyError(self.world, f"{method} {path}", waited) from exc
         except NOT_ANSWERING as exc:
             raise NotRunningError(self.world) from exc
+        finally:
+            if waiter is not None:
+                waiter.done()
         return _decoded(reply)
 
     def long_request(
@@ -158,11 +177,13 @@ class Client:
         return _decoded(reply)
 
     def alive(self) -> bool:
-        """True when the server answers `/health` for this world."""
+        """True when the server answers `/health` for this world within HEALTH_TIMEOUT_S (a busy
+        server that answers later is waited for by `connection.connect`)."""
         try:
-            return self.request("GET", "/health", timeout=2.0).get("world") == self.world
-        except (NotRunningError, RequestError):
+            reply = self.request("GET", "/health", timeout=HEALTH_TIMEOUT_S)
+        except (NotRunningError, RequestError, NoReplyError):
             return False
+        return reply.get("world") == self.world
 
     def stream(self, path: str) -> Generator[dict, None, None]:
         """The JSON objects of a streamed reply (`/topics/echo`), one per line, as they come;

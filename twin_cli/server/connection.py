@@ -54,7 +54,7 @@ def connect(
     paths = client.paths
     if not start:
         if runtime.server_alive(paths):
-            runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
+            _await_answer(client)
             return client
         client.close()
         raise NotRunningError(world, lifecycle.not_running_detail(paths))
@@ -71,8 +71,28 @@ def connect(
                 f"twin: started world [{world}] in the background "
                 f"(pid {runtime.read_pid(paths)}); `twin stop` ends it"
             )
-    runtime.wait_until(paths, client.alive, None, runtime.START_TIMEOUT_S)
+    _await_answer(client)
     return client
+
+
+def _await_answer(client: Client) -> None:
+    """Waits until the server answers `/health`, as long as its process lives (it holds its pid
+    lock: busy on a loaded machine, or stopped for a moment) and `$TWIN_TIMEOUT` allows.
+
+    Raises:
+        NotRunningError: the server ended meanwhile.
+        NoReplyError: the user's limit passed (exit 75).
+    """
+    from twin_cli.errors import NoReplyError
+    from twin_cli.server import lifecycle, patience
+
+    limit, start = patience.limit(), time.monotonic()
+    while not client.alive():
+        if not runtime.server_alive(client.paths):
+            raise NotRunningError(client.world, lifecycle.not_running_detail(client.paths))
+        if limit is not None and time.monotonic() - start > limit:
+            raise NoReplyError(client.world, "GET /health", limit)
+        time.sleep(runtime.START_POLL_S)
 
 
 def _stderr(line: str) -> None:

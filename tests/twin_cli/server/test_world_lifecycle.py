@@ -238,3 +238,43 @@ def test_a_snapshot_that_outlives_the_clients_patience_is_unknown_not_bad_input(
     assert shot.returncode == 75, f"exit {shot.returncode}: {shot.stderr}"
     assert "outcome is unknown" in shot.stderr and "Traceback" not in shot.stderr, shot.stderr
     assert busy.wait(timeout=120) == 0, busy.stderr.read()
+
+
+STALL_S = 5.0  # [s] the server is held stopped (SIGSTOP): a busy machine, made certain
+
+
+@pytest.mark.parametrize("command", [("list", "--json"), ("gravity", "--moon")])
+def test_a_client_waits_for_a_server_that_answers_late_and_succeeds(twin, command):
+    """A live server that answers late is waited for, not given up on after a fixed 2 s (exit 75
+    with 'GET /health no reply within 2 s' before); with TWIN_TIMEOUT set, the user's limit
+    decides (exit 75, the outcome unknown)."""
+    twin("spawn", twin.box, "--name", "box", "-z", "1")
+    pid = int((twin.dir / "default.pid").read_text().strip())
+    runs = {}
+    os.kill(pid, signal.SIGSTOP)
+    try:
+        for limit in (None, "1"):
+            env = twin.env if limit is None else {**twin.env, "TWIN_TIMEOUT": limit}
+            runs[limit] = (
+                time.monotonic(),
+                subprocess.Popen(
+                    [sys.executable, "-m", "twin_cli.cli.app", *command],
+                    env=env,
+                    stdout=subprocess.PIPE,
+                    stderr=subprocess.PIPE,
+                    text=True,
+                ),
+            )
+        time.sleep(STALL_S)
+    finally:
+        os.kill(pid, signal.SIGCONT)
+    start, patient = runs[None]
+    out, err = patient.communicate(timeout=60)
+    assert patient.returncode == 0, f"exit {patient.returncode}: {err}"
+    assert time.monotonic() - start >= STALL_S - 0.5, "answered while the server was stopped"
+    if command[0] == "list":
+        assert [e["name"] for e in json.loads(out)] == ["box"]
+    _, impatient = runs["1"]
+    _, err = impatient.communicate(timeout=60)
+    assert impatient.returncode == 75, f"exit {impatient.returncode}: {err}"
+    assert "no reply within 1 s" in err and "Traceback" not in err, err
