@@ -35,11 +35,17 @@ ORIGINS_VARIABLE = "TWIN_FOXGLOVE_ORIGINS"
 SUBPROTOCOL = "foxglove.sdk.v1"  # the one the SDK (0.30) speaks; it refuses clients without it
 
 
+def origin_key(origin: str) -> str:
+    """An origin as compared: lower case, trailing slashes dropped (`file://` → `file:`), the
+    same for the allowed ones and the one a page sends."""
+    return origin.strip().rstrip("/").lower()
+
+
 def allowed_origins() -> frozenset[str]:
-    """Foxglove's web app and the origins the user lists in TWIN_FOXGLOVE_ORIGINS."""
+    """Foxglove's web app, local app pages and the origins listed in TWIN_FOXGLOVE_ORIGINS."""
     extra = os.environ.get(ORIGINS_VARIABLE, "")
-    listed = {o.strip().rstrip("/").lower() for o in extra.split(",") if o.strip()}
-    return frozenset({*ALLOWED_BY_DEFAULT, *listed})
+    listed = [o for o in extra.split(",") if o.strip()]
+    return frozenset(origin_key(o) for o in (*ALLOWED_BY_DEFAULT, *listed))
 
 
 def refusal(guard: ViewGuard, request: Any, origins: frozenset[str]) -> str | None:
@@ -49,7 +55,7 @@ def refusal(guard: ViewGuard, request: Any, origins: frozenset[str]) -> str | No
     if given is None or not guard.host_allowed(given):
         return f"Host {given!r} is not this stream's address ({guard.host}:{guard.port})"
     sent = request.headers.get_all("Origin")
-    if sent and (len(sent) > 1 or sent[0].rstrip("/").lower() not in origins):
+    if sent and (len(sent) > 1 or origin_key(sent[0]) not in origins):
         return (
             f"Origin {sent!r} may not open this stream; allow a page with "
             f"{ORIGINS_VARIABLE}=https://its.origin (Foxglove's web app is allowed)"

@@ -51,10 +51,12 @@ def _handshake(port: int, headers: dict[str, str]) -> str:
     [
         ({}, "open"),
         ({"Origin": "https://app.foxglove.dev"}, "open"),
+        ({"Origin": "file://"}, "open"),
         ({"Origin": "http://attacker.example"}, "403"),
+        ({"Origin": "null"}, "403"),
         ({"Host": "rebound.attacker.example"}, "403"),
     ],
-    ids=["no origin", "foxglove app", "foreign origin", "rebound host"],
+    ids=["no origin", "foxglove app", "local app page", "foreign origin", "opaque", "rebound host"],
 )
 def test_only_this_machines_clients_and_foxglove_open_the_stream(stream, headers, expected):
     with socket.create_connection(("127.0.0.1", stream.port)):
