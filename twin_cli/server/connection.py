@@ -13,11 +13,14 @@ import sys
 import time
 from typing import Any
 
-from twin_cli.errors import NotRunningError
+from twin_cli.errors import NoReplyError, NotRunningError
 from twin_cli.server import runtime
 from twin_cli.server.client import Client
 
 STOP_TIMEOUT_S = 15.0  # [s] for the server to end after each of shutdown, SIGTERM, SIGKILL
+# [s] for the server to take the shutdown request: one that does not (stopped, wedged) gets the
+# signals, so `twin stop` always ends
+SHUTDOWN_ASK_S = 5.0
 
 
 def connect(
@@ -83,7 +86,6 @@ def _await_answer(client: Client) -> None:
         NotRunningError: the server ended meanwhile.
         NoReplyError: the user's limit passed (exit 75).
     """
-    from twin_cli.errors import NoReplyError
     from twin_cli.server import lifecycle, patience
 
     limit, start = patience.limit(), time.monotonic()
@@ -121,17 +123,22 @@ def stop(world: str = runtime.DEFAULT_WORLD, timeout: float = STOP_TIMEOUT_S) ->
             runtime.clean_stale(paths)
             lifecycle.forget(paths)  # reported here: `twin stop` acknowledges a dead server
         raise NotRunningError(world, detail)
+    asked = True
     with Client(world) as client:
         try:
-            client.request("POST", "/shutdown")
+            client.request("POST", "/shutdown", timeout=SHUTDOWN_ASK_S)
         except NotRunningError:
             pass  # socket gone but process alive: fall through to signals
+        except NoReplyError:
+            asked = False  # stopped (Ctrl-Z) or wedged: straight to the signals
     # The server lets go of its pid lock as it shuts down, while a request thread (a render, a
     # conversion) may still be finishing: wait for the process itself to be gone as well.
-    for sig in (None, signal.SIGTERM, signal.SIGKILL):
+    signals = (None, signal.SIGTERM, signal.SIGKILL) if asked else (signal.SIGTERM, signal.SIGKILL)
+    for sig in signals:
         if sig is not None and pid:
             try:
                 os.kill(pid, sig)
+                os.kill(pid, signal.SIGCONT)  # a stopped process takes its signal only running
             except ProcessLookupError:
                 break
         deadline = time.monotonic() + timeout

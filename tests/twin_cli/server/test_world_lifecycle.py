@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -278,3 +279,19 @@ def test_a_client_waits_for_a_server_that_answers_late_and_succeeds(twin, comman
     _, err = impatient.communicate(timeout=60)
     assert impatient.returncode == 75, f"exit {impatient.returncode}: {err}"
     assert "no reply within 1 s" in err and "Traceback" not in err, err
+
+
+def test_twin_stop_ends_a_server_that_does_not_answer(twin):
+    """A stopped (SIGSTOP) server gets the shutdown request, no reply, then the signals: `twin
+    stop` ends it and returns, instead of waiting on the request for ever."""
+    twin("spawn", twin.box, "--name", "box", "-z", "1")
+    pid = int((twin.dir / "default.pid").read_text().strip())
+    os.kill(pid, signal.SIGSTOP)
+    try:
+        stopped = twin("stop", check=False)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGCONT)
+    assert stopped.returncode == 0, stopped.stderr
+    with pytest.raises(ProcessLookupError):
+        os.kill(pid, 0)
