@@ -29,11 +29,12 @@ COMMAND = 1e9
 range by the world."""
 GAIN = 1e12
 """A saved servo's stiffness [N m/rad] or damping [N m s/rad]."""
-TIMESTEP_S = (1e-6, 0.1)
-"""[s] the physics step (the same range `PUT /physics` takes)."""
+TIMESTEP_S = (1e-6, 1.0)
+"""[s] the physics step: under 1 µs the real-time pacer's steps per second overflow (a 5e-324 s
+step divided by zero); over 1 s no contact or joint resolves."""
 RATE_HZ = 1e7
 """[Hz] the real-time pace; 0 is unthrottled."""
-ITERATIONS = 100_000
+ITERATIONS = 1_000_000
 """Solver iterations per step."""
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 from converters.mjcf import world_options as options
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
+from twin_cli import physical_ranges as ranges
 from twin_cli.errors import InvalidRequestError
 from twin_cli.world.scene import SceneSettings
 
@@ -98,31 +99,30 @@ def finite_vector(what: str, values: Iterable[float], size: int) -> list[float]:
     return vector
 
 
-# [s] smallest step accepted: below it the real-time pacer's steps per second overflow (a
-# 5e-324 s step divided by zero; found by the API fuzz), and no robot needs a step under 1 µs.
-MIN_TIMESTEP_S = 1e-6
-
-
 def check_settings(s: WorldSettings) -> None:
-    """Raises InvalidRequestError for a setting MuJoCo cannot run with."""
+    """Raises InvalidRequestError for a setting outside its physical range
+    (`twin_cli.physical_ranges`: the ranges the API and save files take, so a world's own save
+    always loads)."""
+    low, high = ranges.TIMESTEP_S
     problems = [
         (
             "timestep",
             s.timestep,
-            math.isfinite(s.timestep) and s.timestep >= MIN_TIMESTEP_S,
-            f"give a step >= {MIN_TIMESTEP_S:g} s, e.g. 0.001",
+            math.isfinite(s.timestep) and low <= s.timestep <= high,
+            f"give a step of {low:g}-{high:g} s, e.g. 0.001",
         ),
         (
             "rate",
             s.rate,
-            math.isfinite(s.rate) and s.rate >= 0,
-            "give a rate >= 0 Hz (0 = as fast as possible)",
+            s.rate == 0
+            or (math.isfinite(s.rate) and ranges.MIN_RATE_HZ <= s.rate <= ranges.RATE_HZ),
+            f"give 0 (as fast as possible) or {ranges.MIN_RATE_HZ:g}-{ranges.RATE_HZ:g} Hz",
         ),
         (
             "iterations",
             s.iterations,
-            isinstance(s.iterations, int) and s.iterations >= 1,
-            "give a whole number >= 1",
+            isinstance(s.iterations, int) and 1 <= s.iterations <= ranges.ITERATIONS,
+            f"give a whole number of 1-{ranges.ITERATIONS}",
         ),
         ("solver", s.solver, s.solver in SOLVERS, f"use one of {', '.join(SOLVERS)}"),
         (
@@ -135,4 +135,10 @@ def check_settings(s: WorldSettings) -> None:
     for field, value, ok, fix in problems:
         if not ok:
             raise InvalidRequestError(f"physics {field}", f"{value!r} is not valid", fix)
-    finite_vector("gravity", s.gravity, 3)
+    gravity = finite_vector("gravity", s.gravity, 3)
+    if max(abs(g) for g in gravity) > ranges.GRAVITY_M_S2:
+        raise InvalidRequestError(
+            "physics gravity",
+            f"{s.gravity!r} is beyond ±{ranges.GRAVITY_M_S2:g} m/s² on an axis",
+            "give each component within that (Earth's is 9.81)",
+        )

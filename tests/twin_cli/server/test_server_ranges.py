@@ -128,3 +128,25 @@ def test_a_save_with_an_out_of_range_number_is_refused_naming_it(tmp_path: Path,
     field = [key for key in where if isinstance(key, str)][-1]
     with pytest.raises(WorldFileError, match=field):
         savefile.load(tmp_path / "bad.json")
+
+
+def test_a_world_at_the_edge_of_every_range_saves_and_loads_and_past_it_is_refused(tmp_path):
+    """The world checks its settings against the same ranges as the save schema, so a world
+    twin runs always reloads from its own save."""
+    from twin_cli.errors import InvalidRequestError
+    from twin_cli.world import World
+    from twin_cli.world.values import WorldSettings
+
+    edge = WorldSettings(timestep=1.0, rate=1e7, iterations=1_000_000, gravity=(0.0, 0.0, -1e3))
+    savefile.save(World(edge), tmp_path / "edge.json")
+    loaded = savefile.load(tmp_path / "edge.json")
+    assert loaded.settings.timestep == 1.0 and loaded.settings.iterations == 1_000_000
+    for past in (
+        {"timestep": 1.5},
+        {"rate": 2e7},
+        {"rate": 1e-4},
+        {"iterations": 2_000_000},
+        {"gravity": (0.0, 0.0, -2e3)},
+    ):
+        with pytest.raises(InvalidRequestError, match=next(iter(past))):
+            World(WorldSettings(**past))
