@@ -2,8 +2,9 @@
 
 `Path.read_text` on `/dev/zero` reads until memory runs out (a served world grew to 16 GB and
 the kernel's out-of-memory killer ended it), and on a FIFO it waits for a writer that may never
-come, holding the request. So the file is opened without blocking, checked to be a regular file
-through the open descriptor (a rename between a check and the open cannot swap it), refused when
+come, holding the request. So the path is checked to be a regular file before it is opened (an
+open of a device may act), opened without blocking, checked to be the same file through the
+open descriptor (a rename between the check and the open cannot swap it), refused when
 it is larger than the cap, and read no further than the cap (a file that grows while it is read
 is refused too). Standard library only.
 """
@@ -40,11 +41,14 @@ def read_text(path: str | os.PathLike, limit: int = MAX_INPUT_BYTES) -> str:
         UnicodeDecodeError: not UTF-8.
     """
     path = Path(path)
+    named = os.stat(path)  # a device is refused before it is opened (an open may act)
+    if not stat.S_ISREG(named.st_mode):
+        raise InputFileError(path, f"not a regular file ({_kind(named.st_mode)})")
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
     try:
         facts = os.fstat(fd)
-        if not stat.S_ISREG(facts.st_mode):
-            raise InputFileError(path, f"not a regular file ({_kind(facts.st_mode)})")
+        if (facts.st_dev, facts.st_ino) != (named.st_dev, named.st_ino):
+            raise InputFileError(path, "replaced while it was opened")
         if facts.st_size > limit:
             raise InputFileError(path, f"larger than {limit // (1024 * 1024)} MiB")
     except BaseException:

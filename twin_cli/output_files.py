@@ -60,7 +60,12 @@ def checked_target(
     if not stat.S_ISREG(mode):
         kind = "a directory" if stat.S_ISDIR(mode) else "not a regular file (a device or pipe)"
         raise OutputFileError(target, f"is {kind}", "give the path of a regular file")
-    if ours is not None and not force and (head := _head(target)) and not ours(head):
+    if (
+        ours is not None
+        and not force
+        and (head := _head(target)) != b""
+        and not (head is not None and ours(head))
+    ):
         raise OutputFileError(
             target,
             "exists and is not a file twin wrote",
@@ -69,13 +74,14 @@ def checked_target(
     return target
 
 
-def _head(path: Path) -> bytes:
-    """The file's first HEAD_BYTES (b"" when it is empty or unreadable: nothing to keep)."""
+def _head(path: Path) -> bytes | None:
+    """The file's first HEAD_BYTES (b"": empty, nothing to keep; None: unreadable, so whose it
+    is cannot be told and it is kept)."""
     try:
         with path.open("rb") as stream:
             return stream.read(HEAD_BYTES)
     except OSError:
-        return b""
+        return None
 
 
 def write_atomically(

@@ -142,7 +142,12 @@ def _report_softness(
             subject,
             figures + f"; at μ {geom_mu:g} MuJoCo's pyramidal friction cone makes the rest "
             f"sinkage {softness.pyramid_softening:.3g} times the single contact's "
-            "(docs/contacts.md)",
+            "(docs/contacts.md)"
+            + (
+                "; stiffer than MuJoCo's rigid contact reproduces: clamped"
+                if softness.clamped
+                else ""
+            ),
             tag="kp",
         )
     elif softness.clamped:

@@ -156,10 +156,12 @@ def _staging_prefix(out: Path) -> str:
 def _remove_abandoned_staging(out: Path) -> None:
     """Removes staging folders of `out` whose writing process is gone (a killed `twin convert`
     leaves its half-written model beside the target)."""
-    head = f".{out.name}."
-    for path in out.parent.glob(f"{glob.escape(head)}*"):
-        pid = path.name[len(head) :].split(".", 1)[0]
-        if path.is_dir() and pid.isdigit() and not _alive(int(pid)):
+    # exactly what `_staging_prefix` and mkdtemp's 8-character suffix make: a user's own
+    # `.robot.2023.bak` or another target's staging (`.robot.5.<pid>.…`) never matches
+    pattern = re.compile(rf"\.{re.escape(out.name)}\.(\d+)\.(?:old\.)?[a-z0-9_]{{8}}")
+    for path in out.parent.glob(f".{glob.escape(out.name)}.*"):
+        match = pattern.fullmatch(path.name)
+        if match and path.is_dir() and not _alive(int(match.group(1))):
             shutil.rmtree(path, ignore_errors=True)
 
 

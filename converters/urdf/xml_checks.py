@@ -128,6 +128,12 @@ def check_tree(root: ET.Element, source: str) -> tuple[str, tuple[str, ...]]:
     return roots[0], tuple(name for name, _, _ in loops)
 
 
+def _root(link: str, parent_of: dict[str, str]) -> str:
+    while link in parent_of:
+        link = parent_of[link]
+    return link
+
+
 def _is_ancestor(link: str, of: str, parent_of: dict[str, str]) -> bool:
     while of in parent_of:
         of = parent_of[of]
@@ -140,9 +146,10 @@ def _refuse_loose_loop(
     loops: list[tuple[str, str, str]], parent_of: dict[str, str], source: str
 ) -> None:
     """A second joint into a link whose parent the tree does not reach leaves two trees, not a
-    loop: the likely slip is a joint with the wrong child, so say which."""
+    loop: the likely slip is a joint with the wrong child, so say which (a loop inside one tree
+    beside a stray link is not blamed; the roots' message names the stray link)."""
     for name, parent, child in loops:
-        if child in parent_of:
+        if child in parent_of and _root(parent, parent_of) != _root(child, parent_of):
             raise URDFStructureError(
                 source,
                 f"link '{child}'",

@@ -255,3 +255,18 @@ def test_urdf_second_parent_that_joins_nothing_else_is_refused_naming_both(tmp_p
     path.write_text(text)
     with pytest.raises(ConversionError, match="link 'b'.*two joints.*joint 'j2'"):
         convert(path)
+
+
+def test_a_stray_link_beside_a_closed_loop_is_the_one_named(tmp_path: Path) -> None:
+    text = (
+        '<robot name="r">'
+        + "".join(_urdf_link(n) for n in ("a", "b", "c", "stray"))
+        + _urdf_joint("ab", "continuous", "a", "b", 0, 0)
+        + _urdf_joint("ac", "continuous", "a", "c", 0.1, 0)
+        + _urdf_joint("bc", "continuous", "b", "c", 0.1, 0)
+        + "</robot>"
+    )
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    with pytest.raises(ConversionError, match="links a, stray.*2 root links"):
+        convert(path)

@@ -40,12 +40,15 @@ def test_a_read_only_folder_is_exit_2_naming_it(tmp_path: Path) -> None:
 def test_a_killed_writers_staging_folder_is_removed_and_a_live_ones_kept(tmp_path: Path) -> None:
     spec, report = convert(write_urdf(tmp_path, block(size=0.2, name="box"), "box.urdf"))
     out = tmp_path / "out"
-    dead = tmp_path / f".out.{DEAD_PID}.abc123"
-    live = tmp_path / f".out.{os.getppid()}.def456"
-    for folder in (dead, live):
+    dead = tmp_path / f".out.{DEAD_PID}.abc12_yz"
+    dead_old = tmp_path / f".out.{DEAD_PID}.old.k3j9x0ab"
+    live = tmp_path / f".out.{os.getppid()}.def45678"
+    users = tmp_path / f".out.{DEAD_PID}.bak"  # not a name twin makes: someone's own folder
+    for folder in (dead, dead_old, live, users):
         folder.mkdir()
         (folder / "box.xml").write_text("half")
     write_model(spec, report, out)
-    assert not dead.exists(), "a killed conversion's staging folder stays"
+    assert not dead.exists() and not dead_old.exists(), "a killed conversion's folder stays"
     assert live.exists(), "a running conversion's staging folder was removed"
+    assert users.exists(), "a folder twin did not make was removed"
     assert (out / "scene.xml").is_file()
