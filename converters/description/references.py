@@ -30,9 +30,16 @@ class Dangling:
     target: str
     kind: str
     carries: tuple[str, ...] = ()
+    closes_loop: bool = False  # the joint exists, as a loop's closing equalities
 
     def describe(self) -> str:
         lost = f" ({', '.join(self.carries)})" if self.carries else ""
+        if self.closes_loop:
+            return (
+                f"{self.element}{lost} names joint '{self.target}', which closes a loop: MuJoCo "
+                "holds it by equality constraints, not as a joint a motor can drive (command "
+                "another joint of the loop)"
+            )
         return f"{self.element}{lost} names {self.kind} '{self.target}', which does not exist"
 
 
@@ -40,10 +47,19 @@ def dangling_references(robot: RobotDescription) -> list[Dangling]:
     """Every reference of the robot's Gazebo and control tags that names no link or joint."""
     found = [_gazebo_reference(robot, name) for name in robot.gazebo.unresolved]
     joints = {joint.name for joint in robot.joints}
+    loops = {joint.name for joint in robot.loop_joints}
     for control in robot.controls:
         if control.joint not in joints:
             element = f"{control.where} joint"
-            found.append(Dangling(element, control.joint, "joint", ("command interfaces",)))
+            found.append(
+                Dangling(
+                    element,
+                    control.joint,
+                    "joint",
+                    ("command interfaces",),
+                    closes_loop=control.joint in loops,
+                )  # fmt: skip
+            )
     return found
 
 

@@ -270,3 +270,21 @@ def test_a_stray_link_beside_a_closed_loop_is_the_one_named(tmp_path: Path) -> N
     path.write_text(text)
     with pytest.raises(ConversionError, match="links a, stray.*2 root links"):
         convert(path)
+
+
+def test_a_command_interface_on_a_loop_joint_says_the_joint_closes_a_loop(tmp_path: Path) -> None:
+    text = (
+        '<robot name="r">'
+        + "".join(_urdf_link(n) for n in ("world", "a", "b", "c"))
+        + _urdf_joint("fix", "fixed", "world", "a", 0, 0)
+        + _urdf_joint("ab", "continuous", "a", "b", 0, 0)
+        + _urdf_joint("ac", "continuous", "a", "c", 0.1, 0)
+        + _urdf_joint("bc", "continuous", "b", "c", 0.1, 0)
+        + '<ros2_control name="s" type="system"><joint name="bc">'
+        + '<command_interface name="position"/></joint></ros2_control>'
+        + "</robot>"
+    )
+    path = tmp_path / "r.urdf"
+    path.write_text(text)
+    with pytest.raises(ConversionError, match="joint 'bc', which closes a loop"):
+        convert(path)
