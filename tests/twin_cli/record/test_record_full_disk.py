@@ -1,8 +1,8 @@
 """A recording cut short by a full disk ends `twin record` at once with exit 2 and the cause.
 
 Run as a user would, in a private mount namespace (`unshare -m`, so nothing is mounted on the
-machine): a 64 KiB tmpfs is the bag's folder; the world serves a box; `twin record --duration 60`
-must not wait out its minute on a bag that stopped at the first full write.
+machine): a 64 KiB tmpfs is the bag's folder; the world serves a box; `twin record --duration 600`
+must not wait out its ten minutes on a bag that stopped at the first full write.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ SCRIPT = """
 set -u
 mount -t tmpfs -o size=64k tmpfs "$BAGS" || exit 97
 $TWIN spawn "$URDF" --world full >/dev/null 2>&1 || exit 98
-$TWIN record "$BAGS/out.mcap" --world full --duration 60
+$TWIN record "$BAGS/out.mcap" --world full --duration 600
 rc=$?
 $TWIN stop --world full >/dev/null 2>&1
 exit $rc
@@ -42,7 +42,7 @@ def test_a_full_disk_ends_twin_record_with_exit_2_naming_the_bag(tmp_path: Path)
     }
     start = time.monotonic()
     done = subprocess.run(
-        ["unshare", "-m", "sh", "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=240
+        ["unshare", "-m", "sh", "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=280
     )
     elapsed = time.monotonic() - start
     if done.returncode in (97, 98):
@@ -51,5 +51,6 @@ def test_a_full_disk_ends_twin_record_with_exit_2_naming_the_bag(tmp_path: Path)
     assert done.returncode == 2, done.stdout + done.stderr
     assert f"{bag}: recording stopped early" in done.stderr, done.stderr
     assert "No space left on device" in done.stderr, done.stderr
-    # The CLI's start, a world's start and the spawn are in it; the bag fills in seconds.
-    assert elapsed < 45.0, f"twin record waited {elapsed:.0f} s on a stopped recording"
+    # The CLI's start, a world's start and the spawn are in it (slow on a busy runner); the bag
+    # fills in seconds, and before, the command waited out the whole duration.
+    assert elapsed < 150.0, f"twin record waited {elapsed:.0f} s on a stopped recording"
