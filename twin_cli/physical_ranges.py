@@ -50,8 +50,8 @@ CommandValue = Annotated[float, _bounded(-COMMAND, COMMAND, "rad, m, rad/s, m/s,
 Gain = Annotated[float, _bounded(-GAIN, GAIN, "per rad or m")]
 StateValue = Annotated[float, _bounded(-MAX_VALUE, MAX_VALUE, "state")]
 Timestep = Annotated[float, _bounded(TIMESTEP_S[0], TIMESTEP_S[1], "s")]
-MIN_RATE_HZ = 1e-3
-"""[Hz] the slowest pace other than 0 (unthrottled): one step in 1000 s of wall time."""
+MIN_RATE_HZ = 1e-6
+"""[Hz] the slowest pace other than 0 (unthrottled): one step in about 12 days of wall time."""
 
 
 def _rate(value: float) -> float:

@@ -107,13 +107,10 @@ def _settled(path: Path) -> tuple[mujoco.MjModel, mujoco.MjData]:
     return model, mujoco.MjData(model)
 
 
-def test_four_bar_has_one_degree_of_freedom_and_follows_freudenstein(tmp_path: Path) -> None:
-    model, data = _settled(_four_bar(tmp_path))
-    assert (model.nv, model.neq) == (3, 2)
-    assert all(t == mujoco.mjtEq.mjEQ_CONNECT for t in model.eq_type)
-    assert _mobility(model, data) == 1
+def _assert_rocker_follows_the_crank(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """A full turn of the crank in 30° steps, each from the previous pose (same branch): the
+    rocker within TOL_RAD of the law of cosines."""
     phi0 = _rocker_angle(THETA0)
-    # A full turn of the crank in 30° steps, each from the previous pose (same branch).
     for step in range(1, 13):
         theta = THETA0 + math.radians(30 * step)
         _hold(model, data, "crank_j", theta - THETA0)
@@ -121,6 +118,14 @@ def test_four_bar_has_one_degree_of_freedom_and_follows_freudenstein(tmp_path: P
         expected = _rocker_angle(theta)
         error = math.remainder(measured - expected, 2 * math.pi)
         assert abs(error) < TOL_RAD, (math.degrees(theta), measured, expected)
+
+
+def test_four_bar_has_one_degree_of_freedom_and_follows_freudenstein(tmp_path: Path) -> None:
+    model, data = _settled(_four_bar(tmp_path))
+    assert (model.nv, model.neq) == (3, 2)
+    assert all(t == mujoco.mjtEq.mjEQ_CONNECT for t in model.eq_type)
+    assert _mobility(model, data) == 1
+    _assert_rocker_follows_the_crank(model, data)
 
 
 def test_parallel_gripper_finger_stays_parallel_with_one_degree_of_freedom(
@@ -234,13 +239,7 @@ def test_urdf_four_bar_closed_by_a_second_parent_follows_freudenstein(tmp_path: 
     model, data = _settled(path)
     assert (model.nv, model.neq) == (3, 2)
     assert _mobility(model, data) == 1
-    phi0 = _rocker_angle(THETA0)
-    for step in range(1, 13):
-        theta = THETA0 + math.radians(30 * step)
-        _hold(model, data, "crank_j", theta - THETA0)
-        measured = phi0 + data.qpos[model.joint("rocker_j").qposadr[0]]
-        error = math.remainder(measured - _rocker_angle(theta), 2 * math.pi)
-        assert abs(error) < TOL_RAD, (math.degrees(theta), measured)
+    _assert_rocker_follows_the_crank(model, data)
 
 
 def test_urdf_second_parent_that_joins_nothing_else_is_refused_naming_both(tmp_path: Path) -> None:
@@ -257,34 +256,34 @@ def test_urdf_second_parent_that_joins_nothing_else_is_refused_naming_both(tmp_p
         convert(path)
 
 
-def test_a_stray_link_beside_a_closed_loop_is_the_one_named(tmp_path: Path) -> None:
+def _triangle(tmp_path: Path, links: tuple[str, ...], extra: str) -> Path:
+    """Links a, b, c joined a→b, a→c and b→c (the last closes the loop), plus `links`/`extra`."""
     text = (
         '<robot name="r">'
-        + "".join(_urdf_link(n) for n in ("a", "b", "c", "stray"))
+        + "".join(_urdf_link(n) for n in ("a", "b", "c", *links))
         + _urdf_joint("ab", "continuous", "a", "b", 0, 0)
         + _urdf_joint("ac", "continuous", "a", "c", 0.1, 0)
         + _urdf_joint("bc", "continuous", "b", "c", 0.1, 0)
+        + extra
         + "</robot>"
     )
     path = tmp_path / "r.urdf"
     path.write_text(text)
+    return path
+
+
+def test_a_stray_link_beside_a_closed_loop_is_the_one_named(tmp_path: Path) -> None:
     with pytest.raises(ConversionError, match="links a, stray.*2 root links"):
-        convert(path)
+        convert(_triangle(tmp_path, ("stray",), ""))
 
 
 def test_a_command_interface_on_a_loop_joint_says_the_joint_closes_a_loop(tmp_path: Path) -> None:
-    text = (
-        '<robot name="r">'
-        + "".join(_urdf_link(n) for n in ("world", "a", "b", "c"))
-        + _urdf_joint("fix", "fixed", "world", "a", 0, 0)
-        + _urdf_joint("ab", "continuous", "a", "b", 0, 0)
-        + _urdf_joint("ac", "continuous", "a", "c", 0.1, 0)
-        + _urdf_joint("bc", "continuous", "b", "c", 0.1, 0)
-        + '<ros2_control name="s" type="system"><joint name="bc">'
-        + '<command_interface name="position"/></joint></ros2_control>'
-        + "</robot>"
+    control = (
+        '<ros2_control name="s" type="system"><joint name="bc">'
+        '<command_interface name="position"/></joint></ros2_control>'
     )
-    path = tmp_path / "r.urdf"
-    path.write_text(text)
+    path = _triangle(
+        tmp_path, ("world",), _urdf_joint("fix", "fixed", "world", "a", 0, 0) + control
+    )
     with pytest.raises(ConversionError, match="joint 'bc', which closes a loop"):
         convert(path)

@@ -161,6 +161,17 @@ def _busy_world(twin: Twin, seconds: float) -> subprocess.Popen:
     )
 
 
+def _started(env: dict, *args: str) -> subprocess.Popen:
+    """`twin ARGS` started in the background, its output captured."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "twin_cli.cli.app", *args],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
 def test_delete_and_spawn_that_outlive_the_clients_patience_are_unknown_and_repeats_are_safe(
     twin,
 ):
@@ -170,13 +181,7 @@ def test_delete_and_spawn_that_outlive_the_clients_patience_are_unknown_and_repe
     time.sleep(0.5)  # the step request holds the world's lock now
     impatient = {**twin.env, "TWIN_TIMEOUT": "1"}
     runs = [  # both at once, so both give up while the step still holds the world
-        subprocess.Popen(
-            [sys.executable, "-m", "twin_cli.cli.app", *args],
-            env=impatient,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        _started(impatient, *args)
         for args in (["delete", "box"], ["spawn", twin.box, "--name", "b2", "-x", "2", "-z", "1"])
     ]
     for proc in runs:
@@ -256,16 +261,7 @@ def test_a_client_waits_for_a_server_that_answers_late_and_succeeds(twin, comman
     try:
         for limit in (None, "1"):
             env = twin.env if limit is None else {**twin.env, "TWIN_TIMEOUT": limit}
-            runs[limit] = (
-                time.monotonic(),
-                subprocess.Popen(
-                    [sys.executable, "-m", "twin_cli.cli.app", *command],
-                    env=env,
-                    stdout=subprocess.PIPE,
-                    stderr=subprocess.PIPE,
-                    text=True,
-                ),
-            )
+            runs[limit] = (time.monotonic(), _started(env, *command))
         time.sleep(STALL_S)
     finally:
         os.kill(pid, signal.SIGCONT)
