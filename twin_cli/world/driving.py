@@ -220,7 +220,7 @@ def start_commands(state: WorldState, names: Iterable[str]) -> None:
             j = int(model.actuator_trnid[a, 0])
             joint = model.joint(j).name.removeprefix(f"{name}/")
             limits = joint_control.limits_of(model, name, joint)
-            value = native_servos.start_value(model, data, int(a), law)
+            value = native_servos.start_value(model, data.qpos, int(a), law)
             effort = control.effort_limit(model, int(a))
             _set_native(state, (key, int(a), j, value, effort, limits), law, None)
     gravity_comp.switch(model, state.commands)

@@ -144,12 +144,12 @@ def _dof(model: mujoco.MjModel, a: int) -> int:
     return int(model.jnt_dofadr[model.actuator_trnid[a, 0]])
 
 
-def start_value(model: mujoco.MjModel, data: mujoco.MjData, a: int, law: Law) -> float:
-    """The ctrl that holds actuator `a`'s joint where it is: its position, or speed 0."""
+def start_value(model: mujoco.MjModel, qpos: np.ndarray, a: int, law: Law) -> float:
+    """The ctrl that holds actuator `a`'s joint where `qpos` has it: its position, or speed 0."""
     if law.mode == "velocity":
         return 0.0
     joint = int(model.actuator_trnid[a, 0])
-    return float(data.qpos[model.jnt_qposadr[joint]])
+    return float(qpos[model.jnt_qposadr[joint]])
 
 
 def rule(law: Law) -> str:

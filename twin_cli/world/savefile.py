@@ -214,8 +214,7 @@ def _natives(world: World, laws: dict, commands: list[JointCommand], state: np.n
         if name in out:
             continue
         a = model.actuator(name).id
-        joint = int(model.actuator_trnid[a, 0])
-        value = float(state[1 + model.jnt_qposadr[joint]]) if law.mode == "position" else 0.0
+        value = native_servos.start_value(model, state[1 : 1 + model.nq], a, law)
         limit = native_servos.velocity_limit(model, name)
         out[name] = JointCommand(
             name, law.mode, value, law.kp, law.kv, effort_limit(model, a), limit, 0.0,
