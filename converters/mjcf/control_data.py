@@ -103,4 +103,4 @@ def _mode_text(mode: str, bounds: dict) -> str:
         return mode
     low_text = "-inf" if low is None else f"{low:g}"
     high_text = "inf" if high is None else f"{high:g}"
-    return f"{mode} in [{low_text}, {high_text}]"
+    return f"{mode} (min/max [{low_text}, {high_text}] declared, not applied by Gazebo's hardware)"

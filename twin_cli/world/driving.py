@@ -76,8 +76,8 @@ def _link_name(state: WorldState, name: str, ix: EntityIndex, link: str | None) 
 def command(state: WorldState, name: str, joint: str, *, mode: str, value: float) -> None:
     """Sets a joint's target: "position" [rad|m], "velocity" [rad/s|m/s] or "effort" [N m|N].
 
-    Targets are clipped to what the joint allows (its range, velocity and effort limits and
-    its interface's min/max); `command_joints` refuses them instead. The position and
+    Targets are clipped to what the joint allows (its range, velocity and effort limits);
+    `command_joints` refuses them instead. The position and
     velocity servos never exceed the effort limit (see twin_cli.world.actuation).
 
     Raises:
@@ -94,7 +94,7 @@ def command_joints(
     Raises:
         EntityNotFoundError, PartNotFoundError: unknown entity or actuated joint.
         InvalidRequestError: unknown mode, a mode the joint does not offer, or (unless
-            `clip`) a value outside the interface's min/max or the joint's limits. On any
+            `clip`) a value outside the joint's limits. On any
             error no command changes.
     """
     for joint, value in targets.items():
@@ -130,7 +130,7 @@ def _checked(
     elif not low <= value <= high:
         raise InvalidRequestError(
             f"{mode} command for joint [{joint}] of [{name}]",
-            f"{value:g} is outside [{low:g}, {high:g}] (interface min/max, joint limits)",
+            f"{value:g} is outside [{low:g}, {high:g}] (the joint's limits)",
             "give a value inside that range",
         )
     return key, a, j, mode, float(value), effort, limits

@@ -314,17 +314,17 @@ def _position_gains(inertia: float, h: float, step: float, speed: float) -> tupl
 def allowed_range(
     model: mujoco.MjModel, joint: int, mode: str, limits: JointLimits, effort: float
 ) -> tuple[float, float]:
-    """The values a `mode` command may take: the interface bounds within the joint's limits."""
-    low, high = -math.inf, math.inf
+    """The values a `mode` command may take: the joint's range, velocity or effort limit.
+
+    A `<command_interface>`'s `min`/`max` (`limits.bounds`) is not among them: gazebo_ros2_control
+    and gz_ros2_control pass each command to the joint as the controller wrote it, so a wheel
+    interface declared ±1 still turns at the 6 rad/s its drive asks for.
+    """
     if mode == "position" and model.jnt_limited[joint]:
         low, high = (float(v) for v in model.jnt_range[joint])
-    elif mode == "velocity":
-        low, high = -limits.velocity, limits.velocity
-    elif mode == "effort":
-        low, high = -effort, effort
-    bound = limits.bounds.get(mode, (None, None))
-    if bound[0] is not None:
-        low = max(low, bound[0])
-    if bound[1] is not None:
-        high = min(high, bound[1])
-    return low, high
+        return low, high
+    if mode == "velocity":
+        return -limits.velocity, limits.velocity
+    if mode == "effort":
+        return -effort, effort
+    return -math.inf, math.inf

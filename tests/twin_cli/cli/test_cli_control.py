@@ -41,7 +41,7 @@ def test_command_holds_a_target_and_joints_shows_its_mode(rig):
         (["command", "nobody", "slide=0.1"], "nobody"),
         (["command", "rig", "elbow=0.1"], "elbow"),
         (["command", "rig", "slide=0.1", "--mode", "torque"], "torque"),
-        (["command", "rig", "slide=0.28"], "outside [-0.1, 0.25]"),
+        (["command", "rig", "slide=0.35"], "outside [-0.2, 0.3]"),  # the joint's range
         (["command", "rig", "spin=2", "--mode", "position"], "offer only effort, velocity"),
         (["command", "rig", "slide"], "JOINT=VALUE"),
     ],

@@ -144,8 +144,8 @@ def test_a_mode_the_joint_does_not_offer_is_refused_naming_the_offered_ones(tmp_
         message = str(caught.value)
         assert f"joint [{joint}] of [discs]" in message, message
         assert f'<command_interface name="{mode}"/>' in message, "the fix names the tag"
-    with pytest.raises(InvalidRequestError, match=re.escape("outside [-1, 1]")):
-        world.command_joints("discs", {"d0": 1.5}, mode="position")  # the <param max>
+    with pytest.raises(InvalidRequestError, match=re.escape("outside [-3, 3]")):
+        world.command_joints("discs", {"d0": 3.5}, mode="position")  # the joint's range
     assert world.commands() == held, "a refused request changes no command"
     after = world.model.actuator_gainprm, world.data.ctrl
     assert (after[0] == before[0]).all() and (after[1] == before[1]).all()

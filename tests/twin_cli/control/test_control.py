@@ -42,12 +42,12 @@ def test_full_effort_settles_at_the_velocity_limit_as_gazebo_zeroes_effort_beyon
     assert accel == pytest.approx(-200.0, rel=0.02), f"braking {accel:.1f} rad/s² (expect -200)"
 
 
-def test_a_mode_the_tags_do_not_offer_or_a_value_outside_the_interface_is_refused(rig):
+def test_a_mode_the_tags_do_not_offer_or_a_value_outside_the_joints_limits_is_refused(rig):
     before = rig.data.ctrl.copy(), rig.model.actuator_gainprm.copy()
     held = dict(rig.commands())  # the joints' own servos hold them from load
     bad = [
         ({"slide": 0.0}, "velocity", "offer only position"),
-        ({"slide": 0.28}, "position", "outside [-0.1, 0.25]"),  # interface max below the range
+        ({"slide": 0.35}, "position", "outside [-0.2, 0.3]"),  # the joint's range
         ({"spin": 3.5}, "velocity", "outside [-3, 3]"),  # the joint's velocity limit
         ({"spin": 1.0, "slide": 9.0}, "effort", "offer only position"),
         ({"spin": 2.5}, "effort", "outside [-2, 2]"),
@@ -70,6 +70,16 @@ def _slide_move(rig: World) -> float:
         peak = max(peak, abs(rig.joint_states("rig")[1].velocity))
     assert rig.joint_states("rig")[1].position == pytest.approx(0.25, abs=1e-3), "target"
     return peak
+
+
+@pytest.mark.parametrize("target", [-0.18, -0.15, 0.27, 0.29])
+def test_an_interfaces_min_max_is_not_applied_as_gazebos_hardware_does_not(rig, target):
+    """The slide's interface declares [-0.1, 0.25] inside its [-0.2, 0.3] range:
+    gazebo_ros2_control hands the command to the joint unclipped, so the slide goes there."""
+    rig.command_joints("rig", {"slide": target}, mode="position")
+    rig.step(3000)
+    reached = rig.joint_states("rig")[1].position
+    assert reached == pytest.approx(target, abs=1e-3), f"slide at {reached:.5f} m"
 
 
 def test_position_interface_servo_reaches_its_target(rig):
@@ -197,7 +207,7 @@ def test_ur5e_follows_a_five_point_trajectory_with_a_bounded_tracking_error(tmp_
             "not after 1 s",
         ),
         ("joint_names: [elbow]\npoints:\n  - {positions: [0.1], time_from_start: 1}\n", "elbow"),
-        ("joint_names: [slide]\npoints:\n  - {positions: [0.29], time_from_start: 1}\n", "0.29"),
+        ("joint_names: [slide]\npoints:\n  - {positions: [0.35], time_from_start: 1}\n", "0.35"),
         ("time_from_start,slide\n1,0.1\n,0.2\n", "no time_from_start"),
     ],
 )

@@ -229,3 +229,32 @@ def test_a_served_base_drives_from_its_controller_yaml(tmp_path: Path, serve_wor
     moved = math.hypot(end["x"] - start["x"], end["y"] - start["y"])
     assert moved == pytest.approx(expected, rel=0.02), f"{moved:.4f} m of {expected} m"
     assert (odom["odometry_frame"], odom["robot_base_frame"]) == ("odom_demo", "base_footprint")
+
+
+@pytest.mark.parametrize("bound", [0.5, 1.0, 2.0])
+def test_wheel_interface_min_max_does_not_clip_the_controllers_speeds(
+    tmp_path: Path, bound: float
+) -> None:
+    """Wheels declared ±`bound` rad/s (below the 6 rad/s that 0.3 m/s asks of R = 0.05 m):
+    gazebo_ros2_control applies no min/max to velocity commands, so the base drives 1.5 m in
+    5 s as without them, and the drive's reply names the speeds the wheels really turn at."""
+    from twin_cli.control import drive
+
+    bounded = INTERFACES.replace(
+        '<command_interface name="velocity"/>',
+        f'<command_interface name="velocity"><param name="min">{-bound}</param>'
+        f'<param name="max">{bound}</param></command_interface>',
+    )
+    path = _base(tmp_path, YAML.replace("max_velocity: 0.4", "max_velocity: 1.0"))
+    robot = dm.settled_base(tmp_path, path.read_text().replace(INTERFACES, bounded))
+    start = robot.get_pose("base").x
+    reply = drive(robot, "base", 0.3, 0.0, 5.0)
+    robot.step(2500)
+    speeds = {s.name: s.velocity for s in robot.joint_states("base") if s.name in WHEELS}
+    robot.step(2600)
+    moved = robot.get_pose("base").x - start
+    assert moved == pytest.approx(1.5, rel=0.02), f"drove {moved:.4f} m of 1.5"
+    for side, wheel in zip(("left", "right"), WHEELS, strict=True):
+        asked = reply["applied"]["wheel_speeds"][side]
+        assert asked == pytest.approx(6.0, rel=1e-9), reply
+        assert speeds[wheel] == pytest.approx(asked, rel=0.02), f"{wheel} at {speeds[wheel]:.3f}"
