@@ -24,6 +24,7 @@ _WHERE = {
     "controller_of": "twin_cli.control.drives",
     "drive": "twin_cli.control.drives",
     "odometry": "twin_cli.control.drives",
+    "release_joints": "twin_cli.control.drives",
     "UPDATE_RATE": "twin_cli.control.follower",
     "TrackingReport": "twin_cli.control.follower",
     "TrajectoryFollower": "twin_cli.control.follower",

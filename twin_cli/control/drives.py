@@ -81,6 +81,8 @@ def drive(
     twist = Twist(linear, angular, lateral, steering, curvature)
     _check_options(entity, *_drive_of(world, entity), twist)  # before a controller exists
     controller = controller_of(world, entity)
+    if not controller.observed_rate:  # a joint command stopped it: run it again
+        controller.resume()
     controller.command(twist, duration)
     with world.lock:
         applied = controller.command_reply()
@@ -97,6 +99,26 @@ def drive(
         "update_rate": controller.rate,
         "applied": applied,
     }
+
+
+def release_joints(world: World, entity: str, joints: list[str]) -> list[str]:
+    """Stops the entity's running drive if it turns any of `joints`, so that a joint command
+    given by hand is not overwritten at the drive's next update (as Gazebo's plugin would);
+    returns a note for each drive stopped. `twin drive` starts it again.
+
+    The caller holds the world lock, with the joint command already accepted.
+    """
+    controller = _CONTROLLERS.get(world, {}).get(entity)
+    if controller is None or not controller.observed_rate:
+        return []
+    owned = sorted(set(joints) & set(controller.plugin.wheel_joints()))
+    if not owned:
+        return []
+    controller.stop()
+    return [
+        f"drive [{controller.plugin.name}] ({controller.plugin.family}) of [{entity}] stopped: "
+        f"it turns {', '.join(owned)}; twin drive {entity} starts it again"
+    ]
 
 
 def odometry(world: World, entity: str) -> dict[str, Any]:

@@ -46,8 +46,11 @@ class TrajectoryBody(Body):
 
 @router.post("/entities/{name}/commands")
 def commands(name: str, body: CommandsBody, world: WorldDep) -> dict:
-    done = world.command_joints(name, dict(body.targets), mode=body.mode)
-    with world.lock:
+    from twin_cli.control import release_joints
+
+    with world.lock:  # no drive update between the command and the drive's stop
+        done = world.command_joints(name, dict(body.targets), mode=body.mode)
+        stopped = release_joints(world, name, list(body.targets))
         rows = world.joint_commands(name)
     passive = [j for j in body.targets if rows.get(j, {}).get("source") == "passive"]
     notes = [
@@ -55,6 +58,7 @@ def commands(name: str, body: CommandsBody, world: WorldDep) -> dict:
         f"motor at this {body.mode} command"
         for j in passive
     ]
+    notes += stopped
     return {
         "commanded": name,
         "mode": body.mode,

@@ -185,3 +185,26 @@ def test_the_fix_named_for_an_arm_without_a_drive_moves_it(served: Path) -> None
     joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "arm", "--json"))}
     angle = joints["shoulder"]["position"]
     assert angle == pytest.approx(0.5, abs=0.01), f"shoulder at {angle:.4f} rad (commanded 0.5)"
+
+
+@pytest.mark.parametrize("speed", [1.5, -3.0])
+def test_a_command_on_a_wheel_a_drive_turns_stops_the_drive_and_says_so(
+    served: Path, speed: float
+) -> None:
+    """A wheel commanded by hand after a drive keeps that command (it is not overwritten at the
+    drive's next update), the reply names the drive it stopped, and twin drive restarts it."""
+    _ok(served, "drive", "kobuki", "--linear", "0.2")
+    _ok(served, "step", "200")
+    said = _ok(served, "command", "kobuki", f"wheel_left_joint={speed}", "--mode", "velocity")
+    assert "drive [kobuki_controller]" in said and "stopped" in said, said
+    _ok(served, "step", "1000")
+    joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "kobuki", "--json"))}
+    held = joints["wheel_left_joint"]["velocity"]
+    assert held == pytest.approx(speed, rel=0.05), f"wheel at {held:.3f} rad/s (given {speed})"
+    _ok(served, "drive", "kobuki", "--linear", "0")  # the drive runs again and stops the base
+    _ok(served, "step", "1000")
+    joints = {j["name"]: j for j in json.loads(_ok(served, "joints", "kobuki", "--json"))}
+    left = joints["wheel_left_joint"]["velocity"]
+    assert abs(left) < 0.05, f"wheel at {left:.3f} rad/s after twin drive --linear 0"
+    again = _ok(served, "command", "kobuki", "wheel_left_joint=0", "--mode", "velocity")
+    assert "stopped" in again, again
