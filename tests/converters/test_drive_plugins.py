@@ -16,6 +16,7 @@ import drive_models as dm
 import pytest
 
 from converters.errors import ConversionError, PluginJointError
+from converters.gazebo.drive_motors import PLANAR_TAU
 from converters.pipeline import convert_full
 
 SKID = (
@@ -267,8 +268,8 @@ def test_planar_move_gets_three_velocity_servos_at_the_centre_of_mass(tmp_path: 
     assert names == ["planar:mover:vx", "planar:mover:vy", "planar:mover:wz"]
     mass = float(model.body_subtreemass[1])
     vx = model.actuator("planar:mover:vx").id
-    assert model.actuator_gainprm[vx][0] == pytest.approx(mass / 1e-4), "kv = M/PLANAR_TAU"
-    assert model.actuator_biasprm[vx][2] == pytest.approx(-mass / 1e-4)
+    assert model.actuator_gainprm[vx][0] == pytest.approx(mass / PLANAR_TAU), "kv = M/τ"
+    assert model.actuator_biasprm[vx][2] == pytest.approx(-mass / PLANAR_TAU)
     site = model.site("planar:mover")
     assert list(model.site_pos[site.id]) == pytest.approx([0.0, 0.0, 0.05]), "the robot's COM"
 
