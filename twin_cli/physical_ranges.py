@@ -27,6 +27,8 @@ FORCE_N = 1e9
 COMMAND = 1e9
 """A joint command [rad, m, rad/s, m/s, N m or N]; a position is further held to the joint's
 range by the world."""
+SPEED = 1e4
+"""[m/s] or [rad/s] a twist a client sets on an entity: one 1 ms step moves it at most 10 m."""
 GAIN = 1e12
 """A saved servo's stiffness [N m/rad] or damping [N m s/rad]."""
 TIMESTEP_S = (1e-6, 1.0)

@@ -7,10 +7,12 @@ failure leaves the world, the entity's record included, exactly as it was.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+import mujoco
 import numpy as np
 
 from twin_cli.errors import SpawnError
@@ -87,6 +89,47 @@ def set_pose(state: WorldState, name: str, pose: Pose) -> None:
         data.qpos[ix.free_qpos + 3 : ix.free_qpos + 7] = pose.quat()
         data.qvel[ix.dofs] = 0.0
         data.qacc_warmstart[ix.dofs] = 0.0
+
+
+def set_twist(
+    state: WorldState,
+    name: str,
+    linear: tuple[float, float, float],
+    angular: tuple[float, float, float],
+) -> None:
+    """Sets the velocity of a free-floating entity's root: `linear` [m/s] of its origin and
+    `angular` [rad/s], both in the world frame (gazebo_ros' SetEntityState). Its joints keep
+    their speeds.
+
+    Raises:
+        InvalidRequestError: a value is not finite or beyond SPEED, or the entity is fixed.
+    """
+    from twin_cli.errors import InvalidRequestError
+    from twin_cli.physical_ranges import SPEED
+
+    values = (*linear, *angular)
+    if not all(math.isfinite(v) and abs(v) <= SPEED for v in values):
+        raise InvalidRequestError(
+            f"twist of entity [{name}]", f"{values} is not finite or beyond ±{SPEED:g}",
+            f"give speeds within ±{SPEED:g} m/s or rad/s",
+        )  # fmt: skip
+    with state.lock:
+        ix = state.require(name)
+        if ix.free_qpos < 0 or ix.root < 0:
+            raise InvalidRequestError(
+                f"twist of entity [{name}]", "it is fixed to the world", "set only its pose"
+            )
+        model, data = state.model, state.data
+        dof = int(model.jnt_dofadr[model.body_jntadr[ix.root]])
+        data.qvel[dof : dof + 3] = linear
+        local = np.zeros(3)  # a free joint's angular velocity is in the body's frame
+        turn = data.qpos[ix.free_qpos + 3 : ix.free_qpos + 7]  # the root's orientation
+        mujoco.mju_rotVecQuat(local, np.array(angular), _conjugate(turn))
+        data.qvel[dof + 3 : dof + 6] = local
+
+
+def _conjugate(quat: np.ndarray) -> np.ndarray:
+    return np.array([quat[0], -quat[1], -quat[2], -quat[3]])
 
 
 def _move_free_links(state: WorldState, name: str, ix: EntityIndex, pose: Pose) -> None:

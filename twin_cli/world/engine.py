@@ -147,6 +147,21 @@ class World:
         """Teleports the entity's root to `pose`, at rest (`changes.set_pose`)."""
         changes.set_pose(self._state, name, pose)
 
+    def set_twist(
+        self,
+        name: str,
+        linear: tuple[float, float, float],
+        angular: tuple[float, float, float],
+    ) -> None:
+        """Sets a free-floating entity's root velocity, world frame (`changes.set_twist`)."""
+        changes.set_twist(self._state, name, linear, angular)
+
+    def get_twist(self, name: str) -> queries.Twist:
+        """(linear [m/s], angular [rad/s]) of the entity's root origin, world frame."""
+        state = self._state
+        with self.lock:
+            return queries.root_twist(state.model, state.data, state.require(name))
+
     # ----------------------------------------------------------------- entities
     def entity(self, name: str) -> Entity:
         """The record of entity `name`: its request, spawn pose and state, sensors, plugins.

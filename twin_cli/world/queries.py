@@ -50,6 +50,24 @@ def root_pose(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, sp
     return spawn
 
 
+Twist = tuple[tuple[float, float, float], tuple[float, float, float]]
+"""(linear [m/s], angular [rad/s]), both in the world frame."""
+
+
+def root_twist(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex) -> Twist:
+    """The velocity of a free-floating entity's root origin, in the world frame, from its free
+    joint's qvel (so it is current after a set, before any step); zero for a fixed entity."""
+    if index.free_qpos < 0 or index.root < 0:
+        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    dof = int(model.jnt_dofadr[model.body_jntadr[index.root]])
+    v = data.qvel[dof : dof + 6]
+    angular = np.zeros(3)  # a free joint's angular velocity is in the body's frame
+    mujoco.mju_rotVecQuat(angular, v[3:6], data.qpos[index.free_qpos + 3 : index.free_qpos + 7])
+    return (float(v[0]), float(v[1]), float(v[2])), (
+        float(angular[0]), float(angular[1]), float(angular[2])
+    )  # fmt: skip
+
+
 def joint_states(
     model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
 ) -> list[JointState]:

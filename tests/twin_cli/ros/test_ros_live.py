@@ -152,10 +152,11 @@ def test_the_nodes_are_announced_as_ros2_node_list_reads_them(served) -> None:
     twin, commands = nodes[("/", "twin")], nodes[("/", "twin_commands")]
     assert len(twin["writer_gid_seq"]) >= 9, "writers: 3 world topics + 3 per bot, ..."
     assert not twin["reader_gid_seq"], "the publisher reads nothing"
-    readers = 2 * 3 + 4 + 3  # per bot: Twist, TwistStamped, forward velocity; rig: 3 +
-    # trajectory; a request reader per entity service
+    services = 13  # gazebo_ros' 9 and ros_gz's 4 world services
+    readers = 2 * 3 + 4 + services  # per bot: Twist, TwistStamped, forward velocity; rig: 3 +
+    # trajectory; a request reader per service
     assert len(commands["reader_gid_seq"]) == readers, "a reader per input"
-    assert len(commands["writer_gid_seq"]) == 3, "a reply writer per entity service"
+    assert len(commands["writer_gid_seq"]) == services, "a reply writer per service"
     gids = twin["writer_gid_seq"] + commands["reader_gid_seq"]
     assert all(len(g["data"]) == 16 for g in gids), "GIDs of 16 bytes"
 
@@ -435,7 +436,8 @@ def test_ros_start_and_stop_on_a_running_world_and_their_errors(served) -> None:
     assert got["messages"]["/clock"], "no /clock after twin ros stop and start"
     _twin(root, "ros", "stop")
     opened = json.loads(_twin(root, "ros", "start", "--services", "--json"))
-    assert opened["services"] == ["/spawn_entity", "/delete_entity", "/get_model_list"], opened
+    assert opened["services"][:3] == ["/spawn_entity", "/delete_entity", "/get_model_list"]
+    assert f"/world/{WORLD}/control" in opened["services"], opened
 
 
 def test_twin_ros_imports_no_physics_and_no_dds(served) -> None:
