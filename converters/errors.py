@@ -250,7 +250,19 @@ class DanglingReferenceError(ConversionError):
         shown = ", ".join(names[:30]) + (f" (+{len(names) - 30} more)" if len(names) > 30 else "")
         super().__init__(
             f"{source}: {'; '.join(problems)}; name one of its links or joints ({shown}), or "
-            "convert with --drop-dangling to leave these out, as Gazebo does"
+            "convert without --strict to leave these out with a warning, as Gazebo does"
+        )
+        self.source = source
+        self.problems = problems
+
+
+class MissingVisualMeshError(ConversionError):
+    """With `--strict`: visuals whose mesh file or package is missing (Gazebo draws nothing)."""
+
+    def __init__(self, source: str, problems: list[str]) -> None:
+        super().__init__(
+            f"{source}: " + "\n".join(problems) + "\nor convert without --strict to leave "
+            "these visuals out with a warning, as Gazebo does"
         )
         self.source = source
         self.problems = problems

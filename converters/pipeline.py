@@ -13,7 +13,12 @@ from typing import TYPE_CHECKING
 from converters.budget import XacroBudget
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
-from converters.errors import DanglingReferenceError, InputFileError, URDFStructureError
+from converters.errors import (
+    DanglingReferenceError,
+    InputFileError,
+    MissingVisualMeshError,
+    URDFStructureError,
+)
 from converters.formats import format_of
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
@@ -214,20 +219,30 @@ def check_joints(robot: RobotDescription) -> None:
 
 
 def check_references(robot: RobotDescription, options: ConvertOptions, report: Report) -> None:
-    """Refuse tags that name a missing link or joint, or with `drop_dangling` report each as
-    left out.
+    """Report each tag naming a missing link or joint, and each visual whose mesh is missing,
+    as left out (Gazebo loads the robot without them); with `strict`, refuse them.
 
     Raises:
-        DanglingReferenceError: one or more, each with what it carries, and the valid names.
+        DanglingReferenceError: with `strict`, the tags, each with what it carries, and the
+            valid names.
+        MissingVisualMeshError: with `strict`, the visuals, each with where the mesh was sought.
     """
-    from converters.description.references import dangling_references, part_names
+    from converters.description.references import (
+        dangling_references,
+        missing_visuals,
+        part_names,
+    )
 
-    missing = dangling_references(robot)
-    if missing and not options.drop_dangling:
-        problems = [d.describe() for d in missing]
+    dangling, visuals = dangling_references(robot), missing_visuals(robot)
+    if options.strict and dangling:
+        problems = [d.describe() for d in dangling]
         raise DanglingReferenceError(robot.source, problems, part_names(robot))
-    for d in missing:
-        report.warn(d.element, f"{d.describe()}; left out (--drop-dangling)")
+    if options.strict and visuals:
+        raise MissingVisualMeshError(robot.source, [v.problem for v in visuals])
+    for found in (*dangling, *visuals):
+        report.warn(
+            found.element, f"{found.describe()}; left out, as Gazebo does (--strict refuses)"
+        )
 
 
 def convert(

@@ -36,8 +36,9 @@ class SpawnRequest:
             `spawn_model -J`).
         on_ground: lower the entity until its lowest collision point rests on z = 0.
         repair_inertia: bound non-physical inertias instead of refusing the file.
-        drop_dangling: leave out Gazebo and control tags that name a missing link or joint
-            (Gazebo's behaviour) instead of refusing the file.
+        strict: refuse Gazebo and control tags that name a missing link or joint, and
+            visuals whose mesh is missing, instead of leaving them out with a warning (Gazebo's
+            behaviour).
         fixed_base: weld the root link to the world at the spawn pose (no free joint), as a
             `world` link and a fixed joint do; a robot already fixed is unchanged.
     """
@@ -51,7 +52,7 @@ class SpawnRequest:
     joints: Mapping[str, float] = field(default_factory=dict)
     on_ground: bool = False
     repair_inertia: bool = False
-    drop_dangling: bool = False
+    strict: bool = False
     fixed_base: bool = False
 
     @property
@@ -84,7 +85,7 @@ class SpawnRequest:
             "joints": dict(self.joints),
             "on_ground": self.on_ground,
             "repair_inertia": self.repair_inertia,
-            "drop_dangling": self.drop_dangling,
+            "strict": self.strict,
             "fixed_base": self.fixed_base,
         }
 
@@ -102,7 +103,8 @@ class SpawnRequest:
 
     @classmethod
     def from_body(cls, body: Mapping[str, Any]) -> SpawnRequest:
-        """The request from its JSON form (missing fields take their defaults)."""
+        """The request from its JSON form (missing fields take their defaults; a
+        `drop_dangling` of older clients and saves is the default now, and is not read)."""
         return cls(
             source=body.get("source"),
             xml=body.get("xml"),
@@ -113,7 +115,7 @@ class SpawnRequest:
             joints={k: float(v) for k, v in (body.get("joints") or {}).items()},
             on_ground=bool(body.get("on_ground", False)),
             repair_inertia=bool(body.get("repair_inertia", False)),
-            drop_dangling=bool(body.get("drop_dangling", False)),
+            strict=bool(body.get("strict", False)),
             fixed_base=bool(body.get("fixed_base", False)),
         )
 

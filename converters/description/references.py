@@ -1,11 +1,12 @@
-"""References that name no part of the robot: a `<gazebo reference>` (with its sensors and
-plugins) on a missing link, or a `<ros2_control>`/`<transmission>` joint that does not exist.
+"""What Gazebo loads a robot without: a `<gazebo reference>` (with its sensors and plugins) on a
+missing link, a `<ros2_control>`/`<transmission>` joint that does not exist, a visual whose mesh
+file or package is missing.
 
-Gazebo's own parser drops such a block with a warning and loads the robot without it: a camera
-on a link that was commented out is simply not there, and nothing says so where the user looks.
-twin refuses the description instead, naming the reference, what it carries and the valid
-names, unless the user asks to leave them out (`--drop-dangling`, Gazebo's behaviour), when each
-is reported.
+Gazebo's own parser drops such a block with a warning in a log nobody reads, and loads the robot
+without it: a camera on a link that was commented out is simply not there; a visual whose
+package is not installed is not drawn. twin does the same and reports each where the user
+looks (the conversion report, `twin spawn`'s warnings, a failed `twin validate` check); with
+`--strict` it refuses the description instead, naming each and the fix.
 """
 
 from __future__ import annotations
@@ -74,6 +75,46 @@ def _gazebo_reference(robot: RobotDescription, name: str) -> Dangling:
         if tags:
             carries.append("tags " + ", ".join(tags))
     return Dangling(f"<gazebo reference='{name}'>", name, "link or joint", tuple(carries))
+
+
+@dataclass(frozen=True)
+class MissingVisual:
+    """A `<visual>` whose mesh file or package was not found, left out as Gazebo does.
+
+    Attributes:
+        element: where it is written, e.g. `link 'base' <visual name='shell'>`.
+        problem: the resolver's message: what was looked for, where, and the fix.
+    """
+
+    element: str
+    problem: str
+
+    def describe(self) -> str:
+        """One line: the reason and the fix, without the list of places tried."""
+        lines = [line for line in self.problem.splitlines() if not line.startswith(" ")]
+        return "; ".join(line.removesuffix("; tried:") for line in lines)
+
+
+Ignored = Dangling | MissingVisual
+
+
+def missing_visuals(robot: RobotDescription) -> list[MissingVisual]:
+    """Every visual of the robot whose mesh was not found, in link order."""
+    return [
+        MissingVisual(_visual_element(link.name, visual.name, index), visual.missing)
+        for link in robot.links
+        for index, visual in enumerate(link.visuals)
+        if visual.missing is not None
+    ]
+
+
+def ignored_parts(robot: RobotDescription) -> list[Ignored]:
+    """Everything Gazebo would load the robot without: dangling references, missing visuals."""
+    return [*dangling_references(robot), *missing_visuals(robot)]
+
+
+def _visual_element(link: str, name: str | None, index: int) -> str:
+    return f"link '{link}' <visual name='{name}'>" if name else f"link '{link}' <visual> {index}"
 
 
 def part_names(robot: RobotDescription) -> list[str]:

@@ -67,12 +67,18 @@ class Material:
 
 @dataclass(frozen=True)
 class Visual:
-    """A drawn shape of a link: pose in the link frame, geometry (None when empty), material."""
+    """A drawn shape of a link: pose in the link frame, geometry (None when empty), material.
+
+    `missing` is set when the mesh file (or its package) was not found: the geometry is then
+    None, as Gazebo draws nothing for it, and `missing` is the resolver's message (what was
+    looked for, where, and the fix), reported by `references.missing_visuals`.
+    """
 
     origin: np.ndarray = field(default_factory=identity)
     geometry: Geometry | None = None
     material: Material | None = None
     name: str | None = None
+    missing: str | None = None
 
 
 @dataclass(frozen=True)

@@ -46,7 +46,8 @@ class ConvertOptions:
     """Converter choices: keep fixed joints as bodies, repair inertias, collision-mesh plan,
     `as_written`: apply what a URDF says where Gazebo's own parser drops it (inline `<surface>`,
     link surface values on named collisions) instead of simulating what Gazebo simulates,
-    `drop_dangling`: leave out tags that name a missing link or joint instead of refusing them,
+    `strict`: refuse tags that name a missing link or joint, and visuals whose mesh is missing,
+    instead of leaving them out with a warning as Gazebo does,
     `fixed_base`: weld the root link to the world (no free joint) as a `world` link does,
     and `xacro_budget`: expand xacro in a bounded child process (a server's conversions)."""
 
@@ -54,7 +55,7 @@ class ConvertOptions:
     repair_inertia: bool = False
     collision: CollisionSettings = field(default_factory=CollisionSettings)
     as_written: bool = False
-    drop_dangling: bool = False
+    strict: bool = False
     fixed_base: bool = False
     xacro_budget: XacroBudget | None = None  # None: xacro runs in this process, unbounded
 

@@ -85,6 +85,8 @@ def plan_geoms(robot: RobotDescription, plan: BodyPlan, report: Report) -> list[
         placement = plan.placements[link.name]
         for role, items in (("visual", link.visuals), ("collision", link.collisions)):
             for index, item in enumerate(items):
+                if isinstance(item, Visual) and item.missing is not None:
+                    continue  # its mesh was not found: reported by `check_references`
                 subject = f"link '{link.name}' {role} {index}"
                 geom = _shape(item.geometry, link.name, role, subject, cache, report)
                 if geom is not None and geom[0] == "plane" and placement.body not in static:

@@ -28,7 +28,7 @@ from converters.description import (
     Visual,
 )
 from converters.description.transforms import pose_matrix
-from converters.errors import URDFStructureError
+from converters.errors import PackageNotFoundError, ResourceNotFoundError, URDFStructureError
 from converters.gazebo.blocks import parse_gazebo
 from converters.resources.packages import PackageResolver
 from converters.urdf.control import read_controls
@@ -150,15 +150,24 @@ class _LinkReader:
 
     def link(self, link: ET.Element) -> Link:
         name = link.get("name", "")
-        visuals = tuple(
-            Visual(_origin(v), self.geometry(v, name, "visual", i), self.material(v), v.get("name"))
-            for i, v in enumerate(link.findall("visual"))
-        )
+        visuals = tuple(self.visual(v, name, i) for i, v in enumerate(link.findall("visual")))
         collisions = tuple(
             Collision(_origin(c), self.geometry(c, name, "collision", i), c.get("name"))
             for i, c in enumerate(link.findall("collision"))
         )
         return Link(name, _inertial(link.find("inertial")), visuals, collisions)
+
+    def visual(self, visual: ET.Element, link: str, index: int) -> Visual:
+        """A `<visual>`; one whose mesh file or package is missing keeps no geometry and says
+        why (`Visual.missing`): Gazebo spawns the robot without drawing it. A missing collision
+        mesh still raises, as leaving it out would change the physics."""
+        missing = None
+        try:
+            geometry: Geometry | None = self.geometry(visual, link, "visual", index)
+        except (PackageNotFoundError, ResourceNotFoundError) as exc:
+            geometry, missing = None, str(exc)
+        material = self.material(visual)
+        return Visual(_origin(visual), geometry, material, visual.get("name"), missing)
 
     def geometry(self, owner: ET.Element, link: str, role: str, index: int) -> Geometry:
         """The one shape of a `<visual>`/`<collision>` (xml_checks guarantees there is one)."""

@@ -44,7 +44,7 @@ def spawn_request(
     joint: list[str] | None,
     on_ground: bool,
     repair_inertia: bool,
-    drop_dangling: bool = False,
+    strict: bool = False,
     fixed_base: bool = False,
 ) -> SpawnRequest:
     """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
@@ -66,7 +66,7 @@ def spawn_request(
         joints=pairs.joint_positions(joint) or {},
         on_ground=on_ground,
         repair_inertia=repair_inertia,
-        drop_dangling=drop_dangling,
+        strict=strict,
         fixed_base=fixed_base,
     )
 
@@ -93,13 +93,15 @@ def spawn(
     names: str | None = None,
     view: bool = False,
     repair_inertia: bool = False,
+    strict: bool = False,
     drop_dangling: bool = False,
     fixed_base: bool = False,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
     With `--at` (repeated), one entity per pose in one request, all or none; `view` also shows
-    the world in the web viewer (its URL on stderr).
+    the world in the web viewer (its URL on stderr). `drop_dangling` is the default behaviour
+    and is accepted for older scripts; `strict` refuses what it leaves out.
     """
     if name is not None:
         from twin_cli.names import name_message, name_problem
@@ -114,7 +116,7 @@ def spawn(
     else:
         pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
     request = spawn_request(
-        file, xml, arg, package, joint, on_ground, repair_inertia, drop_dangling, fixed_base
+        file, xml, arg, package, joint, on_ground, repair_inertia, strict, fixed_base
     )
     with connect_world(world, start=True) as c, _progress(world, file, json):
         if many:

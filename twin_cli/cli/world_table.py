@@ -134,10 +134,15 @@ SPAWN = Command(
             help="Bound non-physical inertias instead of failing.",
         ),
         flag(
+            "--strict",
+            dest="strict",
+            help="Refuse tags naming a missing link or joint, and visuals whose mesh is "
+            "missing, instead of leaving them out with a warning (as Gazebo does).",
+        ),
+        flag(
             "--drop-dangling",
             dest="drop_dangling",
-            help="Leave out tags naming a missing link or joint (as Gazebo does) instead of "
-            "failing.",
+            help="Leave those out with a warning: the default (kept for older scripts).",
         ),
         FIXED_BASE,
     ),

@@ -118,9 +118,14 @@ class SpawnBody(Body):
     repair_inertia: bool = Field(
         default=False, description="bound non-physical inertias instead of refusing the file"
     )
+    strict: bool = Field(
+        default=False,
+        description="refuse tags that name a missing link or joint, and visuals whose mesh is "
+        "missing, instead of leaving them out with a warning (Gazebo's behaviour)",
+    )
     drop_dangling: bool = Field(
         default=False,
-        description="leave out tags that name a missing link or joint instead of refusing them",
+        description="older clients' flag: leaving those out is the default now; not read",
     )
     fixed_base: bool = Field(
         default=False,

@@ -4,8 +4,9 @@ A missing or non-physical inertial must still reach validation as a failed model
 robot is always converted with `ConvertOptions(repair_inertia=True)`; the converter's
 `repaired` report entries then become failures (or warnings when the user passed
 `--repair-inertia`, i.e. accepted the repairs). Likewise a sensor on a link that does not exist
-must reach the `sensor_links` check, not stop the conversion, so it converts with
-`drop_dangling=True` (Gazebo's own behaviour: the block is left out and reported).
+must reach the `sensor_links` check, not stop the conversion: it converts as spawn does, without
+`strict` (Gazebo's own behaviour: the block is left out and reported), and the `ignored_parts`
+check fails naming each part left out.
 """
 
 from __future__ import annotations
@@ -49,9 +50,7 @@ def load_robot(
     from converters.pipeline import convert_full
 
     settings = CollisionSettings(mode=collision) if collision else CollisionSettings()
-    options = ConvertOptions(
-        repair_inertia=True, collision=settings, as_written=as_written, drop_dangling=True
-    )
+    options = ConvertOptions(repair_inertia=True, collision=settings, as_written=as_written)
     done = convert_full(path, args=args, package_paths=package_paths, options=options)
     return robot_from_conversion(done, path, repair_inertia=repair_inertia)
 

@@ -223,7 +223,6 @@ def load_variant(path: str, values: Mapping[str, float], opts: Mapping):
         repair_inertia=True,
         collision=CollisionSettings(mode=collision) if collision else CollisionSettings(),
         as_written=bool(opts.get("as_written")),
-        drop_dangling=True,  # as `robot.load_robot`: a dangling sensor is a failed check
     )
     file = Path(path)
     resolver = PackageResolver.create(file, opts.get("package_paths"))

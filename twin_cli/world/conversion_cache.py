@@ -116,7 +116,7 @@ def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> 
         tuple(sorted(request.package_paths.items())),
         tuple(lookup.get(name, "") for name in PACKAGE_ENVS),
         request.repair_inertia,
-        request.drop_dangling,
+        request.strict,
         request.fixed_base,
     )
 

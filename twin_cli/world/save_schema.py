@@ -95,7 +95,8 @@ class SavedEntity(Strict):
     joints: dict[str, Position] = {}
     on_ground: bool = False
     repair_inertia: bool = False
-    drop_dangling: bool = False
+    strict: bool = False
+    drop_dangling: bool = False  # written by older saves; dropping is the default now, not read
     fixed_base: bool = False
     spawn_state: Annotated[dict[str, FiniteArray], AfterValidator(_state_fields)]
 

@@ -116,7 +116,7 @@ def convert_options(request: SpawnRequest) -> ConvertOptions:
 
     return ConvertOptions(
         repair_inertia=request.repair_inertia,
-        drop_dangling=request.drop_dangling,
+        strict=request.strict,
         fixed_base=request.fixed_base,
         xacro_budget=XacroBudget.from_env(),  # a served xacro runs bounded, apart from the world
     )

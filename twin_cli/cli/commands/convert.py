@@ -34,11 +34,19 @@ RepairOpt = Annotated[
     bool,
     typer.Option("--repair-inertia", help="Bound non-physical inertias instead of failing."),
 ]
+StrictOpt = Annotated[
+    bool,
+    typer.Option(
+        "--strict",
+        help="Refuse tags naming a missing link or joint, and visuals whose mesh is missing, "
+        "instead of leaving them out with a warning (as Gazebo does).",
+    ),
+]
 DanglingOpt = Annotated[
     bool,
     typer.Option(
         "--drop-dangling",
-        help="Leave out tags naming a missing link or joint (as Gazebo does) instead of failing.",
+        help="Leave those out with a warning: the default (kept for older scripts).",
     ),
 ]
 
@@ -74,7 +82,7 @@ def _options(
     repair: bool,
     collision: dict[str, Any] | None = None,
     as_written: bool = False,
-    drop_dangling: bool = False,
+    strict: bool = False,
     fixed_base: bool = False,
 ) -> Any:
     from converters.collision.plan import CollisionSettings
@@ -85,7 +93,7 @@ def _options(
         repair,
         CollisionSettings(**(collision or {})),
         as_written=as_written,
-        drop_dangling=drop_dangling,
+        strict=strict,
         fixed_base=fixed_base,
     )
 
@@ -129,6 +137,7 @@ def convert_command(
     package: PackageOpt = None,
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
+    strict: StrictOpt = False,
     drop_dangling: DanglingOpt = False,
     fixed_base: FixedBaseOpt = False,
     print_xml: Annotated[bool, typer.Option("--print", help="Write the MJCF to stdout.")] = False,
@@ -191,9 +200,7 @@ def convert_command(
         done = convert_full(
             robot,
             **source_inputs(arg, package),
-            options=_options(
-                keep_fixed, repair_inertia, settings, as_written, drop_dangling, fixed_base
-            ),
+            options=_options(keep_fixed, repair_inertia, settings, as_written, strict, fixed_base),
         )
     if print_xml:
         typer.echo(standalone_xml(done.spec), nl=False)
@@ -225,6 +232,7 @@ def inspect_command(
     package: PackageOpt = None,
     keep_fixed: KeepFixedOpt = False,
     repair_inertia: RepairOpt = False,
+    strict: StrictOpt = False,
     drop_dangling: DanglingOpt = False,
     fixed_base: FixedBaseOpt = False,
     json_mode: JsonOpt = False,
@@ -240,7 +248,7 @@ def inspect_command(
         robot,
         **source_inputs(arg, package),
         options=_options(
-            keep_fixed, repair_inertia, {"mode": "mesh"}, as_written, drop_dangling, fixed_base
+            keep_fixed, repair_inertia, {"mode": "mesh"}, as_written, strict, fixed_base
         ),
     )
     stats = inertial_stats(done.spec, done.description)
