@@ -94,9 +94,11 @@ class DriveController:
 
     # ------------------------------------------------------------------ commands
     def _start(self) -> None:
-        """Odometry frame = the entity's pose now (Gazebo's encoder odometry starts at zero)."""
+        """Encoder odometry starts at zero, as every Gazebo drive's does: its odometry frame is
+        the base's pose now (`origin`, in the world)."""
         pose = self.world.get_pose(self.entity)
-        self.encoder = Pose2D(pose.x, pose.y, pose.yaw)
+        self.origin = Pose2D(pose.x, pose.y, pose.yaw)
+        self.encoder = Pose2D(0.0, 0.0, 0.0)
         self.last_time = float(self.world.data.time)
 
     def command(self, twist: Twist, duration: float | None) -> None:
