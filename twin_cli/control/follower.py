@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import threading
 import weakref
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from twin_cli.control.trajectory import Trajectory, TrajectoryPoint, sample, segment
@@ -35,7 +35,8 @@ BLOCK = 100  # updates whose references are sampled at once (1 s at 100 Hz)
 
 @dataclass
 class TrackingReport:
-    """Tracking errors [rad or m] by joint: the largest over the run and the one at the end."""
+    """Tracking errors [rad or m] by joint: the largest over the run and the one at the end;
+    `clamped`: the largest move [rad or m] of a waypoint onto the joint's limit, by joint."""
 
     entity: str
     joint_names: tuple[str, ...]
@@ -44,6 +45,7 @@ class TrackingReport:
     elapsed: float = 0.0
     max_error: dict[str, float] = field(default_factory=dict)
     final_error: dict[str, float] = field(default_factory=dict)
+    clamped: dict[str, float] = field(default_factory=dict)  # largest move onto a limit
 
     def to_dict(self) -> dict:
         return {
@@ -54,6 +56,7 @@ class TrackingReport:
             "elapsed": self.elapsed,
             "max_error": dict(self.max_error),
             "final_error": dict(self.final_error),
+            "clamped": dict(self.clamped),
         }
 
 
@@ -61,24 +64,27 @@ class TrajectoryFollower:
     """Follows one trajectory on one entity of a World (see module docstring)."""
 
     def __init__(self, world: World, entity: str, trajectory: Trajectory, rate: float) -> None:
-        self.world, self.entity, self.trajectory = world, entity, trajectory
-        self.report = TrackingReport(entity, trajectory.joint_names, trajectory.duration)
+        self.world, self.entity = world, entity
         with world.lock:
-            _check_points(world, entity, trajectory)
+            self.trajectory, clamped = _check_points(world, entity, trajectory)
+            self.report = TrackingReport(
+                entity, trajectory.joint_names, trajectory.duration, clamped=clamped
+            )
             states = {s.name: s.position for s in world.joint_states(entity)}
             for joint in trajectory.joint_names:
                 if joint not in states:
                     raise PartNotFoundError(entity, "joint", joint, list(states))
-            self.start = tuple(states[j] for j in trajectory.joint_names)
-            commands = world.command_joints(
-                entity, dict(zip(trajectory.joint_names, self.start, strict=True)), mode="position"
-            )
+            # the start state is never refused (an arm may rest just past a limit, as the
+            # controller takes it): the hold is clamped into the range, and so is the start
+            start = {j: states[j] for j in trajectory.joint_names}
+            commands = world.command_joints(entity, start, mode="position", clip=True)
+            self.start = tuple(c.target for c in commands)
             self.keys = [c.actuator for c in commands]
             self._held = commands  # the servos it claimed, as the world holds them
             self._qpos_model, self.qpos = world.model, self._addresses(world.model)
             self.t0 = float(world.data.time)
             self._model, self._ids, self._last = None, None, None
-            self._block = _References(trajectory, self.start, rate)
+            self._block = _References(self.trajectory, self.start, rate)
             self._period = 1.0 / UPDATE_RATE  # [s] ahead of the reference each target is
             self._max: np.ndarray | None = None  # the largest error so far, per joint
             self.handle = world.add_observer(self._update, rate)
@@ -185,41 +191,67 @@ class TrajectoryFollower:
             self.world.record_targets(self._halt(), held=held)
 
 
-def _check_points(world: World, entity: str, trajectory: Trajectory) -> None:
-    """Refuses positions outside a joint's range or velocities past its limit (world unchanged)."""
-    from twin_cli.world.joint_control import allowed_range, limits_of
+def _check_points(
+    world: World, entity: str, trajectory: Trajectory
+) -> tuple[Trajectory, dict[str, float]]:
+    """The trajectory as it will be followed: a position at most `LIMIT_TOLERANCE` past its
+    joint's range is clamped onto it, as ros2_control's joint limiters clamp a controller's
+    commands; with, by joint, the largest such move [rad or m]. Refuses positions further out
+    and velocities past the joint's limit (world unchanged)."""
+    from twin_cli.world.joint_control import onto_range
 
     world.index_of(entity)  # raises EntityNotFoundError
-    model = world.model
+    columns, clamped = [], {}
     for i, joint in enumerate(trajectory.joint_names):
-        j = model.joint(f"{entity}/{joint}").id if f"{entity}/{joint}" in _names(model) else -1
-        if j < 0:
-            continue  # command_joints names the unknown joint with the known ones
-        limits = limits_of(model, entity, joint)
-        if "position" not in limits.modes:
-            raise InvalidRequestError(
-                f"trajectory joint [{joint}] of [{entity}]",
-                f"its tags offer only {', '.join(limits.modes)}, and a trajectory drives "
-                "position interfaces",
-                f"leave it out of joint_names, or drive it with twin command --mode "
-                f"{limits.modes[0]}",
-            )
-        low, high = allowed_range(model, j, "position", limits, math.inf)
+        low, high, velocity = _joint_bounds(world.model, entity, joint)
+        column = []
         for k, point in enumerate(trajectory.points):
+            where = f"trajectory point {k} joint [{joint}] of [{entity}]"
             value = point.positions[i]
-            if not low <= value <= high:
+            near = onto_range(value, low, high)
+            if near is None:
                 raise InvalidRequestError(
-                    f"trajectory point {k} joint [{joint}] of [{entity}]",
+                    where,
                     f"position {value:g} is outside [{low:g}, {high:g}]",
                     "keep positions inside the joint's range",
                 )
+            if near != value:
+                clamped[joint] = max(clamped.get(joint, 0.0), abs(near - value))
+            column.append(near)
             speed = point.velocities[i] if point.velocities else 0.0
-            if abs(speed) > limits.velocity:
+            if abs(speed) > velocity:
                 raise InvalidRequestError(
-                    f"trajectory point {k} joint [{joint}] of [{entity}]",
-                    f"velocity {speed:g} exceeds the limit {limits.velocity:g}",
+                    where, f"velocity {speed:g} exceeds the limit {velocity:g}",
                     "slow the trajectory down",
-                )
+                )  # fmt: skip
+        columns.append(column)
+    points = tuple(
+        replace(p, positions=tuple(column[k] for column in columns))
+        for k, p in enumerate(trajectory.points)
+    )
+    return replace(trajectory, points=points), clamped
+
+
+def _joint_bounds(model: mujoco.MjModel, entity: str, joint: str) -> tuple[float, float, float]:
+    """A trajectory joint's position range [rad or m] and velocity limit (unbounded for a joint
+    the model lacks: command_joints names it with the known ones).
+
+    Raises: InvalidRequestError: the joint offers no position interface."""
+    from twin_cli.world.joint_control import allowed_range, limits_of
+
+    if f"{entity}/{joint}" not in _names(model):
+        return -math.inf, math.inf, math.inf
+    limits = limits_of(model, entity, joint)
+    if "position" not in limits.modes:
+        raise InvalidRequestError(
+            f"trajectory joint [{joint}] of [{entity}]",
+            f"its tags offer only {', '.join(limits.modes)}, and a trajectory drives "
+            "position interfaces",
+            f"leave it out of joint_names, or drive it with twin command --mode {limits.modes[0]}",
+        )
+    j = model.joint(f"{entity}/{joint}").id
+    low, high = allowed_range(model, j, "position", limits, math.inf)
+    return low, high, limits.velocity
 
 
 def _names(model: mujoco.MjModel) -> set[str]:

@@ -94,7 +94,8 @@ def command_joints(
     Raises:
         EntityNotFoundError, PartNotFoundError: unknown entity or actuated joint.
         InvalidRequestError: unknown mode, a mode the joint does not offer, or (unless
-            `clip`) a value outside the joint's limits. On any
+            `clip`) a value outside the joint's limits (a position at most
+            `joint_control.LIMIT_TOLERANCE` past its range is clamped onto it). On any
             error no command changes.
     """
     for joint, value in targets.items():
@@ -125,8 +126,11 @@ def _checked(
     old = state.commands.get(key)
     effort = old.effort if old else control.effort_limit(state.model, a)
     low, high = joint_control.allowed_range(state.model, j, mode, limits, effort)
+    near = joint_control.onto_range(value, low, high) if mode == "position" else None
     if clip:
         value = min(max(value, low), high)
+    elif near is not None:  # on or just past a limit: clamped onto it, as ros2_control does
+        value = near
     elif not low <= value <= high:
         raise InvalidRequestError(
             f"{mode} command for joint [{joint}] of [{name}]",

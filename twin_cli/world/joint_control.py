@@ -32,6 +32,10 @@ from twin_cli.world import servos
 MAX_OMEGA_DT = 0.5
 SPEED_MARGIN = 0.95  # position servo's design speed, as a fraction of the velocity limit
 FULL_EFFORT_SPEED = 1.0  # [rad/s or m/s] velocity error at full effort without a velocity limit
+# [rad or m] how far past a limit a position is still taken and clamped onto it: ros2_control's
+# joint limiters accept a measured position this far out (joint_limits_helpers.hpp
+# OUT_OF_BOUNDS_EXCEPTION_TOLERANCE: 0.5 degree, about 1 cm) and clamp commands into the range
+LIMIT_TOLERANCE = 0.0087
 
 
 @dataclass(frozen=True)
@@ -328,3 +332,11 @@ def allowed_range(
     if mode == "effort":
         return -effort, effort
     return -math.inf, math.inf
+
+
+def onto_range(value: float, low: float, high: float) -> float | None:
+    """A position [rad or m] clamped into [low, high] when it is at most LIMIT_TOLERANCE outside
+    (a joint resting on its limit, a target read from one); None when it is further out."""
+    if low - LIMIT_TOLERANCE <= value <= high + LIMIT_TOLERANCE:
+        return min(max(value, low), high)
+    return None
