@@ -90,6 +90,7 @@ def robot_from_conversion(
         link_names=tuple(link.name for link in done.description.links),
         geom_links={g.geom: g.link for g in done.provenance.geoms if g.geom},
         unplaced_sensors=unplaced_sensors(done.description),
+        ignored_parts=ignored_parts(done.description),
         self_collide_links=frozenset(n for n, e in gazebo.links.items() if e.self_collide),
         model_self_collide=bool(gazebo.self_collide),
     )
@@ -104,6 +105,20 @@ def unplaced_sensors(description: RobotDescription) -> tuple[UnplacedSensor, ...
         for reference, ext in description.gazebo.links.items()
         if reference not in links
         for blob in ext.sensors
+    )
+
+
+def ignored_parts(description: RobotDescription) -> tuple[str, ...]:
+    """What Gazebo loads the robot without, one line each naming the element and the fix."""
+    from converters.description.references import Dangling, part_names
+    from converters.description.references import ignored_parts as found
+
+    names = ", ".join(part_names(description)[:30])
+    return tuple(
+        f"{part.describe()}; name one of its links or joints ({names}) or remove it"
+        if isinstance(part, Dangling) and not part.closes_loop
+        else part.describe()
+        for part in found(description)
     )
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from twin_cli.validate.checks import (
     model_collision,
     model_effort,
+    model_ignored,
     model_inertia,
     model_joints,
     model_sensors,
@@ -62,6 +63,7 @@ CHECKS: dict[str, Check] = {
         _check("joint_definitions", "model", model_joints.check_joint_definitions),
         _check("gravity_hold", "model", model_effort.check_gravity_hold, min_effort_ratio=1.0),
         _check("sensor_links", "model", model_sensors.check_sensor_links),
+        _check("ignored_parts", "model", model_ignored.check_ignored_parts),
         _check("gravity", "physics", physics_gravity.check_gravity, rel_tol=0.01),
         _check(
             "zero_gravity",

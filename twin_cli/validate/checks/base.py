@@ -155,7 +155,9 @@ class RobotUnderTest:
     inertia repairs (then repairs are warnings, not failures). `declared_joints` are the
     URDF's own joint values (empty for MJCF input). `link_names` are the description's links,
     `geom_links` the link each named geom was declared on,
-    `unplaced_sensors` its sensors on links it does not have, `self_collide_links` the links
+    `unplaced_sensors` its sensors on links it does not have, `ignored_parts` what Gazebo
+    loads it without (tags naming a missing part, visuals whose mesh is missing; one line
+    each, with the fix), `self_collide_links` the links
     with Gazebo selfCollide and `model_self_collide` the model's `<self_collide>` (all empty
     for MJCF input).
     """
@@ -172,6 +174,7 @@ class RobotUnderTest:
     link_names: tuple[str, ...] = ()
     geom_links: dict[str, str] = field(default_factory=dict)  # geom name → the link it came from
     unplaced_sensors: tuple[UnplacedSensor, ...] = ()
+    ignored_parts: tuple[str, ...] = ()
     self_collide_links: frozenset[str] = frozenset()
     model_self_collide: bool = False
 
