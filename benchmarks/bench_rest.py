@@ -48,7 +48,6 @@ def corpus_request(robot: dict):  # noqa: ANN201 (SpawnRequest, imported lazily)
         package_paths=packages,
         args=robot["xacro_args"],
         repair_inertia=robot["id"] in NON_PHYSICAL_INERTIA,
-        drop_dangling=True,
         on_ground=True,
     )
 

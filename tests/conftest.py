@@ -11,7 +11,6 @@ from corpus_registry import (
     CORPUS,
     CORPUS_MISSING,
     CORPUS_ROOT,
-    DANGLING,
     NON_PHYSICAL_INERTIA,
     PACKAGES_ROOT,
     REPO_ROOT,
@@ -70,7 +69,6 @@ def converted_corpus(corpus_root: Path) -> Callable[[str], Any]:
             robot = CORPUS[robot_id]
             options = ConvertOptions(
                 repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
-                drop_dangling=robot_id in DANGLING,
                 collision=CollisionSettings(mode="hull"),
             )
             cache[robot_id] = convert_full(

@@ -33,8 +33,8 @@ def corpus_robots() -> list[dict[str, Any]]:
 CORPUS = {robot["id"]: robot for robot in corpus_robots()}
 # Robots whose upstream inertias are non-physical: they must fail, then convert with repair.
 NON_PHYSICAL_INERTIA = ("abb_irb2400_12_155", "anymal_c", "hyq")
-# Robots whose <gazebo reference>s name a link they do not have: refused, then converted with
-# --drop-dangling (robots.toml measured them).
+# Robots whose <gazebo reference>s name a link they do not have: converted without those tags,
+# with a warning, as Gazebo loads them; refused with --strict (robots.toml measured them).
 DANGLING = tuple(
     robot_id
     for robot_id, robot in CORPUS.items()

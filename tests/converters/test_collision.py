@@ -251,7 +251,7 @@ def test_corpus_robot_converts_with_auto_collision(robot_id, corpus_cache, monke
     settings = CollisionSettings(preset="fast", jobs=2, time_limit=CORPUS_TIME_LIMIT)
     # Inertia repair is the core converter's concern (anymal_c, abb need it); this test is
     # about collision meshes.
-    options = ConvertOptions(repair_inertia=True, drop_dangling=True, collision=settings)
+    options = ConvertOptions(repair_inertia=True, collision=settings)
     spec, report = convert(
         packages / robot["entry"],
         args=robot["xacro_args"],

@@ -56,7 +56,6 @@ def test_corpus_robot_converts_through_ros_package_path(
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(PACKAGES_ROOT))
     options = ConvertOptions(
         repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
-        drop_dangling=robot_id in DANGLING,
         collision=CollisionSettings(mode="mesh"),
     )
     done = convert_full(PACKAGES_ROOT / robot["entry"], args=robot["xacro_args"], options=options)
@@ -94,29 +93,29 @@ def test_non_physical_inertia_fails_with_link_named_and_converts_with_repair(
 
 
 @pytest.mark.parametrize("robot_id", corpus_ids(DANGLING))
-def test_a_reference_to_a_missing_link_is_refused_then_left_out_with_drop_dangling(
+def test_a_reference_to_a_missing_link_is_left_out_with_a_warning_and_refused_when_strict(
     robot_id: str, converted_corpus
 ) -> None:
     from converters.errors import DanglingReferenceError
+    from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import convert_full
     from converters.report import Outcome
 
     robot = CORPUS[robot_id]
     missing = robot["gazebo_references_to_missing_links"]
+    warned = [e.subject for e in converted_corpus(robot_id).report.of(Outcome.WARNING)]
+    for link in missing:
+        assert f"<gazebo reference='{link}'>" in warned, f"{robot_id}: {warned}"
     with pytest.raises(DanglingReferenceError) as caught:
         convert_full(
             PACKAGES_ROOT / robot["entry"],
             args=robot["xacro_args"],
             package_paths=package_paths(robot),
-            options=_repair(robot_id),
+            options=ConvertOptions(repair_inertia=robot_id in NON_PHYSICAL_INERTIA, strict=True),
         )
     message = str(caught.value)
-    for link in missing:
-        assert f"<gazebo reference='{link}'>" in message, message
-    assert "--drop-dangling" in message and converted_corpus(robot_id).description.links[0].name
-    warned = [e.subject for e in converted_corpus(robot_id).report.of(Outcome.WARNING)]
-    for link in missing:
-        assert f"<gazebo reference='{link}'>" in warned, f"{robot_id}: {warned}"
+    for part in [*(f"<gazebo reference='{link}'>" for link in missing), "without --strict"]:
+        assert part in message, f"{robot_id}: {part!r} missing from {message!r}"
 
 
 def _repair(robot_id: str):  # noqa: ANN202

@@ -394,22 +394,24 @@ TRANSMISSION = """<transmission name="t"><type>transmission_interface/SimpleTran
     ],
     ids=["tags", "sensor", "transmission"],
 )
-def test_a_reference_to_a_missing_part_is_refused_naming_it_and_the_valid_names(
+def test_a_reference_to_a_missing_part_is_refused_when_strict_naming_it_and_the_valid_names(
     tmp_path, tags: str, named: list[str]
 ):
     from converters.errors import DanglingReferenceError
 
+    path = tmp_path / "tagbot.urdf"
+    path.write_text(tagbot(tags))
     with pytest.raises(DanglingReferenceError) as caught:
-        _convert(tmp_path, tags)
+        convert_full(path, options=ConvertOptions(strict=True))
     message = str(caught.value)
-    for part in [*named, "does not exist", "base, arm", "--drop-dangling", "tagbot.urdf"]:
+    for part in [*named, "does not exist", "base, arm", "without --strict", "tagbot.urdf"]:
         assert part in message, f"{part!r} missing from {message!r}"
 
 
-def test_drop_dangling_leaves_the_reference_out_and_reports_it(tmp_path):
+def test_a_reference_to_a_missing_part_is_left_out_and_reported(tmp_path):
     path = tmp_path / "tagbot.urdf"
     path.write_text(tagbot(_ref("lidar_linkk", LIDAR) + _ref("arm", "<mu1>0.25</mu1>")))
-    done = convert_full(path, options=ConvertOptions(drop_dangling=True))
+    done = convert_full(path)
     warnings = [e for e in done.report.of(Outcome.WARNING) if "lidar_linkk" in e.subject]
     assert warnings and "sensor 'front_lidar'" in warnings[0].detail, warnings
     assert not done.sensors, "the lidar on a missing link is left out"

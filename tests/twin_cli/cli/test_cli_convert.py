@@ -77,14 +77,14 @@ BAD_INPUTS = {
         '<robot name="r"><link name="a"><inertial><mass value="heavy"/></inertial></link></robot>',
         ["link 'a'", "'heavy'"],
     ),
-    "missing_mesh": (
-        '<robot name="r"><link name="a"><visual><geometry><mesh filename='
-        '"meshes/nothere.stl"/></geometry></visual></link></robot>',
+    "missing_collision_mesh": (  # a missing visual mesh is left out instead, as in Gazebo
+        '<robot name="r"><link name="a"><collision><geometry><mesh filename='
+        '"meshes/nothere.stl"/></geometry></collision></link></robot>',
         ["nothere.stl", "link 'a'"],
     ),
-    "unknown_package": (
-        '<robot name="r"><link name="a"><visual><geometry><mesh filename='
-        '"package://no_such_pkg/m.stl"/></geometry></visual></link></robot>',
+    "unknown_collision_package": (
+        '<robot name="r"><link name="a"><collision><geometry><mesh filename='
+        '"package://no_such_pkg/m.stl"/></geometry></collision></link></robot>',
         ["no_such_pkg", "package://no_such_pkg/m.stl", "link 'a'", "tried"],
     ),
     "huge_inertia": (

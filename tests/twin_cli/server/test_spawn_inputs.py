@@ -70,25 +70,3 @@ def test_spawn_repairs_inertia_when_asked_as_its_refusal_says(world, tmp_path):
     client, _ = world
     assert "b1" in [e["name"] for e in client.entities()]
     assert "b0" not in [e["name"] for e in client.entities()]
-
-
-def test_spawn_refuses_a_sensor_on_a_missing_link_and_drops_it_when_asked(world, tmp_path):
-    """A lidar on `lidar_linkk` (a typo): refused on the terminal with the sensor and the link
-    named; `--drop-dangling`, the fix the message names, spawns the robot without it and says so."""
-    lidar = (
-        '<gazebo reference="lidar_linkk"><sensor type="ray" name="front_lidar"><ray><scan>'
-        "<horizontal><samples>8</samples></horizontal></scan><range><min>0.1</min>"
-        "<max>5</max></range></ray></sensor></gazebo>"
-    )
-    robot = tmp_path / "scanner.urdf"
-    robot.write_text(BASE.format(izz="0.01").replace("</robot>", lidar + "</robot>"))
-    refused = _spawn(str(robot), "--name", "c0", env={})
-    assert refused.returncode == 2 and "Traceback" not in refused.stderr, refused.stderr
-    for part in ("lidar_linkk", "sensor 'front_lidar'", "base", "--drop-dangling"):
-        assert part in refused.stderr, f"{part!r} missing from {refused.stderr!r}"
-    done = _spawn(str(robot), "--name", "c1", "--drop-dangling", env={})
-    assert done.returncode == 0 and done.stdout.strip() == "c1", done.stderr
-    assert "lidar_linkk" in done.stderr and "left out" in done.stderr, done.stderr
-    client, _ = world
-    names = [e["name"] for e in client.entities()]
-    assert "c1" in names and "c0" not in names, names

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from corpus_registry import (
     CORPUS,
-    DANGLING,
     NON_PHYSICAL_INERTIA,
     PACKAGES_ROOT,
     corpus_ids_expecting,
@@ -52,7 +51,6 @@ def corpus_spawn_request(robot_id: str) -> SpawnRequest:
         package_paths={k: str(v) for k, v in package_paths(robot).items()},
         args=robot["xacro_args"],
         repair_inertia=robot_id in NON_PHYSICAL_INERTIA,
-        drop_dangling=robot_id in DANGLING,
         on_ground=True,
     )
 
