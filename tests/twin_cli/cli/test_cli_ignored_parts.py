@@ -164,6 +164,27 @@ def test_spawn_leaves_out_what_gazebo_ignores_with_a_warning_and_strict_refuses(
     assert "p1" in names and "p3" in names and "p2" not in names, names
 
 
+def test_a_save_of_older_twin_with_drop_dangling_loads_and_a_new_save_records_strict(
+    world, tmp_path
+):
+    """Saves written before dropping was the default carry `drop_dangling`; they still load."""
+    path = write(tmp_path, robot_urdf())
+    assert spawn(path, "--name", "saved").returncode == 0
+    save = tmp_path / "world.json"
+    done = twin("save", save, "--world", WORLD)
+    assert done.returncode == 0, done.stderr
+    saved = json.loads(save.read_text())
+    (entity,) = [e for e in saved["entities"] if e["name"] == "saved"]
+    assert entity["strict"] is False and "drop_dangling" not in entity, entity.keys()
+    for e in saved["entities"]:
+        e.pop("strict")
+        e["drop_dangling"] = True  # as an older twin wrote it
+    save.write_text(json.dumps(saved))
+    done = twin("load", save, "--world", WORLD)
+    assert done.returncode == 0, done.stderr
+    assert "saved" in entity_names(world), entity_names(world)
+
+
 @pytest.mark.parametrize("robot_id", corpus_ids(DANGLING))
 def test_corpus_robot_with_dangling_references_spawns_with_a_warning(world, robot_id):
     """The corpus robots whose Gazebo tags name a link they lack (a quadruped, a small arm)."""
