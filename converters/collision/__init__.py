@@ -1,7 +1,7 @@
 """Collision meshes: which stay whole, become convex hulls, or are decomposed by CoACD.
 
 `plan` holds the settings and the per-mesh rule, `prepare` carries the plan out (cache, hulls,
-CoACD jobs, fallbacks), `decompose` and `worker` run CoACD in time-limited processes, `hulls`
+CoACD jobs, fallbacks), `decompose` and `worker` run CoACD in CPU-budgeted processes, `hulls`
 computes hulls and volumes, `cache` stores results on disk, `progress` shows them.
 """
 

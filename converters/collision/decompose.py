@@ -1,16 +1,27 @@
-"""CoACD convex decomposition in worker processes: parallel, time-limited, crash-proof.
+"""CoACD convex decomposition in worker processes: parallel, CPU-budgeted, crash-proof.
 
 CoACD is C++ that can abort the whole process on some inputs, so every mesh is
 decomposed in its own child process (`converters.collision.worker`), started with
 `subprocess` rather than `multiprocessing`: no re-import of the caller's `__main__`, no fork
 of a process that may run server threads. Job and result travel as .npz files in a private
-temporary directory, so a child never blocks on a full pipe. A child that dies (abort,
-segfault, kill), exits with an error, or outlives its time limit (it is killed) yields a
-`DecomposeOutcome` with `failure` set and no parts; the caller falls back to the convex hull.
+temporary directory, so a child never blocks on a full pipe.
+
+A mesh's budget is CPU time, counted by the kernel for the worker's CoACD call alone (all its
+threads): the worker arms `ITIMER_PROF`, whose SIGPROF ends it when the budget is spent. CPU
+time does not grow with the machine's load the way wall-clock time does (measured on a 16-section
+cup, fast preset: 3.0-3.4 CPU s idle and beside two busy loops, while wall time went from 4 s
+to 15 s), so a mesh is decomposed or not the same way on an idle and a busy machine. A
+wall-clock backstop (`WALL_BACKSTOP_FACTOR` times the budget, at least `WALL_BACKSTOP_MIN_S`)
+only catches a worker that hangs without using CPU.
+
+A child that dies (abort, segfault, kill), exits with an error, spends its budget or passes the
+backstop yields a `DecomposeOutcome` with `failure` set and no parts; the caller falls back to
+the convex hull.
 """
 
 from __future__ import annotations
 
+import enum
 import json
 import os
 import signal
@@ -27,6 +38,8 @@ from typing import Any
 import numpy as np
 
 from converters.collision.cache import unpack_parts
+from converters.collision.plan import DEFAULT_CPU_LIMIT
+from converters.collision.worker import CPU_SIGNAL
 
 # Test-only hook: "<fault>:<request key>" (or "<fault>:*"), comma-separated, makes the worker
 # for that mesh misbehave (fault = crash | kill | abort | hang | error), so tests exercise real
@@ -35,6 +48,21 @@ FAULT_ENV = "TWIN_TEST_COACD_FAULT"
 FAULTS = ("crash", "kill", "abort", "hang", "error")
 # How often the parent looks at running workers [s].
 POLL_S = 0.02
+# Wall-clock backstop: a worker still running after this many times its CPU budget, and at
+# least WALL_BACKSTOP_MIN_S, is taken as hung (two busy loops on two cores stretched a 3 CPU s
+# run to 15 s wall; ten times leaves room for a far busier machine) [s].
+WALL_BACKSTOP_FACTOR = 10.0
+WALL_BACKSTOP_MIN_S = 60.0
+# libgomp's idle threads spin by default, burning CPU time that grows with the machine's load;
+# passive waiting keeps the CPU time a function of the work (3.27 -> 3.02 CPU s, two threads).
+WORKER_ENV = {"OMP_WAIT_POLICY": "PASSIVE"}
+
+
+class Stop(enum.Enum):
+    """Why a worker was stopped before it finished."""
+
+    CPU = "cpu"  # spent its CPU budget: the same mesh and budget stop again on any machine
+    WALL = "wall"  # passed the wall-clock backstop: a hang or an overloaded machine
 
 
 @dataclass(frozen=True)
@@ -52,16 +80,30 @@ class DecomposeJob:
 class DecomposeOutcome:
     """What became of one job: parts as (vertices [m], faces) pairs, or a failure reason.
 
-    `timed_out` marks a worker stopped at the time limit: the same mesh, parameters and limit
-    would time out again, so that fallback may be cached; a crash may come from outside
-    (out-of-memory killer, Ctrl-C), so it is retried.
+    `seconds` is the worker's wall time [s], `cpu_seconds` the CPU time of its CoACD call
+    [CPU s] (None when it never finished one), `stopped` why it was stopped, if it was.
     """
 
     key: str
     parts: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
     seconds: float = 0.0
     failure: str | None = None
-    timed_out: bool = False
+    stopped: Stop | None = None
+    cpu_seconds: float | None = None
+
+
+@dataclass(frozen=True)
+class Limits:
+    """A worker's budget: `cpu` [CPU s] for CoACD's call, `wall` [s] for the whole process."""
+
+    cpu: float
+    wall: float
+
+    @classmethod
+    def for_cpu(cls, cpu: float, wall: float | None = None) -> Limits:
+        """`cpu` with the default backstop (or the given `wall` [s])."""
+        backstop = max(WALL_BACKSTOP_FACTOR * cpu, WALL_BACKSTOP_MIN_S)
+        return cls(cpu, backstop if wall is None else wall)
 
 
 @dataclass
@@ -89,7 +131,7 @@ def fault_for(key: str) -> str | None:
     return None
 
 
-def _start(job: DecomposeJob, index: int, workdir: Path, threads: int) -> _Running:
+def _start(job: DecomposeJob, index: int, workdir: Path, threads: int, cpu: float) -> _Running:
     job_path, result = workdir / f"job{index}.npz", workdir / f"result{index}.npz"
     np.savez(
         job_path,
@@ -97,9 +139,11 @@ def _start(job: DecomposeJob, index: int, workdir: Path, threads: int) -> _Runni
         faces=np.asarray(job.faces, np.int32),
         params=np.array(json.dumps(job.params)),
         fault=np.array(job.fault or ""),
+        cpu_limit=np.array(float(cpu)),
     )
     errors = workdir / f"errors{index}.txt"
-    env = {**os.environ, "OMP_NUM_THREADS": str(threads)}  # libgomp reads it when coacd loads
+    # libgomp reads these when coacd loads.
+    env = {**os.environ, **WORKER_ENV, "OMP_NUM_THREADS": str(threads)}
     with open(errors, "wb") as err:
         process = subprocess.Popen(
             [sys.executable, "-m", "converters.collision.worker", str(job_path), str(result)],
@@ -111,35 +155,42 @@ def _start(job: DecomposeJob, index: int, workdir: Path, threads: int) -> _Runni
     return _Running(job, process, result, errors, time.perf_counter())
 
 
-def _collect(run: _Running) -> DecomposeOutcome:
+def _collect(run: _Running, limits: Limits) -> DecomposeOutcome:
     """Turn a finished worker's exit status and files into an outcome."""
     elapsed = time.perf_counter() - run.started
-    code = run.process.returncode
+    code, key = run.process.returncode, run.job.key
     if code == 0 and run.result.exists():
         with np.load(run.result, allow_pickle=False) as data:
             parts = unpack_parts(data, int(data["count"]))
-        return DecomposeOutcome(run.job.key, parts=parts, seconds=elapsed)
+            cpu = float(data["cpu_seconds"])
+        return DecomposeOutcome(key, parts=parts, seconds=elapsed, cpu_seconds=cpu)
+    if CPU_SIGNAL is not None and code == -CPU_SIGNAL:
+        failure = f"CoACD used its {limits.cpu:g} CPU s budget and was stopped"
+        return DecomposeOutcome(key, [], elapsed, failure, Stop.CPU, limits.cpu)
     if code is not None and code < 0:
         failure = f"CoACD worker killed by signal {signal.Signals(-code).name}"
     else:
         tail = run.errors.read_text(errors="replace").strip().splitlines()[-1:]
         failure = f"CoACD worker exited with status {code}" + (f": {tail[0]}" if tail else "")
-    return DecomposeOutcome(run.job.key, seconds=elapsed, failure=failure)
+    return DecomposeOutcome(key, seconds=elapsed, failure=failure)
 
 
-def _kill(run: _Running, time_limit: float) -> DecomposeOutcome:
+def _kill(run: _Running, limits: Limits) -> DecomposeOutcome:
     run.process.kill()
     run.process.wait()
-    reason = f"CoACD exceeded the {time_limit:g} s time limit and was stopped"
+    reason = (
+        f"CoACD was still running after {limits.wall:g} s of wall-clock time, within its "
+        f"{limits.cpu:g} CPU s budget (hung, or the machine is overloaded), and was stopped"
+    )
     seconds = time.perf_counter() - run.started
-    return DecomposeOutcome(run.job.key, seconds=seconds, failure=reason, timed_out=True)
+    return DecomposeOutcome(run.job.key, seconds=seconds, failure=reason, stopped=Stop.WALL)
 
 
 def decompose_all(
     jobs: list[DecomposeJob],
     *,
     workers: int | None = None,
-    time_limit: float = 20.0,
+    limits: Limits | None = None,
     on_done: Callable[[DecomposeOutcome], None] | None = None,
 ) -> dict[str, DecomposeOutcome]:
     """Decompose every job, at most `workers` at a time, each in its own process.
@@ -148,7 +199,7 @@ def decompose_all(
         jobs: meshes to decompose.
         workers: processes at once (default: all cores); each gets cores // workers OpenMP
             threads, so a single worker still uses the whole machine.
-        time_limit: seconds one mesh may take before its worker is killed [s].
+        limits: each mesh's CPU budget and wall-clock backstop (default: DEFAULT_CPU_LIMIT).
         on_done: called in this process as each job finishes (progress display).
 
     Returns:
@@ -156,6 +207,7 @@ def decompose_all(
     """
     if not jobs:
         return {}
+    limits = limits or Limits.for_cpu(DEFAULT_CPU_LIMIT)
     workers = max(1, min(workers or default_jobs(), len(jobs)))
     threads = max(1, default_jobs() // workers)
     pending, running, done = deque(enumerate(jobs)), [], {}
@@ -164,10 +216,10 @@ def decompose_all(
             while pending or running:
                 while pending and len(running) < workers:
                     index, job = pending.popleft()
-                    running.append(_start(job, index, Path(tmp), threads))
+                    running.append(_start(job, index, Path(tmp), threads, limits.cpu))
                 time.sleep(POLL_S)
                 for run in list(running):
-                    outcome = _check(run, time_limit)
+                    outcome = _check(run, limits)
                     if outcome is not None:
                         running.remove(run)
                         done[outcome.key] = outcome
@@ -180,10 +232,10 @@ def decompose_all(
     return done
 
 
-def _check(run: _Running, time_limit: float) -> DecomposeOutcome | None:
+def _check(run: _Running, limits: Limits) -> DecomposeOutcome | None:
     """The outcome of a worker that has finished or overrun, else None (still working)."""
     if run.process.poll() is not None:
-        return _collect(run)
-    if time.perf_counter() - run.started > time_limit:
-        return _kill(run, time_limit)
+        return _collect(run, limits)
+    if time.perf_counter() - run.started > limits.wall:
+        return _kill(run, limits)
     return None

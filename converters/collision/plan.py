@@ -18,6 +18,7 @@ The `auto` rule (per mesh, first match wins):
 from __future__ import annotations
 
 import enum
+import os
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
@@ -83,10 +84,13 @@ HEAVY_CAPS = {
     "mcts_iterations": 50,
     "mcts_max_depth": 2,
 }
-# Default per-mesh CoACD time limit [s]: keeps a cold conversion of the corpus's heaviest mesh
-# robot (open_manipulator_x) under ~60 s on 2 cores; a mesh past it falls back to its hull,
-# and that fallback is cached under this limit.
-DEFAULT_TIME_LIMIT = 20.0
+# Default CPU budget of one mesh's CoACD run [CPU s], counted by the kernel in the worker
+# (`converters.collision.worker`), so the same on an idle and a busy machine; a mesh past it
+# falls back to its hull, said in the report and never cached.
+DEFAULT_CPU_LIMIT = 20.0
+# Overrides DEFAULT_CPU_LIMIT for every conversion of a process that does not give its own
+# (`twin serve --coacd-cpu-limit` sets it for the world's file and the spawns into it) [CPU s].
+CPU_LIMIT_ENV = "TWIN_COACD_CPU_LIMIT"
 
 
 @dataclass(frozen=True)
@@ -119,8 +123,10 @@ class CollisionSettings:
 
     `threshold` is CoACD's relative concavity threshold (0.01-1); `threshold_m` gives it in
     metres instead and is converted per mesh (see COACD_THRESHOLD_RANGE). `max_hull_vertices`
-    caps every hull and part (default: the preset's). `time_limit` bounds one mesh's CoACD run
-    [s]; past it the mesh falls back to its hull.
+    caps every hull and part (default: the preset's). `cpu_limit` is one mesh's CoACD budget
+    [CPU s]; past it the mesh falls back to its hull. `wall_limit` [s] is the backstop against
+    a hung worker (None: `decompose.WALL_BACKSTOP_FACTOR` times `cpu_limit`, at least
+    `decompose.WALL_BACKSTOP_MIN_S`).
     """
 
     mode: str = "auto"
@@ -135,7 +141,8 @@ class CollisionSettings:
     progress: bool = False
     threshold_m: float | None = None
     max_hull_vertices: int | None = None
-    time_limit: float = DEFAULT_TIME_LIMIT
+    cpu_limit: float = field(default_factory=lambda: default_cpu_limit())
+    wall_limit: float | None = None
 
 
 @dataclass(frozen=True)
@@ -145,6 +152,24 @@ class Decision:
     mode: CollisionMode
     reason: str
     convexity: float | None = None
+
+
+def default_cpu_limit() -> float:
+    """The CPU budget of one mesh [CPU s]: `$TWIN_COACD_CPU_LIMIT`, else DEFAULT_CPU_LIMIT.
+
+    Raises:
+        CollisionSettingsError: the variable is not a positive number.
+    """
+    text = os.environ.get(CPU_LIMIT_ENV, "").strip()
+    if not text:
+        return DEFAULT_CPU_LIMIT
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        raise CollisionSettingsError(f"${CPU_LIMIT_ENV}", text, ["a positive number of seconds"])
+    return value
 
 
 def parse_mode(value: str, where: str) -> CollisionMode:
@@ -163,6 +188,12 @@ def check_settings(settings: CollisionSettings) -> None:
         parse_mode(mode, f"--collision-link {link}=")
     if settings.preset not in PRESETS:
         raise CollisionSettingsError("--coacd-preset", settings.preset, list(PRESETS))
+    for option, value in (
+        ("--coacd-cpu-limit", settings.cpu_limit),
+        ("wall_limit", settings.wall_limit),
+    ):
+        if value is not None and not value > 0:
+            raise CollisionSettingsError(option, f"{value:g}", ["a positive number of seconds"])
     if settings.threshold is not None and settings.threshold_m is not None:
         raise CollisionSettingsError(
             "--coacd-threshold", "given both relative and in metres", ["one of the two"]

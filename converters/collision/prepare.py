@@ -4,13 +4,16 @@ Each mesh gets one row in `report.meshes`:
 `key, link, source, requested, mode, reason, triangles_before, triangles_after, parts,
 volume_reference ("mesh" when the mesh is closed, else "hull"), volume_ratio (sum of part
 volumes / reference volume), seconds (this run), compute_seconds (when first computed),
-cache ("hit" | "miss" | "off"), fallback (why CoACD was replaced by the hull, else None)`,
-and one line in `report.entries`. `report.summary["collision"]` totals them.
+cpu_seconds (CPU time of the CoACD call, else None), cache ("hit" | "miss" | "off"),
+fallback (why the hull stands in for CoACD's parts, else None)`, and one line in
+`report.entries`. `report.summary["collision"]` totals them.
 
-Cache: a result is stored under its content key (mesh bytes, scale, mode, CoACD parameters).
-A fallback that would recur is cached too, so a mesh that times out costs its time limit once,
-not on every conversion: a timeout under a second key that adds the time limit (a longer limit
-retries), and "no usable part" under the content key. A crashed worker is never cached.
+Cache: a result is stored under its content key (mesh bytes, scale, mode, CoACD parameters),
+and so is "CoACD returned no usable part", which the same bytes and parameters always give.
+A hull standing in for a decomposition that did not finish is never stored, so every
+conversion tries again: a worker over its CPU budget (CPU time varies by a few per cent from
+run to run, so a mesh near its budget may finish next time, and a larger budget must get the
+real parts), past the wall-clock backstop, or dead (out-of-memory kill, Ctrl-C).
 """
 
 from __future__ import annotations
@@ -24,7 +27,14 @@ import numpy as np
 
 from converters.collision import cache as mesh_cache
 from converters.collision import hulls
-from converters.collision.decompose import DecomposeJob, DecomposeOutcome, decompose_all, fault_for
+from converters.collision.decompose import (
+    DecomposeJob,
+    DecomposeOutcome,
+    Limits,
+    Stop,
+    decompose_all,
+    fault_for,
+)
 from converters.collision.plan import (
     CONVEX_RATIO,
     TRIANGLES_ADVISED,
@@ -44,9 +54,10 @@ from converters.collision.progress import MeshProgress
 from converters.report import Report
 
 Pairs = list[tuple[np.ndarray, np.ndarray]]
-RETRY_HINT = (
-    " (cached fallback: a longer CoACD time limit, other CoACD settings or"
-    " `twin cache clear` makes the next conversion try again)"
+# What to do about a mesh that did not finish within its CPU budget [CPU s].
+CPU_HINT = (
+    "; not cached: give it more CPU time (--coacd-cpu-limit, now {limit:g} CPU s), a cheaper"
+    " search (--coacd-preset fast, a larger --coacd-threshold) or --collision-link {link}=hull"
 )
 ROW_FIELDS = (
     "key",
@@ -62,8 +73,10 @@ ROW_FIELDS = (
     "volume_ratio",
     "seconds",
     "compute_seconds",
+    "cpu_seconds",
     "cache",
     "fallback",
+    "stopped",
 )
 
 
@@ -77,7 +90,6 @@ class _Plan:
     params: CoacdParams
     volume_reference: tuple[str, float]
     content_key: str
-    fallback_key: str
     use_cache: bool
     started: float
 
@@ -106,7 +118,8 @@ def prepare(
                 progress.advance(_label(rows[key]))
 
         jobs = [_job(plans) for plans in waiting.values()]
-        decompose_all(jobs, workers=settings.jobs, time_limit=settings.time_limit, on_done=finished)
+        limits = Limits.for_cpu(settings.cpu_limit, settings.wall_limit)
+        decompose_all(jobs, workers=settings.jobs, limits=limits, on_done=finished)
     ordered = [rows[r.key] for r in requests]
     _report(ordered, settings, report, len(jobs), time.perf_counter() - started)
     return {r.key: [MeshPart(v, f) for v, f in results[r.key]] for r in requests}
@@ -122,8 +135,7 @@ def _plan(
     if requested is CollisionMode.MESH:
         return None, None
     key = _cache_key(request, requested, params)
-    fallback_key = _cache_key(request, requested, params, time_limit=settings.time_limit)
-    hit = _load(key, fallback_key) if settings.use_cache else None
+    hit = mesh_cache.load(key) if settings.use_cache else None
     if hit is not None:  # the entry may come from another link with the same mesh bytes
         own = {"key": request.key, "link": request.link, "source": request.source}
         row = {**hit.meta, **own, "cache": "hit", "seconds": time.perf_counter() - started}
@@ -141,16 +153,10 @@ def _plan(
         params,
         reference,
         key,
-        fallback_key,
         settings.use_cache,
         started,
     )
     return plan, None
-
-
-def _load(key: str, fallback_key: str) -> mesh_cache.CachedResult | None:
-    """The stored result, else the stored timeout fallback under this time limit, else None."""
-    return mesh_cache.load(key) or mesh_cache.load(fallback_key)
 
 
 def _decision(
@@ -163,15 +169,10 @@ def _decision(
     return Decision(requested, f"--collision {requested.value}", volumes.convexity)
 
 
-def _cache_key(
-    request: CollisionRequest,
-    requested: CollisionMode,
-    params: CoacdParams,
-    time_limit: float | None = None,
-) -> str:
-    """Content key; with `time_limit` [s], the key of a timeout fallback under that limit."""
+def _cache_key(request: CollisionRequest, requested: CollisionMode, params: CoacdParams) -> str:
+    """The content key: what the result is a function of (no budget: a result is a result)."""
     facts = {
-        "time_limit": time_limit,
+        "time_limit": None,  # kept: entries written by earlier versions stay valid
         "mode": requested.value,
         "scale": list(request.scale),
         "params": params.kwargs(),
@@ -219,13 +220,13 @@ def _from_outcome(plan: _Plan, outcome: DecomposeOutcome) -> tuple[Pairs, dict[s
     failure, store_key = outcome.failure, plan.content_key
     if failure is None and not parts:
         failure = "CoACD returned no usable part"
-    elif outcome.timed_out:
-        store_key = plan.fallback_key
     elif failure is not None:
-        store_key = None  # a crash may not recur (out-of-memory kill, Ctrl-C): retry next time
+        store_key = None  # did not finish: budget, backstop or death; tried again next time
     if failure is not None:
         parts = _hull_parts(plan.request.vertices, cap)
-    row = _finish(plan, parts, failure, store_key=store_key, worker_seconds=outcome.seconds)
+    stopped = None if outcome.stopped is None else outcome.stopped.value
+    worker = {"seconds": outcome.seconds, "cpu_seconds": outcome.cpu_seconds, "stopped": stopped}
+    row = _finish(plan, parts, failure, store_key=store_key, worker=worker)
     return parts, row
 
 
@@ -235,12 +236,12 @@ def _finish(
     fallback: str | None,
     *,
     store_key: str | None,
-    worker_seconds: float | None = None,
+    worker: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Build the row and store the result under `store_key` (None: not stored)."""
+    """Build the row and store the result under `store_key` (None: not stored); `worker`
+    gives a CoACD worker's `seconds`, `cpu_seconds` and `stopped` for the row."""
     mode = CollisionMode.HULL if fallback else plan.decision.mode
-    # A CoACD mesh is timed by its worker (not the wait in the queue behind other meshes).
-    seconds = time.perf_counter() - plan.started if worker_seconds is None else worker_seconds
+    seconds = time.perf_counter() - plan.started
     row = _row(
         plan.request,
         plan.requested.value,
@@ -250,8 +251,9 @@ def _finish(
         plan.volume_reference,
         seconds,
     )
-    row["fallback"] = fallback
-    row["cache"] = "miss" if plan.use_cache else "off"
+    # A CoACD mesh is timed by its worker (not the wait in the queue behind other meshes).
+    row.update(worker or {}, fallback=fallback, cache="miss" if plan.use_cache else "off")
+    row["compute_seconds"] = row["seconds"]
     if plan.use_cache and store_key is not None:
         meta = {k: v for k, v in row.items() if k not in ("cache", "seconds")}
         try:
@@ -286,8 +288,10 @@ def _row(
         "volume_ratio": ratio,
         "seconds": seconds,
         "compute_seconds": seconds,
+        "cpu_seconds": None,
         "cache": "off",
         "fallback": None,
+        "stopped": None,
     }
 
 
@@ -307,8 +311,8 @@ def _report(
         subject = f"link '{row['link']}' collision mesh {Path(row['source']).name}"
         report.meshes.append(row)
         if row["fallback"]:
-            again = RETRY_HINT if row["cache"] == "hit" else ""
-            report.warn(subject, f"{row['fallback']}; using its convex hull instead{again}")
+            hint = _hint(row, settings)
+            report.warn(subject, f"{row['fallback']}; its convex hull stands in for it{hint}")
         elif row["parts"] == 0:
             report.warn(subject, f"{row['reason']}; left out of collision")
         else:
@@ -318,9 +322,19 @@ def _report(
         "coacd_runs": runs,
         "cache_hits": sum(row["cache"] == "hit" for row in rows),
         "fallbacks": sum(bool(row["fallback"]) for row in rows),
+        "coacd_cpu_seconds": sum(
+            row["cpu_seconds"] or 0.0 for row in rows if row["cache"] != "hit"
+        ),
         "parts": sum(row["parts"] for row in rows),
         "seconds": seconds,
     }
+
+
+def _hint(row: dict[str, Any], settings: CollisionSettings) -> str:
+    """What to do about a fallback: for a spent CPU budget, the options that change it."""
+    if row.get("stopped") == Stop.CPU.value:
+        return CPU_HINT.format(limit=settings.cpu_limit, link=row["link"])
+    return ""
 
 
 def _describe(row: dict[str, Any], preset: str) -> str:

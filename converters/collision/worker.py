@@ -1,8 +1,12 @@
 """The CoACD worker process: `python -m converters.collision.worker JOB.npz RESULT.npz`.
 
-Reads one mesh and CoACD's keyword arguments from JOB, writes the convex parts to RESULT, and
-exits 0. A Python error exits 3 with the message on stderr; an abort inside CoACD simply kills
-this process, which is the point of running it here rather than in twin.
+Reads one mesh, CoACD's keyword arguments and a CPU budget from JOB, writes the convex parts
+and the CPU time CoACD took to RESULT, and exits 0. A Python error exits 3 with the message on
+stderr; an abort inside CoACD simply kills this process, which is the point of running it here
+rather than in twin. The budget is enforced by the kernel: `ITIMER_PROF` counts this process's
+CPU time (every thread, user and system) from just before CoACD's call, and its signal,
+CPU_SIGNAL, left at its default action, ends the process when the budget is spent (a Python
+handler could not run while CoACD holds the interpreter).
 """
 
 from __future__ import annotations
@@ -18,6 +22,9 @@ import numpy as np
 from converters.collision.cache import pack_parts
 
 EXIT_ERROR = 3
+# The signal that ends a worker over its CPU budget (None where the platform has no ITIMER_PROF;
+# there only the parent's wall-clock backstop applies).
+CPU_SIGNAL: int | None = getattr(signal, "SIGPROF", None)
 
 
 def _inject(fault: str) -> None:
@@ -34,6 +41,14 @@ def _inject(fault: str) -> None:
         raise RuntimeError("injected error")
 
 
+def _arm_cpu_budget(seconds: float) -> None:
+    """End this process once it has used `seconds` more CPU time [CPU s] (0: disarm)."""
+    if CPU_SIGNAL is None:
+        return
+    signal.signal(CPU_SIGNAL, signal.SIG_DFL)  # an ignored SIGPROF is inherited through exec
+    signal.setitimer(signal.ITIMER_PROF, seconds)
+
+
 def run(job_path: str, result_path: str) -> None:
     """Decompose the mesh in `job_path` and write the parts to `result_path` (atomically)."""
     with np.load(job_path, allow_pickle=False) as job:
@@ -41,12 +56,22 @@ def run(job_path: str, result_path: str) -> None:
         faces = np.asarray(job["faces"], np.int32)
         params = json.loads(str(job["params"]))
         fault = str(job["fault"])
+        cpu_limit = float(job["cpu_limit"])
     _inject(fault)
     import coacd
 
     coacd.set_log_level("error")
-    parts = coacd.run_coacd(coacd.Mesh(vertices, faces), **params)
-    arrays = {**pack_parts(parts), "count": np.array(len(parts))}
+    mesh = coacd.Mesh(vertices, faces)
+    started = time.process_time()
+    _arm_cpu_budget(cpu_limit)
+    parts = coacd.run_coacd(mesh, **params)
+    _arm_cpu_budget(0.0)  # disarm: writing the result is not CoACD's work
+    cpu_seconds = time.process_time() - started
+    arrays = {
+        **pack_parts(parts),
+        "count": np.array(len(parts)),
+        "cpu_seconds": np.array(cpu_seconds),
+    }
     tmp = f"{result_path}.part"
     with open(tmp, "wb") as stream:
         np.savez(stream, allow_pickle=False, **arrays)  # numbers only: no pickles

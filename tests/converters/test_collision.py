@@ -229,11 +229,11 @@ def test_ball_stays_inside_heavy_cup_decomposed_by_the_default_auto_plan(tmp_pat
 # Robots whose converted model must also step 1 s without a MuJoCo warning (MuJoCo Menagerie's
 # gate for a usable model).
 MESH_ROBOTS = {"booster_t1", "solo12", "anymal_c", "open_manipulator_x", "robotiq_2f_85"}
-# CI keeps CoACD cold runs short: fast preset, and a mesh that needs longer than this falls
-# back to its hull (reported). With the heavy-mesh caps open_manipulator_x's 13-21k-triangle
-# meshes need 2-14 s each, one over 20 s (chain_link1) on a shared 2-core machine, so some fall
-# back here; bench_collision measures the defaults.
-CORPUS_TIME_LIMIT = 8.0  # [s]
+# CI keeps CoACD cold runs short: fast preset, and a mesh that needs more CPU time than this
+# falls back to its hull (reported). With the heavy-mesh caps open_manipulator_x's
+# 13-21k-triangle meshes need 2-14 s each, one over 20 s (chain_link1), so some fall back
+# here; bench_collision measures the defaults.
+CORPUS_CPU_LIMIT = 8.0  # [CPU s]
 
 
 @pytest.fixture(scope="module")
@@ -248,7 +248,7 @@ def test_corpus_robot_converts_with_auto_collision(robot_id, corpus_cache, monke
 
     monkeypatch.setenv("TWIN_CACHE_DIR", str(corpus_cache))
     robot, packages = CORPUS[robot_id], PACKAGES_ROOT
-    settings = CollisionSettings(preset="fast", jobs=2, time_limit=CORPUS_TIME_LIMIT)
+    settings = CollisionSettings(preset="fast", jobs=2, cpu_limit=CORPUS_CPU_LIMIT)
     # Inertia repair is the core converter's concern (anymal_c, abb need it); this test is
     # about collision meshes.
     options = ConvertOptions(repair_inertia=True, collision=settings)

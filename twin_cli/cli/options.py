@@ -52,6 +52,7 @@ ArgOpt = annotation(table.ARG)
 PackageOpt = annotation(table.PACKAGE)
 JointOpt = annotation(table.JOINT)
 FixedBaseOpt = annotation(table.FIXED_BASE)
+CoacdCpuLimitOpt = annotation(table.COACD_CPU_LIMIT)
 
 
 def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:

@@ -93,6 +93,14 @@ FIXED_BASE = flag(
     help="Weld the root link to the world (no free joint), as a `world` link and a fixed "
     "joint do; the robot's own joints still move.",
 )
+COACD_CPU_LIMIT = Opt(
+    ("--coacd-cpu-limit", "--coacd-time-limit"),
+    "coacd_cpu_limit",
+    "CPU seconds CoACD may spend decomposing one collision mesh before its convex hull stands "
+    "in (default 20; the same on an idle and a busy machine). --coacd-time-limit: older name.",
+    float,
+    envvar="TWIN_COACD_CPU_LIMIT",  # converters.collision.plan.CPU_LIMIT_ENV
+)
 NAME = Arg("name", "Entity name (see `twin list`).", str)
 
 SPAWN = Command(

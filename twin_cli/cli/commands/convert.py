@@ -9,6 +9,7 @@ import typer
 
 from twin_cli.cli.options import (
     ArgOpt,
+    CoacdCpuLimitOpt,
     FixedBaseOpt,
     JsonOpt,
     PackageOpt,
@@ -108,10 +109,10 @@ def _collision_settings(
     seed: int,
     jobs: int | None,
     no_cache: bool,
-    time_limit: float | None = None,
+    cpu_limit: float | None = None,
     threshold_m: float | None = None,
 ) -> dict[str, Any]:
-    extra = {"time_limit": time_limit} if time_limit is not None else {}
+    extra = {"cpu_limit": cpu_limit} if cpu_limit is not None else {}
     return {
         **extra,
         "threshold_m": threshold_m,
@@ -165,10 +166,7 @@ def convert_command(
         float | None,
         typer.Option("--coacd-threshold-m", help="CoACD concavity threshold in metres."),
     ] = None,
-    coacd_time_limit: Annotated[
-        float | None,
-        typer.Option("--coacd-time-limit", help="Seconds per mesh before the hull fallback."),
-    ] = None,
+    coacd_cpu_limit: CoacdCpuLimitOpt = None,
     seed: Annotated[int, typer.Option("--seed", help="CoACD random seed.")] = 0,
     jobs: Annotated[int | None, typer.Option("--jobs", help="Parallel CoACD workers.")] = None,
     no_cache: Annotated[
@@ -193,7 +191,7 @@ def convert_command(
         seed,
         jobs,
         no_cache,
-        coacd_time_limit,
+        coacd_cpu_limit,
         coacd_threshold_m,
     )
     with LocalProgress():
