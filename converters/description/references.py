@@ -90,9 +90,12 @@ class MissingVisual:
     problem: str
 
     def describe(self) -> str:
-        """One line: the reason and the fix, without the list of places tried."""
-        lines = [line for line in self.problem.splitlines() if not line.startswith(" ")]
-        return "; ".join(line.removesuffix("; tried:") for line in lines)
+        """One line: the reason, the places tried and the fix."""
+        head, *rest = self.problem.splitlines()
+        places = [line.strip() for line in rest if line.startswith(" ")]
+        if places:
+            head = f"{head} {', '.join(places)}"
+        return "; ".join([head, *(line for line in rest if not line.startswith(" "))])
 
 
 Ignored = Dangling | MissingVisual

@@ -93,15 +93,12 @@ def _visual(
     ctx: SdfContext, graph: PoseGraph, element: Any, link: str, prefix: str, X_M_L: np.ndarray
 ) -> Visual:
     pose = _part_pose(ctx, graph, element, prefix, X_M_L)
+    missing = None
     try:
         geometry = _geometry(ctx, element, link)
     except (PackageNotFoundError, ResourceNotFoundError) as exc:  # sdformat never opens it
-        geometry = None
-        ctx.report.warn(
-            f"link '{link}' <visual name='{element.get('name', '')}'>",
-            f"left out, as Gazebo draws nothing for it: {exc}",
-        )
-    return Visual(pose, geometry, _material(ctx, element), element.get("name"))
+        geometry, missing = None, str(exc)  # left out and reported, or refused with --strict
+    return Visual(pose, geometry, _material(ctx, element), element.get("name"), missing)
 
 
 def _geometry(ctx: SdfContext, owner: Any, link: str) -> Geometry | None:

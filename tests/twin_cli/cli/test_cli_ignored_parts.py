@@ -131,6 +131,27 @@ def test_convert_strict_refuses_missing_visual_meshes_naming_each_and_the_fix(tm
     assert_names(done.stderr, [*VISUAL_NAMED, *fixes], "refusal")
 
 
+SDF_MODEL = """<sdf version="1.9"><model name="sdfbot"><link name="body">
+  <inertial><mass>1</mass><inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia>
+  </inertial>
+  <visual name="shell"><geometry><mesh><uri>model://no_such_model/shell.dae</uri></mesh>
+  </geometry></visual>
+  <collision name="box"><geometry><box><size>0.2 0.2 0.2</size></box></geometry></collision>
+</link></model></sdf>"""
+
+
+def test_sdf_visual_whose_model_is_missing_is_left_out_and_refused_when_strict(tmp_path):
+    path = write(tmp_path, SDF_MODEL, "sdfbot.sdf")
+    done = twin("convert", path, "-o", tmp_path / "out", "--json")
+    assert done.returncode == 0, done.stderr
+    warned = [e for e in json.loads(done.stdout)["entries"] if e["outcome"] == "warning"]
+    assert [e["subject"] for e in warned] == ["link 'body' <visual name='shell'>"], warned
+    assert "no_such_model" in warned[0]["detail"], warned
+    refused = twin("convert", path, "-o", tmp_path / "strict", "--strict")
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr, refused.stderr
+    assert_names(refused.stderr, ["model://no_such_model/shell.dae", "--strict"], "refusal")
+
+
 # --- twin spawn -----------------------------------------------------------------------------
 
 
