@@ -9,11 +9,13 @@ references are resolved to files here, so later stages never see `package://`.
 
 from __future__ import annotations
 
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
+from converters.bounded_child import READ_EVENT
 from converters.description import (
     Collision,
     Dynamics,
@@ -166,6 +168,7 @@ class _LinkReader:
             geometry: Geometry | None = self.geometry(visual, link, "visual", index)
         except (PackageNotFoundError, ResourceNotFoundError) as exc:
             geometry, missing = None, str(exc)
+            _announce_missing(exc)
         material = self.material(visual)
         return Visual(_origin(visual), geometry, material, visual.get("name"), missing)
 
@@ -195,6 +198,14 @@ class _LinkReader:
         if shared is None:
             return own
         return Material(own.name, own.rgba or shared.rgba, own.texture or shared.texture)
+
+
+def _announce_missing(exc: Exception) -> None:
+    """Name the files a missing mesh was sought at as read (`READ_EVENT`, with no content): a
+    server's cached conversion depends on them, and is redone once one of them appears."""
+    for path in getattr(exc, "tried", None) or [getattr(exc, "path", None)]:
+        if path:
+            sys.audit(READ_EVENT, str(path))
 
 
 def _scale(mesh: ET.Element) -> tuple[float, float, float]:

@@ -185,6 +185,54 @@ def test_spawn_leaves_out_what_gazebo_ignores_with_a_warning_and_strict_refuses(
     assert "p1" in names and "p3" in names and "p2" not in names, names
 
 
+TETRAHEDRON_STL = """solid t
+facet normal 0 0 -1
+outer loop
+vertex 0 0 0
+vertex 0 0.1 0
+vertex 0.1 0 0
+endloop
+endfacet
+facet normal 0 -1 0
+outer loop
+vertex 0 0 0
+vertex 0.1 0 0
+vertex 0 0 0.1
+endloop
+endfacet
+facet normal -1 0 0
+outer loop
+vertex 0 0 0
+vertex 0 0 0.1
+vertex 0 0.1 0
+endloop
+endfacet
+facet normal 0.577 0.577 0.577
+outer loop
+vertex 0.1 0 0
+vertex 0 0.1 0
+vertex 0 0 0.1
+endloop
+endfacet
+endsolid t
+"""
+
+
+def test_a_missing_visual_mesh_that_appears_later_is_drawn_on_the_next_spawn(world, tmp_path):
+    """The server caches conversions by the files they read; a mesh sought and not found counts
+    as one, so a cached conversion without it is not handed out once it exists."""
+    robot = robot_urdf(dangling=False, missing_visuals=False).replace(
+        "</visual>", "</visual>" + MESH_VISUAL.format(n="late", uri="meshes/late.stl"), 1
+    )
+    path = write(tmp_path, robot, "late.urdf")
+    before = spawn(path, "--name", "late0")
+    assert before.returncode == 0 and "meshes/late.stl" in before.stderr, before.stderr
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "late.stl").write_text(TETRAHEDRON_STL)
+    after = spawn(path, "--name", "late1")
+    assert after.returncode == 0 and "late.stl" not in after.stderr, after.stderr
+
+
 def test_a_save_of_older_twin_with_drop_dangling_loads_and_a_new_save_records_strict(
     world, tmp_path
 ):
