@@ -14,12 +14,17 @@ from converters.errors import (
     ResourceNotAFileError,
     ResourceNotFoundError,
 )
+from converters.resources.package_exports import MEDIA_PATH, MODEL_PATH, exported_paths
 
 # Environment variables searched, in order, as ROS 1 / ROS 2 / Gazebo users set them.
 ROS_ENV = "ROS_PACKAGE_PATH"
 AMENT_ENV = "AMENT_PREFIX_PATH"
-MODEL_ENVS = ("GAZEBO_MODEL_PATH", "GZ_SIM_RESOURCE_PATH")
-# Where Gazebo looks for a relative `file://` resource after the model's own directory.
+# Where a model (`model://NAME`, or an include's scheme-less `NAME`) is looked for, in order:
+# gz-sim's resource paths (and Ignition's name for them), libsdformat's SDF_PATH, Gazebo
+# Classic's model path; then the `gazebo_model_path` exports of ROS packages.
+MODEL_ENVS = ("GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH", "SDF_PATH", "GAZEBO_MODEL_PATH")
+# Where Gazebo looks for a relative `file://` resource after the model's own directory; then
+# the `gazebo_media_path` exports of ROS packages.
 RESOURCE_ENVS = ("GAZEBO_RESOURCE_PATH", "GZ_SIM_RESOURCE_PATH")
 
 _PACKAGE_NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
@@ -45,8 +50,9 @@ class PackageResolver:
 
     Search order for a package name: explicit `--package NAME=PATH` entries, `ROS_PACKAGE_PATH`
     (each entry a package or a directory of packages), `AMENT_PREFIX_PATH` (`<prefix>/share/<pkg>`),
-    for `model://` also `GAZEBO_MODEL_PATH`/`GZ_SIM_RESOURCE_PATH`, then the directories above the
-    input file (one whose package.xml names the package, one named like it, or a sibling).
+    for `model://` also the model roots (`model_roots`: the Gazebo and SDFormat path variables,
+    then ROS packages' `gazebo_model_path` exports), then the directories above the input file
+    (one whose package.xml names the package, one named like it, or a sibling).
 
     Attributes:
         explicit: package name → directory, from `--package` options.
@@ -57,6 +63,7 @@ class PackageResolver:
     explicit: Mapping[str, Path] = field(default_factory=dict)
     input_file: Path | None = None
     env: Mapping[str, str] = field(default_factory=lambda: dict(os.environ))
+    _cache: dict[str, list[Path]] = field(default_factory=dict, compare=False, repr=False)
 
     @classmethod
     def create(
@@ -79,12 +86,25 @@ class PackageResolver:
             out += [entry, entry / name]
         out += [prefix / "share" / name for prefix in _split_env(self.env.get(AMENT_ENV))]
         if model:
-            for var in MODEL_ENVS:
-                out += [entry / name for entry in _split_env(self.env.get(var))]
+            out += [root / name for root in self.model_roots()]
         if self.input_file is not None:
             for ancestor in self.input_file.parents:
                 out += [ancestor, ancestor / name]
         return out
+
+    def model_roots(self) -> list[Path]:
+        """Directories Gazebo models are looked for in (`MODEL_ENVS`, then the
+        `gazebo_model_path` exports of the ROS packages on the package paths), in order."""
+        roots = [entry for var in MODEL_ENVS for entry in _split_env(self.env.get(var))]
+        return roots + self._exported(MODEL_PATH)
+
+    def _exported(self, attribute: str) -> list[Path]:
+        """Paths ROS packages export for Gazebo (`package_exports`), read once per resolver."""
+        if attribute not in self._cache:
+            ros = tuple(_split_env(self.env.get(ROS_ENV)))
+            ament = tuple(_split_env(self.env.get(AMENT_ENV)))
+            self._cache[attribute] = exported_paths(ros, ament, attribute)
+        return self._cache[attribute]
 
     def find_package(
         self, name: str, *, uri: str = "", element: str = "", model: bool = False
@@ -149,6 +169,7 @@ class PackageResolver:
             return []
         relative = uri[len("file://") :]
         entries = [e for var in RESOURCE_ENVS for e in _split_env(self.env.get(var))]
+        entries += self._exported(MEDIA_PATH)
         return [entry / relative for entry in entries]
 
     def _locate(self, uri: str, base_dir: Path, element: str) -> Path:

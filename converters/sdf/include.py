@@ -1,8 +1,10 @@
 """`<include><uri>model://NAME</uri>`: find the model (model.config), splice it in, apply overrides.
 
-Models are found as Gazebo finds them: `model://` through `GAZEBO_MODEL_PATH` /
-`GZ_SIM_RESOURCE_PATH` (and the directories above the file), then among the models twin ships
-(`ground_plane`, `sun`), so a stock Gazebo world loads without a Gazebo install.
+Models are found as Gazebo finds them: `model://NAME` on the model roots (`GZ_SIM_RESOURCE_PATH`,
+`IGN_GAZEBO_RESOURCE_PATH`, `SDF_PATH`, `GAZEBO_MODEL_PATH`, ROS packages' `gazebo_model_path`
+exports) and the directories above the file; a scheme-less `NAME` beside the file, then on the
+model roots; both then among the models twin ships (`ground_plane`, `sun`), so a stock Gazebo
+world loads without a Gazebo install.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from typing import Any
 from urllib.parse import unquote
 
 from converters.errors import PackageNotFoundError
+from converters.resources.packages import MODEL_ENVS
 from converters.sdf.document import (
     INCLUDED_SOURCE,
     INCLUDED_VERSION,
@@ -99,11 +102,35 @@ def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
         if shipped is None:
             raise
         target = shipped
+    if not target.exists() and "://" not in uri and not Path(uri).is_absolute():
+        target = _on_model_roots(ctx, include, uri, target)
     if target.is_dir():
         return _from_config(ctx, include, target)
     if not target.is_file():
         raise ctx.error(include, f"{uri} resolves to {target}, which does not exist", "fix the uri")
     return target
+
+
+def _on_model_roots(ctx: SdfContext, include: Any, uri: str, beside: Path) -> Path:
+    """A scheme-less include URI (`<uri>NAME</uri>`) not beside the file: as libsdformat and
+    gz-sim look it up, under each model root (`PackageResolver.model_roots`), then among the
+    models twin ships.
+
+    Raises:
+        SDFError: found nowhere, with every place tried.
+    """
+    tried = [beside, *(root / uri for root in ctx.resolver.model_roots())]
+    found = next((p for p in tried[1:] if p.exists()), None) or _shipped(f"model://{uri}")
+    if found is not None:
+        return found
+    places = "".join(f"\n  {p}" for p in tried)
+    raise ctx.error(
+        include,
+        f"'{uri}' was found neither beside the file nor on a model path",
+        f"put it beside the file, or its parent directory on {', '.join(MODEL_ENVS)}, or export "
+        "that directory with <gazebo_ros gazebo_model_path=...> in a package.xml on "
+        f"ROS_PACKAGE_PATH or AMENT_PREFIX_PATH; tried:{places}",
+    )
 
 
 def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
