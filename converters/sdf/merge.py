@@ -15,7 +15,7 @@ import numpy as np
 
 from converters.sdf.document import INCLUDED_SOURCE, INCLUDED_VERSION, SdfContext, read_pose
 from converters.sdf.links import INCLUDED_DIR
-from converters.sdf.poses import MODEL_FRAME, SEP, PoseGraph
+from converters.sdf.poses import MODEL_FRAME, SEP, placed_pose
 
 # What a merge copies into the parent (sdformat's list; namespaced custom elements too).
 MERGED = ("link", "model", "joint", "frame", "gripper", "plugin")
@@ -76,7 +76,7 @@ def proxy_frame(ctx: SdfContext, parent: Any, include: Any, model: Any, name: st
     pose = etree.SubElement(frame, "pose") if pose is None else _copy(pose, frame)
     placement = model.get("placement_frame")
     if placement:  # the include's pose places that frame: the model frame is offset from it
-        X_R_M = _placed(ctx, model, placement)
+        X_R_M = _placed(ctx, model)
         pose.text = " ".join(f"{v:.17g}" for v in _xyz_quat(X_R_M))
         if "degrees" in pose.attrib:
             del pose.attrib["degrees"]
@@ -138,11 +138,11 @@ def _copy(pose: Any, parent: Any) -> Any:
     return copied
 
 
-def _placed(ctx: SdfContext, model: Any, placement: str) -> np.ndarray:
-    """X_R_M: the model frame in the include pose's frame when that pose places `placement`."""
+def _placed(ctx: SdfContext, model: Any) -> np.ndarray:
+    """X_R_M: the model frame in the include pose's frame when that pose places the model's
+    `placement_frame`."""
     X_R_P, _ = read_pose(ctx, model)
-    X_M_P = PoseGraph(ctx, model).pose(placement, model)
-    return X_R_P @ np.linalg.inv(X_M_P)
+    return placed_pose(ctx, model, X_R_P)
 
 
 def _xyz_quat(T: np.ndarray) -> list[float]:

@@ -1,7 +1,8 @@
-"""Name clashes between a model's links, joints, frames and nested models, as sdformat settles
-them: before SDFormat 1.7 names had to be unique per element type only, so sdformat renames the
-later of two clashing elements (`arm` → `arm_joint`) and warns; from 1.7 a clash is an error
-(`poses.PoseGraph` refuses it)."""
+"""Name clashes between a model's links, joints, frames and nested models, and between a world's
+frames and models, as sdformat settles them: before SDFormat 1.7 names had to be unique per
+element type only, so sdformat renames the later of two clashing elements of a model (`arm` →
+`arm_joint`), and a world frame that has a model's name (`ground` → `ground_frame`), and warns;
+from 1.7 a clash is an error (`poses.PoseGraph`, `world_frames.WorldFrames` refuse it)."""
 
 from __future__ import annotations
 
@@ -32,6 +33,24 @@ def rename_clashes(ctx: SdfContext, model: Any) -> None:
             taken.add(child.get("name"))
     for nested in model.findall("model"):
         rename_clashes(ctx, nested)
+
+
+def rename_world_clashes(ctx: SdfContext, world: Any) -> None:
+    """Rename, in a 1.4-1.6 world, each `<frame>` whose name a model (or an earlier frame)
+    already has, as sdformat does: frames are checked after every model, in file order."""
+    if not ctx.before_frames(world):
+        return
+    taken = {m.get("name") for m in world.findall("model")}
+    for frame in world.findall("frame"):
+        name = frame.get("name") or ""
+        if name in taken:
+            frame.set("name", _free(name, SUFFIXES["frame"], taken))
+            ctx.report.mapped(
+                f"world frame '{name}'",
+                f"renamed '{frame.get('name')}': a model of the world has its name "
+                f"(allowed before SDFormat 1.7, renamed by sdformat)",
+            )
+        taken.add(frame.get("name"))
 
 
 def _same_type_before(model: Any, child: Any) -> bool:

@@ -35,7 +35,7 @@ class FrameNode:
         attached_to: frames: the scoped frame it is fixed to; joints: the child link;
             models: the canonical link (None while the model has no link).
         placement: models (1.8 `placement_frame`): the frame of the model that `pose` places,
-            instead of the model frame.
+            instead of the model frame (a name in the model's own scope).
     """
 
     kind: str
@@ -64,9 +64,7 @@ class PoseGraph:
         for nested in model.findall("model"):
             name = prefix + nested.get("name", "")
             self._add(name + SEP + MODEL_FRAME, "model", nested, prefix, here)
-            placement = nested.get("placement_frame")
-            if placement:
-                self.nodes[name + SEP + MODEL_FRAME].placement = name + SEP + placement
+            self.nodes[name + SEP + MODEL_FRAME].placement = nested.get("placement_frame")
             self._collect(nested, name + SEP)
         for joint in model.findall("joint"):
             child = self.ctx.text(joint, "child") or ""
@@ -135,26 +133,10 @@ class PoseGraph:
             return np.eye(4)
         base = self._pose(node.relative_to, node.element, (*chain, key))
         pose = node.pose
-        if node.placement is not None:  # the pose places that frame: X_M = X · inv(X_M_frame)
-            pose = pose @ np.linalg.inv(self._pose_within(node.placement, key, node.element))
+        if node.kind == "model" and node.placement:
+            pose = placed_pose(self.ctx, node.element, pose)
         self._resolved[key] = base @ pose
         return self._resolved[key]
-
-    def _pose_within(self, name: str, model_key: str, asked_by: Any) -> np.ndarray:
-        """The pose of frame `name` in the frame of model `model_key` (its own scope)."""
-        key, pose, seen = self._known(name, asked_by), np.eye(4), set()
-        while key != model_key:
-            node = self.nodes[key]
-            if key in seen or node.relative_to is None:
-                raise self.ctx.error(
-                    asked_by,
-                    f"placement_frame '{name}' is not a frame of this model",
-                    "name a link or frame inside the model",
-                )
-            seen.add(key)
-            pose = node.pose @ pose
-            key = self._known(node.relative_to, node.element)
-        return pose
 
     def _known(self, name: str, asked_by: Any) -> str:
         try:
@@ -197,6 +179,22 @@ class PoseGraph:
                 )
             seen.append(key)
             key = node.attached_to
+
+
+def placed_pose(ctx: SdfContext, model: Any, pose: np.ndarray) -> np.ndarray:
+    """X_R_M: where `model`'s frame is when its `<pose>` (`pose`, in frame R) places the frame
+    its `placement_frame` names (SDFormat 1.8): `pose` · X_M_P⁻¹, X_M_P that frame's pose in
+    the model, resolved in the model's own scope (its nested placements included). Without a
+    `placement_frame` (or naming `__model__`) it is `pose` itself.
+
+    Raises:
+        SDFError: the placement frame is not a link, joint, frame or nested model of the model.
+    """
+    placement = (model.get("placement_frame") or "").strip()
+    if not placement or placement == MODEL_FRAME:
+        return pose
+    X_M_P = PoseGraph(ctx, model).pose(placement, model)
+    return pose @ np.linalg.inv(X_M_P)
 
 
 def scoped(reference: str, prefix: str) -> str:

@@ -11,6 +11,7 @@ from converters.description.transforms import vec3
 from converters.sdf.document import SdfContext, read_pose
 from converters.sdf.include import expand_includes
 from converters.sdf.model import read_model
+from converters.sdf.names import rename_world_clashes
 from converters.sdf.world_frames import WorldFrames
 
 # SDF world defaults (sdf/1.11/physics.sdf, world.sdf): 1 ms at 1000 Hz, factor 1, 50 iterations.
@@ -46,6 +47,7 @@ def read_world(ctx: SdfContext, world: Any, text: str = "") -> WorldDescription:
         SDFError: bad values, two models with one name, or an unreadable model.
     """
     expand_includes(ctx, world)
+    rename_world_clashes(ctx, world)
     physics = _physics(ctx, world)
     models, names = [], set()
     for element in world.findall("model"):

@@ -2,7 +2,9 @@
 
 A world `<frame>`'s pose is relative to the frame it is `attached_to` (default `world`) unless
 `relative_to` names another; a model's pose is relative to `world` unless `relative_to` names a
-world frame or another model. Frames are resolved lazily; a cycle is an error naming its frames.
+world frame or another model, and places the frame its `placement_frame` names (1.8), which
+moves the model frame accordingly. Frames are resolved lazily; a cycle is an error naming its
+frames.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from converters.sdf.document import SdfContext, read_pose
+from converters.sdf.poses import placed_pose
 
 WORLD_FRAME = "world"
 
@@ -47,6 +50,8 @@ class WorldFrames:
                 "give world frames and models unique names other than 'world'",
             )
         pose, relative_to = read_pose(self.ctx, element)
+        if element.tag == "model":  # its pose may place a frame of it, not its model frame
+            pose = placed_pose(self.ctx, element, pose)
         self.frames[name] = WorldFrame(element, pose, relative_to or default)
 
     def pose(self, name: str) -> np.ndarray:

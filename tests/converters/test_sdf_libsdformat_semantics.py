@@ -1,0 +1,243 @@
+"""What libsdformat loads, twin loads the same way: placement frames, names, include URIs, 1.6.
+
+- `placement_frame` (1.8) on a `<model>` or an `<include>`, in a world or a model: `<pose>`
+  places that frame (a link, joint, frame or nested model), and the model frame follows.
+- A scheme-less include URI is looked up beside the file, then on GZ_SIM_RESOURCE_PATH,
+  IGN_GAZEBO_RESOURCE_PATH, SDF_PATH, GAZEBO_MODEL_PATH and the `gazebo_model_path` exports of
+  ROS packages; `gazebo_media_path` exports serve relative `file://` resources.
+- A 1.4-1.6 world frame named like a model becomes `NAME_frame` (then `NAME_frame0`, ...).
+Every expected pose is composed by hand from the files' numbers (`X`), every tolerance stated.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from sdf_frame_models import HALF_PI, TOL_M, X, assert_pose
+from sdf_libsdformat_models import (
+    FRAMES_CONFIG,
+    FRAMES_MODEL,
+    INERTIAL,
+    PLACED,
+    PLACEMENT_WORLD,
+    STAND,
+    model_dir,
+    world_link_poses,
+)
+
+from converters.errors import SDFError
+from converters.report import Report
+from converters.sdf import read_sdf_world
+from twin_cli.world.sdf_world import world_from_sdf
+
+PI = np.pi
+inv = np.linalg.inv
+
+
+def _world(tmp_path: Path, body: str, version: str = "1.9") -> Path:
+    path = tmp_path / "world.sdf"
+    path.write_text(f'<?xml version="1.0"?>\n<sdf version="{version}"><world name="w">\n{body}\n'
+                    "</world></sdf>\n")  # fmt: skip
+    return path
+
+
+def _assert_links(poses: dict[str, np.ndarray], expected: dict[str, np.ndarray]) -> None:
+    for name, T in expected.items():
+        assert_pose(poses[name], T, f"link {name}")
+
+
+# --- placement frames, hand-written files -------------------------------------------------
+def test_world_models_and_includes_place_their_placement_frame(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(model_dir(tmp_path / "models", "stand", STAND)))
+    inner = (
+        '<model name="arm" placement_frame="inner::tip"><pose>0 0 2 0 0 0</pose>'
+        '<model name="inner" placement_frame="tip"><pose>0 0 0.5 0 0 0</pose>'
+        f'<link name="tip"><pose>0.2 0 0 0 0 0</pose>{INERTIAL}</link></model></model>'
+    )
+    path = _world(
+        tmp_path,
+        f'<frame name="pad"><pose>2 0 0 0 0 {HALF_PI!r}</pose></frame>'
+        '<model name="table" placement_frame="leg"><pose>0 0 1 0 0 0</pose>'
+        f'<link name="top"><pose>0 0 0.5 0 0 0</pose>{INERTIAL}</link>'
+        f'<link name="leg"><pose>0.3 0 -0.2 0 0 0</pose>{INERTIAL}</link>'
+        '<joint name="j" type="fixed"><parent>top</parent><child>leg</child></joint></model>'
+        '<model name="lamp" placement_frame="socket"><pose relative_to="pad">1 0 0 0 0 0</pose>'
+        f'<link name="base">{INERTIAL}</link>'
+        f'<frame name="socket"><pose>0 0 0.2 0 0 {HALF_PI!r}</pose></frame></model>'
+        "<include><name>stand_a</name><uri>stand</uri><pose>5 0 0 0 0 0</pose>"
+        "<placement_frame>foot</placement_frame></include>"
+        '<include><name>stand_b</name><uri>stand</uri><pose relative_to="pad">0 0 1 0 0 0</pose>'
+        "<placement_frame>mark</placement_frame></include>"
+        f'<model name="shelf"><pose>0 5 0 0 0 0</pose><link name="board">{INERTIAL}</link>'
+        "<include><name>s</name><uri>stand</uri><pose>1 0 0 0 0 0</pose>"
+        f"<placement_frame>foot</placement_frame></include>{inner}</model>",
+    )
+    poses = world_link_poses(world_from_sdf(path))
+    # table: leg (0.3, 0, -0.2) placed at (0, 0, 1): model frame (-0.3, 0, 1.2), top 0.5 above.
+    # lamp: pad·(1, 0, 0) = (2, 1, 0) turned 90°; socket⁻¹ = (0, 0, -0.2) turned -90°, so the
+    #   model frame (and base on it) is at (2, 1, -0.2), unturned.
+    # stand_a: foot⁻¹ = (0.1, 0, 0) turned 180°: model frame (5.1, 0, 0) turned 180°; body 0.5
+    #   above it; foot at (5, 0, 0), turned 360°.
+    # stand_b: mark (0, 0, 0.8) rolled 90° placed at pad·(0, 0, 1) = (2, 0, 1) turned 90°:
+    #   model frame (2, 0, 1) + Rz(90°)·(0, -0.8, 0) = (2.8, 0, 1), R = Rz(90°)·Rx(-90°);
+    #   body = (2.8, 0, 1) + R·(0, 0, 0.5) = (2.3, 0, 1); foot = (2.8, 0, 1) + R·(0.1, 0, 0).
+    R_b = X(0, 0, 0, 0, 0, HALF_PI) @ X(0, 0, 0, -HALF_PI, 0, 0)
+    # shelf at (0, 5, 0): s as stand_a at (1, 0, 0); inner places tip (0.2, 0, 0) at (0, 0, 0.5)
+    #   of arm, so arm's tip is at (0, 0, 0.5) and arm places it at (0, 0, 2): tip (0, 5, 2).
+    _assert_links(
+        poses,
+        {
+            "table/leg": X(0, 0, 1),
+            "table/top": X(-0.3, 0, 1.7),
+            "lamp/base": X(2, 1, -0.2),
+            "stand_a/body": X(5.1, 0, 0.5, 0, 0, PI),
+            "stand_a/foot": X(5, 0, 0),
+            "stand_b/body": X(2.3, 0, 1) @ R_b,
+            "stand_b/foot": X(2.8, 0.1, 1) @ R_b @ X(0, 0, 0, 0, 0, PI),
+            "shelf/board": X(0, 5, 0),
+            "shelf/s::body": X(1.1, 5, 0.5, 0, 0, PI),
+            "shelf/s::foot": X(1, 5, 0),
+            "shelf/arm::inner::tip": X(0, 5, 2),
+        },
+    )
+
+
+def test_a_placement_frame_the_model_lacks_is_one_error_naming_its_frames(tmp_path) -> None:
+    path = _world(
+        tmp_path,
+        '<model name="table" placement_frame="lge"><pose>0 0 1 0 0 0</pose>'
+        f'<link name="top">{INERTIAL}</link><link name="leg">{INERTIAL}</link></model>',
+    )
+    with pytest.raises(SDFError, match=r"world\.sdf:3: <model name='table'>: frame 'lge' does "
+                       r"not exist in this model; name one of: leg, top, __model__"):  # fmt: skip
+        world_from_sdf(path)
+
+
+# --- placement frames, libsdformat's own test world ---------------------------------------
+def _frames_model() -> dict[str, np.ndarray]:
+    """Each frame of test_model_with_frames in its model frame, from the file's numbers."""
+    F1 = X(0, 0, 0, 1.570796, 0, 0)
+    L2 = F1 @ X(1, 0, 0)
+    L3 = L2 @ X(0, 1, 0)
+    M2 = F1 @ X(1, 0, 0)
+    return {
+        "__model__": np.eye(4),
+        "F2": F1 @ X(0, 0, 0, 0, 0.785398, 0),
+        "J2": L3 @ X(0, 0, 1),  # a joint's pose is relative to its child link by default
+        "L1": F1,
+        "L2": L2,
+        "L3": L3,
+        "L4": X(0, 0, 1),
+        "M2::L5": M2 @ X(1, 0, 0),
+    }
+
+
+def test_libsdformats_placement_frame_world_places_every_frame_where_libsdformat_does(
+    tmp_path, monkeypatch
+) -> None:
+    # libsdformat's expectation: every placement frame is at PLACED in the world (in the parent
+    # model's frame, for the includes of parent_model_include, which is at the origin).
+    models = tmp_path / "models" / "test_model_with_frames"
+    models.mkdir(parents=True)
+    (models / "model.sdf").write_text(FRAMES_MODEL)
+    (models / "model.config").write_text(FRAMES_CONFIG)
+    monkeypatch.setenv("SDF_PATH", str(models.parent))
+    path = tmp_path / "placement_frame.sdf"
+    path.write_text(PLACEMENT_WORLD)
+    poses = world_link_poses(world_from_sdf(path))
+    frames, placed = _frames_model(), X(*(float(v) for v in PLACED.split()))
+    cases = {
+        "no_placement_frame": "__model__",
+        "placement_frame_using_link": "L4",
+        "placement_frame_using_frame": "F2",
+        "placement_frame_using_joint": "J2",
+        "placement_frame_using_model": "__model__",
+        "include_with_placement_frame_and_pose_relative_to": "L4",
+    }
+    nested = {f"parent_model_include/{k}::": v for k, v in cases.items() if k[0] == "p"}
+    nested["parent_model_include/nested_include_with_placement_frame_and_pose_relative_to::"] = "L4"
+    checked = 0
+    for prefix, frame in {**{f"{k}/": v for k, v in cases.items()}, **nested}.items():
+        X_W_M = placed @ inv(frames[frame])
+        for link in ("L1", "L2", "L3", "L4", "M2::L5"):
+            assert_pose(poses[prefix + link], X_W_M @ frames[link], f"{prefix}{link}")
+            checked += 1
+    # The <model placement_frame=...> cases hold copies of parts of the model: L1 at F1,
+    # L2/L3 as above, L4 (0, 0, 1) and a nested_model at the model frame.
+    own = {
+        "model_with_link_placement_frame": ("L4", ["L4"]),
+        "model_with_model_placement_frame": ("__model__", ["L4"]),
+        "model_with_frame_placement_frame": ("F2", ["L1"]),
+        "model_with_joint_placement_frame": ("J2", ["L1", "L2", "L3"]),
+        "model_with_placement_frame_and_pose_relative_to": ("L4", ["L4"]),
+        "model_with_nested_model_placement_frame": ("__model__", ["L4"]),
+    }
+    for model, (frame, links) in own.items():
+        for link in links:
+            expected = placed @ inv(frames[frame]) @ frames[link]
+            assert_pose(poses[f"{model}/{link}"], expected, f"{model}/{link}")
+            checked += 1
+    assert_pose(
+        poses["model_with_nested_model_placement_frame/nested_model::L4"],
+        placed @ X(0, 0, 1),
+        "nested_model::L4",
+    )
+    assert checked == 11 * 5 + 8, "every link of the 17 models (13 with a placement frame)"
+
+
+# --- SDFormat 1.6: a world frame named like a model ----------------------------------------
+def _box(name: str, pose: str, attributes: str = "") -> str:
+    link = f'<link name="L">{INERTIAL}</link>'
+    return f'<model name="{name}"><pose{attributes}>{pose}</pose>{link}</model>'
+
+
+def test_a_1_6_world_frame_named_like_a_model_is_renamed_as_libsdformat_does(tmp_path) -> None:
+    # libsdformat's world_model_frame_same_name_1_6.sdf: frame 'ground' becomes 'ground_frame'
+    # (0, 0, 3); a second clash goes on to 'ground_frame0'. 'ground' alone means the model.
+    path = _world(
+        tmp_path,
+        _box("base", "1 0 0 0 0 0")
+        + _box("ground", "0 2 0 0 0 0")
+        + '<frame name="ground"><pose>0 0 3 0 0 0</pose></frame>'
+        + _box("lift", "0 4 0 0 0 0")
+        + _box("lift_frame", "0 6 0 0 0 0")
+        + '<frame name="lift"><pose>0 0 5 0 0 0</pose></frame>'
+        + _box("on_frame", "1 0 0 0 0 0", ' frame="ground_frame"')
+        + _box("on_model", "1 0 0 0 0 0", ' frame="ground"')
+        + _box("on_frame0", "1 0 0 0 0 0", ' frame="lift_frame0"'),
+        version="1.6",
+    )
+    world = world_from_sdf(path)
+    poses = world_link_poses(world)
+    _assert_links(
+        poses,
+        {
+            "base/L": X(1, 0, 0),
+            "ground/L": X(0, 2, 0),
+            "lift/L": X(0, 4, 0),
+            "lift_frame/L": X(0, 6, 0),
+            "on_frame/L": X(1, 0, 3),
+            "on_model/L": X(1, 2, 0),
+            "on_frame0/L": X(1, 0, 5),
+        },
+    )
+    report = Report(source=str(path))
+    read_sdf_world(path.read_text(), str(path), tmp_path, report=report)
+    renamed = {e.subject: e.detail for e in report.entries if "renamed" in e.detail}
+    assert renamed.keys() == {"world frame 'ground'", "world frame 'lift'"}, report.entries
+    assert "'ground_frame'" in renamed["world frame 'ground'"], renamed
+    assert "'lift_frame0'" in renamed["world frame 'lift'"], renamed
+    masses = world.model.body_mass[[world.model.body(f"{m}/L").id for m in ("base", "ground")]]
+    np.testing.assert_allclose(masses, [1.0, 1.0], rtol=0, atol=TOL_M, err_msg="mass [kg]")
+
+
+def test_from_1_7_a_world_frame_named_like_a_model_stays_an_error(tmp_path) -> None:
+    path = _world(
+        tmp_path,
+        _box("ground", "0 2 0 0 0 0") + '<frame name="ground"><pose>0 0 3 0 0 0</pose></frame>',
+        version="1.7",
+    )
+    with pytest.raises(SDFError, match="the name 'ground' is taken in this world"):
+        world_from_sdf(path)
