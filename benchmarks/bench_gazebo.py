@@ -15,7 +15,7 @@ from pathlib import Path
 import mujoco
 import tomllib
 
-from converters.gazebo.apply import DAMPING_FACTOR_PREFIX, apply_gazebo
+from converters.gazebo.apply import apply_gazebo
 from converters.gazebo.blocks import parse_gazebo
 from converters.gazebo.contact import add_gazebo_ground
 from converters.pipeline import convert, convert_full
@@ -42,9 +42,6 @@ def _stage_timing(robot: dict) -> dict[str, float]:
     spec = done.spec.copy()
     for exclude in list(spec.excludes):
         spec.delete(exclude)
-    for numeric in list(spec.numerics):
-        if numeric.name.startswith(DAMPING_FACTOR_PREFIX):
-            spec.delete(numeric)
     start = time.perf_counter()
     ext = parse_gazebo(parse_xml(done.description.text, robot["entry"]), robot["entry"])
     apply_gazebo(spec, ext, done.provenance, Report())

@@ -21,6 +21,7 @@ from converters.gazebo.contact import (
     contact_softness,
     friction_priority,
 )
+from converters.gazebo.friction_pairs import mark_anisotropic_surfaces
 from converters.gazebo.joints import apply_joint_tags, report_blobs
 from converters.gazebo.materials import gazebo_rgba
 from converters.provenance import GeomOrigin, Provenance
@@ -69,6 +70,7 @@ def apply_gazebo(
         if geom.role == "collision":
             _apply_surface(spec, geom, ext.surface_of(geom.link, geom.index), masses, report)
     _report_surfaces(ext, provenance, report)
+    mark_anisotropic_surfaces(spec, ext, provenance, report)
     _apply_visuals(spec, ext, provenance, report)
     flags = body_flags(spec, ext, provenance)
     _apply_body_flags(spec, flags, report)
@@ -200,17 +202,6 @@ def _report_surface(subject: str, surface: Surface, report: Report) -> None:
         )
     elif surface.mu1 is not None:
         report.mapped(subject, f"μ1={surface.mu1}: friction, min-μ priority", tag="mu1")
-    if surface.mu2 is not None and surface.mu2 != (surface.mu1 or DEFAULT_MU):
-        report.approximated(
-            subject,
-            f"μ2={surface.mu2} ≠ μ1: MuJoCo geoms are isotropic; μ1 is used in every "
-            "direction (keeps a wheel's traction along its rolling direction)",
-            tag="mu2",
-        )
-    if surface.fdir1 is not None:
-        report.approximated(
-            subject, f"fdir1={surface.fdir1}: no friction direction in MuJoCo", tag="fdir1"
-        )
     if surface.min_depth is not None:
         report.ignored(
             subject,

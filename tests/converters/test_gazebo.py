@@ -102,11 +102,12 @@ TAG_TABLE = [
         ),
     ),
     (
-        "mu2 differs: mu1 kept, approximated",
+        "mu2 differs: mu1 on the geom, both in the world's pairs",
         _ref("arm", "<mu1>0.4</mu1><mu2>0.8</mu2>"),
         lambda d, m: (
             _geom(d, m, "arm").friction[0] == pytest.approx(0.4)
-            and _entry(d, "mu2").outcome is Outcome.APPROXIMATED
+            and _entry(d, "mu2").outcome is Outcome.MAPPED
+            and list(m.numeric_data[:2]) == pytest.approx([0.4, 0.8])
         ),
     ),
     (
@@ -223,7 +224,7 @@ TAG_TABLE = [
             lambda d, m, tag=tag, outcome=outcome: _entry(d, tag).outcome is outcome,
         )
         for tag, value, outcome in [
-            ("fdir1", "1 0 0", Outcome.APPROXIMATED),
+            ("fdir1", "1 0 0", Outcome.MAPPED),  # μ1 = μ2 (SDF defaults): no direction
             ("maxVel", "0.5", Outcome.IGNORED),
             ("minDepth", "0.001", Outcome.IGNORED),
         ]

@@ -1,4 +1,4 @@
-"""Joint commands (position, velocity, effort), timed pushes and Gazebo dampingFactor.
+"""Joint commands (position, velocity, effort) and timed pushes.
 
 Joint commands reuse the entity's motor actuator (one per actuated joint, `ctrlrange` = ±effort,
 converter contract). Effort mode keeps it a motor. Position and velocity modes turn it into a
@@ -28,7 +28,6 @@ from twin_cli.world import native_servos, servos, sleeping
 MODES = ("position", "velocity", "effort")
 ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
 VELOCITY_BAND = 0.01  # fraction of the velocity limit over which Gazebo's rule fades the effort
-GAZEBO_STEP = 0.001  # [s] dampingFactor is the velocity fraction lost per Gazebo step
 _AFFINE = mujoco.mjtBias.mjBIAS_AFFINE
 _NONE = mujoco.mjtBias.mjBIAS_NONE
 _FIXED = mujoco.mjtGain.mjGAIN_FIXED
@@ -253,40 +252,3 @@ def apply_pushes(
         if body in extra:
             wrenches.append(tuple(extra[body]))
         data.xfrc_applied[b] = np.sum(wrenches or [np.zeros(6)], axis=0)
-
-
-@dataclass(frozen=True)
-class Damping:
-    """Per-step velocity decay of the dofs of bodies with Gazebo `dampingFactor`.
-
-    Attributes:
-        dofs: dof addresses; keep: factor each velocity is multiplied by per world step.
-    """
-
-    dofs: np.ndarray
-    keep: np.ndarray
-
-
-def damping_of(model: mujoco.MjModel, names: list[str]) -> Damping | None:
-    """Reads `<prefix>damping_factor:<body>` numerics into a per-step decay, or None if none.
-
-    `names` are the model's numeric names (index i ↔ numeric i).
-
-    A fraction f lost per GAZEBO_STEP becomes (1 − f)^(dt / GAZEBO_STEP) per world step, applied
-    to the velocity of the body's own joints (exact for a free body; for a body on a joint, the
-    decay acts on the joint speed).
-    """
-    dofs, keep = [], []
-    for i, name in enumerate(names):
-        prefix, sep, body = name.partition("damping_factor:")
-        if not sep:
-            continue
-        b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, prefix + body)
-        fraction = float(model.numeric_data[model.numeric_adr[i]])
-        if b < 0 or fraction <= 0:
-            continue
-        span = range(model.body_dofadr[b], model.body_dofadr[b] + model.body_dofnum[b])
-        factor = (1.0 - min(fraction, 1.0)) ** (model.opt.timestep / GAZEBO_STEP)
-        dofs.extend(span)
-        keep.extend([factor] * len(span))
-    return Damping(np.array(dofs, np.int64), np.array(keep)) if dofs else None

@@ -13,10 +13,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
-from twin_cli.world import actuation as control
 from twin_cli.world.contacts import cap_contact_stiffness, spec_solrefs
 from twin_cli.world.engine_threads import set_engine, sleeping, threads_of
-from twin_cli.world.entities import element_names
 from twin_cli.world.pose import vec3
 from twin_cli.world.scene import ODE_ONLY_FIELDS
 from twin_cli.world.sensor_rings import align_sensor_ticks
@@ -102,10 +100,6 @@ def set_physics(
         if "timestep" in changes:  # contacts resolvable at the old step may not be now
             cap_contact_stiffness(state.model, spec_solrefs(state.spec, state.model))
             align_sensor_ticks(state.model, state.data)  # the lead is half the new step
-        # dampingFactor's per-step keep fraction depends on the timestep.
-        state.damping = control.damping_of(
-            state.model, element_names(state.model, state.model.name_numericadr)
-        )
         loop.reanchor()
         wake_trees(state.data, range(state.model.ntree))  # new settings act on every robot
         return physics(state)

@@ -14,6 +14,7 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
+from converters.gazebo.friction_pairs import add_friction_pairs
 from converters.mjcf.lowest_point import collision_geoms, lowest_point
 from twin_cli.errors import SpawnError
 from twin_cli.world import actuation, placement, spawn
@@ -35,6 +36,7 @@ def rebuild(state: WorldState, trial: mujoco.MjSpec, new: Sequence[str], source:
     Raises:
         SpawnError: the spec does not compile; the world is unchanged.
     """
+    add_friction_pairs(trial)  # mu1/mu2 pairs with the world's geoms as they now are
     try:
         model, data = trial.recompile(state.model, state.data)
     except (ValueError, RuntimeError) as exc:

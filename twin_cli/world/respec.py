@@ -26,6 +26,7 @@ import ctypes
 import mujoco
 import numpy as np
 
+from converters.gazebo.friction_pairs import add_friction_pairs
 from twin_cli.world import shared_meshes, spawn
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.driving import reapply_commands
@@ -77,6 +78,8 @@ def renew_spec(state: WorldState) -> bool:
     caller holds the lock.
     """
     fresh = _fresh_spec(state)
+    if fresh is not None:
+        add_friction_pairs(fresh)
     if fresh is None or not _compiles_to_model(state, fresh):
         state.spec_renewals_refused += 1
         return False

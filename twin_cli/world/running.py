@@ -136,21 +136,13 @@ def _step_chunk(state: WorldState, n: int) -> None:
 
 
 def _mj_steps(state: WorldState, n: int) -> None:
-    """n MuJoCo steps, with velocity decay (dampingFactor) after each when any is set.
+    """n MuJoCo steps in one call (Gazebo's dampingFactor is joint damping in the model).
 
     Called between observer calls with the interpreter's caches cold from the last step, so it
     makes as few lookups as it can: each costs ~0.5 µs there.
     """
     start = perf_counter()
-    damping = state.damping
-    if damping is None:
-        mj_step(state.model, state.data, n)
-    else:
-        m, d = state.model, state.data
-        dofs, keep = damping.dofs, damping.keep
-        for _ in range(n):
-            mj_step(m, d)
-            d.qvel[dofs] *= keep
+    mj_step(state.model, state.data, n)
     state.stepping_time += perf_counter() - start
 
 

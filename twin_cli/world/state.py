@@ -20,7 +20,7 @@ from twin_cli.world.observers import Observers
 
 if TYPE_CHECKING:
     from converters.description import Light
-    from twin_cli.world.actuation import Damping, JointCommand, Push
+    from twin_cli.world.actuation import JointCommand, Push
     from twin_cli.world.divergence import Divergence, SpeedBounds
     from twin_cli.world.entities import Entity, EntityIndex
     from twin_cli.world.loop import WorldLock
@@ -44,7 +44,6 @@ class WorldState:
         commands: actuator name → the joint command it holds.
         native: actuator name → its own servo law as compiled (`native_servos.capture`).
         pushes: wrenches acting until a world iteration; perturbation: a viewer's drag, by body.
-        damping: per-step velocity decay (Gazebo's `dampingFactor`), or None.
         iterations: steps taken since the last reset; stepping_time: [s] spent in `mj_step`.
         paused: the loop's pause; divergences, divergence_log: entities reset after a NaN or
             a speed far past a joint's limit; speed_bounds: the per-dof bounds of `model`
@@ -71,7 +70,6 @@ class WorldState:
     native: dict[str, Law] = field(default_factory=dict)
     pushes: list[Push] = field(default_factory=list)
     perturbation: dict[str, tuple[float, ...]] = field(default_factory=dict)
-    damping: Damping | None = None
     iterations: int = 0
     stepping_time: float = 0.0
     paused: bool = False

@@ -174,20 +174,3 @@ def test_push_is_an_impulse_of_force_times_duration():
     vx = world.data.qvel[0]
     assert vx == pytest.approx(2.0 * 0.25 / 1.0, rel=1e-9), f"momentum after the push {vx}"
     assert not np.any(world.data.xfrc_applied), "the push ended after its duration"
-
-
-def test_damping_factor_numeric_removes_that_velocity_fraction_per_millisecond():
-    # Converter contract: custom numeric `damping_factor:<body>` = velocity fraction lost per
-    # 0.001 s (Gazebo dampingFactor). At a 2 ms step the loss per step is 1 − (1 − f)².
-    xml = mjcf_ball().replace(
-        "<worldbody>",
-        '<custom><numeric name="damping_factor:ball" data="0.01"/></custom><worldbody>',
-    )
-    world = World()
-    world.set_gravity((0.0, 0.0, 0.0))
-    world.set_physics(timestep=0.002)
-    world.spawn(mujoco.MjSpec.from_string(xml), pose=Pose(z=1.0))
-    world.data.qvel[0] = 1.0  # [m/s]
-    world.step(50)  # 0.1 s
-    vx = world.data.qvel[0]
-    assert vx == pytest.approx(0.99**100, rel=1e-9), f"velocity after 0.1 s: {vx} m/s"

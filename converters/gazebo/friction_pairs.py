@@ -1,0 +1,195 @@
+"""Gazebo's two friction coefficients (`mu1`, `mu2`) as MuJoCo contact pairs with the world.
+
+Gazebo's rule (Gazebo Classic `ODEPhysics::Collide`, ODE `dxJointContact::getInfo2`): a contact
+gets μ = min(mu of the two surfaces) along a first friction direction t1 and μ2 = min(mu2 of the
+two) along t2 = n × t1, each bounded on its own (ODE's friction pyramid, `dContactApprox1`).
+t1 is `fdir1` of the first collision of the pair rotated into the world by that collision's
+pose (`fdir1` of the second is read but never used), else ODE's `dPlaneSpace(n)`: for a normal
+n with |n_z| > √½ the unit vector ⟂ n in the y-z plane, so on a flat ground t1 = ±world y and
+t2 = ±world x whatever the body's heading. SDF's default for an unset `mu2` is 1, as for `mu`.
+
+MuJoCo's geom has one sliding coefficient for both tangents; a `<pair>` has two, applied along
+the rows 1 and 2 of the contact frame. For a plane against a sphere, ellipsoid, box, cylinder
+or mesh, MuJoCo builds that frame from the normal alone (`mju_makeFrame`: row 1 = world y made
+⟂ n), measured: t1 = world y, t2 = world x on a flat ground for any heading and wheel angle —
+Gazebo's default directions. A capsule's row 1 follows its axis instead. So:
+  - no `fdir1`, μ1 ≠ μ2, a collider whose frame is built from the normal: explicit pairs with
+    the world body's geoms, friction (μ1, μ2), exact on a ground plane (and on one tilted about a
+    world axis, where `dPlaneSpace` and `mju_makeFrame` agree);
+  - `fdir1` set (a direction that turns with the link), or a capsule: no MuJoCo frame follows
+    it, so μ1 stays isotropic and the report says "approximated", naming μ1, μ2 and `fdir1`.
+
+Explicit pairs come on top of MuJoCo's own contacts, so the body's contacts with the world body
+are excluded and every colliding geom of the body gets its pair with every colliding geom of
+the world body (the min-μ rule written out). The robot spec carries a custom numeric per
+anisotropic geom; `add_friction_pairs` builds the pairs on the world spec before each compile,
+named after the entity, so deleting the entity deletes them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from converters.gazebo.contact import DEFAULT_MU, contact_mu
+
+if TYPE_CHECKING:
+    import mujoco
+
+    from converters.description.gazebo import GazeboExtensions, Surface
+    from converters.provenance import GeomOrigin, Provenance
+    from converters.report import Report
+
+ANISOTROPIC_PREFIX = "anisotropic_friction:"
+"""Custom numeric `anisotropic_friction:<geom>` = (μ1, μ2) of a geom the world pairs."""
+PAIR_MARK = "friction_pair:"
+"""In the name of every pair and exclude `add_friction_pairs` makes (after the entity prefix)."""
+DEFAULT_MU2 = 1.0
+"""SDF default for `surface/friction/ode/mu2` (`sdf/1.11/surface.sdf`)."""
+SAME_MU = 1e-9
+"""μ1 and μ2 closer than this are one isotropic μ."""
+FRAME_FROM_NORMAL = ("sphere", "ellipsoid", "box", "cylinder", "mesh", "sdf")
+"""Geom types whose contact with a plane has MuJoCo's frame from the normal (measured)."""
+
+
+def mark_anisotropic_surfaces(
+    spec: mujoco.MjSpec, ext: GazeboExtensions, provenance: Provenance, report: Report
+) -> None:
+    """Marks each collision geom with μ1 ≠ μ2 and no `fdir1` for pairs; reports every case.
+
+    Args:
+        spec: the robot spec (geoms named as in provenance).
+        ext: the robot's Gazebo extensions; provenance: where each geom came from.
+        report: one line per tagged geom: mapped (pairs) or approximated (isotropic μ1).
+    """
+    for origin in provenance.geoms:
+        if origin.role != "collision":
+            continue
+        surface = ext.surface_of(origin.link, origin.index)
+        geom = spec.geom(origin.geom)
+        if geom is not None and (surface.mu2 is not None or surface.fdir1 is not None):
+            _mark(spec, geom, origin, surface, report)
+
+
+def _mark(
+    spec: mujoco.MjSpec,
+    geom: mujoco.MjsGeom,
+    origin: GeomOrigin,
+    surface: Surface,
+    report: Report,
+) -> None:
+    mu1 = contact_mu(DEFAULT_MU if surface.mu1 is None else surface.mu1)
+    mu2 = contact_mu(DEFAULT_MU2 if surface.mu2 is None else surface.mu2)
+    subject = f"link '{origin.link}' geom '{origin.geom}'"
+    fdir1 = surface.fdir1 if surface.fdir1 is not None and any(surface.fdir1) else None
+    if abs(mu1 - mu2) <= SAME_MU:
+        if fdir1 is not None:
+            report.mapped(subject, f"fdir1={fdir1}: μ1 = μ2 = {mu1:g}, no direction", tag="fdir1")
+        return
+    kind = _type_name(geom)
+    if fdir1 is not None or kind not in FRAME_FROM_NORMAL:
+        why = (
+            f"fdir1={fdir1} turns with the link and no MuJoCo contact frame follows it"
+            if fdir1 is not None
+            else f"a {kind}'s contact frame follows its axis, not Gazebo's world directions"
+        )
+        report.approximated(
+            subject,
+            f"μ1={mu1:g}, μ2={mu2:g}: {why}; twin uses μ1={mu1:g} in every direction "
+            "(docs/contacts.md)",
+            tag="mu2",
+        )
+        return
+    spec.add_numeric(name=f"{ANISOTROPIC_PREFIX}{origin.geom}", data=[mu1, mu2], size=2)
+    report.mapped(
+        subject,
+        f"μ1={mu1:g} along world y, μ2={mu2:g} along world x on the ground (Gazebo's "
+        "directions without fdir1): contact pairs with the world's geoms",
+        tag="mu2",
+    )
+
+
+def _type_name(geom: mujoco.MjsGeom) -> str:
+    import mujoco
+
+    return mujoco.mjtGeom(int(geom.type)).name.removeprefix("mjGEOM_").lower()
+
+
+def add_friction_pairs(spec: mujoco.MjSpec) -> int:
+    """Rebuilds the pairs and excludes of every marked geom on a world spec (idempotent).
+
+    Args:
+        spec: a world spec with entities attached (their numerics, geoms and bodies prefixed
+            alike, or none of them).
+
+    Returns:
+        The number of pairs made.
+    """
+    for element in list(spec.pairs) + list(spec.excludes):
+        if PAIR_MARK in element.name:
+            spec.delete(element)
+    marked = list(_marked(spec))
+    made, done = 0, set()
+    for prefix, geom, _ in marked:
+        body = geom.parent
+        if body.name == spec.worldbody.name or body.name in done:
+            continue
+        done.add(body.name)
+        mus = {g.name: m for _, g, m in marked if g.parent.name == body.name}
+        spec.add_exclude(
+            name=f"{prefix}{PAIR_MARK}{body.name}",
+            bodyname1=spec.worldbody.name,
+            bodyname2=body.name,
+        )
+        for own in _colliding(body.geoms):
+            for other in _colliding(spec.worldbody.geoms):
+                if _filtered(own, other):
+                    _add_pair(spec, prefix, own, other, mus.get(own.name))
+                    made += 1
+    return made
+
+
+def _marked(spec: mujoco.MjSpec) -> Iterable[tuple[str, mujoco.MjsGeom, tuple[float, float]]]:
+    """(entity prefix, geom, (μ1, μ2)) of every marked geom the spec still has."""
+    for numeric in spec.numerics:
+        prefix, mark, name = numeric.name.partition(ANISOTROPIC_PREFIX)
+        geom = spec.geom(prefix + name) if mark else None
+        if geom is not None:
+            yield prefix, geom, (float(numeric.data[0]), float(numeric.data[1]))
+
+
+def _colliding(geoms: Iterable[mujoco.MjsGeom]) -> list[mujoco.MjsGeom]:
+    return [g for g in geoms if int(g.contype) or int(g.conaffinity)]
+
+
+def _filtered(a: mujoco.MjsGeom, b: mujoco.MjsGeom) -> bool:
+    """MuJoCo's contype/conaffinity test: whether the two would collide without the exclude."""
+    return bool((int(a.contype) & int(b.conaffinity)) or (int(b.contype) & int(a.conaffinity)))
+
+
+def _add_pair(
+    spec: mujoco.MjSpec,
+    prefix: str,
+    own: mujoco.MjsGeom,
+    world: mujoco.MjsGeom,
+    mus: tuple[float, float] | None,
+) -> None:
+    """One pair: Gazebo's min μ per direction; the rest from the geom MuJoCo would let decide
+    (the higher priority, the robot's on a tie), as without the pair."""
+    mu1, mu2 = mus if mus is not None else (float(own.friction[0]),) * 2
+    wmu = float(world.friction[0])
+    ruler = world if int(world.priority) > int(own.priority) else own
+    pair = spec.add_pair(
+        name=f"{prefix}{PAIR_MARK}{own.name}|{world.name}",
+        geomname1=world.name,
+        geomname2=own.name,
+    )
+    spin, roll = float(ruler.friction[1]), float(ruler.friction[2])
+    pair.friction = np.array([min(mu1, wmu), min(mu2, wmu), spin, roll, roll])
+    pair.condim = int(ruler.condim)
+    pair.solref = np.array(ruler.solref)
+    pair.solimp = np.array(ruler.solimp)
+    pair.margin = max(float(own.margin), float(world.margin))
+    pair.gap = max(float(own.gap), float(world.gap))
