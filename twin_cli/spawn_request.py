@@ -41,6 +41,8 @@ class SpawnRequest:
             behaviour).
         fixed_base: weld the root link to the world at the spawn pose (no free joint), as a
             `world` link and a fixed joint do; a robot already fixed is unchanged.
+        coacd_cpu_limit: CPU time CoACD may spend on one collision mesh before its hull stands
+            in [CPU s]; None: the converting process's default (`twin serve --coacd-cpu-limit`).
     """
 
     source: Any = None
@@ -54,6 +56,7 @@ class SpawnRequest:
     repair_inertia: bool = False
     strict: bool = False
     fixed_base: bool = False
+    coacd_cpu_limit: float | None = None
 
     @property
     def label(self) -> str:
@@ -87,6 +90,7 @@ class SpawnRequest:
             "repair_inertia": self.repair_inertia,
             "strict": self.strict,
             "fixed_base": self.fixed_base,
+            "coacd_cpu_limit": self.coacd_cpu_limit,
         }
 
     def to_body(self) -> dict[str, Any]:
@@ -117,7 +121,12 @@ class SpawnRequest:
             repair_inertia=bool(body.get("repair_inertia", False)),
             strict=bool(body.get("strict", False)),
             fixed_base=bool(body.get("fixed_base", False)),
+            coacd_cpu_limit=_optional_float(body.get("coacd_cpu_limit")),
         )
+
+
+def _optional_float(value: Any) -> float | None:
+    return None if value is None else float(value)
 
 
 def as_request(source: SpawnRequest | Any) -> SpawnRequest:

@@ -46,6 +46,7 @@ def spawn_request(
     repair_inertia: bool,
     strict: bool = False,
     fixed_base: bool = False,
+    coacd_cpu_limit: float | None = None,
 ) -> SpawnRequest:
     """The spawn request of a command line: a FILE, `-` (stdin) or `--xml` text, and options.
 
@@ -68,6 +69,7 @@ def spawn_request(
         repair_inertia=repair_inertia,
         strict=strict,
         fixed_base=fixed_base,
+        coacd_cpu_limit=coacd_cpu_limit,
     )
 
 
@@ -96,6 +98,7 @@ def spawn(
     strict: bool = False,
     drop_dangling: bool = False,
     fixed_base: bool = False,
+    coacd_cpu_limit: float | None = None,
 ) -> None:
     """Spawn from a file, from stdin (`-`) or from `--xml` text (SpawnEntity's `-stdin`/`xml`).
 
@@ -116,7 +119,16 @@ def spawn(
     else:
         pose = spawn_pose((x, y, z), (roll, pitch, yaw), quat)
     request = spawn_request(
-        file, xml, arg, package, joint, on_ground, repair_inertia, strict, fixed_base
+        file,
+        xml,
+        arg,
+        package,
+        joint,
+        on_ground,
+        repair_inertia,
+        strict,
+        fixed_base,
+        coacd_cpu_limit,
     )
     with connect_world(world, start=True) as c, _progress(world, file, json):
         if many:

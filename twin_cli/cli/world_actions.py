@@ -71,9 +71,19 @@ def list_(*, world: str, json: bool) -> None:
         return
     out.table(
         "entities",
-        ["name", "x", "y", "z", "joints", "source"],
-        [[e["name"], *e["position"], e["n_joints"], e["source"]] for e in rows],
+        ["name", "x", "y", "z", "joints", "source", "hull stand-ins"],
+        [[e["name"], *e["position"], e["n_joints"], e["source"], _stand_ins(e)] for e in rows],
     )
+    for e in rows:
+        for mesh in e.get("hull_stand_ins", []):
+            out.line(f"{e['name']}: convex hull stands in for {mesh}")
+
+
+def _stand_ins(entity: dict) -> str:
+    """How many collision meshes of an entity are convex hulls standing in for their
+    decomposition ("-" for none); an older server sends no such field."""
+    count = len(entity.get("hull_stand_ins", []))
+    return str(count) if count else "-"
 
 
 def pose(

@@ -153,6 +153,7 @@ SPAWN = Command(
             help="Leave those out with a warning: the default (kept for older scripts).",
         ),
         FIXED_BASE,
+        COACD_CPU_LIMIT,
     ),
 )
 

@@ -131,6 +131,13 @@ class SpawnBody(Body):
         default=False,
         description="weld the root link to the world at the spawn pose (no free joint)",
     )
+    coacd_cpu_limit: float | None = Field(
+        default=None,
+        gt=0.0,
+        le=86_400.0,
+        description="CPU seconds CoACD may spend on one collision mesh before its convex hull "
+        "stands in; absent: the server's default",
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> SpawnBody:

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 from converters.bounded_child import READ_EVENT
 from twin_cli.package_env import PACKAGE_ENVS
 from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world.values import hull_stand_ins
 
 if TYPE_CHECKING:
     import mujoco
@@ -118,6 +119,7 @@ def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> 
         request.repair_inertia,
         request.strict,
         request.fixed_base,
+        request.coacd_cpu_limit,
     )
 
 
@@ -151,7 +153,8 @@ class ConversionCache:
     def load(self, key: tuple, convert: Callable[[], LoadedSource]) -> LoadedSource:
         """The cached result for `key` (a copy, with `cached=True`), else `convert()`'s, stored.
 
-        Errors `convert` raises are not cached.
+        Errors `convert` raises are not cached, nor a conversion in which a convex hull stands
+        in for a decomposition that did not finish: the next spawn tries CoACD again.
         """
         with self._lock:
             entry = self._entries.get(key)
@@ -164,6 +167,8 @@ class ConversionCache:
             loaded = convert()
         read = tuple((p, file_digest(p)) for p in sorted(files))
         loaded = replace(loaded, mesh_keys=mesh_keys(loaded.spec, (key, read)))
+        if hull_stand_ins(loaded.report):
+            return loaded
         entry = _Entry(replace(loaded, spec=loaded.spec.copy()), read)
         with self._lock:
             self.misses += 1

@@ -44,6 +44,7 @@ from twin_cli.world.values import (
     Stats,
     WorldSettings,
     check_settings,
+    hull_stand_ins,
     scene_settings,
 )
 
@@ -198,6 +199,7 @@ class World:
                     e.source,
                     self.get_pose(n).position(),
                     len(queries.joint_names(state.model, state.index[n], f"{n}/")),
+                    hull_stand_ins(e.report),
                 )
                 for n, e in state.entities.items()
             ]

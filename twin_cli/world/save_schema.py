@@ -98,6 +98,7 @@ class SavedEntity(Strict):
     strict: bool = False
     drop_dangling: bool = False  # written by older saves; dropping is the default now, not read
     fixed_base: bool = False
+    coacd_cpu_limit: Annotated[float, Field(gt=0.0)] | None = None  # [CPU s]
     spawn_state: Annotated[dict[str, FiniteArray], AfterValidator(_state_fields)]
 
 

@@ -112,10 +112,13 @@ def _load(request: SpawnRequest) -> LoadedSource:
 def convert_options(request: SpawnRequest) -> ConvertOptions:
     """The converter's options that the request sets."""
     from converters.budget import XacroBudget
+    from converters.collision.plan import CollisionSettings
     from converters.mjcf.builder import ConvertOptions
 
+    limit = request.coacd_cpu_limit
     return ConvertOptions(
         repair_inertia=request.repair_inertia,
+        collision=CollisionSettings() if limit is None else CollisionSettings(cpu_limit=limit),
         strict=request.strict,
         fixed_base=request.fixed_base,
         xacro_budget=XacroBudget.from_env(),  # a served xacro runs bounded, apart from the world

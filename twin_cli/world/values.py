@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import PurePath
 
 from converters.mjcf import world_options as options
 from converters.mjcf.world_options import INTEGRATORS, SOLVERS
@@ -55,12 +56,26 @@ class SpawnResult:
 
 @dataclass(frozen=True)
 class EntityInfo:
-    """One line of the entity list: name, source file, root position [m], joints (no free)."""
+    """One line of the entity list: name, source file, root position [m], joints (no free),
+    and the collision meshes whose convex hull stands in for their decomposition
+    (`hull_stand_ins`)."""
 
     name: str
     source: str
     position: tuple[float, float, float]
     n_joints: int
+    hull_stand_ins: tuple[str, ...] = ()
+
+
+def hull_stand_ins(report: dict | None) -> tuple[str, ...]:
+    """`link: mesh file (why)` for each collision mesh of a converter report whose convex hull
+    stands in for its CoACD decomposition (over its CPU budget, stopped, or crashed)."""
+    rows = (report or {}).get("meshes", [])
+    return tuple(
+        f"{row['link']}: {PurePath(row['source']).name} ({row['fallback']})"
+        for row in rows
+        if row.get("fallback")
+    )
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from twin_cli.cli.options import PackageOpt, WorldOpt, usage_errors
+from twin_cli.cli.options import CoacdCpuLimitOpt, PackageOpt, WorldOpt, usage_errors
 from twin_cli.server.autosave import DEFAULT_INTERVAL_S
 
 
@@ -68,18 +68,29 @@ def serve(
             help="With --ros: answer /spawn_entity and /delete_entity (any DDS peer may call).",
         ),
     ] = False,
+    coacd_cpu_limit: CoacdCpuLimitOpt = None,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it.
 
     An SDF world's `model://NAME` is found with `--package NAME=PATH`, then GAZEBO_MODEL_PATH /
-    GZ_SIM_RESOURCE_PATH, then the directories above the file.
+    GZ_SIM_RESOURCE_PATH, then the directories above the file. `--coacd-cpu-limit` applies to
+    the world file's models and to every spawn that does not give its own.
     """
+    import os
+
+    from converters.collision.plan import CPU_LIMIT_ENV
     from twin_cli.cli.pairs import parse_pairs
     from twin_cli.server.process import ServeOptions
     from twin_cli.server.process import serve as run_server
 
     with usage_errors():
         packages = parse_pairs(package, "=", "--package")
+        if coacd_cpu_limit is not None and not 0 < coacd_cpu_limit < float("inf"):
+            raise typer.BadParameter(
+                "give a positive number of CPU seconds", param_hint="--coacd-cpu-limit"
+            )
+    if coacd_cpu_limit is not None:  # read by every conversion in this server (and its children)
+        os.environ[CPU_LIMIT_ENV] = repr(coacd_cpu_limit)
     opts = ServeOptions(
         world,
         str(world_file) if world_file else None,
