@@ -54,7 +54,6 @@ NOT_RUN = {
     "enable_odom_tf": "`twin serve --ros` always publishes the odom frame in /tf",
     "tf_frame_prefix_enable": "frames are prefixed with the entity's name",
     "tf_frame_prefix": "frames are prefixed with the entity's name",
-    "use_stamped_vel": "cmd_vel and cmd_vel_unstamped each take Twist and TwistStamped",
     "angular.z.max_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",
     "linear.x.min_acceleration": "the wheels ramp symmetrically at linear.x.max_acceleration",
     "angular.z.min_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",

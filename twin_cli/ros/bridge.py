@@ -5,7 +5,8 @@ stepping thread copies the state at RATE Hz of sim time into shared memory, and 
 process (`publisher`) builds the ROS messages with the recorder's code and publishes their CDR
 bytes from a participant of its own (node `/twin`). So the live topics, types, frame names and
 stamps are those of a recording, sensors included; `/tf_static` and `robot_description` are
-sent when an entity comes or goes, and a paused world's state is sent again every half second.
+sent when an entity comes or goes, and a paused world's state is sent again every half second
+(`/tf` only once per stamp, as tf2 takes it: `tf_repeats`).
 The publisher sends only the newest sample, at most WALL_SPEEDUP × RATE a wall second: a world
 up to twice as fast as real time loses no message, a faster one is thinned (as `twin topics
 echo`; from four times real time the stepping thread takes only every k-th sample,

@@ -1,9 +1,11 @@
 """What a ROS 2 stack sends the twin: `cmd_vel` for each drive, and ros2_control's forward
 command controllers, acted on through the calls `twin drive` and `twin command` make.
 
-- Each entity with a drive plugin gets readers on `/<entity>/cmd_vel` for geometry_msgs/Twist
-  (as gazebo_ros' drive plugins subscribe) and TwistStamped (as Jazzy's controllers and Nav2
-  publish with stamped commands); both types may share the topic. The newest command goes to
+- Each entity with a drive gets one reader, of one type, on each cmd_vel topic its drive takes:
+  a Gazebo drive plugin's `/<entity>/cmd_vel` (or the name it gives) geometry_msgs/Twist, as
+  gazebo_ros' drive plugins (and ros_gz_bridge for gz-sim's) subscribe; a diff_drive_controller's
+  topic the type its `use_stamped_vel` chooses (`plugin_names`). A topic never carries two
+  types (`ros2 topic echo` refuses such a topic). The newest command goes to
   `twin_cli.control.drive` with no duration: like the plugins, a base keeps its last command.
 - Each entity whose joints offer a command mode (position, velocity, effort) gets
   `/<entity>/forward_<mode>_controller/commands` (std_msgs/Float64MultiArray, the controller
@@ -33,7 +35,7 @@ from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.record.frames import entity_topic
-from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST, TWIST_STAMPED
+from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST
 from twin_cli.ros.plugin_names import TRAJECTORY, Controller, plugin_names
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
@@ -77,12 +79,11 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     if drives:
         kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
         own = getattr(drives[0], "cmd_vel_topic", "")  # as the converter read its plugin
-        topics = (entity_topic(name, own),) if own else named.cmd_vel or (f"/{name}/cmd_vel",)
-        for topic in topics:
-            inputs += [
-                Input(topic, message, drive=kind, timeout=timeout or None)
-                for message in (TWIST, TWIST_STAMPED)
-            ]
+        plugin = ((entity_topic(name, own) if own else f"/{name}/cmd_vel", TWIST),)
+        topics = named.cmd_vel if named.cmd_vel and not own else plugin
+        inputs += [
+            Input(topic, message, drive=kind, timeout=timeout or None) for topic, message in topics
+        ]
     if named.controllers:
         return (*inputs, *(_controller_input(c) for c in named.controllers))
     return (*inputs, *_default_controllers(name, world.joint_commands(name)))

@@ -7,9 +7,11 @@ YAML files gazebo_ros2_control (or gz_ros2_control) loads. (A gazebo_ros drive p
   (`joints`, `interface_name` or the type's interface). Forward command controllers and the
   joint group position, velocity and effort controllers take `<ns>/<controller>/commands`; a
   joint_trajectory_controller takes `<ns>/<controller>/joint_trajectory`; a
-  diff_drive_controller takes `<ns>/<controller>/cmd_vel` (TwistStamped, and Twist as well) and,
-  as Humble's does with `use_stamped_vel: false`, `<ns>/<controller>/cmd_vel_unstamped`; `<ns>`
-  is the plugin's `<ros><namespace>`, else the entity's name.
+  diff_drive_controller takes one cmd_vel topic of one type, as the controller subscribes:
+  `<ns>/<controller>/cmd_vel` (geometry_msgs/TwistStamped: Jazzy's only input, and Humble's
+  default, `use_stamped_vel: true`), or with `use_stamped_vel: false` (a Humble parameter;
+  Jazzy has none) `<ns>/<controller>/cmd_vel_unstamped` (geometry_msgs/Twist). `<ns>` is the
+  plugin's `<ros><namespace>`, else the entity's name.
 
 Only URDF descriptions carry these (`Entity.description`); a YAML file that cannot be read is
 logged once and the entity keeps twin's default controller names.
@@ -33,6 +35,7 @@ from converters.gazebo.controller_yaml import (
     node_parameters,
     parameter_files,
 )
+from twin_cli.ros.graph import TWIST, TWIST_STAMPED
 
 log = logging.getLogger("twin.ros")
 TRAJECTORY = "trajectory"  # a controller's mode: joint_trajectory_controller's topic
@@ -53,14 +56,15 @@ class Controller:
     topic: str
     mode: str
     joints: tuple[str, ...]
+    message: str = ""  # a drive's cmd_vel message type
 
 
 @dataclass(frozen=True)
 class PluginNames:
-    """What an entity's description names: a diff_drive_controller's cmd_vel topics (empty:
-    none) and its controllers (empty: twin's default controller names)."""
+    """What an entity's description names: a diff_drive_controller's cmd_vel topics with their
+    message types (empty: none) and its controllers (empty: twin's default controller names)."""
 
-    cmd_vel: tuple[str, ...] = ()
+    cmd_vel: tuple[tuple[str, str], ...] = ()
     controllers: tuple[Controller, ...] = ()
 
 
@@ -80,7 +84,7 @@ def plugin_names(entity: str, description: str | None, base: str = "") -> Plugin
         if is_control_plugin(plugin.get("filename", "")):
             controllers = _controllers(plugin, entity, base)
             break
-    drive_topics = tuple(c.topic for c in controllers if c.mode == DRIVE)
+    drive_topics = tuple((c.topic, c.message) for c in controllers if c.mode == DRIVE)
     named = tuple(c for c in controllers if c.mode != DRIVE)
     return PluginNames(drive_topics, named)
 
@@ -102,22 +106,22 @@ def _controllers(plugin: ET.Element, entity: str, base: str) -> tuple[Controller
     return tuple(_from_yaml(nodes, manager_name(xml), _namespace(plugin, entity)))
 
 
-def _drive_topics(name: str, namespace: str) -> list[Controller]:
-    """A diff_drive_controller's inputs: `~/cmd_vel`, and Humble's `~/cmd_vel_unstamped`."""
-    return [
-        Controller(f"/{namespace}/{name}/{leaf}", DRIVE, ())
-        for leaf in ("cmd_vel", "cmd_vel_unstamped")
-    ]
+def _drive_topic(name: str, namespace: str, params: dict) -> Controller:
+    """A diff_drive_controller's input: `~/cmd_vel` (TwistStamped), or with Humble's
+    `use_stamped_vel: false` `~/cmd_vel_unstamped` (Twist)."""
+    if params.get("use_stamped_vel") is False:
+        return Controller(f"/{namespace}/{name}/cmd_vel_unstamped", DRIVE, (), TWIST)
+    return Controller(f"/{namespace}/{name}/cmd_vel", DRIVE, (), TWIST_STAMPED)
 
 
 def _from_yaml(nodes: dict[str, dict], manager: str, namespace: str) -> list[Controller]:
     """The command-taking controllers the controller manager's parameter files declare."""
     out = []
     for name, kind in controller_types(nodes, manager).items():
-        if kind == DIFF_DRIVE_TYPE:
-            out += _drive_topics(name, namespace)
-            continue
         params = node_parameters(nodes, name)
+        if kind == DIFF_DRIVE_TYPE:
+            out.append(_drive_topic(name, namespace, params))
+            continue
         mode = params.get("interface_name") if kind == FORWARD else CONTROLLER_MODES.get(kind)
         joints = tuple(str(j) for j in params.get("joints") or ())
         if mode is None or not joints:

@@ -6,7 +6,8 @@ them (rosbags) and writing them to DDS never hold the stepping loop's GIL. It is
 loop (`record.encoder.run_encoder`) with a DDS participant as its sink, and it publishes at
 most `max_wall_rate` samples a wall second: a world faster than that is thinned (the newest are
 taken each time), as a ROS node could not take more anyway; a slower one loses none. The
-process holds its own participant (node `/twin`, the world's writers) in the server's scope.
+process holds its own participant (node `/twin`, the world's writers) in the server's scope;
+`/tf` goes through `tf_repeats`, so a paused world's beats send no transform tf2 already has.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from twin_cli.record.encoder import Encoder, conn_pending, run_encoder, signals
 from twin_cli.record.topics import Message, Topic
 from twin_cli.ros.participant import Participant
 from twin_cli.ros.scope import Scope
+from twin_cli.ros.tf_repeats import RepeatFilter
 
 NICE = 10  # added niceness of the publisher process (the bag encoder's)
 BURST_S = 1.0  # [s]: a publisher stalled this long still sends every record of a world running
@@ -68,6 +70,7 @@ class DdsSink:
 
     def __init__(self, participant: Participant) -> None:
         self.participant = participant
+        self._repeats = RepeatFilter()  # /tf: a frame once per stamp (a paused world's beats)
         self._layout: list[Topic] = []
         self._sensors: dict[str, Topic] = {}
 
@@ -82,7 +85,9 @@ class DdsSink:
             self._announce()
 
     def write(self, message: Message) -> None:
-        self.participant.write(message)
+        fresh = self._repeats.filter(message)
+        if fresh is not None:
+            self.participant.write(fresh)
 
     def close(self) -> None:
         self.participant.close()

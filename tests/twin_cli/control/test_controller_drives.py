@@ -194,10 +194,9 @@ def test_a_ros_cmd_vel_holds_for_the_controllers_timeout(tmp_path: Path) -> None
     world = World()
     world.spawn(SpawnRequest(str(_base(tmp_path)), on_ground=True), name="base")
     drives = [i for i in entity_inputs(world)["base"] if i.mode is None]
-    assert {i.topic for i in drives} == {
-        "/base/base_controller/cmd_vel",
-        "/base/base_controller/cmd_vel_unstamped",
-    }
+    assert [(i.topic, i.type) for i in drives] == [
+        ("/base/base_controller/cmd_vel", "geometry_msgs/msg/TwistStamped")
+    ], "one topic of one type: the controller's default, use_stamped_vel true"
     assert {i.timeout for i in drives} == {0.5}
     from twin_cli.live.catalogue import live_topics
 

@@ -79,26 +79,37 @@ def test_an_unreadable_controller_yaml_keeps_the_default_names(tmp_path) -> None
     assert plugin_names("bot", None).cmd_vel == ()
 
 
-def test_a_diff_drive_controller_takes_cmd_vel_under_its_own_name(tmp_path) -> None:
+@pytest.mark.parametrize(
+    ("setting", "expected"),
+    [
+        ("", ("/tb/base/cmd_vel", "geometry_msgs/msg/TwistStamped")),  # Jazzy's, Humble's default
+        (", use_stamped_vel: true", ("/tb/base/cmd_vel", "geometry_msgs/msg/TwistStamped")),
+        (", use_stamped_vel: false", ("/tb/base/cmd_vel_unstamped", "geometry_msgs/msg/Twist")),
+    ],
+)
+def test_a_diff_drive_controller_takes_one_cmd_vel_of_the_type_use_stamped_vel_chooses(
+    tmp_path, setting: str, expected: tuple[str, str]
+) -> None:
     """A relative `<parameters>` path starts at the description's folder; the plugin's ign_
-    name is a ros2_control plugin as well."""
+    name is a ros2_control plugin as well. One topic, one type, as the controller subscribes."""
     (tmp_path / "ddc.yaml").write_text(
         "controller_manager:\n  ros__parameters:\n"
         "    base: {type: diff_drive_controller/DiffDriveController}\n"
-        "base: {ros__parameters: {left_wheel_names: [l], right_wheel_names: [r]}}\n"
+        f"base: {{ros__parameters: {{left_wheel_names: [l], right_wheel_names: [r]{setting}}}}}\n"
     )
     plugin = (
         '<plugin name="c" filename="libign_ros2_control-system.so"><ros><namespace>/tb</namespace>'
         "</ros><parameters>ddc.yaml</parameters></plugin>"
     )
+    plugin_names.cache_clear()  # the same text under one path, three files
     names = plugin_names("bot", _robot(plugin), str(tmp_path))
-    assert names.cmd_vel == ("/tb/base/cmd_vel", "/tb/base/cmd_vel_unstamped")
+    assert names.cmd_vel == (expected,)
     assert names.controllers == (), "a drive is not a joint command controller"
 
 
 def test_an_sdf_models_drive_plugin_names_its_cmd_vel_too(tmp_path) -> None:
     """An SDF model has no URDF text: the converter's drive record carries the name its
-    gazebo_ros plugin gives cmd_vel, and odom the same way."""
+    gazebo_ros plugin gives cmd_vel, and odom the same way; the plugin subscribes Twist."""
     import drive_models as dm
 
     from twin_cli.live.catalogue import live_topics
@@ -116,5 +127,6 @@ def test_an_sdf_models_drive_plugin_names_its_cmd_vel_too(tmp_path) -> None:
     path.write_text(dm.sdf_diff_drive(plugin))
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="b")
-    assert {i.topic for i in entity_inputs(world)["b"] if i.mode is None} == {"/sdfbot/cmd_vel"}
+    drives = [(i.topic, i.type) for i in entity_inputs(world)["b"] if i.mode is None]
+    assert drives == [("/sdfbot/cmd_vel", "geometry_msgs/msg/Twist")], "the plugin's one type"
     assert "/sdfbot/odom" in {t.name for t in live_topics(world)}
