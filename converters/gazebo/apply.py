@@ -2,7 +2,8 @@
 
 Called by the converter core after every body, joint and geom exists. Surface tags act on the
 collision geoms that came from the tagged link (also after lumping, through provenance);
-link-level tags (gravity, selfCollide, dampingFactor) act on the body that carries the link.
+link-level tags (gravity, selfCollide, dampingFactor as joint damping, `damping`) act on the
+body that carries the link.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from converters.description.gazebo import GazeboExtensions, LinkExtension, Surface
+from converters.gazebo import damping
 from converters.gazebo.contact import (
     CONTACT_MU_MAX,
     DEFAULT_MU,
@@ -29,9 +31,6 @@ from converters.report import Report
 
 if TYPE_CHECKING:
     import mujoco
-
-DAMPING_FACTOR_PREFIX = "damping_factor:"
-"""Custom numeric `damping_factor:<body>`: fraction of velocity lost per 0.001 s (world applies)."""
 
 IGNORED_SURFACE = {  # Surface field -> (Gazebo tag, why MuJoCo does without it)
     "max_vel": ("maxVel", "MuJoCo has no cap on penetration-correction speed; solref sets it"),
@@ -73,7 +72,7 @@ def apply_gazebo(
     mark_anisotropic_surfaces(spec, ext, provenance, report)
     _apply_visuals(spec, ext, provenance, report)
     flags = body_flags(spec, ext, provenance)
-    _apply_body_flags(spec, flags, report)
+    _apply_body_flags(spec, flags, masses, report)
     add_self_collision_excludes(spec, provenance, flags, model_self_collide=ext.self_collide)
     apply_joint_tags(spec, ext, provenance, report)
     report_blobs(ext, report)
@@ -90,12 +89,18 @@ class _BodyMasses:
         mass = float(self.spec.body(body).mass)
         if mass > 0:
             return mass
+        model = self.compiled()
+        # the core reports uncompilable specs; 0 kg clamps to stiffest
+        return 0.0 if model is None else float(model.body(body).mass[0])
+
+    def compiled(self) -> mujoco.MjModel | None:
+        """The spec compiled once (masses and inertias), or None if it does not compile."""
         if self.model is None:
             try:
                 self.model = self.spec.copy().compile()
-            except ValueError:  # the core reports uncompilable specs; 0 kg clamps to stiffest
-                return 0.0
-        return float(self.model.body(body).mass[0])
+            except ValueError:
+                return None
+        return self.model
 
 
 def _apply_surface(
@@ -295,26 +300,41 @@ def body_flags(
     return flags
 
 
-def _apply_body_flags(spec: mujoco.MjSpec, flags: dict[str, BodyFlags], report: Report) -> None:
+def _apply_body_flags(
+    spec: mujoco.MjSpec, flags: dict[str, BodyFlags], masses: _BodyMasses, report: Report
+) -> None:
     for flag in flags.values():
         subject = f"body '{flag.body}' (links {', '.join(flag.links)})"
         if not flag.feels_gravity:
             spec.body(flag.body).gravcomp = 1.0
             report.mapped(subject, "gravity off: gravcomp=1 cancels its weight", tag="gravity")
         if flag.damping_factor is not None:
-            spec.add_numeric(
-                name=f"{DAMPING_FACTOR_PREFIX}{flag.body}", data=[flag.damping_factor], size=1
-            )
-            report.mapped(
-                subject,
-                f"dampingFactor={flag.damping_factor}: velocity fraction lost per 0.001 s, "
-                f"custom numeric '{DAMPING_FACTOR_PREFIX}{flag.body}' applied by the world",
-                tag="dampingFactor",
-            )
+            _apply_damping_factor(spec, flag.body, flag.damping_factor, masses, subject, report)
         if flag.self_collide:
             report.mapped(
                 subject, "selfCollide: collides with the robot's other links", tag="selfCollide"
             )
+
+
+def _apply_damping_factor(
+    spec: mujoco.MjSpec,
+    body: str,
+    fraction: float,
+    masses: _BodyMasses,
+    subject: str,
+    report: Report,
+) -> None:
+    """Adds `dampingFactor` to the damping of the body's own joints (`damping`)."""
+    model = masses.compiled()
+    if model is None:
+        return
+    joints = damping.body_joint_damping(model, body, fraction)
+    for j in joints:
+        joint = spec.joint(j.joint)
+        if joint is not None:
+            joint.damping = joint.damping + np.array([j.damping, 0.0, 0.0])
+    text, approximated = damping.describe(fraction, joints)
+    (report.approximated if approximated else report.mapped)(subject, text, tag="dampingFactor")
 
 
 def add_self_collision_excludes(

@@ -21,7 +21,7 @@ from twin_cli.world import actuation, placement, spawn
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.driving import reapply_commands
 from twin_cli.world.engine_threads import install_pool
-from twin_cli.world.entities import EntityIndex, element_names, index_entities, move_states
+from twin_cli.world.entities import EntityIndex, index_entities, move_states
 from twin_cli.world.pose import Pose
 from twin_cli.world.sensor_rings import align_sensor_ticks
 from twin_cli.world.state import STATE, WorldState
@@ -64,7 +64,6 @@ def commit(state: WorldState, spec: mujoco.MjSpec, built: Built) -> None:
     install_pool(state, model, data)
     cap_contact_stiffness(model)
     state.scratch_state = np.empty(mujoco.mj_stateSize(model, STATE))
-    state.damping = actuation.damping_of(model, element_names(model, model.name_numericadr))
     actuation.apply_pushes(
         model,
         data,
