@@ -1,9 +1,9 @@
 """Apply Gazebo extensions (and Gazebo's defaults) to a built robot MjSpec, reporting each tag.
 
 Called by the converter core after every body, joint and geom exists. Surface tags act on the
-collision geoms that came from the tagged link (also after lumping, through provenance);
-link-level tags (gravity, selfCollide, dampingFactor as joint damping, `damping`) act on the
-body that carries the link.
+collision geoms that came from the tagged link (also after lumping, through provenance), the
+collision bitmasks as contype/conaffinity (`collide_bits`); link-level tags (gravity,
+selfCollide, dampingFactor as joint damping, `damping`) act on the body that carries the link.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from converters.description.gazebo import GazeboExtensions, LinkExtension, Surface
-from converters.gazebo import damping
+from converters.gazebo import collide_bits, damping
 from converters.gazebo.contact import (
     CONTACT_MU_MAX,
     DEFAULT_MU,
@@ -37,8 +37,6 @@ IGNORED_SURFACE = {  # Surface field -> (Gazebo tag, why MuJoCo does without it)
     "max_contacts": ("maxContacts", "MuJoCo has no per-geom contact cap"),
     "laser_retro": ("laserRetro", "twin's ray sensors report ranges, not intensities; not used"),
     "restitution": ("restitution_coefficient", "no restitution in MuJoCo; kp/kd set bounce"),
-    "category_bitmask": ("category_bitmask", "collision filter follows Gazebo's selfCollide rule"),
-    "collide_bitmask": ("collide_bitmask", "collision filter follows Gazebo's selfCollide rule"),
 }
 
 
@@ -119,6 +117,9 @@ def _apply_surface(
     geom.priority = friction_priority(mu)
     if mu <= 0.0:  # Gazebo's μ 0 is frictionless; a zero-width friction pyramid is singular
         geom.condim = 1
+    bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
+    if bits is not None:
+        geom.contype, geom.conaffinity = bits.contype, bits.conaffinity
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
     softness = contact_softness(
@@ -213,7 +214,23 @@ def _report_surface(subject: str, surface: Surface, report: Report) -> None:
             f"minDepth={surface.min_depth} m: MuJoCo corrects any penetration (as 0)",
             tag="minDepth",
         )
+    _report_bitmasks(subject, surface, report)
     _report_ignored_surface(subject, surface, report)
+
+
+def _report_bitmasks(subject: str, surface: Surface, report: Report) -> None:
+    bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
+    if bits is None:
+        return
+    text = collide_bits.describe(bits)
+    classic = surface.category_bitmask is not None and bits.category != bits.collide
+    if classic:
+        text += "; Gazebo Classic (ODE) ignores category_bitmask and tests collide & collide"
+    tag = "category_bitmask" if surface.collide_bitmask is None else "collide_bitmask"
+    if classic or bits.dropped:
+        report.approximated(subject, text, tag=tag)
+    else:
+        report.mapped(subject, text, tag=tag)
 
 
 def _report_gazebo_drops(ext: GazeboExtensions, report: Report) -> None:
