@@ -42,8 +42,10 @@ def batch_names(base: str, count: int) -> list[str]:
 
 
 def safe_base(default: str) -> str:
-    """A robot's own name made usable as an entity name."""
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in default) or "model"
+    """A robot's own name made usable as an entity name (`names.as_entity_name`)."""
+    from twin_cli.names import as_entity_name
+
+    return as_entity_name(default)
 
 
 def check_batch(

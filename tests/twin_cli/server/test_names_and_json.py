@@ -13,14 +13,14 @@ from models import block
 from twin_cli.names import name_message, name_problem
 
 
-@pytest.mark.parametrize("bad", ["", "a/b", "a b", "tab\there", "x" * 201, "bell\x07"])
+@pytest.mark.parametrize("bad", ["", "a/b", " a", "a ", "tab\there", "x" * 201, "bell\x07"])
 def test_bad_names_get_the_rule_with_an_example(bad):
     assert name_problem(bad) is not None, f"{bad!r} accepted"
     message = name_message(bad)
     assert "without '/'" in message and "robot_1" in message, message
 
 
-@pytest.mark.parametrize("good", ["robot_1", "a.b-c", "ü", "x" * 200])
+@pytest.mark.parametrize("good", ["robot_1", "a.b-c", "ü", "Heightmap Bowl", "x" * 200])
 def test_good_names_pass(good):
     assert name_problem(good) is None
 
