@@ -118,3 +118,28 @@ def test_bits_above_sixteen_are_dropped_and_reported():
     bits = collide_bits(None, 0x10002)
     assert bits is not None and (bits.collide, bits.dropped) == (0x2, 0x10000), bits
     assert bits.conaffinity < 2**31, f"MuJoCo's contype/conaffinity are int: {bits}"
+
+
+def sdf_cube(name: str, collide: int) -> str:
+    """An SDF model: a 1 kg cube of edge EDGE whose collision has `collide_bitmask`."""
+    i = EDGE**2 / 6  # [kg m²] solid cube of 1 kg
+    return f"""<?xml version="1.0"?>
+<sdf version="1.9"><model name="{name}"><link name="{name}">
+  <inertial><mass>1</mass><inertia><ixx>{i}</ixx><iyy>{i}</iyy><izz>{i}</izz></inertia></inertial>
+  <collision name="c"><geometry><box><size>{EDGE} {EDGE} {EDGE}</size></box></geometry>
+    <surface><contact><collide_bitmask>{collide}</collide_bitmask></contact></surface>
+  </collision></link></model></sdf>"""
+
+
+@pytest.mark.parametrize(("lower", "upper", "collides"), [(0x1, 0x1, True), (0x1, 0x2, False)])
+def test_sdf_collision_bitmask_decides_as_in_urdf(tmp_path, lower, upper, collides):
+    world = World()
+    for name, mask, z in (("lower", lower, ON_GROUND), ("upper", upper, 0.3)):
+        path = tmp_path / f"{name}.sdf"
+        path.write_text(sdf_cube(name, mask))
+        spec, _ = convert(path)
+        world.spawn(spec, name=name, pose=Pose(z=z))
+    world.step(SETTLE_STEPS)
+    upper_z = float(world.data.body("upper/upper").xpos[2])
+    expected = ON_TOP if collides else ON_GROUND
+    assert upper_z == pytest.approx(expected, abs=HEIGHT_TOL), f"SDF upper cube z {upper_z} m"
