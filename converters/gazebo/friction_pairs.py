@@ -29,6 +29,7 @@ named after the entity, so deleting the entity deletes them.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -117,6 +118,30 @@ def _type_name(geom: mujoco.MjsGeom) -> str:
     return mujoco.mjtGeom(int(geom.type)).name.removeprefix("mjGEOM_").lower()
 
 
+@dataclass(frozen=True)
+class PairPlan:
+    """One `<pair>`: names, Gazebo's min μ per direction, and the deciding geom's settings."""
+
+    name: str
+    geom1: str
+    geom2: str
+    friction: tuple[float, ...]
+    condim: int
+    solref: tuple[float, float]
+    solimp: tuple[float, ...]
+    margin: float
+    gap: float
+
+
+@dataclass(frozen=True)
+class ExcludePlan:
+    """One `<exclude>`: a marked body's own contacts with the world body."""
+
+    name: str
+    body1: str
+    body2: str
+
+
 def add_friction_pairs(spec: mujoco.MjSpec) -> int:
     """Rebuilds the pairs and excludes of every marked geom on a world spec (idempotent).
 
@@ -130,25 +155,73 @@ def add_friction_pairs(spec: mujoco.MjSpec) -> int:
     for element in list(spec.pairs) + list(spec.excludes):
         if PAIR_MARK in element.name:
             spec.delete(element)
+    excludes, pairs = plan_pairs(spec, list(spec.worldbody.geoms), spec.worldbody.name)
+    for exclude in excludes:
+        spec.add_exclude(name=exclude.name, bodyname1=exclude.body1, bodyname2=exclude.body2)
+    for plan in pairs:
+        pair = spec.add_pair(name=plan.name, geomname1=plan.geom1, geomname2=plan.geom2)
+        pair.friction = np.array(plan.friction)
+        pair.condim = plan.condim
+        pair.solref = np.array(plan.solref)
+        pair.solimp = np.array(plan.solimp)
+        pair.margin, pair.gap = plan.margin, plan.gap
+    return len(pairs)
+
+
+def contact_xml(robot: mujoco.MjSpec, world_geoms: list[mujoco.MjsGeom]) -> str:
+    """The `<contact>` block a scene that includes `robot` after `world_geoms` needs: the same
+    pairs and excludes a World builds for it (empty when the robot marks no geom).
+
+    Args:
+        robot: the exported robot spec (unprefixed names, as its file has them).
+        world_geoms: the scene's world-body geoms, in the scene's order (the ground).
+    """
+    world_geoms = world_geoms + list(robot.worldbody.geoms)
+    excludes, pairs = plan_pairs(robot, world_geoms, "world")
+    if not pairs:
+        return ""
+    lines = [
+        f'    <exclude name="{e.name}" body1="{e.body1}" body2="{e.body2}"/>' for e in excludes
+    ]
+    lines += [
+        f'    <pair name="{p.name}" geom1="{p.geom1}" geom2="{p.geom2}" condim="{p.condim}" '
+        f'friction="{_numbers(p.friction)}" solref="{_numbers(p.solref)}" '
+        f'solimp="{_numbers(p.solimp)}" margin="{p.margin!r}" gap="{p.gap!r}"/>'
+        for p in pairs
+    ]
+    return "  <contact>\n" + "\n".join(lines) + "\n  </contact>\n"
+
+
+def _numbers(values: Iterable[float]) -> str:
+    """Floats as Python writes them: the shortest text that reads back to the same double."""
+    return " ".join(repr(float(v)) for v in values)
+
+
+def plan_pairs(
+    spec: mujoco.MjSpec, world_geoms: list[mujoco.MjsGeom], world_body: str
+) -> tuple[list[ExcludePlan], list[PairPlan]]:
+    """The excludes and pairs for every marked geom of `spec` against `world_geoms`.
+
+    Args:
+        spec: the spec holding the marks and the marked geoms' bodies.
+        world_geoms: the geoms of the world body, in order; world_body: its name.
+    """
     marked = list(_marked(spec))
-    made, done = 0, set()
+    excludes: list[ExcludePlan] = []
+    pairs: list[PairPlan] = []
+    done: set[str] = set()
     for prefix, geom, _ in marked:
         body = geom.parent
-        if body.name == spec.worldbody.name or body.name in done:
+        if body.name in (world_body, spec.worldbody.name) or body.name in done:
             continue
         done.add(body.name)
         mus = {g.name: m for _, g, m in marked if g.parent.name == body.name}
-        spec.add_exclude(
-            name=f"{prefix}{PAIR_MARK}{body.name}",
-            bodyname1=spec.worldbody.name,
-            bodyname2=body.name,
-        )
+        excludes.append(ExcludePlan(f"{prefix}{PAIR_MARK}{body.name}", world_body, body.name))
         for own in _colliding(body.geoms):
-            for other in _colliding(spec.worldbody.geoms):
+            for other in _colliding(world_geoms):
                 if _filtered(own, other):
-                    _add_pair(spec, prefix, own, other, mus.get(own.name))
-                    made += 1
-    return made
+                    pairs.append(_pair(prefix, own, other, mus.get(own.name)))
+    return excludes, pairs
 
 
 def _marked(spec: mujoco.MjSpec) -> Iterable[tuple[str, mujoco.MjsGeom, tuple[float, float]]]:
@@ -169,27 +242,23 @@ def _filtered(a: mujoco.MjsGeom, b: mujoco.MjsGeom) -> bool:
     return bool((int(a.contype) & int(b.conaffinity)) or (int(b.contype) & int(a.conaffinity)))
 
 
-def _add_pair(
-    spec: mujoco.MjSpec,
-    prefix: str,
-    own: mujoco.MjsGeom,
-    world: mujoco.MjsGeom,
-    mus: tuple[float, float] | None,
-) -> None:
+def _pair(
+    prefix: str, own: mujoco.MjsGeom, world: mujoco.MjsGeom, mus: tuple[float, float] | None
+) -> PairPlan:
     """One pair: Gazebo's min μ per direction; the rest from the geom MuJoCo would let decide
     (the higher priority, the robot's on a tie), as without the pair."""
     mu1, mu2 = mus if mus is not None else (float(own.friction[0]),) * 2
     wmu = float(world.friction[0])
     ruler = world if int(world.priority) > int(own.priority) else own
-    pair = spec.add_pair(
-        name=f"{prefix}{PAIR_MARK}{own.name}|{world.name}",
-        geomname1=world.name,
-        geomname2=own.name,
-    )
     spin, roll = float(ruler.friction[1]), float(ruler.friction[2])
-    pair.friction = np.array([min(mu1, wmu), min(mu2, wmu), spin, roll, roll])
-    pair.condim = int(ruler.condim)
-    pair.solref = np.array(ruler.solref)
-    pair.solimp = np.array(ruler.solimp)
-    pair.margin = max(float(own.margin), float(world.margin))
-    pair.gap = max(float(own.gap), float(world.gap))
+    return PairPlan(
+        name=f"{prefix}{PAIR_MARK}{own.name}|{world.name}",
+        geom1=world.name,
+        geom2=own.name,
+        friction=(min(mu1, wmu), min(mu2, wmu), spin, roll, roll),
+        condim=int(ruler.condim),
+        solref=(float(ruler.solref[0]), float(ruler.solref[1])),
+        solimp=tuple(float(v) for v in ruler.solimp),
+        margin=max(float(own.margin), float(world.margin)),
+        gap=max(float(own.gap), float(world.gap)),
+    )

@@ -108,21 +108,24 @@ def _with_mesh_files(copy: mujoco.MjSpec, assets_dir: Path) -> str:
     return restore_precision(copy.to_xml(), copy)
 
 
-def scene_xml(robot_file: str, model_name: str) -> str:
+def scene_xml(robot_file: str, model_name: str, robot: mujoco.MjSpec | None = None) -> str:
     """The empty world a twin World starts from (`world_rules.world_spec`: Gazebo's ground, the
     sun, the world's options and flags) with the robot included, so plain MuJoCo runs the
     physics `twin validate` proved.
 
     The robot is included after the ground, as a world attaches it: the same body, geom and
-    contact order gives the same trajectory as the world to rounding.
+    contact order gives the same trajectory as the world to rounding. `robot` (the exported
+    spec) brings the `<contact>` pairs a world gives its mu1/mu2 geoms (`friction_pairs`).
     """
+    from converters.gazebo.friction_pairs import contact_xml
     from converters.mjcf.precision import restore_precision
     from converters.mjcf.world_rules import world_spec
 
     scene = world_spec(name=f"{model_name} scene")
+    contact = "" if robot is None else contact_xml(robot, list(scene.worldbody.geoms))
     text = restore_precision(scene.to_xml(), scene)
     head, sep, rest = text.rpartition("</mujoco>")
-    return f'{head}  <include file="{robot_file}"/>\n{sep}{rest}'
+    return f'{head}  <include file="{robot_file}"/>\n{contact}{sep}{rest}'
 
 
 def write_model(spec: mujoco.MjSpec, report: Report, out_dir: str | Path) -> Path:
@@ -184,7 +187,7 @@ def _fill_and_replace(spec: mujoco.MjSpec, report: Report, staging: Path, out: P
         exported, servoed = exported_spec(spec)
         (staging / robot_file).write_text(_with_mesh_files(exported, staging / ASSETS))
         _report_servos(report, servoed)
-        (staging / SCENE).write_text(scene_xml(robot_file, name))
+        (staging / SCENE).write_text(scene_xml(robot_file, name, exported))
         os.chmod(staging, 0o755)
         _replace(staging, out)
     except BaseException:

@@ -116,3 +116,39 @@ def test_pairs_follow_spawns_and_deletes(tmp_path: Path):
     assert world.model.pair(0).name.startswith("b/")
     friction = world.model.pair_friction[0]
     assert tuple(friction[:2]) == pytest.approx((1.0, 0.3)), friction
+
+
+SAME_M = 1e-9  # [m or rad] the largest joint-coordinate difference between scene and world
+
+
+def test_the_exported_scene_has_the_worlds_pairs_and_slides_alike(tmp_path: Path):
+    """Oracle: plain MuJoCo on `scene.xml` steps the plate down a slope along its μ2 as the
+    World does, to SAME_M (same pairs, same exclude)."""
+    import mujoco
+    import numpy as np
+
+    from converters.mjcf.writer import write_model
+    from twin_cli.spawn_request import SpawnRequest
+
+    path = tmp_path / "plate.urdf"
+    path.write_text(plate(1.0, 0.3))
+    done = convert(path)
+    scene = write_model(done[0], done[1], tmp_path / "out").parent / "scene.xml"
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    world = World()
+    world.spawn(SpawnRequest(done[0].copy(), on_ground=True), name="r")
+    assert (model.npair, model.nexclude) == (world.model.npair, world.model.nexclude) == (1, 1)
+    assert np.array_equal(model.pair_friction, world.model.pair_friction)
+    theta = math.atan(0.39)  # 1.3·μ2: slides along x
+    g = abs(float(model.opt.gravity[2]))
+    gravity = (g * math.sin(theta), 0.0, -g * math.cos(theta))
+    world.set_gravity(gravity)
+    model.opt.gravity[:] = gravity
+    for _ in range(1000):
+        world.step(1)
+        mujoco.mj_step(model, data)
+    apart = float(np.abs(data.qpos[:7] - world.data.qpos[:7]).max())
+    assert apart < SAME_M, f"{apart:.3g} apart after 1 s"
+    assert data.qpos[0] > 0.1, f"it slid {data.qpos[0]:.4f} m"
