@@ -4,8 +4,9 @@ The container is written by foxglove-sdk's MCAP writer, in Rust: a message costs
 process ~1 µs there against ~6 µs in the pure-Python `mcap` writer (the tests read the files
 back with that library, an independent reader). The layout is the one rosbag2's MCAP storage
 plugin writes: profile `ros2`, one `ros2msg` schema per message type (rosbags' definitions),
-`cdr` channels carrying rosbag2's `offered_qos_profiles` (transient local for latched topics, so
-`ros2 bag play` re-offers `/tf_static` and `robot_description` to late subscribers) and
+`cdr` channels carrying rosbag2's `offered_qos_profiles` (the live writers' QoS, `qos`:
+transient local for latched topics, so `ros2 bag play` re-offers `/tf_static` and
+`robot_description` to late subscribers; best effort, depth 5 for sensor topics) and
 `topic_type_hash`, and a closing `rosbag2` metadata record (the bag's metadata.yaml, version 9,
 read by Jazzy and later only). The QoS on the channels are numbers (Humble's form, which Jazzy
 also reads), those in the metadata record names (Jazzy's form for version 9). Messages
@@ -29,6 +30,7 @@ import yaml
 from twin_cli.errors import RequestError
 from twin_cli.output_files import PRIVATE
 from twin_cli.record import messages as ros
+from twin_cli.record.qos import Qos, qos_of
 from twin_cli.record.topics import Message, Topic
 
 CHUNK_SIZE = 1 << 20  # [B] a chunk closes when its content exceeds this
@@ -38,25 +40,32 @@ _FLUSH_NS = int(FLUSH_PERIOD_S * 1e9)
 BAG_VERSION = 9  # rosbag2 metadata version of Jazzy (QoS written as names, not numbers)
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}  # rmw's "infinite" duration
 # QoS policies as rmw's enum values (what rosbag2 before Jazzy reads and writes) and names
-# (Jazzy's metadata version 9): keep_last, reliable, transient_local / volatile, automatic.
-_NUMBERS = {"keep_last": 1, "reliable": 1, "transient_local": 1, "volatile": 2, "automatic": 1}
+# (Jazzy's metadata version 9): keep_last, reliable / best_effort, transient_local / volatile,
+# automatic (rmw/types.h: RMW_QOS_POLICY_*).
+_NUMBERS = {
+    "keep_last": 1,
+    "reliable": 1,
+    "best_effort": 2,
+    "transient_local": 1,
+    "volatile": 2,
+    "automatic": 1,
+}
 
 
-def qos_profiles(latched: bool, *, numbers: bool = False) -> list[dict[str, Any]]:
-    """The offered QoS of a topic as rosbag2 stores it (tf2's static broadcaster's for latched
-    topics: reliable, transient local, depth 1): policies by name (metadata version 9), or by
-    number (`numbers`: the form every rosbag2 reads, see `channel_qos`)."""
+def qos_profiles(qos: Qos, *, numbers: bool = False) -> list[dict[str, Any]]:
+    """A topic's offered QoS `qos` as rosbag2 stores it: policies by name (metadata version 9),
+    or by number (`numbers`: the form every rosbag2 reads, see `channel_qos`)."""
     names = {
         "history": "keep_last",
-        "reliability": "reliable",
-        "durability": "transient_local" if latched else "volatile",
+        "reliability": "reliable" if qos.reliable else "best_effort",
+        "durability": "transient_local" if qos.transient_local else "volatile",
         "liveliness": "automatic",
     }
     policies = {k: _NUMBERS[v] for k, v in names.items()} if numbers else names
     return [
         {
             "history": policies["history"],
-            "depth": 1 if latched else 10,
+            "depth": qos.depth,
             "reliability": policies["reliability"],
             "durability": policies["durability"],
             "deadline": _INFINITE,
@@ -68,12 +77,12 @@ def qos_profiles(latched: bool, *, numbers: bool = False) -> list[dict[str, Any]
     ]
 
 
-def channel_qos(latched: bool) -> str:
+def channel_qos(qos: Qos) -> str:
     """A channel's `offered_qos_profiles`: YAML with the policies as numbers. Humble's MCAP
     storage reads only this (not the `rosbag2` metadata record) and its player converts each
     policy with `as<int>`, so names would stop `ros2 bag play`; Jazzy reads it with the bag's
     version but first tries numbers (a history that parses as an integer means numbers)."""
-    return yaml.safe_dump(qos_profiles(latched, numbers=True), sort_keys=False)
+    return yaml.safe_dump(qos_profiles(qos, numbers=True), sort_keys=False)
 
 
 def open_output(path: str | os.PathLike, *, overwrite: bool = False) -> Any:
@@ -139,7 +148,7 @@ class BagWriter:
         from twin_cli.record.foxglove import ros2_channel
 
         metadata = {
-            "offered_qos_profiles": channel_qos(topic.latched),
+            "offered_qos_profiles": channel_qos(qos_of(topic)),
             "topic_type_hash": ros.definition(topic.type).rihs01,
         }
         self._channels[topic.name] = ros2_channel(topic, self._context, metadata)
@@ -211,7 +220,7 @@ class BagWriter:
                         "name": t.name,
                         "type": t.type,
                         "serialization_format": "cdr",
-                        "offered_qos_profiles": qos_profiles(t.latched),
+                        "offered_qos_profiles": qos_profiles(qos_of(t)),
                         "type_description_hash": ros.definition(t.type).rihs01,
                     },
                     "message_count": self._counts[t.name],

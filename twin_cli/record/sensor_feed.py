@@ -40,7 +40,8 @@ MAX_RATE = 1000.0  # [Hz] of sim time, as recordings (recorder.MAX_RATE)
 KEPT = -1.0  # `capture(KEPT)`: every sensor with a history, whatever its rate (a last look)
 POLLS_PER_HISTORY = 2  # looks at a sensor's kept samples per HISTORY_SAMPLES periods
 
-Captured = list[tuple[SensorSuite, Any]]  # (suite, SensorSuite.capture's Pending)
+# (suite, SensorSuite.capture's Pending, sensor → frame as named at the capture)
+Captured = list[tuple[SensorSuite, Any, dict[str, str]]]
 
 
 class SensorFeed:
@@ -109,31 +110,24 @@ class SensorFeed:
             pending = suite.capture(names, since)
             for name, (times, _) in pending.batches.items():
                 self._last[(entity, name)] = float(times[-1])
-            if pending.native or pending.rest or pending.batches:
-                out.append((suite, pending))
+            if pending.native or pending.rest or pending.batches:  # frames named now: a
+                # delete before the build must not strip the entity's prefix from them
+                out.append((suite, pending, self._frames.get(entity, {})))
         return out
 
     def build(self, captured: Captured) -> list[tuple[Topic, Reading]]:
         """The readings of `captured` with their topics (any thread but the stepping one)."""
         out = []
-        for suite, pending in captured:
+        for suite, pending, frames in captured:
             errors: dict[str, Exception] = {}
             for reading in suite.complete(pending, errors):
                 name = reading.sensor
                 topic = sensor_topic(suite.entity, name, suite.specs[name].topic, reading)
                 if topic is not None:
-                    out.append((topic, self._framed(suite.entity, reading)))
+                    out.append((topic, _framed(frames, reading)))
             for name, error in errors.items():
                 self._drop(suite.entity, name, error)
         return out
-
-    def _framed(self, entity: str, reading: Reading) -> Reading:
-        """The reading with the tf frame its data is in: contacts are in world coordinates."""
-        if isinstance(reading, ContactReading):
-            frame = WORLD_FRAME
-        else:
-            frame = self._frames.get(entity, {}).get(reading.sensor, reading.frame_id)
-        return dataclasses.replace(reading, frame_id=frame)
 
     def _since(self, entity: str, name: str, now: float) -> float:
         """Sim time [s] after which a kept sample is new: the last one taken, or (first look, or
@@ -205,3 +199,14 @@ class SensorFeed:
         if name in self._kept.get(entity, ()):
             return (spec.update_rate or step) * POLLS_PER_HISTORY / HISTORY_SAMPLES
         return min(spec.update_rate or step, MAX_RATE, step)
+
+
+def _framed(frames: dict[str, str], reading: Reading) -> Reading:
+    """The reading with the tf frame its data is in (`frames`: sensor → frame, as named when it
+    was captured): contacts are in world coordinates."""
+    frame = (
+        WORLD_FRAME
+        if isinstance(reading, ContactReading)
+        else frames.get(reading.sensor, reading.frame_id)
+    )
+    return dataclasses.replace(reading, frame_id=frame)

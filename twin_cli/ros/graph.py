@@ -5,10 +5,11 @@ The topics themselves (names, message types, which are latched) are the recorder
 
 - topic `/a/b` is DDS topic `rt/a/b`; message type `pkg/msg/Name` is DDS type
   `pkg::msg::dds_::Name_`, and its nested types likewise;
-- QoS as ROS's own publishers offer them: reliable, volatile, keep last 10 (rclcpp's default);
-  latched topics (`/tf_static`, `robot_description`) reliable, transient local, keep last 1
-  (tf2's static broadcaster, robot_state_publisher); sensor topics best effort, keep last 5
-  (rclcpp's SensorDataQoS, which gazebo_ros' sensor plugins use);
+- QoS as ROS's own publishers offer them (`twin_cli.record.qos`, which a bag's channels
+  carry too): reliable, volatile, keep last 10 (rclcpp's default); latched topics
+  (`/tf_static`, `robot_description`) reliable, transient local, keep last 1 (tf2's static
+  broadcaster, robot_state_publisher); sensor topics best effort, keep last 5 (rclcpp's
+  SensorDataQoS, which gazebo_ros' sensor plugins use);
 - each endpoint's user data carries `typehash=RIHS01_<hex>;`, as Jazzy's rmw puts it there.
 
 The DDS types are built from rosbags' definitions of each message (`idl_type`), so no message
@@ -17,33 +18,23 @@ is written by hand; twin sends rosbags' CDR bytes as they are and reads commands
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
 from twin_cli.record import messages as ros
-from twin_cli.record.sensor_messages import SPEC_TYPES
-from twin_cli.record.topics import Topic
+from twin_cli.record.qos import (  # noqa: F401 (the bridge's modules take them from here)
+    DEFAULT_QOS,
+    LATCHED_QOS,
+    SENSOR_QOS,
+    SENSOR_TYPES,
+    Qos,
+    qos_of,
+)
 
 TWIST = "geometry_msgs/msg/Twist"
 TWIST_STAMPED = "geometry_msgs/msg/TwistStamped"
 FLOAT64_ARRAY = "std_msgs/msg/Float64MultiArray"
-SENSOR_TYPES = frozenset(SPEC_TYPES.values())
 _EMPTY_MEMBER = "structure_needs_at_least_one_member"  # rosidl's member of an empty message
-
-
-@dataclass(frozen=True)
-class Qos:
-    """A topic's QoS: reliable or best effort; transient local or volatile; keep last `depth`."""
-
-    reliable: bool
-    transient_local: bool
-    depth: int
-
-
-DEFAULT_QOS = Qos(reliable=True, transient_local=False, depth=10)
-LATCHED_QOS = Qos(reliable=True, transient_local=True, depth=1)
-SENSOR_QOS = Qos(reliable=False, transient_local=False, depth=5)
 
 
 def dds_topic(name: str) -> str:
@@ -55,13 +46,6 @@ def dds_type(name: str) -> str:
     """The DDS type of message type `name` (`pkg/msg/Name` → `pkg::msg::dds_::Name_`)."""
     package, kind, message = name.split("/")
     return f"{package}::{kind}::dds_::{message}_"
-
-
-def qos_of(topic: Topic) -> Qos:
-    """The QoS ROS's own publisher of `topic` offers (see module docstring)."""
-    if topic.latched:
-        return LATCHED_QOS
-    return SENSOR_QOS if topic.type in SENSOR_TYPES else DEFAULT_QOS
 
 
 def user_data(name: str) -> bytes:

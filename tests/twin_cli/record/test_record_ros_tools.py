@@ -39,7 +39,7 @@ CART = f"""<robot name="cart"><link name="chassis">{INERTIAL}</link>
 # rmw's QoS enum values (rmw/types.h) and the names rosbag2 >= Jazzy writes for them
 NUMBERS = {
     "history": {"keep_last": 1},
-    "reliability": {"reliable": 1},
+    "reliability": {"reliable": 1, "best_effort": 2},
     "durability": {"transient_local": 1, "volatile": 2},
     "liveliness": {"automatic": 1},
 }
@@ -203,7 +203,9 @@ def test_a_sensor_off_its_links_origin_names_its_own_frame_fixed_to_the_link(pos
 def test_qos_profiles_are_numbers_on_channels_and_names_in_the_metadata(posed):
     """Channels: rmw's enum numbers (rosbag2 before Jazzy converts each policy with `as<int>`;
     Jazzy tries numbers first). The `rosbag2` record (metadata version 9, read by Jazzy only):
-    names. Both say the same."""
+    names. Both say the same, and both are the live writers' QoS: latched topics reliable,
+    transient local, depth 1; the IMU best effort, depth 5 (SensorDataQoS); the rest reliable,
+    depth 10."""
     from mcap.reader import make_reader
 
     with posed.open("rb") as stream:
@@ -217,6 +219,7 @@ def test_qos_profiles_are_numbers_on_channels_and_names_in_the_metadata(posed):
         for t in info["topics_with_message_count"]
     }
     latched = {"/tf_static", "/imu/robot_description"}
+    assert "/imu/imu" in named, f"no IMU topic in {sorted(named)}"
     for channel in channels:
         (numbers,) = yaml.safe_load(channel.metadata["offered_qos_profiles"])
         (names,) = named[channel.topic]
@@ -225,6 +228,10 @@ def test_qos_profiles_are_numbers_on_channels_and_names_in_the_metadata(posed):
             assert table[names[policy]] == numbers[policy], f"{channel.topic} {policy}"
         durability = "transient_local" if channel.topic in latched else "volatile"
         assert names["durability"] == durability and numbers["depth"] == names["depth"]
+        sensor = channel.topic == "/imu/imu"
+        reliability = "best_effort" if sensor else "reliable"
+        depth = 1 if channel.topic in latched else 5 if sensor else 10
+        assert (names["reliability"], names["depth"]) == (reliability, depth), channel.topic
         assert type(numbers["deadline"]["sec"]) is int and numbers["deadline"]["sec"] > 0
 
 
