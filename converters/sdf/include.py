@@ -211,6 +211,12 @@ def _override(ctx: SdfContext, include: Any, element: Any) -> None:
         element.set("name", name)
     placement = ctx.text(include, "placement_frame")
     if placement:
+        if include.find("pose") is None:  # libsdformat refuses it too
+            raise ctx.error(
+                include,
+                f"has <placement_frame>{placement}</placement_frame> but no <pose>",
+                "give the <pose> the placement frame is placed at",
+            )
         element.set("placement_frame", placement)
     for tag in ("pose", "static"):
         given = include.find(tag)

@@ -48,6 +48,8 @@ def read_model(ctx: SdfContext, model: Any, text: str = "") -> RobotDescription:
     expand_includes(ctx, model)
     rename_clashes(ctx, model)
     graph = PoseGraph(ctx, model)
+    if model.get("placement_frame"):  # an unknown frame is an error even where unused
+        graph.pose(model.get("placement_frame"), model)
     scopes = list(_scopes(model, ""))
     links, ext_links, surfaces = [], {}, []
     for element, prefix in ((el, p) for m, p in scopes for el in m.findall("link")):

@@ -27,6 +27,7 @@ from sdf_libsdformat_models import (
     world_link_poses,
 )
 
+from converters import convert
 from converters.errors import SDFError
 from converters.report import Report
 from converters.sdf import read_sdf_world
@@ -241,3 +242,21 @@ def test_from_1_7_a_world_frame_named_like_a_model_stays_an_error(tmp_path) -> N
     )
     with pytest.raises(SDFError, match="the name 'ground' is taken in this world"):
         world_from_sdf(path)
+
+
+def test_placement_frame_errors_libsdformat_also_refuses(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv("GZ_SIM_RESOURCE_PATH", str(model_dir(tmp_path / "models", "stand", STAND)))
+    no_pose = _world(
+        tmp_path, "<include><uri>stand</uri><placement_frame>foot</placement_frame></include>"
+    )
+    with pytest.raises(SDFError, match=r"<include>: has <placement_frame>foot</placement_frame> "
+                       r"but no <pose>; give the <pose>"):  # fmt: skip
+        world_from_sdf(no_pose)
+    model = tmp_path / "model.sdf"
+    model.write_text(
+        '<sdf version="1.8"><model name="m" placement_frame="link3">'
+        f'<link name="link1">{INERTIAL}</link><link name="link2">{INERTIAL}</link></model></sdf>'
+    )
+    with pytest.raises(SDFError, match="frame 'link3' does not exist in this model; name one of: "
+                       "link1, link2, __model__"):  # fmt: skip
+        convert(model)
