@@ -262,3 +262,21 @@ def _pair(
         margin=max(float(own.margin), float(world.margin)),
         gap=max(float(own.gap), float(world.gap)),
     )
+
+
+def follow_geom_solrefs(model: mujoco.MjModel) -> None:
+    """Gives each friction pair of a compiled model the solref its deciding geom has now.
+
+    A world caps every geom's direct solref at its timestep, and uncaps it when the step
+    shortens again; a pair holds a copy, so it must follow, or a longer step integrates it
+    unstably (measured: a plate on a 4 ms step was thrown 11 m up by its uncapped pair).
+
+    Args:
+        model: a compiled model; `pair_solref` is changed in place.
+    """
+    for i in range(model.npair):
+        if PAIR_MARK not in model.pair(i).name:
+            continue
+        g1, g2 = int(model.pair_geom1[i]), int(model.pair_geom2[i])
+        ruler = g1 if model.geom_priority[g1] > model.geom_priority[g2] else g2
+        model.pair_solref[i] = model.geom_solref[ruler]

@@ -22,6 +22,7 @@ from converters.gazebo.contact import (
     friction_priority,
     max_contact_stiffness,
 )
+from converters.gazebo.friction_pairs import follow_geom_solrefs
 from converters.mjcf.world_options import WorldOptions, apply_world_options
 
 # Gazebo's empty.world sun: directional, from above, casting shadows.
@@ -94,7 +95,8 @@ def capped_solrefs(solref: np.ndarray, timestep: float) -> tuple[np.ndarray, np.
 
 
 def cap_contact_stiffness(model: mujoco.MjModel, original: np.ndarray | None = None) -> int:
-    """Caps every direct geom solref of a compiled model at its timestep; returns how many.
+    """Caps every direct geom solref of a compiled model at its timestep (friction pairs
+    follow their geoms); returns how many geoms were capped.
 
     Args:
         model: `geom_solref` is changed in place.
@@ -103,6 +105,7 @@ def cap_contact_stiffness(model: mujoco.MjModel, original: np.ndarray | None = N
     solref = model.geom_solref if original is None else original
     capped, over = capped_solrefs(solref, float(model.opt.timestep))
     model.geom_solref[:] = capped
+    follow_geom_solrefs(model)  # mu1/mu2 pairs copy their deciding geom's solref
     return int(over.sum())
 
 

@@ -152,3 +152,20 @@ def test_the_exported_scene_has_the_worlds_pairs_and_slides_alike(tmp_path: Path
     apart = float(np.abs(data.qpos[:7] - world.data.qpos[:7]).max())
     assert apart < SAME_M, f"{apart:.3g} apart after 1 s"
     assert data.qpos[0] > 0.1, f"it slid {data.qpos[0]:.4f} m"
+
+
+@pytest.mark.parametrize("timestep", [0.004, 0.008])
+def test_pairs_are_capped_with_their_geoms_at_a_longer_step(tmp_path: Path, timestep: float):
+    """A world's longer step caps a pair's stiffness as its geom's (uncapped, a plate on a 4 ms
+    step was thrown 11 m up); a shorter step again uncaps both. The plate rests within 0.01 mm."""
+    path = tmp_path / "plate.urdf"
+    path.write_text(plate(1.0, 0.3))
+    world = World()
+    world.spawn(path, name="plate", pose=Pose(z=0.01))
+    geom = world.model.pair_geom2[0]
+    for step in (timestep, 0.001):
+        world.set_physics(timestep=step)
+        assert tuple(world.model.pair_solref[0]) == tuple(world.model.geom_solref[geom]), step
+        world.step(round(1.0 / step))
+        assert world.get_pose("plate").z == pytest.approx(0.01, abs=1e-5), f"step {step} s"
+    assert world.model.pair_solref[0][0] == pytest.approx(-62_500.0), "uncapped at 1 ms"
