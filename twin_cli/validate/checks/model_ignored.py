@@ -20,10 +20,7 @@ def check_ignored_parts(
     if not robot.described:
         reason = "an MJCF robot has no Gazebo tags or package meshes to check"
         return not_applicable("ignored_parts", "model", "MJCF input", reason)
-    hints = [
-        f"{found}; Gazebo and twin load the robot without it"
-        for found in robot.ignored_parts
-    ]
+    hints = [f"{found}; Gazebo and twin load the robot without it" for found in robot.ignored_parts]
     return judged(
         "ignored_parts",
         "model",
