@@ -220,9 +220,11 @@ def check_joints(robot: RobotDescription) -> None:
 
 def check_references(robot: RobotDescription, options: ConvertOptions, report: Report) -> None:
     """Report each tag naming a missing link or joint, and each visual whose mesh is missing,
-    as left out (Gazebo loads the robot without them); with `strict`, refuse them.
+    as left out (Gazebo loads the robot without them); with `strict`, refuse them. A command
+    interface on a joint that closes a loop is refused: the joint exists, but not as a joint.
 
     Raises:
+        URDFStructureError: a control tag names a joint that closes a loop.
         DanglingReferenceError: with `strict`, the tags, each with what it carries, and the
             valid names.
         MissingVisualMeshError: with `strict`, the visuals, each with where the mesh was sought.
@@ -234,6 +236,14 @@ def check_references(robot: RobotDescription, options: ConvertOptions, report: R
     )
 
     dangling, visuals = dangling_references(robot), missing_visuals(robot)
+    for loop in [d for d in dangling if d.closes_loop][:1]:  # there, not ignored: refused
+        raise URDFStructureError(
+            robot.source,
+            loop.element,
+            f"names joint '{loop.target}', which closes a loop: MuJoCo holds it by equality "
+            "constraints, not as a joint a motor can drive",
+            "command another joint of the loop",
+        )
     if options.strict and dangling:
         problems = [d.describe() for d in dangling]
         raise DanglingReferenceError(robot.source, problems, part_names(robot))

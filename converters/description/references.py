@@ -31,16 +31,10 @@ class Dangling:
     target: str
     kind: str
     carries: tuple[str, ...] = ()
-    closes_loop: bool = False  # the joint exists, as a loop's closing equalities
+    closes_loop: bool = False  # the joint exists, as a loop's closing equalities (refused)
 
     def describe(self) -> str:
         lost = f" ({', '.join(self.carries)})" if self.carries else ""
-        if self.closes_loop:
-            return (
-                f"{self.element}{lost} names joint '{self.target}', which closes a loop: MuJoCo "
-                "holds it by equality constraints, not as a joint a motor can drive (command "
-                "another joint of the loop)"
-            )
         return f"{self.element}{lost} names {self.kind} '{self.target}', which does not exist"
 
 

@@ -116,7 +116,7 @@ def ignored_parts(description: RobotDescription) -> tuple[str, ...]:
     names = ", ".join(part_names(description)[:30])
     return tuple(
         f"{part.describe()}; name one of its links or joints ({names}) or remove it"
-        if isinstance(part, Dangling) and not part.closes_loop
+        if isinstance(part, Dangling)
         else part.describe()
         for part in found(description)
     )
