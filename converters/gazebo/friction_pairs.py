@@ -60,6 +60,9 @@ def mark_anisotropic_surfaces(
 ) -> None:
     """Marks each collision geom with μ1 ≠ μ2 and no `fdir1` for pairs; reports every case.
 
+    A surface that sets `mu1` alone has SDF's default μ2 = 1 in Gazebo, so it is anisotropic
+    unless its μ1 is 1 (as it is for a `mu2` alone, with μ1 = 1).
+
     Args:
         spec: the robot spec (geoms named as in provenance).
         ext: the robot's Gazebo extensions; provenance: where each geom came from.
@@ -70,7 +73,8 @@ def mark_anisotropic_surfaces(
             continue
         surface = ext.surface_of(origin.link, origin.index)
         geom = spec.geom(origin.geom)
-        if geom is not None and (surface.mu2 is not None or surface.fdir1 is not None):
+        tagged = (surface.mu1, surface.mu2, surface.fdir1) != (None, None, None)
+        if geom is not None and tagged:
             _mark(spec, geom, origin, surface, report)
 
 
@@ -90,12 +94,8 @@ def _mark(
             report.mapped(subject, f"fdir1={fdir1}: μ1 = μ2 = {mu1:g}, no direction", tag="fdir1")
         return
     kind = _type_name(geom)
-    if fdir1 is not None or kind not in FRAME_FROM_NORMAL:
-        why = (
-            f"fdir1={fdir1} turns with the link and no MuJoCo contact frame follows it"
-            if fdir1 is not None
-            else f"a {kind}'s contact frame follows its axis, not Gazebo's world directions"
-        )
+    why = _why_isotropic(kind, fdir1, min(mu1, mu2))
+    if why:
         report.approximated(
             subject,
             f"μ1={mu1:g}, μ2={mu2:g}: {why}; twin uses μ1={mu1:g} in every direction "
@@ -104,12 +104,25 @@ def _mark(
         )
         return
     spec.add_numeric(name=f"{ANISOTROPIC_PREFIX}{origin.geom}", data=[mu1, mu2], size=2)
+    unset = " (SDF's default, mu2 unset)" if surface.mu2 is None else ""
     report.mapped(
         subject,
-        f"μ1={mu1:g} along world y, μ2={mu2:g} along world x on the ground (Gazebo's "
-        "directions without fdir1): contact pairs with the world's geoms",
+        f"μ1={mu1:g} along world y, μ2={mu2:g}{unset} along world x on the ground (Gazebo's "
+        "directions without fdir1): contact pairs with the world's geoms; contacts with "
+        f"other entities use μ1={mu1:g}",
         tag="mu2",
     )
+
+
+def _why_isotropic(kind: str, fdir1: tuple[float, ...] | None, low_mu: float) -> str:
+    """Why pairs cannot give this geom Gazebo's two directions ("" when they can)."""
+    if fdir1 is not None:
+        return f"fdir1={fdir1} turns with the link and no MuJoCo contact frame follows it"
+    if kind not in FRAME_FROM_NORMAL:
+        return f"a {kind}'s contact frame follows its axis, not Gazebo's world directions"
+    if low_mu <= 0.0:
+        return "one direction frictionless: MuJoCo's friction pyramid needs both μ > 0"
+    return ""
 
 
 def _type_name(geom: mujoco.MjsGeom) -> str:

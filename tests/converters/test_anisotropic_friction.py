@@ -23,16 +23,17 @@ SLIDE_LAW = 0.05  # mean acceleration within this fraction of Coulomb's
 PAIRS = [(1.0, 0.3), (0.3, 1.0), (0.8, 0.4)]  # (mu1, mu2)
 
 
-def plate(mu1: float, mu2: float, fdir1: str | None = None) -> str:
-    """A free 1 kg plate 0.2 m × 0.2 m × 0.02 m with Gazebo mu1, mu2 (and fdir1) on it."""
+def plate(mu1: float, mu2: float | None, fdir1: str | None = None) -> str:
+    """A free 1 kg plate 0.2 m × 0.2 m × 0.02 m with Gazebo mu1, mu2 (unset if None) and fdir1."""
     extra = f"<fdir1>{fdir1}</fdir1>" if fdir1 else ""
+    second = "" if mu2 is None else f"<mu2>{mu2}</mu2>"
     return f"""<robot name="plate"><link name="plate"><inertial><mass value="1"/>
 <inertia ixx="0.0034" iyy="0.0034" izz="0.0067" ixy="0" ixz="0" iyz="0"/></inertial>
 <collision><geometry><box size="0.2 0.2 0.02"/></geometry></collision></link>
-<gazebo reference="plate"><mu1>{mu1}</mu1><mu2>{mu2}</mu2>{extra}</gazebo></robot>"""
+<gazebo reference="plate"><mu1>{mu1}</mu1>{second}{extra}</gazebo></robot>"""
 
 
-def _slide(tmp_path: Path, mu1: float, mu2: float, axis: int, tan_theta: float):
+def _slide(tmp_path: Path, mu1: float, mu2: float | None, axis: int, tan_theta: float):
     """(distance [m] down a slope along world `axis` (0 x, 1 y) in SLIDE_S, mean acceleration
     [m/s²], Coulomb's acceleration for that axis's μ [m/s²])."""
     path = tmp_path / "plate.urdf"
@@ -50,7 +51,7 @@ def _slide(tmp_path: Path, mu1: float, mu2: float, axis: int, tan_theta: float):
     world.step(round(SLIDE_S / world.model.opt.timestep))
     end = world.get_pose("plate")
     moved = (end.x - start.x, end.y - start.y)[axis]
-    mu = (mu2, mu1)[axis]
+    mu = (1.0 if mu2 is None else mu2, mu1)[axis]  # SDF's default mu2 is 1
     law = g * (math.sin(theta) - mu * math.cos(theta))
     return moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2, law
 
@@ -169,3 +170,22 @@ def test_pairs_are_capped_with_their_geoms_at_a_longer_step(tmp_path: Path, time
         world.step(round(1.0 / step))
         assert world.get_pose("plate").z == pytest.approx(0.01, abs=1e-5), f"step {step} s"
     assert world.model.pair_solref[0][0] == pytest.approx(-62_500.0), "uncapped at 1 ms"
+
+
+def test_mu1_alone_leaves_sdfs_default_mu2_of_one_along_world_x(tmp_path: Path):
+    """Gazebo's `mu2` defaults to 1: mu1 0.3 alone slides along world y at tan θ 0.39 and
+    holds along world x."""
+    moved, a, law = _slide(tmp_path, 0.3, None, 1, 0.39)
+    assert a == pytest.approx(law, rel=SLIDE_LAW), f"a {a:.4f} m/s², Coulomb {law:.4f}"
+    held, _, _ = _slide(tmp_path, 0.3, None, 0, 0.39)
+    assert abs(held) < HOLD_M, f"along world x (μ2 = 1) it moved {held * 1e3:.3f} mm"
+
+
+def test_a_frictionless_direction_is_reported_and_left_isotropic(tmp_path: Path):
+    path = tmp_path / "plate.urdf"
+    path.write_text(plate(0.0, None))
+    spec, report = convert(path)
+    found = [e for e in report.entries if e.tag == "mu2"]
+    assert [e.outcome for e in found] == [Outcome.APPROXIMATED], found
+    assert "frictionless" in found[0].detail and "μ2=1" in found[0].detail, found[0].detail
+    assert not any(n.name.startswith("anisotropic_friction:") for n in spec.numerics)
