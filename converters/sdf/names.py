@@ -16,23 +16,30 @@ SUFFIXES = {"link": "_link", "joint": "_joint", "frame": "_frame"}
 
 def rename_clashes(ctx: SdfContext, model: Any) -> None:
     """Rename, in `model` and its nested models of 1.4-1.6 files, each link, joint or frame
-    whose name an earlier element of another type already took, as sdformat does."""
+    whose name an earlier element of another type already took (or an earlier renaming gave),
+    as sdformat does. Two elements of one type and name stay a duplicate, which is an error."""
     if ctx.before_frames(model):
-        taken: set[str] = set()
-        for child in [c for c in model if isinstance(c.tag, str)]:
-            name = child.get("name")
-            if not name or child.tag not in (*SUFFIXES, "model"):
-                continue
-            if name in taken and child.tag in SUFFIXES and not _same_type_before(model, child):
-                child.set("name", _free(name, SUFFIXES[child.tag], taken))
-                ctx.report.mapped(
-                    f"{child.tag} '{name}'",
-                    f"renamed '{child.get('name')}': another element of the model has its name "
-                    f"(allowed before SDFormat 1.7, renamed by sdformat)",
-                )
-            taken.add(child.get("name"))
+        _rename_children(ctx, model)
     for nested in model.findall("model"):
         rename_clashes(ctx, nested)
+
+
+def _rename_children(ctx: SdfContext, model: Any) -> None:
+    taken: set[str] = set()  # names given so far, renamed ones included
+    written: dict[str, set[str]] = {tag: set() for tag in (*SUFFIXES, "model")}  # as written
+    for child in [c for c in model if isinstance(c.tag, str) and c.tag in written]:
+        name = child.get("name")
+        if not name or name in written[child.tag]:
+            continue  # a nameless or same-type duplicate: the pose graph refuses it
+        written[child.tag].add(name)
+        if name in taken and child.tag in SUFFIXES:
+            child.set("name", _free(name, SUFFIXES[child.tag], taken))
+            ctx.report.mapped(
+                f"{child.tag} '{name}'",
+                f"renamed '{child.get('name')}': another element of the model has its name "
+                f"(allowed before SDFormat 1.7, renamed by sdformat)",
+            )
+        taken.add(child.get("name"))
 
 
 def rename_world_clashes(ctx: SdfContext, world: Any) -> None:
@@ -51,16 +58,6 @@ def rename_world_clashes(ctx: SdfContext, world: Any) -> None:
                 f"(allowed before SDFormat 1.7, renamed by sdformat)",
             )
         taken.add(frame.get("name"))
-
-
-def _same_type_before(model: Any, child: Any) -> bool:
-    """A same-type element of that name came first: a real duplicate, which stays an error."""
-    for other in model.findall(child.tag):
-        if other is child:
-            return False
-        if other.get("name") == child.get("name"):
-            return True
-    return False
 
 
 def _free(name: str, suffix: str, taken: set[str]) -> str:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 from sdf_frame_models import HALF_PI, TOL_M, X, assert_pose
@@ -260,3 +261,23 @@ def test_placement_frame_errors_libsdformat_also_refuses(tmp_path, monkeypatch) 
     with pytest.raises(SDFError, match="frame 'link3' does not exist in this model; name one of: "
                        "link1, link2, __model__"):  # fmt: skip
         convert(model)
+
+
+def test_a_1_6_model_frame_named_like_its_link_becomes_name_frame(tmp_path) -> None:
+    # Inside a model the same rule holds: the later element is renamed, a link keeps its name.
+    path = tmp_path / "m.sdf"
+    path.write_text(
+        '<sdf version="1.6"><model name="m">'
+        f'<link name="ground"><pose>0 0 1 0 0 {HALF_PI!r}</pose>{INERTIAL}</link>'
+        '<frame name="ground"><pose frame="ground">1 0 0 0 0 0</pose></frame>'
+        '<frame name="ground_frame"><pose>0 0 2 0 0 0</pose></frame></model></sdf>'
+    )
+    model = convert(path)[0].compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    # 'ground' (1, 0, 0) in the link turned 90° at (0, 0, 1): (0, 1, 1); the second frame,
+    # clashing with the first one's new name, becomes its own name + _frame: ground_frame_frame.
+    for site, expected in (("ground_frame", (0, 1, 1)), ("ground_frame_frame", (0, 0, 2))):
+        np.testing.assert_allclose(
+            data.site_xpos[model.site(site).id], expected, rtol=0, atol=TOL_M, err_msg=site
+        )
