@@ -76,6 +76,21 @@ def test_trajectory_is_followed_and_bad_files_exit_2(rig):
     assert _joints(t) == before, "a refused trajectory leaves the world unchanged"
 
 
+def test_a_waypoint_just_past_a_limit_is_clamped_and_the_report_says_by_how_much(rig):
+    """slide's range ends at 0.3 m: a waypoint at 0.305 m (within the 0.0087 m tolerance) is
+    followed to 0.3 m, and both the JSON and the table name the 0.005 m move."""
+    t, tmp_path = rig
+    path = tmp_path / "past.csv"
+    path.write_text("time_from_start,slide\n0.5,0.305\n")
+    t("resume")
+    report = json.loads(t("trajectory", "rig", str(path), "--json", timeout=60).stdout)
+    assert report["clamped"]["slide"] == pytest.approx(0.005, abs=1e-12), report
+    table = t("trajectory", "rig", str(path), timeout=60).stdout
+    assert "clamped onto limit" in table and "0.005" in table, table
+    t("pause")
+    assert _joints(t)["slide"]["target"] == pytest.approx(0.3, abs=1e-6), "held at the limit"
+
+
 def test_command_and_trajectory_import_no_physics(rig):
     from test_lazy_imports import HEAVY, _imported
 

@@ -113,9 +113,14 @@ def _print_report(report: dict, out: Output) -> None:
     out.table(
         f"trajectory of {report['entity']}: {state} at {report['elapsed']:.3f} / "
         f"{report['duration']:.3f} s",
-        ["joint", "max error", "final error"],
+        ["joint", "max error", "final error", "clamped onto limit"],
         [
-            [j, report["max_error"].get(j), report["final_error"].get(j)]
+            [
+                j,
+                report["max_error"].get(j),
+                report["final_error"].get(j),
+                report.get("clamped", {}).get(j),
+            ]
             for j in report["joint_names"]
         ],
     )
