@@ -117,6 +117,24 @@ class CollisionRequest:
     faces: np.ndarray
 
 
+def default_cpu_limit() -> float:
+    """The CPU budget of one mesh [CPU s]: `$TWIN_COACD_CPU_LIMIT`, else DEFAULT_CPU_LIMIT.
+
+    Raises:
+        CollisionSettingsError: the variable is not a positive number.
+    """
+    text = os.environ.get(CPU_LIMIT_ENV, "").strip()
+    if not text:
+        return DEFAULT_CPU_LIMIT
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise CollisionSettingsError(f"${CPU_LIMIT_ENV}", text, ["a positive number of seconds"])
+    return value
+
+
 @dataclass(frozen=True)
 class CollisionSettings:
     """User choices: `mode` is auto|coacd|hull|mesh; `per_link` overrides it for named links.
@@ -141,7 +159,7 @@ class CollisionSettings:
     progress: bool = False
     threshold_m: float | None = None
     max_hull_vertices: int | None = None
-    cpu_limit: float = field(default_factory=lambda: default_cpu_limit())
+    cpu_limit: float = field(default_factory=default_cpu_limit)
     wall_limit: float | None = None
 
 
@@ -152,24 +170,6 @@ class Decision:
     mode: CollisionMode
     reason: str
     convexity: float | None = None
-
-
-def default_cpu_limit() -> float:
-    """The CPU budget of one mesh [CPU s]: `$TWIN_COACD_CPU_LIMIT`, else DEFAULT_CPU_LIMIT.
-
-    Raises:
-        CollisionSettingsError: the variable is not a positive number.
-    """
-    text = os.environ.get(CPU_LIMIT_ENV, "").strip()
-    if not text:
-        return DEFAULT_CPU_LIMIT
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not value > 0 or value == float("inf"):
-        raise CollisionSettingsError(f"${CPU_LIMIT_ENV}", text, ["a positive number of seconds"])
-    return value
 
 
 def parse_mode(value: str, where: str) -> CollisionMode:
@@ -192,7 +192,7 @@ def check_settings(settings: CollisionSettings) -> None:
         ("--coacd-cpu-limit", settings.cpu_limit),
         ("wall_limit", settings.wall_limit),
     ):
-        if value is not None and not value > 0:
+        if value is not None and not 0 < value < float("inf"):
             raise CollisionSettingsError(option, f"{value:g}", ["a positive number of seconds"])
     if settings.threshold is not None and settings.threshold_m is not None:
         raise CollisionSettingsError(
