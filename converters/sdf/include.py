@@ -102,8 +102,9 @@ def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
         if shipped is None:
             raise
         target = shipped
-    if not target.exists() and "://" not in uri and not Path(uri).is_absolute():
-        target = _on_model_roots(ctx, include, uri, target)
+    relative = uri.removeprefix("file://")  # libsdformat strips a scheme before its search
+    if not target.exists() and "://" not in relative and not Path(relative).is_absolute():
+        target = _on_model_roots(ctx, include, relative, target)
     if target.is_dir():
         return _from_config(ctx, include, target)
     if not target.is_file():
@@ -112,9 +113,9 @@ def _model_file(ctx: SdfContext, include: Any, uri: str) -> Path:
 
 
 def _on_model_roots(ctx: SdfContext, include: Any, uri: str, beside: Path) -> Path:
-    """A scheme-less include URI (`<uri>NAME</uri>`) not beside the file: as libsdformat and
-    gz-sim look it up, under each model root (`PackageResolver.model_roots`), then among the
-    models twin ships.
+    """A scheme-less include URI (`<uri>NAME</uri>`, or a relative `file://NAME`) not beside the
+    file: as libsdformat and gz-sim look it up, under each model root
+    (`PackageResolver.model_roots`), then among the models twin ships.
 
     Raises:
         SDFError: found nowhere, with every place tried.

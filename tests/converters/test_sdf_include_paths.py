@@ -162,3 +162,10 @@ def test_a_scheme_less_include_found_nowhere_names_every_place_tried(tmp_path) -
     )  # fmt: skip
     assert cli.returncode == 2, cli.stderr
     assert "'crate' was found neither" in cli.stderr and "Traceback" not in cli.stderr
+
+
+def test_a_relative_file_uri_include_is_searched_like_a_scheme_less_one(tmp_path) -> None:
+    path = _holder(tmp_path)
+    path.write_text(path.read_text().replace("<uri>crate</uri>", "<uri>file://crate</uri>"))
+    env = _env(SDF_PATH=model_dir(tmp_path / "sdf_path", "crate", _crate(5.5)))
+    assert _crate_found(path, env) == pytest.approx(5.5, abs=TOL)
