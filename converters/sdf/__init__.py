@@ -1,8 +1,9 @@
 """The SDFormat reader (1.4-1.11): models and worlds → the neutral descriptions.
 
 `document` parses and reads values with file:line errors, `poses` resolves SDFormat's pose
-frame semantics, `links` and `joints` read a model's parts, `model` assembles a robot
-description, `include` brings in `model://` models, `world` reads a world. The builder and the
+frame semantics (placement frames included), `names` settles pre-1.7 name clashes, `links` and
+`joints` read a model's parts, `model` assembles a robot description, `include` brings in
+included models (`model://`, scheme-less, Fuel), `world` reads a world. The builder and the
 Gazebo stage consume what this produces exactly as they consume a URDF robot.
 """
 
