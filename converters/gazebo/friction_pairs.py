@@ -16,8 +16,11 @@ Gazebo's default directions. A capsule's row 1 follows its axis instead. So:
   - no `fdir1`, μ1 ≠ μ2, a collider whose frame is built from the normal: explicit pairs with
     the world body's geoms, friction (μ1, μ2), exact on a ground plane (and on one tilted about a
     world axis, where `dPlaneSpace` and `mju_makeFrame` agree);
-  - `fdir1` set (a direction that turns with the link), or a capsule: no MuJoCo frame follows
-    it, so μ1 stays isotropic and the report says "approximated", naming μ1, μ2 and `fdir1`.
+  - `fdir1` along the axis of a cylinder, capsule or round ellipsoid (a wheel's axle): the same
+    pairs, made by a capsule on that axis, whose plane frame follows it (`friction_axis`);
+  - any other `fdir1` (a direction that turns with the link), or a capsule without one: no
+    MuJoCo frame follows it, so μ1 stays isotropic and the report says "approximated", naming
+    μ1, μ2 and `fdir1`.
 
 Explicit pairs come on top of MuJoCo's own contacts, so the body's contacts with the world body
 are excluded and every colliding geom of the body gets its pair with every colliding geom of
@@ -35,6 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from converters.gazebo.contact import DEFAULT_MU, contact_mu
+from converters.gazebo.friction_axis import along_axis, axis_capsule, stands_for
 
 if TYPE_CHECKING:
     import mujoco
@@ -94,6 +98,17 @@ def _mark(
             report.mapped(subject, f"fdir1={fdir1}: μ1 = μ2 = {mu1:g}, no direction", tag="fdir1")
         return
     kind = _type_name(geom)
+    if fdir1 is not None and along_axis(geom, fdir1) and min(mu1, mu2) > 0.0:
+        capsule = axis_capsule(spec, geom)
+        spec.add_numeric(name=f"{ANISOTROPIC_PREFIX}{capsule}", data=[mu1, mu2], size=2)
+        report.mapped(
+            subject,
+            f"μ1={mu1:g} along fdir1={fdir1} (the {kind}'s axis), μ2={mu2:g} across it, turning "
+            f"with the link as in Gazebo: contact pairs of the capsule '{capsule}' on that axis "
+            f"with the world's geoms; contacts with other entities use μ1={mu1:g}",
+            tag="mu2",
+        )
+        return
     why = _why_isotropic(kind, fdir1, min(mu1, mu2))
     if why:
         report.approximated(
@@ -117,7 +132,10 @@ def _mark(
 def _why_isotropic(kind: str, fdir1: tuple[float, ...] | None, low_mu: float) -> str:
     """Why pairs cannot give this geom Gazebo's two directions ("" when they can)."""
     if fdir1 is not None:
-        return f"fdir1={fdir1} turns with the link and no MuJoCo contact frame follows it"
+        return (
+            f"fdir1={fdir1} is not along the {kind}'s axis: it turns with the link as no MuJoCo "
+            "contact frame does"
+        )
     if kind not in FRAME_FROM_NORMAL:
         return f"a {kind}'s contact frame follows its axis, not Gazebo's world directions"
     if low_mu <= 0.0:
@@ -230,11 +248,24 @@ def plan_pairs(
         done.add(body.name)
         mus = {g.name: m for _, g, m in marked if g.parent.name == body.name}
         excludes.append(ExcludePlan(f"{prefix}{PAIR_MARK}{body.name}", world_body, body.name))
-        for own in _colliding(body.geoms):
+        for own, source in _contact_geoms(spec, body):
             for other in _colliding(world_geoms):
-                if _filtered(own, other):
+                if _filtered(source, other):
                     pairs.append(_pair(prefix, own, other, mus.get(own.name)))
     return excludes, pairs
+
+
+def _contact_geoms(
+    spec: mujoco.MjSpec, body: mujoco.MjsBody
+) -> list[tuple[mujoco.MjsGeom, mujoco.MjsGeom]]:
+    """(geom that touches the world, geom whose collision bits decide) for each of the body's
+    colliding geoms: itself, or the axis capsule that stands for it (`friction_axis`)."""
+    stand_ins = {}
+    for geom in body.geoms:
+        source = stands_for(spec, geom)
+        if source is not None:
+            stand_ins[source.name] = geom
+    return [(stand_ins.get(g.name, g), g) for g in _colliding(body.geoms)]
 
 
 def _marked(spec: mujoco.MjSpec) -> Iterable[tuple[str, mujoco.MjsGeom, tuple[float, float]]]:

@@ -30,6 +30,7 @@ from converters.gazebo.drive_records import (
     HolonomicDrive,
     TricycleDrive,
 )
+from converters.gazebo.friction_axis import centre_axis_capsule
 from converters.report import Report
 
 if TYPE_CHECKING:
@@ -69,6 +70,7 @@ def centre_wheel_contacts(
             for geom in _wheel_cylinders(spec.joint(joint)):
                 radius, half_width = float(geom.size[0]), float(geom.size[1])
                 _to_ellipsoid(geom)
+                centre_axis_capsule(spec, geom)  # an fdir1 capsule touches where it does
                 report.approximated(
                     f"joint '{joint}'",
                     f"<plugin> '{record.name}': wheel cylinder (radius {radius:g} m, width "

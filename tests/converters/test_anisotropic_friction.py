@@ -189,3 +189,89 @@ def test_a_frictionless_direction_is_reported_and_left_isotropic(tmp_path: Path)
     assert [e.outcome for e in found] == [Outcome.APPROXIMATED], found
     assert "frictionless" in found[0].detail and "μ2=1" in found[0].detail, found[0].detail
     assert not any(n.name.startswith("anisotropic_friction:") for n in spec.numerics)
+
+
+WHEEL_HOLD_M = 1e-3  # [m] in SLIDE_S: a cylinder's two rim contacts creep 0.69 mm (any fdir1)
+
+
+def wheel(mu1: float, mu2: float, fdir1: str | None) -> str:
+    """A free 1 kg wheel (radius 0.05 m, 0.04 m wide) whose collision's z is its axle (link y)."""
+    extra = f"<fdir1>{fdir1}</fdir1>" if fdir1 else ""
+    return f"""<robot name="wheel"><link name="wheel"><inertial><mass value="1"/>
+<inertia ixx="0.0007" iyy="0.00125" izz="0.0007" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="0.05" length="0.04"/></geometry>
+</collision></link><gazebo reference="wheel"><mu1>{mu1}</mu1><mu2>{mu2}</mu2>{extra}</gazebo>
+</robot>"""
+
+
+def _wheel_sideways(tmp_path: Path, fdir1: str | None, yaw: float, tan_theta: float):
+    """(distance [m] along the axle in SLIDE_S down a slope along the axle, mean acceleration
+    [m/s²]) of a wheel with μ 0.3 in its fdir1 and 1 in the other direction, at heading `yaw`."""
+    path = tmp_path / "wheel.urdf"
+    path.write_text(wheel(0.3, 1.0, fdir1))
+    world = World()
+    world.spawn(path, name="wheel", pose=Pose(z=0.05, yaw=yaw))
+    world.step(200)
+    axis = 1 if yaw == 0.0 else 0  # the axle: world y at heading 0, world x at 90°
+    theta = math.atan(tan_theta)
+    g = abs(float(world.model.opt.gravity[2]))
+    gravity = [0.0, 0.0, -g * math.cos(theta)]
+    gravity[axis] = g * math.sin(theta)
+    world.set_gravity(tuple(gravity))
+    world.step(300)
+    start, v0 = world.get_pose("wheel"), float(world.data.qvel[axis])
+    world.step(round(SLIDE_S / world.model.opt.timestep))
+    end = world.get_pose("wheel")
+    moved = (end.x - start.x, end.y - start.y)[axis]
+    return moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2
+
+
+@pytest.mark.parametrize("yaw", [0.0, math.pi / 2], ids=["axle_y", "axle_x"])
+def test_fdir1_along_the_axle_turns_the_directions_with_the_wheel(tmp_path: Path, yaw: float):
+    """fdir1 '0 0 1' (the axle, μ1 0.3): sideways the wheel holds at tan θ 0.24 and slides at
+    0.39 with Coulomb's μ 0.3 at either heading."""
+    held, _ = _wheel_sideways(tmp_path, "0 0 1", yaw, 0.8 * 0.3)
+    assert abs(held) < WHEEL_HOLD_M, f"moved {held * 1e3:.3f} mm"
+    theta = math.atan(1.3 * 0.3)
+    law = 9.8 * (math.sin(theta) - 0.3 * math.cos(theta))
+    _, a = _wheel_sideways(tmp_path, "0 0 1", yaw, 1.3 * 0.3)
+    assert a == pytest.approx(law, rel=SLIDE_LAW), f"a {a:.4f} m/s², Coulomb {law:.4f}"
+
+
+def test_without_fdir1_the_directions_stay_on_the_worlds_axes(tmp_path: Path):
+    """Gazebo's default: μ1 (0.3) along world y, μ2 (1) along world x, whatever the heading. The
+    wheel turned 90° (axle along world x) holds sideways at tan θ 0.39."""
+    held, _ = _wheel_sideways(tmp_path, None, math.pi / 2, 1.3 * 0.3)
+    assert abs(held) < WHEEL_HOLD_M, f"moved {held * 1e3:.3f} mm"
+
+
+def test_fdir1_across_the_axle_is_reported_and_left_isotropic(tmp_path: Path):
+    path = tmp_path / "wheel.urdf"
+    path.write_text(wheel(0.3, 1.0, "1 0 0"))
+    spec, report = convert(path)
+    found = [e for e in report.entries if e.tag == "mu2"]
+    assert [e.outcome for e in found] == [Outcome.APPROXIMATED], found
+    assert "not along the cylinder's axis" in found[0].detail, found[0].detail
+    assert not any(n.name.startswith("anisotropic_friction:") for n in spec.numerics)
+
+
+def test_fdir1_along_the_axle_gives_the_ground_to_a_capsule_on_the_axle(tmp_path: Path):
+    """The pair is the axle capsule's (μ1 0.3 on frame row 1, the capsule's axis), and the
+    frame's row 1 lies along the axle at heading 0.6 rad: μ1 acts across the wheel."""
+    import mujoco
+    import numpy as np
+
+    path = tmp_path / "wheel.urdf"
+    path.write_text(wheel(0.3, 1.0, "0 0 1"))
+    world = World()
+    world.spawn(path, name="w", pose=Pose(z=0.05, yaw=0.6))
+    world.step(50)
+    model, data = world.model, world.data
+    assert model.npair == 1 and tuple(model.pair_friction[0][:2]) == pytest.approx((0.3, 1.0))
+    capsule = model.geom(int(model.pair_geom2[0]))
+    assert capsule.type[0] == mujoco.mjtGeom.mjGEOM_CAPSULE and capsule.contype[0] == 0
+    contacts = [data.contact[i] for i in range(data.ncon)]
+    assert contacts and all(c.geom2 == capsule.id for c in contacts), "ground contacts: capsule's"
+    axle = data.geom_xmat[capsule.id].reshape(3, 3)[:, 2]
+    row1 = contacts[0].frame[3:6]
+    assert abs(float(np.dot(row1, axle))) > 0.999, f"row 1 {row1}, axle {axle}"
