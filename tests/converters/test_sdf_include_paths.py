@@ -169,3 +169,26 @@ def test_a_relative_file_uri_include_is_searched_like_a_scheme_less_one(tmp_path
     path.write_text(path.read_text().replace("<uri>crate</uri>", "<uri>file://crate</uri>"))
     env = _env(SDF_PATH=model_dir(tmp_path / "sdf_path", "crate", _crate(5.5)))
     assert _crate_found(path, env) == pytest.approx(5.5, abs=TOL)
+
+
+def test_twin_spawn_sends_the_shells_model_paths_to_the_world(tmp_path) -> None:
+    # The world starts from a shell without SDF_PATH; a later `twin spawn` from a shell with it
+    # resolves the include there, as `twin convert` in that shell does.
+    path = _holder(tmp_path)
+    bare = _env(TWIN_RUNTIME_DIR=tmp_path / "rt", TWIN_AUTOSAVE="0")
+    with_path = {**bare, "SDF_PATH": str(model_dir(tmp_path / "sdf_path", "crate", _crate(2.0)))}
+
+    def twin(env: dict[str, str], *args: str) -> subprocess.CompletedProcess:
+        command = [sys.executable, "-m", "twin_cli.cli.app", *args]
+        return subprocess.run(command, env=env, capture_output=True, text=True, timeout=120)
+
+    try:
+        refused = twin(bare, "spawn", str(path), "--name", "first", "-z", "1")
+        assert refused.returncode == 2 and "'crate' was found neither" in refused.stderr, refused
+        spawned = twin(with_path, "spawn", str(path), "--name", "second", "-z", "1")
+        assert spawned.returncode == 0, spawned.stderr
+        links = twin(bare, "model", "second", "--json")
+        assert links.returncode == 0, links.stderr
+        assert "crate::box" in links.stdout, links.stdout
+    finally:
+        twin(bare, "stop")
