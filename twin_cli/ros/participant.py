@@ -1,7 +1,10 @@
 """The twin's DDS participant: writers of the world's topics, readers of the commands it takes.
 
 One Cyclone DDS domain and participant per bridge, configured by `scope.cyclone_config` alone;
-the participant announces one node, `/twin`, with its readers and writers (`node`).
+the participant announces one node, `/twin`, with its readers and writers (`node`), in the GID
+form of the scope's distribution, and carries rmw's participant USER_DATA, `enclave=/;` (the
+default enclave, as rmw_cyclonedds_cpp writes it: no terminating NUL), which ROS 2's graph
+cache reads to list the participant's nodes.
 Writers send the CDR bytes rosbags encoded (a recording's very bytes) through a topic typed by
 `graph.idl_type`, so subscribers see the types rmw_cyclonedds_cpp announces; readers hand back
 the cyclonedds objects of those same types.
@@ -22,11 +25,13 @@ from twin_cli.errors import RequestError
 from twin_cli.record.topics import Message, Topic
 from twin_cli.ros import graph
 from twin_cli.ros.graph import LATCHED_QOS, Qos, dds_qos, dds_topic, idl_type, qos_of
-from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, NODE_NAME, discovery_info
+from twin_cli.ros.node import DISCOVERY_TOPIC, INFO, NODE_NAME, discovery_info, info_type
 from twin_cli.ros.scope import Scope, cyclone_config
 from twin_cli.ros.sockets import confine_to_loopback, open_sockets
 
 log = logging.getLogger("twin.ros")
+ENCLAVE = "/"  # the default enclave: SROS2's root, what a node without --enclave runs in
+USER_DATA = f"enclave={ENCLAVE};".encode()  # rmw_cyclonedds_cpp's participant USER_DATA
 
 
 @cache
@@ -53,6 +58,7 @@ class Participant:
         interface) or is not installed."""
         try:
             from cyclonedds.domain import Domain, DomainParticipant
+            from cyclonedds.qos import Policy, Qos
         except ImportError as exc:
             raise RequestError(
                 "ROS 2 bridge", f"cyclonedds cannot be imported ({exc})",
@@ -66,7 +72,9 @@ class Participant:
             self._domain = Domain(scope.domain_id, cyclone_config(scope))
             # before the participant announces itself: nothing is sent off the device
             self.on_loopback_device = scope.local_only and confine_to_loopback(before)
-            self._participant = DomainParticipant(scope.domain_id)
+            self._participant = DomainParticipant(
+                scope.domain_id, qos=Qos(Policy.Userdata(USER_DATA))
+            )
         except Exception as exc:  # cyclonedds raises DDSException with Cyclone's return code
             raise RequestError(
                 f"ROS 2 participant ({scope.describe()})",
@@ -110,7 +118,7 @@ class Participant:
             self._closed = True
             entities = [w for w, _ in self._writers.values()] + self._readers
             entities += self._service_writers
-            entities.append(self._info_writer[0])
+            entities.append(self._info_writer)
             entities += [*self._topics.values(), self._participant, self._domain]
             self._writers.clear()
             self._readers.clear()
@@ -173,15 +181,13 @@ class Participant:
         )
         return writer, _encoded_type(topic.type)
 
-    def _open_info_writer(self) -> tuple[Any, type]:
+    def _open_info_writer(self) -> Any:
         from cyclonedds.pub import DataWriter
         from cyclonedds.topic import Topic as DdsTopic
 
-        topic = DdsTopic(self._participant, DISCOVERY_TOPIC, idl_type(INFO))
+        topic = DdsTopic(self._participant, DISCOVERY_TOPIC, info_type(self.scope.distro))
         self._topics[(DISCOVERY_TOPIC, INFO)] = topic
-        return DataWriter(self._participant, topic, qos=dds_qos(LATCHED_QOS, INFO)), _encoded_type(
-            INFO
-        )
+        return DataWriter(self._participant, topic, qos=dds_qos(LATCHED_QOS, INFO))
 
     def _announce(self) -> None:
         """Publishes the node's readers and writers on `ros_discovery_info` (`ros2 node`)."""
@@ -190,9 +196,10 @@ class Participant:
         writers = [w.get_guid().bytes for w, _ in self._writers.values()]
         writers += [w.get_guid().bytes for w in self._service_writers]
         readers = [r.get_guid().bytes for r in self._readers]
-        data = discovery_info(self._participant.get_guid().bytes, readers, writers, self.node)
-        writer, sample_type = self._info_writer
-        writer.write(sample_type(data.ljust((len(data) + 3) & ~3, b"\0")))
+        guid = self._participant.get_guid().bytes
+        self._info_writer.write(
+            discovery_info(self.scope.distro, guid, readers, writers, self.node)
+        )
 
     def _topic(self, name: str, type_name: str) -> Any:
         return self._dds_topic(dds_topic(name), idl_type(type_name))

@@ -17,10 +17,16 @@ sends only through loopback, so no other host can reach the twin's ports and non
 them. Such a socket still shows its address as 0.0.0.0 wherever the device is not reported
 (/proc/net/udp); the kernel's socket diagnostics (`ss`) show 0.0.0.0%lo. A socket bound to a
 device needs no privilege while it has none yet (Linux 5.7 and later).
+
+Cyclone's send socket, bound to the interface's address 127.0.0.1, is left as it is: the kernel
+never routes a datagram from 127.0.0.1 off loopback, and bound to the device it could not reach
+this host's other addresses, where a Jazzy LOCALHOST node on the host's network card (multicast
+off, its locators on the card's address) waits for the twin's replies.
 """
 
 from __future__ import annotations
 
+import ipaddress
 import logging
 import os
 import socket
@@ -67,6 +73,9 @@ def confine_to_loopback(before: dict[int, str]) -> bool:
             continue
         try:
             if sock.type == socket.SOCK_DGRAM and sock.family in (socket.AF_INET, socket.AF_INET6):
+                if _on_loopback_address(sock):
+                    bound += 1  # already confined, and free to reach this host's other addresses
+                    continue
                 sock.setsockopt(socket.SOL_SOCKET, option, LOOPBACK_DEVICE.encode())
                 bound += 1
         except OSError as exc:
@@ -75,3 +84,8 @@ def confine_to_loopback(before: dict[int, str]) -> bool:
         finally:
             sock.detach()
     return bound > 0
+
+
+def _on_loopback_address(sock: socket.socket) -> bool:
+    """Whether `sock` is bound to a loopback address (Cyclone's send socket on 127.0.0.1)."""
+    return ipaddress.ip_address(sock.getsockname()[0]).is_loopback

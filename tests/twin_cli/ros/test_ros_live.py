@@ -323,16 +323,17 @@ def _server_sockets(pid: int) -> list:
 def test_the_server_binds_no_address_but_loopback(served) -> None:
     """Every internet socket of the server and its publisher process is bound to 127.0.0.1,
     except Cyclone's receive sockets, which Cyclone binds to the wildcard address whatever its
-    configuration says: those are UDP sockets on the domain's unicast ports (7400 + 250·id + 10
-    + 2·index and + 11) bound to the loopback device, so none can receive from or send to
-    another host. None is connected outside 127.0.0.1 (the kernel's sock_diag)."""
+    configuration says: those are UDP sockets on the domain's ports (multicast 7400 + 250·id and
+    + 1, on loopback; unicast + 10 + 2·index and + 11) bound to the loopback device, so none can
+    receive from or send to another host. None is connected outside 127.0.0.1 (the kernel's
+    sock_diag)."""
     _, proc = served
     found = _server_sockets(proc.pid)
     udp = [s for s in found if s.protocol.startswith("udp")]
     assert len(udp) >= 6, f"not two participants' sockets: is the bridge on? {udp}"
     loopback = socket.if_nametoindex("lo")
     domain_ports = range(
-        DDS_BASE_PORT + 250 * int(DOMAIN_ID) + 10, DDS_BASE_PORT + 250 * (int(DOMAIN_ID) + 1)
+        DDS_BASE_PORT + 250 * int(DOMAIN_ID), DDS_BASE_PORT + 250 * (int(DOMAIN_ID) + 1)
     )
     wildcard = [s for s in found if s.local[0] != "127.0.0.1"]
     for s in wildcard:

@@ -1,5 +1,5 @@
 """Where the ROS 2 participant may be seen: ROS's variables read as ROS reads them, loopback only
-unless widened, and Cyclone's XML saying exactly that (pure functions, no DDS)."""
+(multicast on it) unless widened, and Cyclone's XML saying exactly that (pure functions, no DDS)."""
 
 from __future__ import annotations
 
@@ -17,23 +17,26 @@ def _general(scope) -> tuple[ET.Element, ET.Element]:
     return domain.find("General"), domain.find("Discovery")
 
 
-def test_by_default_only_loopback_with_multicast_off_and_loopback_as_the_peer() -> None:
+def test_by_default_only_loopback_with_multicast_on_it_and_loopback_as_the_peer() -> None:
+    """Multicast on loopback: how Humble's localhost-only nodes announce themselves."""
     scope = scope_from({})
     assert (scope.domain_id, scope.range, scope.local_only) == (0, "LOCALHOST", True)
     general, discovery = _general(scope)
     interface = general.find("Interfaces/NetworkInterface")
     assert interface is not None and interface.get("address") == LOOPBACK
-    assert general.findtext("AllowMulticast") == "false"
+    assert interface.get("multicast") == "true"
+    assert general.findtext("AllowMulticast") == "true"
     assert [p.get("address") for p in discovery.iter("Peer")] == [LOOPBACK]
     assert discovery.findtext("ParticipantIndex") == "auto"
+    assert discovery.findtext("MaxAutoParticipantIndex") == "32"
 
 
 @pytest.mark.parametrize(
     ("env", "interface", "local_only", "multicast"),
     [
-        ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}, None, True, False),
-        ({"ROS_LOCALHOST_ONLY": "1", "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"}, None, True, False),
-        ({"ROS_LOCALHOST_ONLY": "0"}, None, True, False),  # Humble's 0 does not widen alone
+        ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}, None, True, True),
+        ({"ROS_LOCALHOST_ONLY": "1", "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"}, None, True, True),
+        ({"ROS_LOCALHOST_ONLY": "0"}, None, True, True),  # Humble's 0 does not widen alone
         ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"}, None, True, False),
         ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "subnet"}, None, False, True),
         ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "SYSTEM_DEFAULT"}, None, False, True),
@@ -45,12 +48,18 @@ def test_only_an_explicit_setting_widens_the_scope(env, interface, local_only, m
     scope = scope_from(env, interface)
     assert scope.local_only is local_only, scope
     general, _ = _general(scope)
-    assert general.findtext("AllowMulticast") == str(multicast).lower()
+    allowed = general.findtext("AllowMulticast")  # absent: Cyclone's default, multicast on
+    assert (allowed != "false") is multicast, allowed
 
 
 def test_off_has_no_peers_and_an_interface_is_named_as_given() -> None:
-    _, discovery = _general(scope_from({"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"}))
+    """OFF as rmw_cyclonedds_cpp: no participant index and a domain tag of this process's."""
+    off = scope_from({"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF", "ROS_STATIC_PEERS": "10.0.0.7"})
+    domain = ET.fromstring(cyclone_config(off, pid=4321)).find("Domain")
+    discovery = domain.find("Discovery")
     assert list(discovery.iter("Peer")) == []
+    assert discovery.findtext("ParticipantIndex") == "none"
+    assert discovery.findtext("Tag") == "ros_discovery_off_4321"
     general, _ = _general(scope_from({}, "eth0"))
     assert general.find("Interfaces/NetworkInterface").get("name") == "eth0"
 
@@ -61,6 +70,38 @@ def test_static_peers_join_loopback_by_unicast_only() -> None:
     assert (scope.interface, scope.multicast) == (None, False), "loopback could not reach them"
     assert "unicast to 10.0.0.7, 10.0.0.8" in scope.describe()
     assert scope_from({"ROS_STATIC_PEERS": "127.0.0.2"}).local_only
+
+
+def test_localhost_only_drops_static_peers_and_system_default_ignores_them() -> None:
+    """rcl: ROS_LOCALHOST_ONLY=1 is the LOCALHOST range without static peers; rmw_cyclonedds_cpp:
+    SYSTEM_DEFAULT leaves Cyclone's defaults, peers and participant index alike."""
+    only = scope_from({"ROS_LOCALHOST_ONLY": "1", "ROS_STATIC_PEERS": "10.0.0.7"})
+    assert (only.range, only.peers, only.local_only) == ("LOCALHOST", (LOOPBACK,), True)
+    system = scope_from(
+        {"ROS_AUTOMATIC_DISCOVERY_RANGE": "SYSTEM_DEFAULT", "ROS_STATIC_PEERS": "10.0.0.7"}
+    )
+    general, discovery = _general(system)
+    assert (list(general), list(discovery)) == ([], []), cyclone_config(system)
+
+
+def test_subnet_keeps_multicast_takes_the_peers_and_a_participant_index() -> None:
+    """As rmw_cyclonedds_cpp's SUBNET: the index with or without peers, so Jazzy's LOCALHOST
+    nodes, which probe 127.0.0.1's participant ports, find the twin."""
+    for peers, wanted in (("", []), ("10.0.0.7;10.0.0.8", ["10.0.0.7", "10.0.0.8"])):
+        env = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "ROS_STATIC_PEERS": peers}
+        general, discovery = _general(scope_from(env))
+        assert general.find("Interfaces") is None and general.find("AllowMulticast") is None
+        assert [p.get("address") for p in discovery.iter("Peer")] == wanted
+        assert discovery.findtext("ParticipantIndex") == "auto"
+
+
+@pytest.mark.parametrize(
+    ("env", "distro", "wanted"),
+    [({}, None, "jazzy"), ({"ROS_DISTRO": "humble"}, None, "humble"),
+     ({"ROS_DISTRO": "humble"}, "jazzy", "jazzy"), ({"ROS_DISTRO": "Iron"}, None, "iron")],
+)  # fmt: skip
+def test_the_distribution_is_the_option_else_ros_distro_else_jazzy(env, distro, wanted) -> None:
+    assert scope_from(env, distro=distro).distro == wanted
 
 
 def test_domain_id_is_read_from_ros_domain_id() -> None:
@@ -75,6 +116,9 @@ def test_domain_id_is_read_from_ros_domain_id() -> None:
         ({"ROS_DOMAIN_ID": "abc"}, None, ("ROS_DOMAIN_ID=abc", "unset it")),
         ({"ROS_AUTOMATIC_DISCOVERY_RANGE": "LAN"}, None, ("LAN", "LOCALHOST, SUBNET")),
         ({"ROS_STATIC_PEERS": "robot.local"}, None, ("robot.local", "192.168.1.20")),
+        ({"ROS_LOCALHOST_ONLY": "2"}, None, ("ROS_LOCALHOST_ONLY=2", "set it to 1")),
+        ({"ROS_LOCALHOST_ONLY": "true"}, None, ("ROS_LOCALHOST_ONLY=true", "or 0")),
+        ({"ROS_DISTRO": "ardent2"}, None, ("ROS_DISTRO 'ardent2'", "humble")),
         ({}, "<eth0>", ("--ros-interface", "eth0")),
     ],
 )

@@ -3,7 +3,7 @@
 Client-side (no mujoco, numpy or cyclonedds here): the server runs the DDS participant
 (`twin_cli.ros`); this side only asks. The scope is the ROS_DOMAIN_ID and
 discovery variables as this shell has them (sent with the request), loopback only unless
-`--interface` is given.
+`--interface` is given; ROS_DISTRO (or `--distro`) shapes the node's GIDs for that distribution.
 """
 
 from __future__ import annotations
@@ -15,12 +15,14 @@ import typer
 
 from twin_cli.cli.options import JsonOpt, WorldOpt
 from twin_cli.cli.output import Output
+from twin_cli.ros.distro import distro_from
 
 SCOPE_VARIABLES = (
     "ROS_DOMAIN_ID",
     "ROS_AUTOMATIC_DISCOVERY_RANGE",
     "ROS_STATIC_PEERS",
     "ROS_LOCALHOST_ONLY",
+    "ROS_DISTRO",
 )
 app = typer.Typer(
     help="Publish a running world's topics on the ROS 2 graph and take its cmd_vel "
@@ -42,12 +44,22 @@ def start(
             "the scope may then change the world (ROS 2 has no access control without SROS2).",
         ),
     ] = False,
+    distro: Annotated[
+        str | None,
+        typer.Option(
+            help="The nodes' ROS 2 distribution (humble, jazzy, ...): the form of the GIDs "
+            "`ros2 node list` reads. Default: $ROS_DISTRO, else jazzy."
+        ),
+    ] = None,
     world: WorldOpt = "default",
     json: JsonOpt = False,
 ) -> None:
     """Join the ROS 2 graph: /clock, /tf, /tf_static and each entity's topics out; cmd_vel and
     controller commands in (gazebo_ros' entity services with --services)."""
-    body: dict[str, Any] = {"environment": ros_environment(), "services": services}
+    environment = ros_environment()
+    if distro is not None:
+        environment["ROS_DISTRO"] = distro_from(environment, distro, "--distro")
+    body: dict[str, Any] = {"environment": environment, "services": services}
     if interface is not None:
         body["interface"] = interface
     _show(_ask(world, "POST", body), json, "publishing")
