@@ -1,8 +1,12 @@
 """Where the ROS 2 participant may be seen: ROS's variables read as ROS reads them, loopback only
-(multicast on it) unless widened, and Cyclone's XML saying exactly that (pure functions, no DDS)."""
+(multicast on it) unless widened, and Cyclone's XML saying exactly that (pure functions, no DDS);
+`twin serve --ros` refuses a bad variable before it opens a socket."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -134,3 +138,24 @@ def test_the_description_says_where_the_participant_reaches() -> None:
     assert "interface eth0, multicast" in scope_from({}, "eth0").describe()
     wide = scope_from({"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "ROS_DOMAIN_ID": "3"})
     assert wide.describe() == "ROS 2 domain 3, SUBNET: Cyclone's interface choice, multicast"
+
+
+@pytest.mark.parametrize(
+    ("variable", "value", "fix"),
+    [
+        ("ROS_LOCALHOST_ONLY", "2", "set it to 1"),
+        ("ROS_AUTOMATIC_DISCOVERY_RANGE", "LAN", "SUBNET"),
+    ],
+)
+def test_twin_serve_ros_with_a_bad_variable_exits_2_with_one_message(
+    variable: str, value: str, fix: str, tmp_path
+) -> None:
+    """Before any socket: exit 2, one line naming the variable, its value and the fix."""
+    env = {**os.environ, "TWIN_RUNTIME_DIR": str(tmp_path), variable: value}
+    done = subprocess.run(
+        [sys.executable, "-m", "twin_cli", "serve", "--ros", "--world", "bad_scope"],
+        env=env, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"{variable}={value}" in lines[0] and fix in lines[0], lines
