@@ -97,7 +97,7 @@ COACD_CPU_LIMIT = Opt(
     ("--coacd-cpu-limit", "--coacd-time-limit"),
     "coacd_cpu_limit",
     "CPU seconds CoACD may spend decomposing one collision mesh before its convex hull stands "
-    "in (default 20; the same on an idle and a busy machine). --coacd-time-limit: older name.",
+    "in (default 60; the same on an idle and a busy machine). --coacd-time-limit: older name.",
     float,
     envvar="TWIN_COACD_CPU_LIMIT",  # converters.collision.plan.CPU_LIMIT_ENV
 )
