@@ -90,7 +90,7 @@ HEAVY_CAPS = {
 # the work itself; this is a safety net kept far above what real meshes take, since CPU time
 # varies a few per cent between runs (a mesh right at the budget could go either way). The
 # corpus's costliest mesh, open_manipulator_x chain_link1 (21,376 triangles), takes 21.2-22.5
-# CPU s; the robot's seven meshes 73 CPU s in all.
+# CPU s; the robot's seven meshes 48-50 CPU s in all.
 DEFAULT_CPU_LIMIT = 60.0
 # Overrides DEFAULT_CPU_LIMIT for every conversion of a process that does not give its own
 # (`twin serve --coacd-cpu-limit` sets it for the world's file and the spawns into it) [CPU s].
