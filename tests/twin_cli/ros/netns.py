@@ -45,11 +45,13 @@ def available() -> str | None:
 class Namespace:
     """A network namespace held by a `sleep` process, set up as the module docstring says."""
 
-    def __init__(self, lan: bool = False) -> None:
+    def __init__(self, lan: bool = False, lo_multicast: bool = True) -> None:
+        """`lo_multicast=False`: `lo` as most hosts have it, up without multicast or its route."""
         self._holder = subprocess.Popen(["unshare", "-n", "sleep", "3600"])
+        setup = SETUP_LO if lo_multicast else SETUP_LO[:1]
         try:
             self._wait_until_apart()
-            for command in SETUP_LO + (SETUP_LAN if lan else ()):
+            for command in setup + (SETUP_LAN if lan else ()):
                 self.run(command, check=True)
         except BaseException:
             self.close()

@@ -9,7 +9,7 @@ The peers share no code with twin: `rmw_peer.py` configures Cyclone DDS as rmw_c
 does on Humble's and on Jazzy's code path, and `fastdds_peer.py` is a stock rclpy node on
 rmw_fastrtps_cpp, run by the Python that TWIN_FASTDDS_PYTHON names (else `.venv-ros/bin/python`
 in the repository: `pip install ros-jazzy-rclpy ros-jazzy-rmw-fastrtps-cpp
-ros-jazzy-geometry-msgs ros-jazzy-rosgraph-msgs`); without one, the Fast DDS peers skip. Each
+ros-jazzy-geometry-msgs ros-jazzy-rosgraph-msgs`); without one, only the Cyclone peers run. Each
 peer counts /clock for SESSION_S while sending a Twist on /bot/cmd_vel, and the base must move.
 """
 
@@ -99,11 +99,15 @@ class Twin:
 
 
 @contextmanager
-def served(ns: netns.Namespace, root: Path, variables: dict[str, str]) -> Iterator[Twin]:
-    """`twin serve --ros` in `ns` with ROS `variables`, a diff-drive base `bot` on the ground."""
+def served(
+    ns: netns.Namespace, root: Path, variables: dict[str, str], *serve_args: str
+) -> Iterator[Twin]:
+    """`twin serve --ros [serve_args]` in `ns` with ROS `variables`, a diff-drive base `bot` on
+    the ground."""
     twin = Twin(ns, root / "runtime", variables)
     log = open(root / "serve.out", "wb")  # noqa: SIM115 (the server writes to it until the end)
     command = [sys.executable, "-m", "twin_cli.cli.app", "serve", "--world", WORLD, "--ros"]
+    command += serve_args
     server = ns.popen(command, env=twin.env, cwd=ROOT, stdout=log, stderr=log)
     try:
         deadline = time.monotonic() + 60.0
@@ -129,10 +133,7 @@ def _session(twin: Twin, root: Path, peer: tuple[str, str, dict[str, str]]) -> d
     if kind == "cyclone":
         command = [sys.executable, str(HERE / "rmw_peer.py"), distro]
     else:
-        python = _fastdds_python()
-        if python is None:
-            pytest.skip("no Python with rclpy and rmw_fastrtps_cpp (TWIN_FASTDDS_PYTHON)")
-        command = [python, str(HERE / "fastdds_peer.py")]
+        command = [str(_fastdds_python()), str(HERE / "fastdds_peer.py")]
         variables = {**variables, "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp"}
     start = twin.position()
     command += ["session", str(SESSION_S), "bot", str(VX)]
@@ -144,6 +145,10 @@ def _session(twin: Twin, root: Path, peer: tuple[str, str, dict[str, str]]) -> d
 
 
 def _meets(twin: Twin, root: Path, peers: dict[str, tuple[str, str, dict[str, str]]]) -> None:
+    """Each peer (the Fast DDS ones only where a Python with rclpy is at hand) gets /clock,
+    matches the base's cmd_vel reader and moves the base."""
+    if _fastdds_python() is None:
+        peers = {name: peer for name, peer in peers.items() if peer[0] != "fastdds"}
     results = {name: _session(twin, root, peer) for name, peer in peers.items()}
     for name, got in results.items():
         assert got["clock"] >= MIN_CLOCK, f"{name}: {got['clock']} /clock samples; {results}"
@@ -185,6 +190,24 @@ def test_a_stock_node_with_the_same_variables_gets_clock_and_drives_the_base(
         _meets(twin, tmp_path, peers)
 
 
+def test_on_a_loopback_without_multicast_the_default_meets_every_kind_of_node(
+    tmp_path: Path,
+) -> None:
+    """`lo` as most hosts have it (no MULTICAST flag, no multicast route): twin's default still
+    meets default, LOCALHOST and localhost-only peers of both middlewares."""
+    peers = {
+        "cyclone humble": ("cyclone", "humble", {}),
+        "cyclone humble LOCALHOST_ONLY": ("cyclone", "humble", ONLY),
+        "cyclone jazzy LOCALHOST": ("cyclone", "jazzy", LOCALHOST),
+        "fastdds jazzy": ("fastdds", "jazzy", {}),
+        "fastdds humble LOCALHOST_ONLY": (
+            "fastdds", "humble", {"FASTRTPS_DEFAULT_PROFILES_FILE": HUMBLE_PROFILE}
+        ),
+    }  # fmt: skip
+    with netns.Namespace(lo_multicast=False) as ns, served(ns, tmp_path, {}) as twin:
+        _meets(twin, tmp_path, peers)
+
+
 LAN_PEER = {"ROS_STATIC_PEERS": netns.LAN_ADDRESS}  # the card's address: another host's place
 LAN_SETTINGS = {
     "default: localhost-scoped nodes, nothing on the card": ({}, {
@@ -221,14 +244,21 @@ def test_with_a_network_card_the_same_variables_meet_and_localhost_stays_off_it(
             assert ns.sent_on("eth0") == before, "twin's LOCALHOST scope sent on the card"
 
 
-@pytest.mark.parametrize(("distro", "gid_size"), [("humble", 24), ("jazzy", 16)])
+@pytest.mark.parametrize(
+    ("distro", "gid_size", "variables", "serve_args"),
+    [
+        ("humble", 24, {}, ("--ros-distro", "humble")),
+        ("humble", 24, {"ROS_DISTRO": "humble"}, ()),
+        ("jazzy", 16, {}, ()),
+    ],
+)
 def test_the_nodes_are_listed_with_the_distributions_gids_and_the_enclave(
-    distro: str, gid_size: int, tmp_path: Path
+    distro: str, gid_size: int, variables: dict, serve_args: tuple, tmp_path: Path
 ) -> None:
-    """ROS_DISTRO shapes `ros_discovery_info` as that distribution's `ros2 node list` reads it
-    (Gid of RMW_GID_STORAGE_SIZE bytes: 24 in Humble, 16 in Jazzy), and each of twin's
-    participants carries rmw's USER_DATA `enclave=/;`."""
-    with netns.Namespace() as ns, served(ns, tmp_path, {"ROS_DISTRO": distro}):
+    """`--ros-distro`, else ROS_DISTRO, else Jazzy shapes `ros_discovery_info` as that
+    distribution's `ros2 node list` reads it (Gid of RMW_GID_STORAGE_SIZE bytes: 24 in Humble,
+    16 in Jazzy), and each of twin's participants carries rmw's USER_DATA `enclave=/;`."""
+    with netns.Namespace() as ns, served(ns, tmp_path, variables, *serve_args):
         command = [sys.executable, str(HERE / "rmw_peer.py"), distro, "graph", "3"]
         done = ns.run(command, env=_env({}), cwd=HERE, timeout=120)
         assert done.returncode == 0, done.stderr[-1500:]

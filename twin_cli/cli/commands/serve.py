@@ -68,6 +68,13 @@ def serve(
             help="With --ros: answer /spawn_entity and /delete_entity (any DDS peer may call).",
         ),
     ] = False,
+    ros_distro: Annotated[
+        str | None,
+        typer.Option(
+            help="With --ros: the nodes' ROS 2 distribution (humble, jazzy, ...), the form of "
+            "the GIDs `ros2 node list` reads. Default: $ROS_DISTRO, else jazzy."
+        ),
+    ] = None,
     coacd_cpu_limit: CoacdCpuLimitOpt = None,
 ) -> None:
     """Run a world server in the foreground (like gzserver); Ctrl-C or SIGTERM ends it.
@@ -91,6 +98,10 @@ def serve(
             )
     if coacd_cpu_limit is not None:  # read by every conversion in this server (and its children)
         os.environ[CPU_LIMIT_ENV] = repr(coacd_cpu_limit)
+    if ros_distro is not None:  # the server's bridge reads ROS_DISTRO as the other variables
+        from twin_cli.ros.distro import distro_from
+
+        os.environ["ROS_DISTRO"] = distro_from(os.environ, ros_distro)
     opts = ServeOptions(
         world,
         str(world_file) if world_file else None,
