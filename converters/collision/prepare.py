@@ -56,8 +56,9 @@ from converters.report import Report
 Pairs = list[tuple[np.ndarray, np.ndarray]]
 # What to do about a mesh that did not finish within its CPU budget [CPU s].
 CPU_HINT = (
-    "; not cached: give it more CPU time (--coacd-cpu-limit, now {limit:g} CPU s), a cheaper"
-    " search (--coacd-preset fast, a larger --coacd-threshold) or --collision-link {link}=hull"
+    "; not cached: give it more CPU time (--coacd-cpu-limit, now {limit:g} CPU s) or, in"
+    " `twin convert`, a cheaper search (--coacd-preset fast, a larger --coacd-threshold) or"
+    " --collision-link {link}=hull"
 )
 ROW_FIELDS = (
     "key",
