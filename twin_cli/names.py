@@ -58,3 +58,9 @@ def topic_segment(name: str) -> str:
     segment = "".join(c if c.isascii() and (c.isalnum() or c == "_") else "_" for c in plain)
     segment = segment or "_"
     return f"_{segment}" if segment[0].isdigit() else segment
+
+
+def namespace(entity: str) -> str:
+    """An entity's ROS namespace: `/` and its name as one topic segment (`topic_segment`), so a
+    model named `Heightmap Bowl` publishes `/Heightmap_Bowl/joint_states`."""
+    return f"/{topic_segment(entity)}"

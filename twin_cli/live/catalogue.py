@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING
 
 from twin_cli.errors import TopicNotFoundError
+from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.frames import odom_topic, unique_odom_topics
 from twin_cli.record.sensor_messages import spec_topic
@@ -64,9 +65,13 @@ def live_topics(world: World) -> list[LiveTopic]:
         LiveTopic(TF_STATIC.name, TF_STATIC.type, 0.0, latched=True),
     ]
     for name, record, free_qpos in entities:
-        out.append(LiveTopic(f"/{name}/joint_states", ros.JOINT_STATE, state, entity=name))
+        out.append(
+            LiveTopic(f"{namespace(name)}/joint_states", ros.JOINT_STATE, state, entity=name)
+        )
         if record.description:
-            out.append(LiveTopic(f"/{name}/robot_description", ros.STRING, 0.0, True, name))
+            out.append(
+                LiveTopic(f"{namespace(name)}/robot_description", ros.STRING, 0.0, True, name)
+            )
         if free_qpos >= 0:
             out.append(LiveTopic(odom[name], ros.ODOMETRY, state, entity=name))
         for spec in record.sensors:

@@ -25,6 +25,7 @@ from functools import lru_cache
 from typing import TYPE_CHECKING
 
 from converters.gazebo.plugins import DIFF_DRIVE_FILES, DiffDrive
+from twin_cli.names import namespace
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
@@ -101,7 +102,7 @@ def unique_odom_topics(topics: dict[str, str]) -> dict[str, str]:
     seen: set[str] = set()
     out: dict[str, str] = {}
     for name, topic in topics.items():
-        out[name] = topic if topic not in seen else f"/{name}/odom"
+        out[name] = topic if topic not in seen else f"{namespace(name)}/odom"
         seen.add(out[name])
     return out
 
@@ -113,13 +114,13 @@ def odom_topic(entity: str, plugins: Sequence[object]) -> str:
         topic = getattr(plugin, "odom_topic", None)
         if topic:
             return entity_topic(entity, topic)
-    return f"/{entity}/odom"
+    return f"{namespace(entity)}/odom"
 
 
 def entity_topic(entity: str, topic: str) -> str:
     """A topic a plugin names: absolute as it is, relative under the entity's name (twin's
     namespace for each robot)."""
-    return topic if topic.startswith("/") else f"/{entity}/{topic.strip('/')}"
+    return topic if topic.startswith("/") else f"{namespace(entity)}/{topic.strip('/')}"
 
 
 def record_frames(plugins: Sequence[object]) -> tuple[str, str] | None:

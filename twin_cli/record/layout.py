@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from twin_cli.names import namespace
 from twin_cli.record.frames import Pose, Sources, unique_odom_topics
 from twin_cli.record.tf_tree import Edge, EntityTree, entity_tree, model_names, static_pose
 from twin_cli.world.entities import EntityIndex, element_names
@@ -146,7 +147,7 @@ def entity_layout(
         free_dof=int(model.jnt_dofadr[free[0]]) if free else -1,
         description=description,
         ball_joints=tuple(k for k, j in enumerate(joints) if is_ball(model, j)),
-        odom_topic=odom_topic or f"/{name}/odom",
+        odom_topic=odom_topic or f"{namespace(name)}/odom",
     )
 
 

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.layout import EntityLayout, Layout, MovingEdges
 from twin_cli.record.sampler import Samples
@@ -159,7 +160,7 @@ class _JointStates:
         self._qpos = model.jnt_qposadr[e.joint_ids]
         self._dofs = model.jnt_dofadr[e.joint_ids]
         self._balls = e.ball_joints
-        self._topic = f"/{e.name}/joint_states"
+        self._topic = f"{namespace(e.name)}/joint_states"
         self._message = T[ros.JOINT_STATE](
             header=T["std_msgs/msg/Header"](stamp=stamp, frame_id=""),
             name=list(e.joint_names),

@@ -22,6 +22,7 @@ from converters.description.sensors import (
     RaySpec,
     SensorSpec,
 )
+from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.contact_types import CONTACTS
 from twin_cli.record.topics import Message, Topic
@@ -71,7 +72,7 @@ def _named(entity: str, name: str, topic: str, kind: str | None) -> Topic | None
     if kind is None:
         return None
     suffix = "/image_raw" if kind == IMAGE else ""  # as gazebo_ros' cameras (image_transport)
-    return Topic(f"/{entity}/{(topic or name).strip('/')}{suffix}", kind)
+    return Topic(f"{namespace(entity)}/{(topic or name).strip('/')}{suffix}", kind)
 
 
 def sensor_message(topic: Topic, reading: Reading) -> Message:

@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.layout import Layout
 
@@ -61,9 +62,9 @@ def topics(layout: Layout) -> list[Topic]:
     """Every topic of the layout's entities, world-wide ones first."""
     out = [CLOCK, TF, TF_STATIC]
     for e in layout.entities:
-        out.append(Topic(f"/{e.name}/joint_states", ros.JOINT_STATE))
+        out.append(Topic(f"{namespace(e.name)}/joint_states", ros.JOINT_STATE))
         if e.description:
-            out.append(Topic(f"/{e.name}/robot_description", ros.STRING, latched=True))
+            out.append(Topic(f"{namespace(e.name)}/robot_description", ros.STRING, latched=True))
         if e.free_qpos >= 0:
             out.append(Topic(e.odom_topic, ros.ODOMETRY))
     return out
@@ -84,7 +85,7 @@ def latched_messages(layout: Layout, time: float) -> list[Message]:
     for e in layout.entities:
         if e.description:
             text = T[ros.STRING](data=e.description)
-            out.append(Message(f"/{e.name}/robot_description", ros.STRING, time, text))
+            out.append(Message(f"{namespace(e.name)}/robot_description", ros.STRING, time, text))
     return out
 
 

@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.names import namespace
 from twin_cli.record.frames import entity_topic
 from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST
 from twin_cli.ros.plugin_names import TRAJECTORY, Controller, plugin_names
@@ -79,7 +80,7 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     if drives:
         kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
         own = getattr(drives[0], "cmd_vel_topic", "")  # as the converter read its plugin
-        plugin = ((entity_topic(name, own) if own else f"/{name}/cmd_vel", TWIST),)
+        plugin = ((entity_topic(name, own) if own else f"{namespace(name)}/cmd_vel", TWIST),)
         topics = named.cmd_vel if named.cmd_vel and not own else plugin
         inputs += [
             Input(topic, message, drive=kind, timeout=timeout or None) for topic, message in topics
@@ -103,10 +104,10 @@ def _default_controllers(name: str, rows: dict[str, Any]) -> list[Input]:
     for mode in MODES:
         joints = tuple(j for j, row in rows.items() if mode in row["modes"])
         if joints:
-            topic = f"/{name}/forward_{mode}_controller/commands"
+            topic = f"{namespace(name)}/forward_{mode}_controller/commands"
             inputs.append(Input(topic, FLOAT64_ARRAY, mode, joints))
         if joints and mode == "position":
-            topic = f"/{name}/joint_trajectory_controller/joint_trajectory"
+            topic = f"{namespace(name)}/joint_trajectory_controller/joint_trajectory"
             inputs.append(Input(topic, JOINT_TRAJECTORY, TRAJECTORY, joints))
     return inputs
 

@@ -10,6 +10,7 @@ from models import block
 from sensor_models import imu_box
 
 from twin_cli.live import Echo, find_topic
+from twin_cli.live.catalogue import live_topics
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import Pose, World
 
@@ -53,3 +54,24 @@ def test_a_sensor_echo_sends_every_reading_of_that_sensor(world):
     assert all(abs(b - a - 0.005) < 1e-9 for a, b in zip(times, times[1:], strict=False)), times
     assert got[0]["type"] == "sensor_msgs/msg/Imu"
     assert got[0]["message"]["header"]["frame_id"] == "imu/imu_link"
+
+
+ROS_NAME = r"^(/[A-Za-z_][A-Za-z0-9_]*)+$"  # a ROS 2 topic name: segments of [A-Za-z0-9_]
+
+
+@pytest.mark.parametrize(
+    ("name", "segment"),
+    [("imu box", "imu_box"), ("Ünïcödé körper", "Unicode_korper"), ("2nd imu", "_2nd_imu")],
+)
+def test_an_entity_named_with_spaces_or_accents_publishes_valid_ros_topics(name, segment):
+    """The entity keeps its name; its topics live under one valid ROS segment of it."""
+    import re
+
+    world = World()
+    world.spawn(SpawnRequest(xml=imu_box()), name=name, pose=Pose(z=0.5))
+    assert world.entity_names() == [name]
+    topics = [t.name for t in live_topics(world) if t.entity == name]
+    assert f"/{segment}/joint_states" in topics, topics
+    assert all(re.match(ROS_NAME, t) for t in topics), topics
+    assert any(t.startswith(f"/{segment}/") and t != f"/{segment}/joint_states" for t in topics)
+    assert find_topic(world, f"{segment}/joint_states").entity == name
