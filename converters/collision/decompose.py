@@ -10,7 +10,9 @@ A mesh's budget is CPU time, counted by the kernel for the worker's CoACD call a
 threads): the worker arms `ITIMER_PROF`, whose SIGPROF ends it when the budget is spent. CPU
 time does not grow with the machine's load the way wall-clock time does (measured on a 16-section
 cup, fast preset: 3.0-3.4 CPU s idle and beside two busy loops, while wall time went from 4 s
-to 15 s), so a mesh is decomposed or not the same way on an idle and a busy machine. A
+to 15 s), so a mesh well within its budget is decomposed the same way on an idle and a busy
+machine. It is not exact (up to a third more on a shared virtual machine), hence budgets far
+above what a mesh needs (`plan.DEFAULT_CPU_LIMIT`). A
 wall-clock backstop (`WALL_BACKSTOP_FACTOR` times the budget, at least `WALL_BACKSTOP_MIN_S`)
 only catches a worker that hangs without using CPU.
 

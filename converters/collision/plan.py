@@ -87,10 +87,10 @@ HEAVY_CAPS = {
 # Default CPU budget of one mesh's CoACD run [CPU s], counted by the kernel in the worker
 # (`converters.collision.worker`), so the same on an idle and a busy machine; a mesh past it
 # falls back to its hull, said in the report and never cached. The presets and HEAVY_CAPS bound
-# the work itself; this is a safety net kept far above what real meshes take, since CPU time
-# varies a few per cent between runs (a mesh right at the budget could go either way). The
-# corpus's costliest mesh, open_manipulator_x chain_link1 (21,376 triangles), takes 21.2-22.5
-# CPU s; the robot's seven meshes 48-50 CPU s in all.
+# the work itself; this is a safety net kept far above what real meshes take, since CPU time is
+# not exact (a mesh right at the budget could go either way). The corpus's costliest mesh,
+# open_manipulator_x chain_link1 (21,376 triangles), took 21.2-28.3 CPU s over six runs on a
+# shared 2-core virtual machine (the other six meshes 1.5-10 CPU s each, within 7 % run to run).
 DEFAULT_CPU_LIMIT = 60.0
 # Overrides DEFAULT_CPU_LIMIT for every conversion of a process that does not give its own
 # (`twin serve --coacd-cpu-limit` sets it for the world's file and the spawns into it) [CPU s].

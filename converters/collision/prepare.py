@@ -11,9 +11,10 @@ fallback (why the hull stands in for CoACD's parts, else None)`, and one line in
 Cache: a result is stored under its content key (mesh bytes, scale, mode, CoACD parameters),
 and so is "CoACD returned no usable part", which the same bytes and parameters always give.
 A hull standing in for a decomposition that did not finish is never stored, so every
-conversion tries again: a worker over its CPU budget (CPU time varies by a few per cent from
-run to run, so a mesh near its budget may finish next time, and a larger budget must get the
-real parts), past the wall-clock backstop, or dead (out-of-memory kill, Ctrl-C).
+conversion tries again: a worker over its CPU budget (CPU time varies from run to run, by up
+to a third on a shared virtual machine, so a mesh near its budget may finish next time, and a
+larger budget must get the real parts), past the wall-clock backstop, or dead (out-of-memory
+kill, Ctrl-C).
 """
 
 from __future__ import annotations
