@@ -24,10 +24,10 @@ RATIO_TARGET = 2.0
 
 def run() -> dict[str, object]:
     """Per robot: median in-process and served conversion [s], their ratio and difference."""
-    from converters import bounded
-    from converters.budget import XacroBudget
+    from converters.isolated import bounded
+    from converters.isolated.budget import XacroBudget
     from converters.mjcf.builder import ConvertOptions
-    from converters.served import ConversionJob, convert_job, convert_served
+    from converters.serving.served import ConversionJob, convert_job, convert_served
 
     bounded.enable()
     robots = {r["id"]: r for r in tomllib.loads((CORPUS / "robots.toml").read_text())["robot"]}

@@ -10,7 +10,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from converters.budget import XacroBudget
 from converters.description import RobotDescription
 from converters.description.sensors import SensorSpec
 from converters.errors import (
@@ -20,11 +19,12 @@ from converters.errors import (
     URDFStructureError,
 )
 from converters.formats import format_of
+from converters.isolated.budget import XacroBudget
+from converters.isolated.stages import stage
 from converters.mjcf.builder import ConvertOptions, build_spec
 from converters.provenance import Provenance
 from converters.report import Report
 from converters.resources.packages import PackageResolver
-from converters.stages import stage
 from converters.urdf.reader import parse_urdf
 from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 

@@ -30,7 +30,7 @@ class SpawnRequest:
         base_dir: where relative mesh paths in `xml` start (the client's working directory).
         args: xacro arguments, name → value (`--arg name:=value`).
         package_paths: package name → directory (`--package NAME=PATH`).
-        env: the client's package search variables (`twin_cli.package_env`); None: the
+        env: the client's package search variables (`twin_cli.files.package_env`); None: the
             server's own.
         joints: initial joint positions by joint name [rad] or [m] (`-J`, Gazebo's
             `spawn_model -J`).

@@ -366,8 +366,8 @@ def prepare_collision_meshes(
         CollisionSettingsError: an unknown mode or preset. A mesh that fails to decompose
             never raises: it falls back to its convex hull and the report says why.
     """
-    from converters.replay import read_once
-    from converters.stages import stage
+    from converters.isolated.replay import read_once
+    from converters.isolated.stages import stage
 
     check_settings(settings)
     by_key = {r.key: r for r in requests}

@@ -10,7 +10,7 @@ its name, written as ROS reads it: `name`, `/name`, `/ns/name`, nested namespace
 keys (`linear.x.max_velocity`). A controller's type comes from the manager's listing, or, as in
 gz_ros2_control's demos, from the `type` among the controller's own parameters.
 
-Each file is read once per conversion through `converters.replay`, so a served conversion's
+Each file is read once per conversion through `converters.isolated.replay`, so a served conversion's
 world builds the same drives without opening it.
 """
 
@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
 
-from converters.replay import read_once
+from converters.isolated.replay import read_once
 
 MANAGER = "controller_manager"
 WILDCARD = "**"

@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from converters.budget import XacroBudget
 from converters.collision.plan import CollisionRequest, CollisionSettings
 from converters.collision.prepare import prepare_collision_meshes
 from converters.description import RobotDescription
+from converters.isolated.budget import XacroBudget
 from converters.mjcf import inertia as inr
 from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
 from converters.mjcf.bodies import body_inertias

@@ -16,11 +16,11 @@ import numpy as np
 
 from converters.description import Collision, RobotDescription
 from converters.errors import InputFileError
+from converters.isolated.replay import read_once
 from converters.mjcf.builder import COLLISION_CLASS, pose
 from converters.mjcf.fixed_base import weld_base
 from converters.mjcf.geometry import HEIGHTMAP, static_bodies
 from converters.mjcf.lumping import WORLDBODY, LinkPlacement, plan_bodies
-from converters.replay import read_once
 from converters.report import Report
 from converters.resources.height_images import read_height_image
 

@@ -47,19 +47,19 @@ class MeshCache:
 def load_mesh(path: Path, link: str) -> MeshData:
     """A mesh file's triangles in metres: from the mesh store when these bytes were loaded
     before, else read with trimesh (and stored); from the read log when a bounded conversion's
-    spec is built again (`converters.replay`).
+    spec is built again (`converters.isolated.replay`).
 
     Raises:
         MeshError: the file cannot be parsed or holds no triangles.
     """
-    from converters.replay import read_once
+    from converters.isolated.replay import read_once
 
     return read_once("mesh", (str(path),), lambda: _read_mesh(path, link))
 
 
 def _read_mesh(path: Path, link: str) -> MeshData:
+    from converters.isolated.stages import stage
     from converters.resources import mesh_store
-    from converters.stages import stage
 
     stage(f"reading mesh {path}{_size_of(path)}")
     try:

@@ -15,7 +15,6 @@ from pathlib import Path
 
 import numpy as np
 
-from converters.bounded_child import READ_EVENT
 from converters.description import (
     Collision,
     Dynamics,
@@ -32,6 +31,7 @@ from converters.description import (
 from converters.description.transforms import pose_matrix
 from converters.errors import PackageNotFoundError, ResourceNotFoundError, URDFStructureError
 from converters.gazebo.blocks import parse_gazebo
+from converters.isolated.bounded_child import READ_EVENT
 from converters.resources.packages import PackageResolver
 from converters.urdf.control import read_controls
 from converters.urdf.xml_checks import check_kinds, check_numbers, check_tree, parse_xml

@@ -26,9 +26,9 @@ import threading
 from pathlib import Path
 from typing import Any
 
-from converters.bounded_child import CHILD_NICENESS, READ_EVENT, die_with_parent
-from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import ConversionError, XacroBudgetError, XacroError, rebuilt_error
+from converters.isolated.bounded_child import CHILD_NICENESS, READ_EVENT, die_with_parent
+from converters.isolated.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.resources.packages import PackageResolver
 from converters.urdf.xacro_expand import XacroResult
 

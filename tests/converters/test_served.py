@@ -11,12 +11,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from converters import bounded
-from converters.bounded_child import READ_EVENT
-from converters.budget import XacroBudget
 from converters.errors import ConversionBudgetError, ResourceNotFoundError
+from converters.isolated import bounded
+from converters.isolated.bounded_child import READ_EVENT
+from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
-from converters.served import ConversionJob, convert_job, convert_served
+from converters.serving.served import ConversionJob, convert_job, convert_served
 from tests.corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus, package_paths
 
 CUBE_OBJ = "\n".join(
@@ -133,9 +133,9 @@ def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path):
 
 CALLER = """
 import sys, threading, time
-from converters import bounded
-from converters.budget import XacroBudget
-from converters.served import ConversionJob, convert_served
+from converters.isolated import bounded
+from converters.isolated.budget import XacroBudget
+from converters.serving.served import ConversionJob, convert_served
 
 if __name__ == "__main__":
     bounded.enable()

@@ -2,11 +2,11 @@
 or a budget refusal; never another exception (exit 70, HTTP 500), never a hang, never a secret.
 
 SDF: `model://` include graphs (cycles, self-includes, merges, deep chains, fan-outs) and
-`file://` URIs to a file outside the models. URDF/xacro: macros fanning out exponentially,
-macros recursing without end, include circles, includes and `load_yaml` of files outside the
-package, `$(env)` and `$(optenv)` of a server variable. The planted secret (a file's content,
-a server variable's value) must appear in no result and no message. Each case runs the world's
-path (`converters.served`, a bounded child) under a small budget. The attacks found so far are
+`file://` URIs to a file outside the models. URDF/xacro: macros fanning out exponentially, macros
+recursing without end, include circles, includes and `load_yaml` of files outside the package,
+`$(env)` and `$(optenv)` of a server variable. The planted secret (a file's content, a server
+variable's value) must appear in no result and no message. Each case runs the world's path
+(`converters.serving.served`, a bounded child) under a small budget. The attacks found so far are
 fixed cases below. Bounded in `make test`; `make fuzz` raises the example count.
 """
 
@@ -21,8 +21,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from converters import bounded
-from converters.budget import XacroBudget
 from converters.errors import (
     ConversionBudgetError,
     ConversionError,
@@ -30,8 +28,10 @@ from converters.errors import (
     SDFError,
     XacroError,
 )
+from converters.isolated import bounded
+from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
-from converters.served import ConversionJob, convert_served
+from converters.serving.served import ConversionJob, convert_served
 
 # 5 s: the bounded child's own start (Python, xacro, the converter) is part of the budget, and
 # on a runner with two busy loops per core it alone passed 2 s, so that every attack, refused in

@@ -58,7 +58,7 @@ def _known(exc: Exception) -> bool:
     `converters.errors` is imported only here, on the error path (~14 ms a command saves).
     """
     from twin_cli.errors import TwinError
-    from twin_cli.output_files import OutputFileError
+    from twin_cli.files.output_files import OutputFileError
 
     if isinstance(exc, TwinError | OutputFileError):
         return True

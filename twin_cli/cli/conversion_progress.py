@@ -1,7 +1,7 @@
 """What a long conversion is doing, on a terminal: a rich status line with the stage and time.
 
-A 2-million-triangle mesh took minutes with nothing on the screen. The converter names each
-stage (`converters.stages.stage`: "reading mesh …/base.obj (96.0 MB)", "preparing 7 collision
+A 2-million-triangle mesh took minutes with nothing on the screen. The converter names each stage
+(`converters.isolated.stages.stage`: "reading mesh …/base.obj (96.0 MB)", "preparing 7 collision
 meshes"); `twin convert` hears them in its own process, `twin spawn` asks the world for its
 running conversions (`GET /conversions`) while its request waits. The line appears only after
 SHOW_AFTER_S, so a quick spawn prints nothing, and only when stderr is a terminal: piped or
@@ -83,7 +83,7 @@ class LocalProgress:
     """`twin convert`: the stages of the conversion running in this process."""
 
     def __enter__(self) -> LocalProgress:
-        from converters.stages import listening
+        from converters.isolated.stages import listening
 
         self.display = StageDisplay()
         self._listening = listening(self.display.show)

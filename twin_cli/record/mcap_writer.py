@@ -28,7 +28,7 @@ from typing import Any
 import yaml
 
 from twin_cli.errors import RequestError
-from twin_cli.output_files import PRIVATE
+from twin_cli.files.output_files import PRIVATE
 from twin_cli.record import messages as ros
 from twin_cli.record.qos import Qos, qos_of
 from twin_cli.record.topics import Message, Topic

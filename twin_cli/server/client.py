@@ -16,7 +16,7 @@ from typing import Any
 
 from twin_cli import errors as twin_errors
 from twin_cli.errors import NoReplyError, NotRunningError, RequestError
-from twin_cli.package_env import package_env
+from twin_cli.files.package_env import package_env
 from twin_cli.server import runtime
 from twin_cli.server.transport import NOT_ANSWERING, Http, path_segment
 from twin_cli.spawn_request import SpawnRequest, as_request, body_key
@@ -235,7 +235,7 @@ class Client:
         """Spawn the request's file or text as `name` at `pose` (the server's reply).
 
         Paths are made absolute here (the server has its own working directory), and this
-        process's package search variables go along (`twin_cli.package_env`).
+        process's package search variables go along (`twin_cli.files.package_env`).
         """
         body = {**self._request_body(request), "name": name, "pose": pose or {}}
         label = name or as_request(request).label

@@ -43,7 +43,7 @@ def conversions() -> list[dict]:
     the stage the conversion is in, and how long it has run [s, wall]."""
     import time
 
-    from converters import bounded
+    from converters.isolated import bounded
 
     now = time.monotonic()
     return [

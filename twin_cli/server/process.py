@@ -272,11 +272,11 @@ def serve(opts: ServeOptions) -> None:
 def _end_conversions_on_exit(server: Any) -> None:
     """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every conversion
     still running: the requests waiting on them end, and the process with them. Conversions
-    are bounded from now on (`converters.bounded.enable`): their fork server starts now, so
+    are bounded from now on (`converters.isolated.bounded.enable`): their fork server starts now, so
     that the first spawn finds it warm."""
     import threading
 
-    from converters import bounded
+    from converters.isolated import bounded
     from converters.urdf.xacro_worker import stop_all
 
     try:

@@ -75,7 +75,7 @@ PICTURE_MODE = 0o644  # a picture holds no world state, unlike a save (0600)
 def snapshot(body: SnapshotBody, world: WorldDep) -> dict:
     """Render the world offscreen into a PNG at `path` (atomically); reply with the camera."""
     from twin_cli.errors import RequestError
-    from twin_cli.output_files import OutputFileError, checked_target, write_atomically
+    from twin_cli.files.output_files import OutputFileError, checked_target, write_atomically
     from twin_cli.view.offscreen import is_twin_png, snapshot_png
 
     try:

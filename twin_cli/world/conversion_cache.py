@@ -25,8 +25,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from converters.bounded_child import READ_EVENT
-from twin_cli.package_env import PACKAGE_ENVS
+from converters.isolated.bounded_child import READ_EVENT
+from twin_cli.files.package_env import PACKAGE_ENVS
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.values import hull_stand_ins
 

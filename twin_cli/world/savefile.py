@@ -18,9 +18,9 @@ import mujoco
 import numpy as np
 
 from converters.errors import ConversionError
-from twin_cli import input_files
 from twin_cli.errors import InvalidRequestError, TwinError, WorldFileError
-from twin_cli.output_files import OutputFileError, write_atomically
+from twin_cli.files import input_files
+from twin_cli.files.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.engine import World
@@ -86,7 +86,7 @@ def is_save(head: bytes) -> bool:
 
 
 def _write_atomically(path: Path, text: str, force: bool) -> None:
-    """Atomically, to a regular file only, 0600 (`twin_cli.output_files`)."""
+    """Atomically, to a regular file only, 0600 (`twin_cli.files.output_files`)."""
     try:
         write_atomically(path, text.encode("utf-8"), ours=is_save, force=force)
     except OutputFileError as exc:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from twin_cli import input_files
+from twin_cli.files import input_files
 from twin_cli.world.engine import World
 from twin_cli.world.pose import Pose
 from twin_cli.world.values import WorldSettings

@@ -111,8 +111,8 @@ def _load(request: SpawnRequest) -> LoadedSource:
 
 def convert_options(request: SpawnRequest) -> ConvertOptions:
     """The converter's options that the request sets."""
-    from converters.budget import XacroBudget
     from converters.collision.plan import CollisionSettings
+    from converters.isolated.budget import XacroBudget
     from converters.mjcf.builder import ConvertOptions
 
     limit = request.coacd_cpu_limit
@@ -126,7 +126,7 @@ def convert_options(request: SpawnRequest) -> ConvertOptions:
 
 
 def convert_bounded(request: SpawnRequest, *, source: str, **given: str | None) -> Conversion:
-    """The request's description converted in a bounded child process (`converters.served`):
+    """The request's description converted in a bounded child process (`converters.serving.served`):
     whatever the description holds, the world keeps stepping and answering, and a conversion
     over `TWIN_CONVERT_TIMEOUT` / `TWIN_CONVERT_MEMORY` is stopped with what it was doing.
 
@@ -134,8 +134,8 @@ def convert_bounded(request: SpawnRequest, *, source: str, **given: str | None) 
         source: the file, or a name for a text.
         given: `path=` a file, or `text=` and `base_dir=` a description sent as text.
     """
-    from converters.budget import XacroBudget
-    from converters.served import ConversionJob, convert_served
+    from converters.isolated.budget import XacroBudget
+    from converters.serving.served import ConversionJob, convert_served
 
     job = ConversionJob(
         source,

@@ -136,7 +136,7 @@ BESIDE = """<robot name="beside" xmlns:xacro="http://www.ros.org/wiki/xacro">
 
 
 def _bounded(path: Path):  # noqa: ANN202
-    from converters.budget import XacroBudget
+    from converters.isolated.budget import XacroBudget
     from converters.resources.packages import PackageResolver
     from converters.urdf.xacro_worker import expand_bounded
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from converters import bounded
+from converters.isolated import bounded
 from twin_cli.world import World
 from twin_cli.world.pose import Pose
 

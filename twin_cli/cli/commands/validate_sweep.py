@@ -73,7 +73,7 @@ def check_report_targets(*paths: Path | None) -> None:
     Raises:
         OutputFileError: exit 2, naming the path.
     """
-    from twin_cli.output_files import checked_target
+    from twin_cli.files.output_files import checked_target
 
     for path in paths:
         if path is not None:
@@ -82,8 +82,8 @@ def check_report_targets(*paths: Path | None) -> None:
 
 
 def write_report(path: Path, text: str) -> None:
-    """Atomically, to a regular file only (`twin_cli.output_files`), readable by others."""
-    from twin_cli.output_files import REPORT, write_atomically
+    """Atomically, to a regular file only (`twin_cli.files.output_files`), readable by others."""
+    from twin_cli.files.output_files import REPORT, write_atomically
 
     write_atomically(path, text.encode("utf-8"), REPORT)
 

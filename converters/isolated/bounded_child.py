@@ -1,4 +1,4 @@
-"""The child side of a bounded conversion (`converters.bounded`): what runs after the fork.
+"""The child side of a bounded conversion (`converters.isolated.bounded`): what runs after the fork.
 
 It takes the caller's environment and folder (the fork server's are from its own start), limits
 its address space, records the files it reads, runs the work and sends one message: the result
@@ -18,8 +18,8 @@ from collections.abc import Callable
 from types import MappingProxyType
 from typing import Any
 
-from converters import stages
 from converters.errors import ConversionError
+from converters.isolated import stages
 
 READ_EVENT = "converters.read"
 SLACK_S = 2.0  # [s] a child outlives its time budget by at most this much, caller or not

@@ -1,10 +1,10 @@
 """A conversion a running world asks for: read in a bounded child, built again in the caller.
 
-The child (`converters.bounded`) does everything that touches the description's files or could
-run away on them: xacro (in its own sandboxed grandchild), URDF/SDF parsing, mesh reading,
-collision hulls and CoACD, and the build. It sends back the robot description, the report and
-the log of what it read (`converters.replay`); the caller builds the MjSpec from those without
-opening a file (< 0.1 s for a corpus robot), since an MjSpec itself cannot cross processes
+The child (`converters.isolated.bounded`) does everything that touches the description's files or
+could run away on them: xacro (in its own sandboxed grandchild), URDF/SDF parsing, mesh reading,
+collision hulls and CoACD, and the build. It sends back the robot description, the report and the
+log of what it read (`converters.isolated.replay`); the caller builds the MjSpec from those
+without opening a file (< 0.1 s for a corpus robot), since an MjSpec itself cannot cross processes
 without losing precision.
 """
 
@@ -15,8 +15,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from converters import bounded, replay
-from converters.budget import XacroBudget
+from converters.isolated import bounded, replay
+from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
 from converters.pipeline import Conversion, build_description, convert_full, convert_text
 from converters.report import Report

@@ -28,17 +28,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from converters import bounded_child, stages
-from converters.bounded_child import READ_EVENT
-from converters.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 from converters.errors import (
     ConversionBudgetError,
     ConversionStoppedError,
     rebuilt_error,
 )
+from converters.isolated import bounded_child, stages
+from converters.isolated.bounded_child import READ_EVENT
+from converters.isolated.budget import MEMORY_ENV, TIMEOUT_ENV, XacroBudget
 
 # What the fork server imports once, so that a conversion's child starts warm.
-PRELOAD = ["mujoco", "converters.warm"]
+PRELOAD = ["mujoco", "converters.serving.warm"]
 POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
 
 
@@ -54,7 +54,7 @@ class Running:
 
     @property
     def stage(self) -> str:
-        """The stage the child said last (`converters.stages`)."""
+        """The stage the child said last (`converters.isolated.stages`)."""
         return stages.read(self.board)
 
 

@@ -13,8 +13,8 @@ DEFAULT_MEMORY_MIB = 4096  # [MiB] address space (mostly the interpreter's own m
 
 @dataclass(frozen=True)
 class XacroBudget:
-    """How long [s] and how much address space [MiB] one served conversion (`converters.bounded`)
-    and, within it, its xacro expansion may take."""
+    """How long [s] and how much address space [MiB] one served conversion
+    (`converters.isolated.bounded`) and, within it, its xacro expansion may take."""
 
     timeout_s: float = DEFAULT_TIMEOUT_S
     memory_mib: int = DEFAULT_MEMORY_MIB

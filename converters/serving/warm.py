@@ -1,5 +1,6 @@
-"""Imported once by the fork server of bounded conversions (`converters.bounded`): the modules
-a conversion uses and the values it computes once per process, so that every child starts warm.
+"""Imported once by the fork server of bounded conversions (`converters.isolated.bounded`): the
+modules a conversion uses and the values it computes once per process, so that every child starts
+warm.
 
 Measured: a child that imported these itself spent ~0.1-0.3 s more on a corpus robot than the
 same conversion in a warm process.
@@ -16,7 +17,7 @@ import converters.gazebo.sensor_sites
 import converters.mjcf.heightfields
 import converters.mjcf.passive_motors
 import converters.sdf
-import converters.served
+import converters.serving.served
 import converters.urdf.xacro_worker
 from converters.resources import mesh_store
 

@@ -1,10 +1,10 @@
 """What a conversion is doing now (a step and its file), for progress and for budget messages.
 
-The converter names its stages with `stage` ("reading mesh …/base.obj (96.0 MB)", "expanding
-xacro …", "preparing 7 collision meshes"). In a bounded child (`converters.bounded`) each goes
-to a buffer shared with the caller, which names the last one when the budget runs out and
-serves it as progress; in any process it also goes to a `listening` callback (a CLI's display).
-The converter itself never writes to a stream.
+The converter names its stages with `stage` ("reading mesh …/base.obj (96.0 MB)", "expanding xacro
+…", "preparing 7 collision meshes"). In a bounded child (`converters.isolated.bounded`) each goes
+to a buffer shared with the caller, which names the last one when the budget runs out and serves
+it as progress; in any process it also goes to a `listening` callback (a CLI's display). The
+converter itself never writes to a stream.
 """
 
 from __future__ import annotations
