@@ -20,6 +20,7 @@ from converters.mjcf.world_options import INTEGRATORS, SOLVERS
 from twin_cli.errors import SpawnError
 from twin_cli.world.engine import World
 from twin_cli.world.pose import vec3
+from twin_cli.world.spawn import MUJOCO_DEFAULT_NAME
 from twin_cli.world.values import WorldSettings
 
 MJCF_SUFFIXES = (".xml", ".mjcf")
@@ -67,10 +68,11 @@ def _named(names: Mapping[str, SupportsInt], value: SupportsInt) -> str:
 
 
 def _entity_name(model: str, path: Path) -> str:
-    """The model's name when it follows twin's name rule, else the file's stem."""
+    """The model's name when it has one of its own that follows twin's name rule, else the
+    file's stem (MuJoCo names a model without `model=` "MuJoCo Model")."""
     from twin_cli.names import name_problem
 
-    if model and name_problem(model) is None:
+    if model and model != MUJOCO_DEFAULT_NAME and name_problem(model) is None:
         return model
     stem = path.name.split(".")[0]
     return stem if name_problem(stem) is None else "scene"

@@ -85,12 +85,20 @@ def load_source(request: SpawnRequest) -> LoadedSource:
     return loaded
 
 
+MUJOCO_DEFAULT_NAME = "MuJoCo Model"  # MjSpec.modelname of a <mujoco> without `model=`
+
+
+def own_name(spec: mujoco.MjSpec) -> str:
+    """The model's own name, "" when MJCF gave none (MuJoCo's default is not the model's)."""
+    return "" if spec.modelname == MUJOCO_DEFAULT_NAME else spec.modelname
+
+
 def _load(request: SpawnRequest) -> LoadedSource:
     if request.xml is not None:
         return _load_text(request)
     if isinstance(request.source, mujoco.MjSpec):
         spec = request.source.copy()
-        return LoadedSource(spec, "<MjSpec>", None, xml_or_none(spec), spec.modelname or "model")
+        return LoadedSource(spec, "<MjSpec>", None, xml_or_none(spec), own_name(spec) or "model")
     if request.source is None:
         raise SpawnError("model", "<none>", "no source", "give a file or the description text")
     path = Path(request.source).expanduser().resolve()
@@ -175,7 +183,7 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
             spec = mujoco.MjSpec.from_string(text)
         except ValueError as exc:
             raise SpawnError(label, label, f"not valid MJCF ({exc})", "fix it") from exc
-        return LoadedSource(spec, label, None, text, spec.modelname or "model")
+        return LoadedSource(spec, label, None, text, own_name(spec) or "model")
     base_dir = str(request.base_dir) if request.base_dir is not None else None
     done = convert_bounded(request, source=label, text=text, base_dir=base_dir)
     name = done.report.robot or "model"
@@ -198,7 +206,7 @@ def _load_mjcf(path: Path) -> LoadedSource:
         raise SpawnError(path.stem, str(path), f"not valid MJCF ({exc})", "fix the file") from exc
     note = strip_scene(spec, path.name)
     notes = (note,) if note else ()
-    return LoadedSource(spec, str(path), None, None, spec.modelname or path.stem, notes=notes)
+    return LoadedSource(spec, str(path), None, None, own_name(spec) or path.stem, notes=notes)
 
 
 def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
@@ -235,7 +243,7 @@ def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
     done = convert_bounded(request, source=str(path), path=str(path))
     spec, report = done.spec, done.report
     servos.carry_exported_servos(spec)  # cached with its servos: a later spawn pays nothing
-    name = report.robot or spec.modelname or path.name.split(".")[0]
+    name = report.robot or own_name(spec) or path.name.split(".")[0]
     description = _urdf_or_none(done.description.text)
     return LoadedSource(
         spec,

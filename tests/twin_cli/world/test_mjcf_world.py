@@ -83,3 +83,27 @@ def test_twin_serve_takes_a_scene(scene: Path, tmp_path: Path, serve_world) -> N
         assert twin("physics")["timestep"] == 0.002
         assert twin("gravity")["gravity"] == [0.0, 0.0, -MOON_G]
         assert [e["name"] for e in twin("list")] == ["moon_scene"]
+
+
+@pytest.mark.parametrize(
+    ("attribute", "expected"),
+    [("", "plain_box"), (' model="crate"', "crate"), (' model="a b"', "a b")],
+)
+def test_a_spawned_mjcf_is_named_by_its_own_model_name_else_its_file(
+    tmp_path: Path, attribute: str, expected: str
+) -> None:
+    """MuJoCo calls a model without `model=` "MuJoCo Model": that is not the model's name, so
+    the entity takes the file's (or, from text, "model")."""
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    text = (
+        f"<mujoco{attribute}><worldbody><body><freejoint/><geom type='box' size='.1 .1 .1'/>"
+        "</body></worldbody></mujoco>"
+    )
+    path = tmp_path / "plain_box.xml"
+    path.write_text(text)
+    world = World()
+    assert world.spawn(SpawnRequest(str(path))).name == expected
+    named = world.spawn(SpawnRequest(xml=text)).name
+    assert named == (expected + "_1" if attribute else "model"), named
