@@ -23,7 +23,7 @@ BLOB_REASONS = {
     "light": "lights attached to links are not converted",
     "projector": "projectors are not converted",
     "enable_wind": "twin has no wind",
-    "allow_auto_disable": "twin never puts resting bodies to sleep",
+    "allow_auto_disable": "sleeping is set for the whole world (twin physics --sleep)",
 }
 
 

@@ -1,7 +1,7 @@
 """URDF as XML, checked before any reader trusts it: well-formed, numbers parse, one tree.
 
 Every failure names the file and the element (link, joint, attribute) and says how to fix it,
-so a hand-edited file never reaches yourdfpy or the builder with a value they would choke on.
+so a hand-edited file never reaches the reader or the builder with a value they would choke on.
 """
 
 from __future__ import annotations
