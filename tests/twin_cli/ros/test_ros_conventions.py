@@ -21,6 +21,7 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
+from ros_cli import ros_env, script_json, twin_ok
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
 pytestmark = pytest.mark.xdist_group("ros_live")
@@ -77,19 +78,11 @@ PLUGIN = (
 
 
 def _env(runtime: Path) -> dict[str, str]:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime), "ROS_DOMAIN_ID": DOMAIN_ID}
-    for name in ("TWIN_WORLD", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS"):
-        env.pop(name, None)
-    return env
+    return ros_env(runtime, DOMAIN_ID)
 
 
 def _twin(runtime: Path, *args: str) -> str:
-    proc = subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, DOMAIN_ID, WORLD, *args)
 
 
 def _listen(runtime: Path, seconds: float) -> subprocess.Popen:
@@ -198,12 +191,7 @@ def test_a_late_transient_local_reader_gets_every_static_frame(served) -> None:
 
 
 def _peer(runtime: Path, *args: str) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(PEER), *args],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"ros_peer {' '.join(args)}: {proc.stderr[-2000:]}"
-    return json.loads(proc.stdout)
+    return script_json(PEER, runtime, DOMAIN_ID, *args)
 
 
 def _x(runtime: Path, entity: str) -> float:

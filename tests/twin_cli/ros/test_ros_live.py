@@ -22,6 +22,7 @@ import drive_models as dm
 import numpy as np
 import pytest
 from models import CONTROL_RIG
+from ros_cli import ros_env, script_json, twin_ok
 from sensor_models import lidar_post
 from sock_diag import sockets_of
 
@@ -46,28 +47,15 @@ DIFF = (
 
 
 def _env(runtime: Path) -> dict[str, str]:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime), "ROS_DOMAIN_ID": DOMAIN_ID}
-    for name in ("TWIN_WORLD", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS"):
-        env.pop(name, None)
-    return env
+    return ros_env(runtime, DOMAIN_ID)
 
 
 def _twin(runtime: Path, *args: str) -> str:
-    proc = subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, DOMAIN_ID, WORLD, *args)
 
 
 def _peer(runtime: Path, *args: str) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(PEER), *args],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"ros_peer {' '.join(args)}: {proc.stderr[-2000:]}"
-    return json.loads(proc.stdout)
+    return script_json(PEER, runtime, DOMAIN_ID, *args)
 
 
 @pytest.fixture(scope="module")

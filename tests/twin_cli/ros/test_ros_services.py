@@ -14,11 +14,10 @@ from __future__ import annotations
 import json
 import math
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from ros_cli import ros_env, script_json, twin_ok
 
 pytest.importorskip("cyclonedds", reason="cyclonedds is not installed (CI installs it)")
 pytestmark = pytest.mark.xdist_group("ros_services")
@@ -41,28 +40,15 @@ URDF = (
 
 
 def _env(runtime: Path) -> dict[str, str]:
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(runtime), "ROS_DOMAIN_ID": DOMAIN_ID}
-    for name in ("TWIN_WORLD", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS"):
-        env.pop(name, None)
-    return env
+    return ros_env(runtime, DOMAIN_ID)
 
 
 def _twin(runtime: Path, *args: str) -> str:
-    proc = subprocess.run(
-        [sys.executable, "-m", "twin_cli", *args, "--world", WORLD],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"twin {' '.join(args)}: {proc.returncode} {proc.stderr}"
-    return proc.stdout
+    return twin_ok(runtime, DOMAIN_ID, WORLD, *args)
 
 
 def _call(runtime: Path, service: str, kind: str, fields: dict) -> dict:
-    proc = subprocess.run(
-        [sys.executable, str(PEER), service, kind, json.dumps(fields)],
-        env=_env(runtime), capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
-    assert proc.returncode == 0, f"service_peer {service}: {proc.stderr[-2000:]}"
-    reply = json.loads(proc.stdout)
+    reply = script_json(PEER, runtime, DOMAIN_ID, service, kind, json.dumps(fields))
     assert reply["header"] == [0x5EED_0000_0000_0002, 11], f"{service}: {reply}"
     return reply["reply"]
 
