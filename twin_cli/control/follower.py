@@ -145,9 +145,6 @@ class TrajectoryFollower:
         """
         import numpy as np
 
-        from twin_cli.world.servos import follow
-        from twin_cli.world.sleeping import wake_actuated
-
         world = self.world
         if self._model is not world.model:
             self._model = world.model
@@ -157,8 +154,7 @@ class TrajectoryFollower:
             gear[gear == 0] = 1.0
             self._kv = np.array([c.kv for c in commands]) / gear
         bias = self._kv * speeds
-        follow(world.model, world.data, self._ids, (reference, positions, self._period), bias)
-        wake_actuated(world.model, world.data, self._ids)  # a sleeping robot follows too
+        world.follow_references(self._ids, (reference, positions, self._period), bias)
         self._last = (positions, speeds)
 
     def _halt(self) -> dict[str, tuple[float, float]]:
@@ -177,8 +173,7 @@ class TrajectoryFollower:
             target = float(positions[i])
             if servos.has_reference(world.model, a):
                 target = float(world.data.act[world.model.actuator_actadr[a]])
-            world.data.ctrl[a] = 0.0 if servos.has_reference(world.model, a) else target
-            world.model.actuator_biasprm[a, 0] = 0.0
+            world.hold_servo(a, 0.0 if servos.has_reference(world.model, a) else target)
             targets[key] = (target, 0.0)
         return targets
 

@@ -18,7 +18,6 @@ import mujoco
 from converters.gazebo.drive_motors import planar_actuator
 from twin_cli.control.drive_base import DriveController
 from twin_cli.control.kinematics import ramp
-from twin_cli.world.sleeping import wake_actuated
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import HolonomicDrive
@@ -51,7 +50,7 @@ class HolonomicController(DriveController):
         goals = self.goals()
         limits = (LINEAR_RAMP, LINEAR_RAMP, ANGULAR_RAMP)
         now = tuple(ramp(c, g, a, dt) for c, g, a in zip(self.current, goals, limits, strict=True))
-        m, d = self.world.model, self.world.data
+        m = self.world.model
         name = self.plugin.name
         ids = [
             mujoco.mj_name2id(
@@ -62,9 +61,7 @@ class HolonomicController(DriveController):
         if any(a < 0 for a in ids):
             return  # a hand-written model without the servos: nothing to drive
         if force or now != self.current:
-            wake_actuated(m, d, ids)
-            for a, value in zip(ids, now, strict=True):
-                d.ctrl[a] = value
+            self.world.set_controls(ids, now)
             self.current = now  # type: ignore[assignment]
         self._written = dict(self.world.commands())
 

@@ -362,3 +362,41 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
 
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
+
+
+def set_controls(state: WorldState, actuators: Sequence[int], values: Sequence[float]) -> None:
+    """Writes actuators' ctrl (a plugin's update: a planar drive's twist), waking the trees
+    they move."""
+    with state.lock:
+        sleeping.wake_actuated(state.model, state.data, actuators)
+        for a, value in zip(actuators, values, strict=True):
+            state.data.ctrl[a] = value
+
+
+def set_joint_forces(state: WorldState, dofs: Sequence[int], forces: Sequence[float]) -> None:
+    """Applies generalised forces [N or N m] on dofs until changed (`qfrc_applied`)."""
+    with state.lock:
+        for dof, force in zip(dofs, forces, strict=True):
+            state.data.qfrc_applied[dof] = force
+
+
+def follow_references(
+    state: WorldState,
+    actuators: Sequence[int],
+    references: tuple,
+    bias: Sequence[float],
+) -> None:
+    """One trajectory controller update of position servos (`servos.follow`), waking them."""
+    import numpy as np
+
+    ids = np.asarray(actuators)
+    with state.lock:
+        servos.follow(state.model, state.data, ids, references, np.asarray(bias))
+        sleeping.wake_actuated(state.model, state.data, ids)
+
+
+def hold_servo(state: WorldState, actuator: int, ctrl: float) -> None:
+    """Stops a position servo where it is: `ctrl` and no speed feed-forward (bias constant)."""
+    with state.lock:
+        state.data.ctrl[actuator] = ctrl
+        state.model.actuator_biasprm[actuator, 0] = 0.0

@@ -236,6 +236,32 @@ class World:
         """A world-frame force [N] and torque [N m] on a link for `duration` [s] of sim time."""
         driving.push(self._state, name, force, torque, link=link, duration=duration)
 
+    def set_controls(self, actuators: Sequence[int], values: Sequence[float]) -> None:
+        """Writes actuators' ctrl, waking what they move (`driving.set_controls`)."""
+        driving.set_controls(self._state, actuators, values)
+
+    def set_joint_forces(self, dofs: Sequence[int], forces: Sequence[float]) -> None:
+        """Generalised forces on dofs until changed (`driving.set_joint_forces`)."""
+        driving.set_joint_forces(self._state, dofs, forces)
+
+    def follow_references(
+        self, actuators: Sequence[int], references: tuple, bias: Sequence[float]
+    ) -> None:
+        """One trajectory update of position servos (`driving.follow_references`)."""
+        driving.follow_references(self._state, actuators, references, bias)
+
+    def hold_servo(self, actuator: int, ctrl: float) -> None:
+        """Stops a position servo at `ctrl` without feed-forward (`driving.hold_servo`)."""
+        driving.hold_servo(self._state, actuator, ctrl)
+
+    def energy(self) -> float:
+        """Total mechanical energy now [J], MuJoCo's energy computation switched on for it."""
+        state = self._state
+        with self.lock:
+            state.model.opt.enableflags |= int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+            mujoco.mj_forward(state.model, state.data)
+            return float(state.data.energy[0] + state.data.energy[1])
+
     def perturb(self, wrenches: dict[str, Sequence[float]]) -> None:
         """Sets a viewer's mouse drag: world-frame wrench [N, N m] per full body name."""
         driving.perturb(self._state, wrenches)

@@ -286,9 +286,7 @@ class ScenarioRun:
 
     def _apply_joint_forces(self) -> None:
         tau = self.joint_torques()
-        with self.world.lock:
-            for value, joint in zip(tau, self.joints, strict=True):
-                self.world.data.qfrc_applied[joint.dof] = value
+        self.world.set_joint_forces([j.dof for j in self.joints], list(tau))
 
     def close(self) -> None:
         """Release the world (no thread runs; nothing else to free)."""
