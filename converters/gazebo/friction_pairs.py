@@ -186,7 +186,7 @@ def add_friction_pairs(spec: mujoco.MjSpec) -> int:
     for element in list(spec.pairs) + list(spec.excludes):
         if PAIR_MARK in element.name:
             spec.delete(element)
-    excludes, pairs = plan_pairs(spec, list(spec.worldbody.geoms), spec.worldbody.name)
+    excludes, pairs = plan_pairs(spec, static_bodies(spec))
     for exclude in excludes:
         spec.add_exclude(name=exclude.name, bodyname1=exclude.body1, bodyname2=exclude.body2)
     for plan in pairs:
@@ -207,8 +207,7 @@ def contact_xml(robot: mujoco.MjSpec, world_geoms: list[mujoco.MjsGeom]) -> str:
         robot: the exported robot spec (unprefixed names, as its file has them).
         world_geoms: the scene's world-body geoms, in the scene's order (the ground).
     """
-    world_geoms = world_geoms + list(robot.worldbody.geoms)
-    excludes, pairs = plan_pairs(robot, world_geoms, "world")
+    excludes, pairs = plan_pairs(robot, static_bodies(robot), world_geoms, world="world")
     if not pairs:
         return ""
     lines = [
@@ -228,26 +227,56 @@ def _numbers(values: Iterable[float]) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
+def static_bodies(spec: mujoco.MjSpec) -> list[mujoco.MjsBody]:
+    """The world body and every body welded to it (no joint on the way up, not mocap): a
+    static SDF model's links, a fixed-base robot's root. MuJoCo moves none of them, so their
+    geoms are the world's for contact."""
+    out = [spec.worldbody]
+    for body in spec.worldbody.find_all("body"):
+        chain, welded = body, True
+        while chain is not None and chain.name != spec.worldbody.name:
+            if chain.mocap or any(True for _ in chain.joints):
+                welded = False
+                break
+            chain = chain.parent
+        if welded:
+            out.append(body)
+    return out
+
+
 def plan_pairs(
-    spec: mujoco.MjSpec, world_geoms: list[mujoco.MjsGeom], world_body: str
+    spec: mujoco.MjSpec,
+    statics: list[mujoco.MjsBody],
+    scene_geoms: list[mujoco.MjsGeom] | None = None,
+    world: str | None = None,
 ) -> tuple[list[ExcludePlan], list[PairPlan]]:
-    """The excludes and pairs for every marked geom of `spec` against `world_geoms`.
+    """The excludes and pairs for every marked geom of `spec` against the static geoms: those of
+    the world body and of the bodies welded to it, but not the marked body's own entity's (its
+    self-collision stays its own rule's).
 
     Args:
         spec: the spec holding the marks and the marked geoms' bodies.
-        world_geoms: the geoms of the world body, in order; world_body: its name.
+        statics: `static_bodies(spec)`, the world body first. scene_geoms: geoms a scene file
+            adds to the world body before the spec's (the ground). world: the world body's
+            name in the file the plans are written to (default: the spec's).
     """
     marked = list(_marked(spec))
     excludes: list[ExcludePlan] = []
     pairs: list[PairPlan] = []
     done: set[str] = set()
+    static_names = {b.name for b in statics}
     for prefix, geom, _ in marked:
         body = geom.parent
-        if body.name in (world_body, spec.worldbody.name) or body.name in done:
-            continue
+        if body.name in static_names or body.name in done:
+            continue  # a static body's contacts with the world are no contacts at all
         done.add(body.name)
         mus = {g.name: m for _, g, m in marked if g.parent.name == body.name}
-        excludes.append(ExcludePlan(f"{prefix}{PAIR_MARK}{body.name}", world_body, body.name))
+        others = [statics[0]] + [b for b in statics[1:] if prefix and not b.name.startswith(prefix)]
+        world_geoms = list(scene_geoms or []) + [g for b in others for g in b.geoms]
+        for i, static in enumerate(others):
+            other = (world or static.name) if i == 0 else static.name
+            tag = "" if i == 0 else f"@{static.name}"
+            excludes.append(ExcludePlan(f"{prefix}{PAIR_MARK}{body.name}{tag}", other, body.name))
         for own, source in _contact_geoms(spec, body):
             for other in _colliding(world_geoms):
                 if _filtered(source, other):

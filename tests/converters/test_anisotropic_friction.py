@@ -275,3 +275,61 @@ def test_fdir1_along_the_axle_gives_the_ground_to_a_capsule_on_the_axle(tmp_path
     axle = data.geom_xmat[capsule.id].reshape(3, 3)[:, 2]
     row1 = contacts[0].frame[3:6]
     assert abs(float(np.dot(row1, axle))) > 0.999, f"row 1 {row1}, axle {axle}"
+
+
+GROUND_MODEL = """<sdf version="1.9"><model name="ground_plane"><static>true</static>
+<link name="link"><collision name="c"><geometry><box><size>20 20 0.1</size></box></geometry>
+<surface><friction><ode><mu>1.0</mu><mu2>1.0</mu2></ode></friction></surface></collision>
+</link></model></sdf>"""
+
+
+@pytest.mark.parametrize(("mu1", "mu2"), [(1.0, 0.3), (0.3, 1.0)])
+def test_a_static_ground_model_is_the_worlds_ground_for_both_directions(
+    tmp_path: Path, mu1: float, mu2: float
+):
+    """Gazebo worlds bring their ground as a static model (a body welded to the world, not a
+    world-body geom): the plate slides along its low μ there too and holds along the high."""
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import WorldSettings
+
+    path = tmp_path / "plate.urdf"
+    path.write_text(plate(mu1, mu2))
+    low_axis = 0 if mu2 < mu1 else 1
+    tan_theta = 1.3 * min(mu1, mu2)
+    results = []
+    for axis in (low_axis, 1 - low_axis):
+        world = World(WorldSettings(ground=False))
+        world.spawn(SpawnRequest(xml=GROUND_MODEL), name="ground_plane", pose=Pose(z=-0.05))
+        world.spawn(path, name="plate", pose=Pose(z=0.01))
+        world.step(200)
+        theta = math.atan(tan_theta)
+        g = abs(float(world.model.opt.gravity[2]))
+        gravity = [0.0, 0.0, -g * math.cos(theta)]
+        gravity[axis] = g * math.sin(theta)
+        world.set_gravity(tuple(gravity))
+        world.step(300)
+        start, v0 = world.get_pose("plate"), float(world.data.qvel[axis])
+        world.step(round(SLIDE_S / world.model.opt.timestep))
+        end = world.get_pose("plate")
+        moved = (end.x - start.x, end.y - start.y)[axis]
+        results.append((moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2))
+        law = g * (math.sin(theta) - min(mu1, mu2) * math.cos(theta))
+    (_, a), (held, _) = results
+    assert a == pytest.approx(law, rel=SLIDE_LAW), f"a {a:.4f} m/s², Coulomb {law:.4f}"
+    assert abs(held) < HOLD_M, f"along the high μ it moved {held * 1e3:.3f} mm"
+
+
+def test_a_plate_welded_to_the_world_makes_no_contact_with_the_ground(tmp_path: Path):
+    """A fixed-base link with mu1 ≠ mu2 resting on the ground: MuJoCo makes no contact between
+    two bodies that cannot move, and no pair may bring one back."""
+    fixed = plate(1.0, 0.3).replace(
+        '<robot name="plate">',
+        '<robot name="plate"><link name="world"/><joint name="fix" type="fixed">'
+        '<parent link="world"/><child link="plate"/></joint>',
+    )
+    path = tmp_path / "fixed.urdf"
+    path.write_text(fixed)
+    world = World()
+    world.spawn(path, name="plate", pose=Pose(z=0.005))  # its lower half in the ground
+    world.step(10)
+    assert world.data.ncon == 0, f"{world.data.ncon} contacts between static bodies"

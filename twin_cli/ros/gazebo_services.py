@@ -8,8 +8,8 @@
 - `/delete_entity`, `/get_model_list`: remove one entity; the entities' names, stamped.
 - `/get_entity_state`, `/set_entity_state` (gazebo_ros_state's): an entity's root pose and twist
   in `reference_frame`, as gazebo_ros_state gives them: the pose relative to that entity's root,
-  the velocities' differences turned into its frame. Links (`model::link`) are refused, naming
-  the entity to ask for.
+  the velocities' differences turned into its frame (a twist is ignored on an entity fixed to
+  the world, as Gazebo ignores it). Links (`model::link`) are refused, naming the entity.
 - `/pause_physics`, `/unpause_physics`, `/reset_simulation`, `/reset_world` (std_srvs/Empty,
   gazebo_ros_init's): `twin pause`, `twin resume` and `twin reset`. twin's reset also returns
   sim time to 0, which Gazebo's `/reset_world` keeps.
@@ -99,13 +99,12 @@ def set_state(world: World, request: Any) -> dict[str, Any]:
         linear, angular = _twist_in_world(world, state.twist, state.reference_frame)
         moving = any(linear) or any(angular)
         with world.lock:
-            if moving and world.index_of(name).free_qpos < 0:
-                raise InvalidRequestError(
-                    f"twist of entity [{name}]", "it is fixed to the world", "send a zero twist"
-                )
+            free = world.index_of(name).free_qpos >= 0
             world.set_pose(name, pose)
-            if moving:
+            if moving and free:
                 world.set_twist(name, linear, angular)
+            elif moving:  # gazebo_ros_state sets what the entity can take
+                log.info("set_entity_state: [%s] is fixed to the world; twist ignored", name)
     except TwinError as exc:
         log.warning("set_entity_state: %s", exc)
         return {"success": False}

@@ -8,9 +8,10 @@ and `reset` act on it. Replies carry only `success`; a refused request is logged
   as gz-sim renames), `pose` in `relative_to` ("" or "world": the world; else an entity).
 - `remove` (DeleteEntity) and `set_pose` (SetEntityPose): an Entity by name, of type MODEL (or
   NONE); ids are gz-sim's own and are refused.
-- `control` (ControlWorld, a WorldControl): `reset` (`all`/`model_only`: `twin reset`,
-  `time_only`: time only), then `pause` sets the paused state, then `step`/`multi_step` steps a
-  paused world that many times and `run_to_sim_time` steps it to that time.
+- `control` (ControlWorld, a WorldControl): a rewind (`reset.all` or `time_only`: `twin reset`,
+  the whole starting state, as gz-sim rewinds; `model_only`, which gz-sim does not support,
+  is logged and ignored), then `pause` sets the paused state, then `step`/`multi_step` steps a
+  paused world that many times; `run_to_sim_time` steps it to that time and leaves it paused.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("twin.ros")
 ENTITY_NONE, ENTITY_MODEL = 0, 2  # ros_gz_interfaces/Entity's type constants
 MAX_STEPS = 1_000_000  # steps one control request may ask for
+STEP_CHUNK = 1000  # steps taken under the world's lock at once
 
 
 def create(world: World, request: Any) -> dict[str, Any]:
@@ -67,29 +69,43 @@ def set_pose(world: World, request: Any) -> dict[str, Any]:
 
 
 def control(world: World, request: Any) -> dict[str, Any]:
-    """Reset, pause state, then stepping, in gz-sim's order; a running world is not stepped
-    (gz-sim steps only a paused one)."""
+    """gz-sim's order: a rewind (`reset.all` or `time_only`: the whole starting state, as
+    gz-sim's rewind restores it; `model_only` gz-sim does not support: logged, nothing done),
+    the paused state, then steps. A paused world steps `multi_step` (`step`: 1) at once; a
+    `run_to_sim_time` ahead of now is stepped to, and the world is left paused there (gz-sim
+    runs to it at its pace, then pauses). Checked first, so a refused request changes nothing.
+    """
     wc = request.world_control
+    with world.lock:
+        now, h = float(world.data.time), float(world.model.opt.timestep)
     target = wc.run_to_sim_time.sec + wc.run_to_sim_time.nanosec * 1e-9
-    if wc.reset.all or wc.reset.model_only:
+    rewind = bool(wc.reset.all or wc.reset.time_only)
+    start = 0.0 if rewind else now
+    steps = max(int(wc.multi_step), 1 if wc.step else 0)
+    to_target = math.ceil((target - start) / h - 1e-9) if target > start else 0
+    if max(steps, to_target) > MAX_STEPS:
+        log.warning("control: %d steps asked, at most %d", max(steps, to_target), MAX_STEPS)
+        return {"success": False}
+    if wc.reset.model_only and not rewind:
+        log.warning("control: a model-only reset is not supported (nor by gz-sim); ignored")
+    if rewind:
         world.reset()
-    elif wc.reset.time_only:
-        world.reset(time_only=True)
-    if wc.pause:
+    if to_target > 0 or wc.pause:
         world.pause()
     else:
         world.resume()
-    steps = max(int(wc.multi_step), 1 if wc.step else 0)
-    if target > 0:
-        with world.lock:
-            ahead = target - float(world.data.time)
-            steps = max(steps, math.ceil(ahead / world.model.opt.timestep - 1e-9))
-    if steps > MAX_STEPS:
-        log.warning("control: %d steps asked, at most %d", steps, MAX_STEPS)
-        return {"success": False}
-    if steps > 0 and world.paused:
-        world.step(steps)
+    if world.paused:
+        _step(world, max(steps, to_target))
     return {"success": True}
+
+
+def _step(world: World, steps: int) -> None:
+    """`steps` steps in chunks, the world's lock free between them (its server, viewers and
+    publishers keep answering)."""
+    while steps > 0:
+        chunk = min(steps, STEP_CHUNK)
+        world.step(chunk)
+        steps -= chunk
 
 
 def _source(world: World, factory: Any) -> SpawnRequest:

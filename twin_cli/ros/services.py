@@ -87,9 +87,28 @@ class ServiceServer:
                     log.exception("service %s", name)
 
     def _answer(self, name: str, request: Any) -> Any:
-        """The reply to `request`: the handler's fields, with the request's rmw header."""
+        """The reply to `request`: the handler's fields, with the request's rmw header. A
+        handler that fails unexpectedly still answers, with a failure (a client waits for it)."""
         kind, handler = self._table[name]
-        fields = handler(self._world, request)
+        try:
+            fields = handler(self._world, request)
+        except Exception as exc:
+            log.exception("service %s", name)
+            fields = failure(kind, f"{name} failed: {exc}")
         self.calls += 1
         reply = srv.service_idl(kind, srv.RESPONSE)
         return reply(guid=request.guid, seq=request.seq, **fields)
+
+
+def failure(kind: str, message: str) -> dict[str, Any]:
+    """A failure reply's fields for service type `kind`."""
+    if kind == srv.EMPTY:
+        return gazebo.EMPTY_REPLY
+    if kind in (srv.SPAWN, srv.DELETE):
+        return {"success": False, "status_message": message}
+    if kind == srv.MODEL_LIST:
+        return {"header": gazebo.header(0.0, ""), "model_names": [], "success": False}
+    if kind == srv.GET_STATE:
+        return {"header": gazebo.header(0.0, ""), "state": gazebo.entity_state("", ""),
+                "success": False}  # fmt: skip
+    return {"success": False}

@@ -196,6 +196,16 @@ def test_bad_entity_requests_fail_and_leave_the_world_as_it_was(served: Path) ->
            "frame": "world"}  # fmt: skip
     assert not _call(root, "/set_entity_state", "set_state", {"state": far})["success"]
     assert not _call(root, f"{gz}/remove", "gz_remove", {"name": "no_such"})["success"]
+    static = BOX.replace('<model name="box">', '<model name="post"><static>true</static>')
+    assert _create(root, name="post", sdf=static, pose=_pose(3, -5, 0.5))
+    spin = {"name": "post", "pose": _pose(3, -6, 0.5), "linear": [1, 0, 0], "angular": [0, 0, 1],
+            "frame": "world"}  # fmt: skip
+    assert _call(root, "/set_entity_state", "set_state", {"state": spin})["success"], (
+        "twist ignored"
+    )
+    assert _at(root, "post")["y"] == pytest.approx(-6.0, abs=TOL), "the pose is set"
+    _twin(root, "delete", "post")
+    names = _names(root)
     link = {"name": "still", "type": 3, "pose": _pose(0, 0, 9)}  # a LINK-type entity
     assert not _call(root, f"{gz}/set_pose", "gz_set_pose", link)["success"]
     assert _names(root) == names and _at(root, "still") == at, "the world changed"
@@ -222,14 +232,18 @@ def test_pause_unpause_and_resets_act_as_gazebos(served: Path) -> None:
     assert _at(root, "drop")["z"] == pytest.approx(2.0, abs=TOL), "back at its spawn pose"
     assert _control(root, pause=True, multi_step=100)
     fallen = _at(root, "drop")["z"]
-    assert _call(
-        root, f"{gz}/control", "gz_control", {"pause": True, "reset": [False, True, False]}
-    )["success"]
-    assert _sim_time(root) == 0.0 and _at(root, "drop")["z"] == fallen, "time only"
-    assert _control(root, pause=True, run_to=[0, 250_000_000])
-    assert _sim_time(root) == pytest.approx(0.25, abs=1e-9), "ran to 0.25 s"
-    assert _call(
-        root, f"{gz}/control", "gz_control", {"pause": True, "reset": [True, False, False]}
-    )["success"]
+    assert fallen < 2.0 - 1e-3 and _sim_time(root) == pytest.approx(0.1, abs=1e-9)
+    assert _control(root, pause=True, reset=[False, False, True]), "model only: ignored"
+    assert _sim_time(root) == pytest.approx(0.1, abs=1e-9) and _at(root, "drop")["z"] == fallen
+    assert _control(root, pause=True, reset=[False, True, False]), "time only: gz-sim rewinds"
     assert _sim_time(root) == 0.0 and _at(root, "drop")["z"] == pytest.approx(2.0, abs=TOL)
+    assert _control(root, pause=False, run_to=[0, 250_000_000]), "runs there, then pauses"
+    assert _sim_time(root) == pytest.approx(0.25, abs=1e-9), "paused at 0.25 s"
+    refused = {"pause": True, "reset": [True, False, False], "multi_step": 4_000_000_000}
+    assert not _call(root, f"{gz}/control", "gz_control", refused)["success"]
+    assert _sim_time(root) == pytest.approx(0.25, abs=1e-9), "a refused request reset nothing"
+    assert _control(root, pause=True, reset=[True, False, False])
+    assert _sim_time(root) == 0.0 and _at(root, "drop")["z"] == pytest.approx(2.0, abs=TOL)
+    missing = {"name": "gone", "sdf_filename": "/no/such/model.sdf", "pose": _pose(0, 0, 1)}
+    assert not _create(root, **missing), "a file that is not there"
     _twin(root, "delete", "drop")
