@@ -35,7 +35,7 @@ def script_json(script: Path, runtime: Path, domain: str, *args: str) -> dict:
     """A peer script's JSON document on stdout; fails the test on a non-zero exit."""
     proc = subprocess.run(
         [sys.executable, str(script), *args],
-        env=ros_env(runtime, domain), capture_output=True, text=True, timeout=120,
+        env=ros_env(runtime, domain), capture_output=True, text=True, timeout=180,
     )  # fmt: skip
     assert proc.returncode == 0, f"{script.name} {' '.join(args)}: {proc.stderr[-2000:]}"
     return json.loads(proc.stdout)

@@ -40,6 +40,8 @@ from ros_peer import (
 )
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+MATCH_S = 60.0  # [s] wall for discovery to match both topics (a loaded runner is slow)
+REPLY_S = 60.0  # [s] wall for the reply after that
 CLIENT_GUID = 0x5EED_0000_0000_0002
 SEQUENCE = 11
 
@@ -266,14 +268,15 @@ def call(service: str, kind: str, fields: dict) -> dict:
     name = service.lstrip("/")
     writer = DataWriter(dp, Topic(dp, f"rq/{name}Request", request_type, qos=qos()), qos=qos())
     reader = DataReader(dp, Topic(dp, f"rr/{name}Reply", reply_type, qos=qos()), qos=qos())
-    deadline = time.monotonic() + 10.0
+    deadline = time.monotonic() + MATCH_S
     while time.monotonic() < deadline and not (
         writer.get_matched_subscriptions() and reader.get_matched_publications()
     ):
         time.sleep(0.05)
+    matched = bool(writer.get_matched_subscriptions() and reader.get_matched_publications())
     writer.write(_request(kind, fields))
     mask = SampleState.Any | ViewState.Any | InstanceState.Any
-    while time.monotonic() < deadline + 30.0:
+    while time.monotonic() < deadline + REPLY_S:
         for cdr, info in ddspy_take(reader._ref, mask, 16):
             if not info.valid_data:
                 continue
@@ -282,7 +285,7 @@ def call(service: str, kind: str, fields: dict) -> dict:
                 reply = store.deserialize_cdr(cdr[:4] + cdr[20:], reply_name)
                 return {"reply": to_plain(reply), "header": [guid, seq]}
         time.sleep(0.02)
-    return {"reply": None}
+    return {"reply": None, "matched": matched}
 
 
 if __name__ == "__main__":

@@ -49,7 +49,7 @@ def _twin(runtime: Path, *args: str) -> str:
 
 def _call(runtime: Path, service: str, kind: str, fields: dict) -> dict:
     reply = script_json(PEER, runtime, DOMAIN_ID, service, kind, json.dumps(fields))
-    assert reply["header"] == [0x5EED_0000_0000_0002, 11], f"{service}: {reply}"
+    assert reply.get("header") == [0x5EED_0000_0000_0002, 11], f"{service}: {reply}"
     return reply["reply"]
 
 
