@@ -33,12 +33,25 @@ def plate(mu1: float, mu2: float | None, fdir1: str | None = None) -> str:
 <gazebo reference="plate"><mu1>{mu1}</mu1>{second}{extra}</gazebo></robot>"""
 
 
-def _slide(tmp_path: Path, mu1: float, mu2: float | None, axis: int, tan_theta: float):
+def _slide(
+    tmp_path: Path,
+    mu1: float,
+    mu2: float | None,
+    axis: int,
+    tan_theta: float,
+    ground: str | None = None,
+):
     """(distance [m] down a slope along world `axis` (0 x, 1 y) in SLIDE_S, mean acceleration
-    [m/s²], Coulomb's acceleration for that axis's μ [m/s²])."""
+    [m/s²], Coulomb's acceleration for that axis's μ [m/s²]); on the world's ground plane, or
+    on `ground` (an SDF model's text) instead."""
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import WorldSettings
+
     path = tmp_path / "plate.urdf"
     path.write_text(plate(mu1, mu2))
-    world = World()
+    world = World(WorldSettings(ground=ground is None))
+    if ground is not None:
+        world.spawn(SpawnRequest(xml=ground), name="ground_plane", pose=Pose(z=-0.05))
     world.spawn(path, name="plate", pose=Pose(z=0.01))
     world.step(200)
     theta = math.atan(tan_theta)
@@ -289,33 +302,11 @@ def test_a_static_ground_model_is_the_worlds_ground_for_both_directions(
 ):
     """Gazebo worlds bring their ground as a static model (a body welded to the world, not a
     world-body geom): the plate slides along its low μ there too and holds along the high."""
-    from twin_cli.spawn_request import SpawnRequest
-    from twin_cli.world import WorldSettings
-
-    path = tmp_path / "plate.urdf"
-    path.write_text(plate(mu1, mu2))
     low_axis = 0 if mu2 < mu1 else 1
     tan_theta = 1.3 * min(mu1, mu2)
-    results = []
-    for axis in (low_axis, 1 - low_axis):
-        world = World(WorldSettings(ground=False))
-        world.spawn(SpawnRequest(xml=GROUND_MODEL), name="ground_plane", pose=Pose(z=-0.05))
-        world.spawn(path, name="plate", pose=Pose(z=0.01))
-        world.step(200)
-        theta = math.atan(tan_theta)
-        g = abs(float(world.model.opt.gravity[2]))
-        gravity = [0.0, 0.0, -g * math.cos(theta)]
-        gravity[axis] = g * math.sin(theta)
-        world.set_gravity(tuple(gravity))
-        world.step(300)
-        start, v0 = world.get_pose("plate"), float(world.data.qvel[axis])
-        world.step(round(SLIDE_S / world.model.opt.timestep))
-        end = world.get_pose("plate")
-        moved = (end.x - start.x, end.y - start.y)[axis]
-        results.append((moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2))
-        law = g * (math.sin(theta) - min(mu1, mu2) * math.cos(theta))
-    (_, a), (held, _) = results
+    _, a, law = _slide(tmp_path, mu1, mu2, low_axis, tan_theta, GROUND_MODEL)
     assert a == pytest.approx(law, rel=SLIDE_LAW), f"a {a:.4f} m/s², Coulomb {law:.4f}"
+    held, _, _ = _slide(tmp_path, mu1, mu2, 1 - low_axis, tan_theta, GROUND_MODEL)
     assert abs(held) < HOLD_M, f"along the high μ it moved {held * 1e3:.3f} mm"
 
 
