@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +26,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("twin.ros")
 POLL_S = 0.05  # [s] wall between looks at the requests
+REPLY_MATCH_S = 5.0  # [s] wall a reply waits for its client's reader to be discovered
 Handler = Callable[["World", Any], dict[str, Any]]
 
 
@@ -82,7 +84,9 @@ class ServiceServer:
             for name, (reader, writer) in self._endpoints.items():
                 try:
                     for request in [r for r in reader.take(16) if hasattr(r, "__idl__")]:
-                        writer.write(self._answer(name, request))
+                        reply = self._answer(name, request)
+                        _await_reply_reader(reader, writer)
+                        writer.write(reply)
                 except Exception:  # one bad request must not end the server: the world goes on
                     log.exception("service %s", name)
 
@@ -98,6 +102,18 @@ class ServiceServer:
         self.calls += 1
         reply = srv.service_idl(kind, srv.RESPONSE)
         return reply(guid=request.guid, seq=request.seq, **fields)
+
+
+def _await_reply_reader(reader: Any, writer: Any) -> None:
+    """Waits (at most REPLY_MATCH_S) until the reply writer has matched a reader for every
+    client whose request writer the request reader has matched: discovery is not symmetric,
+    and a reply written before the client's reader is known is lost (rmw_cyclonedds_cpp's
+    services wait for the client's response reader the same way)."""
+    deadline = time.monotonic() + REPLY_MATCH_S
+    while time.monotonic() < deadline:
+        if len(writer.get_matched_subscriptions()) >= len(reader.get_matched_publications()):
+            return
+        time.sleep(0.01)
 
 
 def failure(kind: str, message: str) -> dict[str, Any]:

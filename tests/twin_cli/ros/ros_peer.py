@@ -300,6 +300,7 @@ SERVICES = {
     "/delete_entity": (DeleteEntityRequest, DeleteEntityResponse, "DeleteEntity"),
     "/get_model_list": (GetModelListRequest, GetModelListResponse, "GetModelList"),
 }
+FIRST_CLOCK_S = 30.0  # [s] wall a listener waits for the first /clock before its window
 CLIENT_GUID = 0x5EED_0000_0000_0001  # this client's id in the request header
 SEQUENCE = 7
 
@@ -370,9 +371,14 @@ def listen(seconds: float, entity: str) -> dict:
     readers["ros_discovery_info"] = DataReader(dp, topic, qos=qos(True, depth=100))
     out: dict[str, list] = {name: [] for name in wanted}
     types_seen = {name: r.topic.get_type_name() for name, r in readers.items()}
-    end = time.monotonic() + seconds
+    # The window opens at the first /clock (discovery on a loaded runner takes seconds), or
+    # after FIRST_CLOCK_S when none comes.
+    end = time.monotonic() + FIRST_CLOCK_S + seconds
+    opened = False
     mask = SampleState.Any | ViewState.Any | InstanceState.Any
     while time.monotonic() < end:
+        if not opened and out["/clock"]:
+            opened, end = True, time.monotonic() + seconds
         for name, reader in readers.items():
             idl, type_name, _ = wanted[name]
             for cdr, info in ddspy_take(reader._ref, mask, 64):  # the bytes as received
