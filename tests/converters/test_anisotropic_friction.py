@@ -53,6 +53,16 @@ def _slide(
     if ground is not None:
         world.spawn(SpawnRequest(xml=ground), name="ground_plane", pose=Pose(z=-0.05))
     world.spawn(path, name="plate", pose=Pose(z=0.01))
+    moved, a = _down_a_slope(world, "plate", axis, tan_theta)
+    g = abs(float(world.model.opt.gravity[2])) * math.sqrt(1.0 + tan_theta**2)
+    theta = math.atan(tan_theta)
+    mu = (1.0 if mu2 is None else mu2, mu1)[axis]  # SDF's default mu2 is 1
+    return moved, a, g * (math.sin(theta) - mu * math.cos(theta))
+
+
+def _down_a_slope(world: World, name: str, axis: int, tan_theta: float) -> tuple[float, float]:
+    """Settles `name` for 0.2 s, tilts gravity by atan(tan_theta) along world `axis` (0 x, 1 y),
+    waits 0.3 s, then returns (distance [m] along `axis` in SLIDE_S, mean acceleration [m/s²])."""
     world.step(200)
     theta = math.atan(tan_theta)
     g = abs(float(world.model.opt.gravity[2]))
@@ -60,13 +70,11 @@ def _slide(
     gravity[axis] = g * math.sin(theta)
     world.set_gravity(tuple(gravity))
     world.step(300)
-    start, v0 = world.get_pose("plate"), float(world.data.qvel[axis])
+    start, v0 = world.get_pose(name), float(world.data.qvel[axis])
     world.step(round(SLIDE_S / world.model.opt.timestep))
-    end = world.get_pose("plate")
+    end = world.get_pose(name)
     moved = (end.x - start.x, end.y - start.y)[axis]
-    mu = (1.0 if mu2 is None else mu2, mu1)[axis]  # SDF's default mu2 is 1
-    law = g * (math.sin(theta) - mu * math.cos(theta))
-    return moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2, law
+    return moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2
 
 
 @pytest.mark.parametrize(("mu1", "mu2"), PAIRS)
@@ -224,19 +232,8 @@ def _wheel_sideways(tmp_path: Path, fdir1: str | None, yaw: float, tan_theta: fl
     path.write_text(wheel(0.3, 1.0, fdir1))
     world = World()
     world.spawn(path, name="wheel", pose=Pose(z=0.05, yaw=yaw))
-    world.step(200)
     axis = 1 if yaw == 0.0 else 0  # the axle: world y at heading 0, world x at 90°
-    theta = math.atan(tan_theta)
-    g = abs(float(world.model.opt.gravity[2]))
-    gravity = [0.0, 0.0, -g * math.cos(theta)]
-    gravity[axis] = g * math.sin(theta)
-    world.set_gravity(tuple(gravity))
-    world.step(300)
-    start, v0 = world.get_pose("wheel"), float(world.data.qvel[axis])
-    world.step(round(SLIDE_S / world.model.opt.timestep))
-    end = world.get_pose("wheel")
-    moved = (end.x - start.x, end.y - start.y)[axis]
-    return moved, 2.0 * (moved - v0 * SLIDE_S) / SLIDE_S**2
+    return _down_a_slope(world, "wheel", axis, tan_theta)
 
 
 @pytest.mark.parametrize("yaw", [0.0, math.pi / 2], ids=["axle_y", "axle_x"])
