@@ -97,6 +97,19 @@ class PackageNotFoundError(ConversionError):
         self.uri = uri
 
 
+class OutsideRootsError(ConversionError):
+    """A confined conversion (a DDS peer's spawn) opened a file outside its folders."""
+
+    def __init__(self, path: str, roots: tuple[str, ...]) -> None:
+        shown = ", ".join(r.rstrip("/") for r in roots[:4]) or "none"
+        super().__init__(
+            f"{path}: outside the folders a spawn over DDS may read (the world's package and "
+            f"model paths: {shown}); put it on GZ_SIM_RESOURCE_PATH or ROS_PACKAGE_PATH before "
+            "`twin serve`, or spawn it with `twin spawn`"
+        )
+        self.path = path
+
+
 class ResourceNotAFileError(ConversionError):
     """A mesh or included file resolves to something that is not a regular file (a device, a
     directory): reading it would never end or fail."""

@@ -43,6 +43,9 @@ class SpawnRequest:
             `world` link and a fixed joint do; a robot already fixed is unchanged.
         coacd_cpu_limit: CPU time CoACD may spend on one collision mesh before its hull stands
             in [CPU s]; None: the converting process's default (`twin serve --coacd-cpu-limit`).
+        read_roots: the only folders the spawn may read (a DDS peer's request: the world's
+            package and model paths); None: wherever the server's user may. Not saved: a
+            saved world is loaded by its user.
     """
 
     source: Any = None
@@ -57,6 +60,7 @@ class SpawnRequest:
     strict: bool = False
     fixed_base: bool = False
     coacd_cpu_limit: float | None = None
+    read_roots: tuple[str, ...] | None = None
 
     @property
     def label(self) -> str:

@@ -30,6 +30,8 @@ class ConversionJob:
         source: the file, or a name for the text (`<xml>`), used in messages.
         base_dir: for a text, where relative mesh paths start.
         env: the package search variables to resolve in; None: the process's own.
+        read_roots: the only folders the conversion may read (`converters.isolated.confine`);
+            None: wherever this process may.
     """
 
     source: str
@@ -40,6 +42,7 @@ class ConversionJob:
     package_paths: tuple[tuple[str, str], ...] = ()
     options: ConvertOptions = ConvertOptions()
     env: dict[str, str] | None = None
+    read_roots: tuple[str, ...] | None = None
 
 
 def convert_served(job: ConversionJob, budget: XacroBudget) -> Conversion:
@@ -69,7 +72,17 @@ def read_and_build(job: ConversionJob) -> tuple[Any, Report, dict]:
 
 
 def convert_job(job: ConversionJob) -> Conversion:
-    """The conversion `job` describes, in this process."""
+    """The conversion `job` describes, in this process (reading only in `job.read_roots`)."""
+    if job.read_roots is None:
+        return _convert(job)
+    from converters.collision.cache import cache_root
+    from converters.isolated.confine import confined
+
+    with confined(job.read_roots, also=(str(cache_root()),)):  # collision parts are read there
+        return _convert(job)
+
+
+def _convert(job: ConversionJob) -> Conversion:
     packages = dict(job.package_paths)
     if job.text is not None:
         return convert_text(

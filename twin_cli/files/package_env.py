@@ -27,3 +27,15 @@ PACKAGE_ENVS = (
 def package_env() -> dict[str, str]:
     """This process's values of PACKAGE_ENVS (unset ones left out)."""
     return {name: os.environ[name] for name in PACKAGE_ENVS if name in os.environ}
+
+
+def package_roots(env: dict[str, str] | None = None) -> tuple[str, ...]:
+    """The folders the PACKAGE_ENVS of `env` (default: this process's) name: where packages,
+    models and their meshes may be found, and all a DDS peer's spawn may read."""
+    values = package_env() if env is None else env
+    roots: list[str] = []
+    for name in PACKAGE_ENVS:
+        for entry in values.get(name, "").split(os.pathsep):
+            if entry and os.path.isabs(entry) and entry not in roots:
+                roots.append(entry)
+    return tuple(roots)

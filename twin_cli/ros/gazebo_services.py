@@ -4,7 +4,9 @@
 - `/spawn_entity` (gazebo_msgs/SpawnEntity): `xml` (URDF or SDF text) spawned as `twin spawn -`
   spawns a description read from stdin, named `name` (empty: twin's default name), at
   `initial_pose` in `reference_frame` ("", "world" or "map": the world; an entity's name: that
-  entity's root). `robot_namespace` is not read: the entity's topics are under its name.
+  entity's root). `robot_namespace` is not read: the entity's topics are under its name. The
+  description is URDF or SDF (as gazebo_ros takes), and it may read only the world's package
+  and model paths (`package_env.package_roots`): a peer is not the server's user.
 - `/delete_entity`, `/get_model_list`: remove one entity; the entities' names, stamped.
 - `/get_entity_state`, `/set_entity_state` (gazebo_ros_state's): an entity's root pose and twist
   in `reference_frame`, as gazebo_ros_state gives them: the pose relative to that entity's root,
@@ -26,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from converters.errors import ConversionError
 from twin_cli.errors import EntityNotFoundError, InvalidRequestError, TwinError
+from twin_cli.files.package_env import package_roots
 from twin_cli.physical_ranges import POSITION_M, SPEED
 from twin_cli.ros.graph import idl_type
 from twin_cli.spawn_request import SpawnRequest
@@ -43,8 +46,8 @@ Vector = tuple[float, float, float]
 def spawn(world: World, request: Any) -> dict[str, Any]:
     try:
         pose = pose_in_world(world, request.initial_pose, request.reference_frame)
-        result = world.spawn(SpawnRequest(xml=request.xml).absolute(), name=request.name or None,
-                             pose=pose)  # fmt: skip
+        asked = SpawnRequest(xml=request.xml, read_roots=package_roots()).absolute()
+        result = world.spawn(asked, name=request.name or None, pose=pose)
     except (TwinError, ConversionError) as exc:
         return {"success": False, "status_message": str(exc)}
     except Exception as exc:  # a caller must always get its answer

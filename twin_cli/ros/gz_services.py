@@ -6,6 +6,7 @@ and `reset` act on it. Replies carry only `success`; a refused request is logged
   `sdf_filename` (an absolute path) and `clone_name` (an entity spawned again from its own
   request); `name` (empty: twin's default), `allow_renaming` (a taken name gets `_1`, `_2`, …
   as gz-sim renames), `pose` in `relative_to` ("" or "world": the world; else an entity).
+  Text and files read only the world's package and model paths, as `/spawn_entity`'s do.
 - `remove` (DeleteEntity) and `set_pose` (SetEntityPose): an Entity by name, of type MODEL (or
   NONE); ids are gz-sim's own and are refused.
 - `control` (ControlWorld, a WorldControl): a rewind (`reset.all` or `time_only`: `twin reset`,
@@ -24,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from converters.errors import ConversionError
 from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.files.package_env import package_roots
 from twin_cli.ros.gazebo_services import pose_in_world
 from twin_cli.spawn_request import SpawnRequest
 
@@ -116,15 +118,16 @@ def _source(world: World, factory: Any) -> SpawnRequest:
             "entity_factory", f"sets {', '.join(given) or 'none'} of sdf, sdf_filename and "
             "clone_name", "set exactly one",
         )  # fmt: skip
+    roots = package_roots()  # a peer reads through the world's package and model paths only
     if factory.sdf:
-        return SpawnRequest(xml=factory.sdf).absolute()
+        return SpawnRequest(xml=factory.sdf, read_roots=roots).absolute()
     if factory.sdf_filename:
         if not Path(factory.sdf_filename).is_absolute():
             raise InvalidRequestError(
                 f"sdf_filename [{factory.sdf_filename}]", "is relative",
                 "give an absolute path: the server's folder is not the caller's",
             )  # fmt: skip
-        return SpawnRequest(factory.sdf_filename)
+        return SpawnRequest(factory.sdf_filename, read_roots=roots)
     return replace(world.entity(factory.clone_name).request)
 
 

@@ -120,6 +120,7 @@ def cache_key(path: Path, request: SpawnRequest, env: dict[str, str] | None) -> 
         request.strict,
         request.fixed_base,
         request.coacd_cpu_limit,
+        request.read_roots,
     )
 
 

@@ -94,6 +94,8 @@ def own_name(spec: mujoco.MjSpec) -> str:
 
 
 def _load(request: SpawnRequest) -> LoadedSource:
+    if request.read_roots is not None:
+        _check_confined(request)
     if request.xml is not None:
         return _load_text(request)
     if isinstance(request.source, mujoco.MjSpec):
@@ -151,6 +153,7 @@ def convert_bounded(request: SpawnRequest, *, source: str, **given: str | None) 
         package_paths=tuple((k, str(v)) for k, v in sorted(request.package_paths.items())),
         options=convert_options(request),
         env=resolving_env(request),
+        read_roots=request.read_roots,
         **given,
     )
     return convert_served(job, XacroBudget.from_env())
@@ -197,6 +200,39 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
         done.sensors,
         plugins=done.plugins,
     )
+
+
+def _check_confined(request: SpawnRequest) -> None:
+    """A confined request (a DDS peer's) names a file inside its folders, and no MJCF, which
+    MuJoCo's own reader would open in this process unwatched.
+
+    Raises:
+        SpawnError: it does not.
+    """
+    from converters.formats import format_of
+    from converters.isolated.confine import inside
+
+    roots = request.read_roots or ()
+    if isinstance(request.source, (str, Path)):
+        path = Path(request.source)
+        if not path.is_absolute() or not inside(path, roots):
+            raise SpawnError(
+                path.stem, str(path), "is outside the world's package and model paths",
+                f"a spawn over DDS reads only there ({_roots_text(roots)}); put the file on "
+                "GZ_SIM_RESOURCE_PATH or ROS_PACKAGE_PATH before `twin serve`, or use `twin spawn`",
+            )  # fmt: skip
+        if path.name.lower().endswith(MJCF_SUFFIXES) or _sniff(path) == "mjcf":
+            raise SpawnError(path.stem, str(path), "is MJCF", CONFINED_FORMATS)
+    elif request.xml is not None and format_of(request.xml) == "mjcf":
+        raise SpawnError(request.label, request.label, "is MJCF", CONFINED_FORMATS)
+
+
+CONFINED_FORMATS = "a spawn over DDS takes URDF or SDF, as Gazebo's services do; use `twin spawn`"
+
+
+def _roots_text(roots: tuple[str, ...], shown: int = 4) -> str:
+    listed = ", ".join(roots[:shown]) or "none: the server started without package paths"
+    return listed + (f" and {len(roots) - shown} more" if len(roots) > shown else "")
 
 
 def _load_mjcf(path: Path) -> LoadedSource:

@@ -38,6 +38,8 @@ from ros_peer import (
     qos,
     to_plain,
 )
+from ros_peer import SpawnEntityRequest as GazeboSpawnRequest
+from ros_peer import SpawnEntityResponse as GazeboSpawnResponse
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 MATCH_S = 60.0  # [s] wall for discovery to match both topics (a loaded runner is slow)
@@ -218,6 +220,7 @@ KINDS = {  # kind → (request type, reply type, reply definition)
     "get_state": (GetEntityStateRequest, GetEntityStateResponse, GET_STATE_REPLY_MSG),
     "set_state": (SetEntityStateRequest, SetEntityStateResponse, SUCCESS_MSG),
     "empty": (EmptyRequest, EmptyResponse, "uint8 structure_needs_at_least_one_member\n"),
+    "spawn": (GazeboSpawnRequest, GazeboSpawnResponse, "bool success\nstring status_message\n"),
     "gz_create": (SpawnEntityRequest, GzSpawnResponse, SUCCESS_MSG),
     "gz_remove": (DeleteEntityRequest, GzDeleteResponse, SUCCESS_MSG),
     "gz_set_pose": (SetEntityPoseRequest, GzSetPoseResponse, SUCCESS_MSG),
@@ -244,6 +247,10 @@ def _request(kind: str, fields: dict):  # noqa: ANN202 - the IDL class of `kind`
                                 f.get("clone_name", ""), _pose(f["pose"]),
                                 f.get("relative_to", "world"))  # fmt: skip
         return request_type(guid=CLIENT_GUID, seq=SEQUENCE, entity_factory=factory)
+    if kind == "spawn":
+        return request_type(guid=CLIENT_GUID, seq=SEQUENCE, name=fields["name"],
+                            xml=fields["xml"], robot_namespace="",
+                            initial_pose=_pose(fields["pose"]), reference_frame="")  # fmt: skip
     if kind in ("gz_remove", "gz_set_pose"):
         entity = Entity(0, fields["name"], fields.get("type", 2))
         extra = {"pose": _pose(fields["pose"])} if kind == "gz_set_pose" else {}

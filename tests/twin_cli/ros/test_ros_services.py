@@ -85,9 +85,12 @@ def _sim_time(runtime: Path) -> float:
 
 @pytest.fixture(scope="module")
 def served(tmp_path_factory, serve_world):
-    """A paused world served with --ros --ros-services, and the world name's gz services."""
+    """A paused world served with --ros --ros-services, and the world name's gz services; its
+    model path (GZ_SIM_RESOURCE_PATH) is `models` in the runtime folder."""
     root = tmp_path_factory.mktemp("ros_services")
+    (root / "models").mkdir()
     with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("GZ_SIM_RESOURCE_PATH", str(root / "models"))
         patch.setenv("ROS_DOMAIN_ID", DOMAIN_ID)
         patch.delenv("ROS_AUTOMATIC_DISCOVERY_RANGE", raising=False)
         with serve_world(root, WORLD, "--ros", "--ros-services", "--paused"):
@@ -110,8 +113,9 @@ def test_ros_gz_create_spawns_from_text_a_file_or_a_clone_and_renames_on_request
     assert _create(root, name="box_copy", clone_name="box", pose=_pose(1, 0, 0), relative_to="box")
     copy = _at(root, "box_copy")  # 1 m along the box's x, which points along the world's y
     assert (copy["x"], copy["y"], copy["z"]) == pytest.approx((1.0, 3.0, 0.5), abs=TOL)
-    (root / "cube.urdf").write_text(URDF)
-    assert _create(root, name="cube", sdf_filename=str(root / "cube.urdf"), pose=_pose(-2, 0, 0.3))
+    (root / "models" / "cube.urdf").write_text(URDF)
+    cube = str(root / "models" / "cube.urdf")
+    assert _create(root, name="cube", sdf_filename=cube, pose=_pose(-2, 0, 0.3))
     assert _at(root, "cube")["x"] == pytest.approx(-2.0, abs=TOL)
     before = _names(root)
     for bad in (
@@ -247,3 +251,64 @@ def test_pause_unpause_and_resets_act_as_gazebos(served: Path) -> None:
     missing = {"name": "gone", "sdf_filename": "/no/such/model.sdf", "pose": _pose(0, 0, 1)}
     assert not _create(root, **missing), "a file that is not there"
     _twin(root, "delete", "drop")
+
+
+MJCF = '<mujoco model="m"><worldbody><body><geom size="0.1"/></body></worldbody></mujoco>'
+
+
+def _mesh_urdf(name: str, mesh: Path) -> str:
+    return URDF.replace('name="cube"', f'name="{name}"').replace(
+        '<box size="0.2 0.2 0.2"/>', f'<mesh filename="file://{mesh}"/>'
+    )
+
+
+def _write_box_stl(path: Path) -> Path:
+    """A 0.2 m cube as ASCII STL (12 facets), written without twin's code."""
+    import itertools
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    corners = list(itertools.product((-0.1, 0.1), repeat=3))
+    facets = []
+    for axis, side in itertools.product(range(3), (-0.1, 0.1)):
+        face = [c for c in corners if c[axis] == side]
+        a, b, c, d = face[0], face[1], face[3], face[2]  # around the face
+        facets += [(a, b, c), (a, c, d)]
+    lines = ["solid box"]
+    for tri in facets:
+        lines += ["facet normal 0 0 0", "outer loop"]
+        lines += [f"vertex {x} {y} {z}" for x, y, z in tri] + ["endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid box"]) + "\n")
+    return path
+
+
+def test_a_peers_spawn_reads_only_the_worlds_package_and_model_paths(served: Path) -> None:
+    """A DDS peer is not the server's user: its spawns (gazebo_ros' and ros_gz's) read files
+    only under the world's package and model paths (here GZ_SIM_RESOURCE_PATH); a file or mesh
+    elsewhere, a link out of the path, or MJCF (which MuJoCo would read unwatched) is refused
+    with the reason, and the world is left as it was. The server's own user spawns them all."""
+    root = served
+    inside = _write_box_stl(root / "models" / "crate" / "box.stl")
+    secret = _write_box_stl(root / "private" / "secret.stl")
+    (root / "private" / "bot.urdf").write_text(_mesh_urdf("bot", secret))
+    (root / "models" / "link.urdf").symlink_to(root / "private" / "bot.urdf")
+    assert _create(root, name="crate", sdf=_mesh_urdf("crate", inside), pose=_pose(0, 9, 1))
+    before = _names(root)
+    spawn = {"name": "peek", "xml": _mesh_urdf("peek", secret), "pose": _pose(0, 8, 1)}
+    refused = _call(root, "/spawn_entity", "spawn", spawn)
+    assert not refused["success"], refused
+    message = refused["status_message"]
+    assert str(secret) in message and "outside" in message and "GZ_SIM_RESOURCE_PATH" in message
+    for bad in (
+        {"sdf": _mesh_urdf("peek", secret)},  # a mesh outside
+        {"sdf_filename": str(root / "private" / "bot.urdf")},  # a file outside
+        {"sdf_filename": str(root / "models" / "link.urdf")},  # a link to one
+        {"sdf": MJCF},
+    ):
+        assert not _create(root, name="peek", pose=_pose(0, 8, 1), **bad), f"created: {bad}"
+    mjcf = {**spawn, "xml": MJCF}
+    assert "MJCF" in _call(root, "/spawn_entity", "spawn", mjcf)["status_message"]
+    assert _names(root) == before, "a refused spawn changed the world"
+    _twin(root, "spawn", str(root / "private" / "bot.urdf"), "-x", "3", "-y", "9")
+    assert "bot" in _names(root), "the server's own user spawns from anywhere"
+    for name in ("crate", "bot"):
+        _twin(root, "delete", name)
