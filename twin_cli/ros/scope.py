@@ -25,6 +25,10 @@ CYCLONEDDS_URI), so what the twin opens is decided here alone.
   rcl does), 0 or unset leaves the range to the variable above; other values are refused.
 - `--ros-interface ADDRESS`: that interface instead of loopback, multicast as Cyclone's default.
 - `ROS_DISTRO` / `--ros-distro`: the distribution the node's GIDs are shaped for (`distro`).
+- `ROS_SECURITY_ENABLE=true` (SROS2): the cyclonedds wheel carries no DDS Security plugins
+  (authentication, access control, cryptography), so twin cannot be secured. As rcl does for a
+  node without its security files: `ROS_SECURITY_STRATEGY=Enforce` refuses to start, any other
+  strategy (Permissive, rcl's default) runs unsecured and says so.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ from __future__ import annotations
 import ipaddress
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from xml.sax.saxutils import quoteattr
 
 from twin_cli.errors import InvalidRequestError
@@ -64,6 +68,7 @@ class Scope:
     multicast: bool
     peers: tuple[str, ...]
     distro: str = DEFAULT_DISTRO
+    unsecured: bool = False  # ROS_SECURITY_ENABLE asked for SROS2, Permissive: run without it
 
     @property
     def local_only(self) -> bool:
@@ -88,6 +93,8 @@ class Scope:
             where = f"interface {self.interface}" + (", multicast" if self.multicast else "")
         else:
             where = f"{self.range}: Cyclone's interface choice, multicast"
+        if self.unsecured:
+            where += UNSECURED_NOTE
         return f"ROS 2 domain {self.domain_id}, {where}"
 
 
@@ -102,6 +109,10 @@ def scope_from(
             it and the values it takes).
     """
     env = os.environ if env is None else env
+    return replace(_scope(env, interface, distro), unsecured=_security_asked(env))
+
+
+def _scope(env: Mapping[str, str], interface: str | None, distro: str | None) -> Scope:
     domain = _domain_id(env.get("ROS_DOMAIN_ID", ""))
     ros_distro = distro_from(env, distro)
     wanted = _range(env)
@@ -158,6 +169,32 @@ def cyclone_config(scope: Scope, pid: int | None = None) -> str:
         f"<General>{''.join(general)}</General><Discovery>{discovery}</Discovery>"
         "</Domain></CycloneDDS>"
     )
+
+
+UNSECURED_NOTE = (
+    "; unsecured: ROS_SECURITY_ENABLE is true, but twin's Cyclone DDS has no security plugins"
+    " (Permissive, as rcl runs a node without its keys)"
+)
+
+
+def _security_asked(env: Mapping[str, str]) -> bool:
+    """Whether SROS2 was asked for (rcl enables it for `true` only), in a strategy that lets a
+    node run without it.
+
+    Raises:
+        InvalidRequestError: asked with the Enforce strategy, which twin cannot honour.
+    """
+    if env.get("ROS_SECURITY_ENABLE", "") != "true":
+        return False
+    if env.get("ROS_SECURITY_STRATEGY", "") == "Enforce":
+        raise InvalidRequestError(
+            "ROS_SECURITY_ENABLE=true with ROS_SECURITY_STRATEGY=Enforce",
+            "asks for DDS Security, and twin's Cyclone DDS (the cyclonedds wheel) has no "
+            "security plugins",
+            "unset ROS_SECURITY_ENABLE for twin, or set ROS_SECURITY_STRATEGY=Permissive to "
+            "run it unsecured",
+        )
+    return True
 
 
 def _range(env: Mapping[str, str]) -> str:

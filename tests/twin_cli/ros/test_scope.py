@@ -14,6 +14,8 @@ import pytest
 from twin_cli.errors import InvalidRequestError
 from twin_cli.ros.scope import LOOPBACK, cyclone_config, scope_from
 
+ENFORCED = {"ROS_SECURITY_ENABLE": "true", "ROS_SECURITY_STRATEGY": "Enforce"}
+
 
 def _general(scope) -> tuple[ET.Element, ET.Element]:
     domain = ET.fromstring(cyclone_config(scope)).find("Domain")
@@ -124,6 +126,7 @@ def test_domain_id_is_read_from_ros_domain_id() -> None:
         ({"ROS_LOCALHOST_ONLY": "true"}, None, ("ROS_LOCALHOST_ONLY=true", "or 0")),
         ({"ROS_DISTRO": "ardent2"}, None, ("ROS_DISTRO 'ardent2'", "humble")),
         ({}, "<eth0>", ("--ros-interface", "eth0")),
+        (ENFORCED, None, ("ROS_SECURITY_STRATEGY=Enforce", "security plugins", "Permissive")),
     ],
 )
 def test_a_bad_setting_names_itself_and_the_fix(env, interface, names) -> None:
@@ -131,6 +134,21 @@ def test_a_bad_setting_names_itself_and_the_fix(env, interface, names) -> None:
         scope_from(env, interface)
     for name in names:
         assert name in str(caught.value), str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("env", "unsecured"),
+    [({"ROS_SECURITY_ENABLE": "true"}, True),
+     ({"ROS_SECURITY_ENABLE": "true", "ROS_SECURITY_STRATEGY": "Permissive"}, True),
+     ({"ROS_SECURITY_ENABLE": "True"}, False),  # rcl enables security for "true" only
+     ({"ROS_SECURITY_STRATEGY": "Enforce"}, False)],
+)  # fmt: skip
+def test_sros2_asked_permissively_runs_unsecured_and_says_so(env, unsecured) -> None:
+    """rcl runs a node whose security files are missing unsecured unless the strategy is
+    Enforce; twin, whose Cyclone DDS has no security plugins, is always that node."""
+    scope = scope_from(env)
+    assert scope.unsecured is unsecured
+    assert ("unsecured: ROS_SECURITY_ENABLE is true" in scope.describe()) is unsecured
 
 
 def test_the_description_says_where_the_participant_reaches() -> None:
@@ -145,13 +163,14 @@ def test_the_description_says_where_the_participant_reaches() -> None:
     [
         ("ROS_LOCALHOST_ONLY", "2", "set it to 1"),
         ("ROS_AUTOMATIC_DISCOVERY_RANGE", "LAN", "SUBNET"),
+        ("ROS_SECURITY_ENABLE", "true", "Permissive"),
     ],
 )
 def test_twin_serve_ros_with_a_bad_variable_exits_2_with_one_message(
     variable: str, value: str, fix: str, tmp_path
 ) -> None:
     """Before any socket: exit 2, one line naming the variable, its value and the fix."""
-    env = {**os.environ, "TWIN_RUNTIME_DIR": str(tmp_path), variable: value}
+    env = {**os.environ, **ENFORCED, "TWIN_RUNTIME_DIR": str(tmp_path), variable: value}
     done = subprocess.run(
         [sys.executable, "-m", "twin_cli", "serve", "--ros", "--world", "bad_scope"],
         env=env, capture_output=True, text=True, timeout=120,
