@@ -93,19 +93,17 @@ class SpawnBody(Body):
     """Spawn a description at a pose: a file on the server host (`source`), or its text (`xml`:
     URDF, xacro output, SDF or MJCF, as SpawnEntity's `xml`), with xacro args and packages."""
 
-    source: Annotated[str, Field(min_length=1)] | None = Field(
-        default=None, description="absolute path on the server host"
-    )
+    source: HostPath | None = None
     xml: Annotated[str, Field(min_length=1, max_length=MAX_BODY_BYTES)] | None = Field(
         default=None, description="the description as text, instead of `source`"
     )
-    base_dir: str | None = Field(
-        default=None, description="where relative mesh paths in `xml` start (server host path)"
+    base_dir: HostPath | None = Field(
+        default=None, description="where relative mesh paths in `xml` start (absolute)"
     )
     name: EntityName | None = None
     pose: PoseBody = PoseBody()
     args: dict[str, str] = {}
-    package_paths: dict[str, str] = {}
+    package_paths: dict[str, HostPath] = {}
     on_ground: bool = False
     joints: dict[str, Position] = Field(
         default={}, description="initial joint positions [rad] or [m] by URDF joint name (-J)"

@@ -90,6 +90,21 @@ def test_the_api_takes_only_absolute_paths(server, route, path):
     assert "path" in reply.text
 
 
+@pytest.mark.parametrize("field", ["source", "base_dir", "package_paths"])
+@pytest.mark.parametrize("path", ["../robot.urdf", "robot.urdf", "/a\x00b"])
+def test_a_spawn_takes_only_absolute_paths(server, field, path):
+    """A spawn's file, text folder and packages are paths on the server host, which the client
+    resolves: a relative one would be looked up in the server's own folder."""
+    client, _ = server
+    value = {"pkg": path} if field == "package_paths" else path
+    body = {"xml": "<robot name='r'/>", field: value} if field != "source" else {field: value}
+    names = lambda: [e["name"] for e in client._http.request("GET", "/entities").json()]  # noqa: E731
+    before = names()
+    reply = client._http.request("POST", "/entities", json=body)
+    assert reply.status_code == 422, (field, path, reply.status_code, reply.text)
+    assert field in reply.text and names() == before
+
+
 def test_the_cli_saves_in_the_clients_folder(server, tmp_path):
     client, _ = server
     done = subprocess.run(
