@@ -4,9 +4,10 @@ A world command is one small request, yet importing typer (with click: 56 ms, `-
 and building the app with every command module cost more than the request and Python's start-up
 together; `twin gravity --moon` takes 115 ms median wall on the fast path (339 ms before, with
 httpx; `benchmarks/bench_server.py`).
-This module reads the options `world_table` declares (the same table the Typer commands are built
-from), for the plain forms people and scripts type (`--opt VALUE`, `--opt=VALUE`, flags,
-positionals in any order), and calls the `world_actions` function the table names. It *declines*
+This module reads the options each command declares in the registry (`registry.world_commands`,
+from which the Typer commands are built too), for the plain forms people and scripts type
+(`--opt VALUE`, `--opt=VALUE`, flags, positionals in any order), and calls the command's
+function. It *declines*
 (returns None) whenever Typer would do anything else: `--help`, an unknown or clustered option, a
 missing or extra argument, a value that does not convert, so help and click's usage errors come
 from Typer itself. A value the action refuses (BadOption) reaches `app.main`'s error boundary.
@@ -20,16 +21,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from twin_cli.cli.world_table import COMMANDS, Command, Opt
-
-GRAMMARS: dict[str, Command] = COMMANDS  # the name the tests and the lazy-import check use
+from twin_cli.cli.registry import Command, Opt, world_commands
 
 
 @dataclass(frozen=True)
 class Call:
-    """A parsed command line: the `world_actions` function name and its keyword arguments."""
+    """A parsed command line: the command's function and its keyword arguments."""
 
-    action: str
+    action: Callable[..., None]
     kwargs: dict[str, Any]
 
 
@@ -39,9 +38,10 @@ class _Decline(Exception):
 
 def parse(argv: list[str]) -> Call | None:
     """The call `argv` (without the program name) asks for, or None to leave it to Typer."""
-    if not argv or argv[0] not in COMMANDS:
+    commands = world_commands()
+    if not argv or argv[0] not in commands:
         return None
-    command = COMMANDS[argv[0]]
+    command = commands[argv[0]]
     try:
         values, positionals = _read_options(command, argv[1:])
         values.update(_read_args(command, positionals))
@@ -124,7 +124,5 @@ def run(argv: list[str]) -> bool:
     call = parse(argv)
     if call is None:
         return False
-    from twin_cli.cli import world_actions
-
-    getattr(world_actions, call.action)(**call.kwargs)
+    call.action(**call.kwargs)
     return True

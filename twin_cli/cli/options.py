@@ -1,8 +1,8 @@
 """Options shared by several commands, defined once (Gazebo's names where Gazebo has them).
 
-The world commands' options are declared in `world_table` (plain Python, for the fast path);
+The world commands' parameters are plain declarations (`registry`, `params`: for the fast path);
 `annotation` turns one of them into the `Annotated[type, typer.Option(...)]` Typer reads, so the
-options other command modules share (--world, --json, --arg, --package, -J) come from there too.
+options other command modules share (--world, --json, --arg, --package, -J) come from `params`.
 """
 
 from __future__ import annotations
@@ -14,45 +14,44 @@ from typing import Annotated, Any
 
 import typer
 
-from twin_cli.cli import pairs
-from twin_cli.cli import world_table as table
+from twin_cli.cli import pairs, params, registry
 
 
-def _kind(param: table.Arg | table.Opt) -> Any:
+def _kind(param: registry.Arg | registry.Opt) -> Any:
     """The Python type Typer infers the click type from: bool, a tuple, a list, or Optional."""
-    if isinstance(param, table.Opt) and param.convert is None:
+    if isinstance(param, registry.Opt) and param.convert is None:
         return bool
     kind: Any = param.convert
-    if isinstance(param, table.Opt) and param.nargs > 1:
+    if isinstance(param, registry.Opt) and param.nargs > 1:
         kind = tuple[(kind,) * param.nargs]
-    if isinstance(param, table.Opt) and param.multiple:
+    if isinstance(param, registry.Opt) and param.multiple:
         kind = list[kind]
     return kind | None if param.default is None else kind
 
 
-def annotation(param: table.Arg | table.Opt) -> Any:
+def annotation(param: registry.Arg | registry.Opt) -> Any:
     """`Annotated[type, typer.Option(...)]` (or `typer.Argument`) for a table parameter."""
-    if isinstance(param, table.Arg):
+    if isinstance(param, registry.Arg):
         return Annotated[_kind(param), typer.Argument(help=param.help, min=param.minimum)]
     info = typer.Option(*param.flags, help=param.help, envvar=param.envvar)
     return Annotated[_kind(param), info]
 
 
-def parameter(param: table.Arg | table.Opt) -> inspect.Parameter:
+def parameter(param: registry.Arg | registry.Opt) -> inspect.Parameter:
     """A keyword-only parameter of a command function's signature, as Typer reads it."""
-    required = isinstance(param, table.Arg) and param.required
+    required = isinstance(param, registry.Arg) and param.required
     default = inspect.Parameter.empty if required else param.default
     kind = inspect.Parameter.KEYWORD_ONLY
     return inspect.Parameter(param.dest, kind, default=default, annotation=annotation(param))
 
 
-JsonOpt = annotation(table.JSON)
-WorldOpt = annotation(table.WORLD)
-ArgOpt = annotation(table.ARG)
-PackageOpt = annotation(table.PACKAGE)
-JointOpt = annotation(table.JOINT)
-FixedBaseOpt = annotation(table.FIXED_BASE)
-CoacdCpuLimitOpt = annotation(table.COACD_CPU_LIMIT)
+JsonOpt = annotation(params.JSON)
+WorldOpt = annotation(params.WORLD)
+ArgOpt = annotation(params.ARG)
+PackageOpt = annotation(params.PACKAGE)
+JointOpt = annotation(params.JOINT)
+FixedBaseOpt = annotation(params.FIXED_BASE)
+CoacdCpuLimitOpt = annotation(params.COACD_CPU_LIMIT)
 
 
 def parse_pairs(items: list[str] | None, sep: str, what: str) -> dict[str, str]:

@@ -63,14 +63,15 @@ def test_convert_imports_no_gl_backend_and_no_world_client(
     tmp_path: Path, command: str, gl: str | None
 ) -> None:
     """A conversion never renders or talks to a world: `import mujoco` without its GL backend
-    (glfw: ~60 ms; EGL's loads PyOpenGL), and the world commands' actions (~44 ms) only when one
-    runs; whatever MUJOCO_GL says."""
+    (glfw: ~60 ms; EGL's loads PyOpenGL), and the world commands' client (the spawn request with
+    hashlib, the server connection) only when one runs; whatever MUJOCO_GL says."""
     robot = tmp_path / "box.urdf"
     robot.write_text(STL_VISUAL.replace('<mesh filename="tet.stl" scale="0.5 0.5 0.5"/>', BOX))
     args = [command, str(robot)] + (["-o", str(tmp_path / "out")] if command == "convert" else [])
     imported = twin_imports(args, tmp_path / "c", full=True, gl=gl)
     assert "mujoco" in imported
-    unwanted = {"glfw", "mujoco.glfw", "mujoco.egl", "OpenGL", "twin_cli.cli.world_actions"}
+    unwanted = {"glfw", "mujoco.glfw", "mujoco.egl", "OpenGL"}
+    unwanted |= {"twin_cli.spawn_request", "twin_cli.server.connection"}
     assert not imported & unwanted, f"imported {sorted(imported & unwanted)}"
 
 

@@ -16,7 +16,6 @@ with warnings.catch_warnings():  # typer's own import of click's deprecated name
 
 from twin_cli.cli import app as cli_app
 from twin_cli.cli.app import build_app, narrowed
-from twin_cli.cli.world_table import COMMANDS as WORLD_TABLE
 
 WIDE = {"COLUMNS": "100", "TERM": "dumb"}  # one page width for both renderings
 
@@ -64,11 +63,3 @@ def test_a_run_builds_only_its_own_command(monkeypatch: pytest.MonkeyPatch, caps
     cli_app._run_app(["cache", "info", "--json"])
     assert '"entries"' in capsys.readouterr().out
     assert built == ["info", "clear"], built  # the cache group's two, of the app's 35
-
-
-def test_every_world_command_names_an_action_that_exists() -> None:
-    """The actions are looked up when a command runs; a misspelt one fails here instead."""
-    from twin_cli.cli import world_actions
-
-    missing = [c.action for c in WORLD_TABLE.values() if not hasattr(world_actions, c.action)]
-    assert not missing, missing

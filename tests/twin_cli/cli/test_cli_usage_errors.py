@@ -1,6 +1,6 @@
 """Every world command refuses a bad option or value as a usage error: exit 2, one message.
 
-The cases come from the world command table, so a command added there is covered here too. Each
+The cases come from the world command registry, so a command added there is covered here too. Each
 runs the real entry point (`python -m twin_cli`) with a private runtime directory, and none may
 start a world.
 """
@@ -14,8 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from twin_cli.cli.world_table import COMMANDS as TABLE
-from twin_cli.cli.world_table import Arg, Command, Opt
+from twin_cli.cli.registry import Arg, Command, Opt, world_commands
+
+TABLE = world_commands()
 
 SAMPLE = {str: "box", Path: "world.twin", int: "3", float: "1.5"}
 UNKNOWN = "--no-such-option"

@@ -1,21 +1,34 @@
 """`twin spawn`: a FILE, stdin or `--xml` text as one spawn request, at one pose or many.
 
-Called by the world commands' table (`world_table`) through `world_actions`; client-side only.
+Client-side only; `SpawnRequest` (with hashlib) is imported when a spawn runs, not when the
+commands are registered for another one.
 """
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from twin_cli.cli import pairs
 from twin_cli.cli.output import Output
+from twin_cli.cli.params import (
+    ARG,
+    COACD_CPU_LIMIT,
+    FIXED_BASE,
+    JOINT,
+    JSON,
+    PACKAGE,
+    POSE,
+    POSE_KEYS,
+    WORLD,
+    Vec3,
+)
+from twin_cli.cli.registry import Arg, Opt, command, flag
 from twin_cli.cli.world_client import connect_world
-from twin_cli.spawn_request import SpawnRequest
 
-POSE_KEYS = ("x", "y", "z", "roll", "pitch", "yaw")
-Vec3 = tuple[float, float, float]
+if TYPE_CHECKING:
+    from twin_cli.spawn_request import SpawnRequest
 
 
 def spawn_pose(
@@ -55,6 +68,8 @@ def spawn_request(
     """
     if (file is None) == (xml is None):
         raise pairs.BadOption("give a FILE (or - for stdin) or --xml TEXT, not both or neither")
+    from twin_cli.spawn_request import SpawnRequest
+
     if file is not None and str(file) == "-":
         file, xml = None, sys.stdin.read()
     inputs = pairs.source_inputs(arg, package)
@@ -73,6 +88,57 @@ def spawn_request(
     )
 
 
+@command(
+    "spawn",
+    Arg("file", "URDF, xacro, SDF or MJCF file; - reads it from stdin.", Path, False),
+    *POSE,
+    Opt(("--name",), "name", "Entity name (default: the robot's).", str),
+    ARG,
+    PACKAGE,
+    flag("--on-ground", dest="on_ground", help="Rest on the ground."),
+    JOINT,
+    WORLD,
+    JSON,
+    Opt(("--xml",), "xml", "The description as text (URDF or SDF), instead of FILE.", str),
+    Opt(
+        ("--quat",),
+        "quat",
+        "Orientation as a quaternion X Y Z W, instead of -R -P -Y.",
+        float,
+        nargs=4,
+    ),
+    Opt(
+        ("--at",),
+        "at",
+        "Spawn one entity per pose X,Y[,Z[,YAW]] (repeat it), in one request; "
+        "named NAME_0, NAME_1, … All or nothing.",
+        str,
+        multiple=True,
+    ),
+    Opt(("--names",), "names", "Names of the --at entities, comma-separated.", str),
+    flag("--view", dest="view", help="Also show the world in the web viewer (twin view)."),
+    flag(
+        "--repair-inertia",
+        dest="repair_inertia",
+        help="Bound non-physical inertias instead of failing.",
+    ),
+    flag(
+        "--strict",
+        dest="strict",
+        help="Refuse tags naming a missing link or joint, and visuals whose mesh is "
+        "missing, instead of leaving them out with a warning (as Gazebo does).",
+    ),
+    flag(
+        "--drop-dangling",
+        dest="drop_dangling",
+        help="Leave those out with a warning: the default (kept for older scripts).",
+    ),
+    FIXED_BASE,
+    COACD_CPU_LIMIT,
+    help="Spawn a robot or model; prints its name once it exists in the world.\n\n"
+    "Packages (`$(find)`, `package://`, `model://`) resolve with this shell's ROS_PACKAGE_PATH,\n"
+    "AMENT_PREFIX_PATH, GAZEBO_MODEL_PATH and GZ_SIM_RESOURCE_PATH, as `twin convert` would.",
+)
 def spawn(
     *,
     file: Path | None,
