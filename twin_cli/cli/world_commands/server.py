@@ -53,9 +53,8 @@ def load(*, file: Path | None, world: str, last: bool = False) -> None:
     """
     if (file is None) == (not last):
         raise pairs.BadOption("give a FILE written by `twin save`, or --last, not both")
-    if last:
-        file = _last_autosave(world)
-    path = str(Path(file).expanduser().absolute())
+    chosen = _last_autosave(world) if file is None else file
+    path = str(Path(chosen).expanduser().absolute())
     started: list[str] = []
 
     def announce(line: str) -> None:

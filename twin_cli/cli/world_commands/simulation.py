@@ -96,9 +96,9 @@ def physics(
 ) -> None:
     if sleep and no_sleep:
         raise pairs.BadOption("give --sleep or --no-sleep, not both")
-    sleep = True if sleep else (False if no_sleep else None)
+    asleep = True if sleep else (False if no_sleep else None)
     given = (("timestep", step), ("rate", rate), ("iterations", iterations))
-    given += (("threads", threads), ("sleep", sleep), ("sleep_tolerance", sleep_tolerance))
+    given += (("threads", threads), ("sleep", asleep), ("sleep_tolerance", sleep_tolerance))
     changes = {k: v for k, v in given if v is not None}
     with connect_world(world) as c:
         result = c.set_physics(**changes) if changes else c.physics()
