@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from converters.description import RobotDescription
-from converters.description.sensors import SensorSpec
 from converters.errors import (
     DanglingReferenceError,
     InputFileError,
@@ -30,6 +29,8 @@ from converters.urdf.xacro_expand import expand_xacro, needs_xacro
 
 if TYPE_CHECKING:
     import mujoco
+
+    from converters.description.sensors import SensorSpec
 
 
 @dataclass(frozen=True)
@@ -179,8 +180,6 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
-    from converters.gazebo.plugins import add_drive_motors, read_plugins
-    from converters.gazebo.sensor_sites import add_sensors
     from converters.mjcf.heightfields import add_height_fields
     from converters.mjcf.passive_motors import add_passive_motors
 
@@ -196,14 +195,36 @@ def build_description(
         spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
     )  # SDF terrain
     apply_gazebo(spec, robot.gazebo, provenance, report)
-    sensors = add_sensors(spec, robot, provenance, report)
+    sensors = _add_sensors(spec, robot, provenance, report)
+    plugins = _add_plugins(spec, robot, report)
+    add_passive_motors(spec, robot, report)
+    return Conversion(spec, report, provenance, robot, sensors, plugins)
+
+
+def _add_sensors(
+    spec: mujoco.MjSpec, robot: RobotDescription, provenance: Provenance, report: Report
+) -> tuple[SensorSpec, ...]:
+    """The robot's sensors as sites; the sensor family is imported only if it declares one."""
+    if not robot.gazebo.declares_sensors:
+        return ()
+    from converters.gazebo.sensor_sites import add_sensors
+
+    return add_sensors(spec, robot, provenance, report)
+
+
+def _add_plugins(spec: mujoco.MjSpec, robot: RobotDescription, report: Report) -> tuple:
+    """The robot's drives, controllers and rotors with their motors (`gazebo.plugins`); the
+    plugin families (drives, wheels, multicopter) are imported only if it declares a plugin."""
+    if not robot.gazebo.plugins:
+        return ()
+    from converters.gazebo.plugins import add_drive_motors, read_plugins
+
     base = Path(robot.base_dir) if robot.base_dir else Path(robot.source).parent
     plugins = read_plugins(
         robot.gazebo.plugins, robot.source, spec, robot.name, robot.base_link, report, base
     )
     add_drive_motors(spec, plugins, report)
-    add_passive_motors(spec, robot, report)
-    return Conversion(spec, report, provenance, robot, sensors, plugins)
+    return plugins
 
 
 def check_joints(robot: RobotDescription) -> None:

@@ -158,6 +158,11 @@ class GazeboExtensions:
     unresolved: tuple[str, ...] = ()
     sources: tuple[TagSource, ...] = ()
 
+    @property
+    def declares_sensors(self) -> bool:
+        """Whether a link or joint carries a `<sensor>` (the sensor stages run only then)."""
+        return any(ext.sensors for ext in (*self.links.values(), *self.joints.values()))
+
     def link(self, name: str) -> LinkExtension:
         """The extension of link `name` (an empty one when it has no tags)."""
         return self.links.get(name) or LinkExtension(name)

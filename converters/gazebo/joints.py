@@ -133,9 +133,10 @@ def report_blobs(ext: GazeboExtensions, report: Report) -> None:
     Sensors are reported by `converters.gazebo.sensor_sites`, which maps them; model plugins by
     `converters.gazebo.plugins` (run as twin controllers or not run).
     """
-    from converters.gazebo.plugins import report_plugins
+    if ext.plugins:  # the plugin families are imported only for a model that has one
+        from converters.gazebo.plugins import report_plugins
 
-    report_plugins(ext.plugins, report)
+        report_plugins(ext.plugins, report)
     for blob in ext.model_blobs:
         _report_blob("model", blob, report)
     for link, link_ext in ext.links.items():

@@ -132,7 +132,8 @@ def build_spec(
         mimic_equalities=len(spec.equalities) - locked,
         locked_joints=locked,
     )
-    report.summary.update(loop_equalities=add_loop_equalities(spec, robot, plan, report))
+    loops = add_loop_equalities(spec, robot, plan, report) if robot.loop_joints else 0
+    report.summary.update(loop_equalities=loops)
     return spec
 
 

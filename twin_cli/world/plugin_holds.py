@@ -26,6 +26,8 @@ def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
     names = list(names)
     driving.start_commands(state, names)
     for name in names:
+        if not state.entities[name].plugins:  # no drive or controller holds a joint
+            continue
         motors = driving.motor_joints(state, name)
         by_mode: dict[str, dict[str, float]] = {}
         for joint, (mode, target) in held_from_load(state.entities[name].plugins).items():

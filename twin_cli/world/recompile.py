@@ -60,17 +60,14 @@ def commit(state: WorldState, spec: mujoco.MjSpec, built: Built) -> None:
     velocity decay, and the pushes and drags still acting."""
     model, data, index = built
     state.spec, state.model, state.data, state.index = spec, model, data, index
-    align_sensor_ticks(model, data)
+    if model.nsensor:
+        align_sensor_ticks(model, data)
     install_pool(state, model, data)
     cap_contact_stiffness(model)
     state.scratch_state = np.empty(mujoco.mj_stateSize(model, STATE))
-    actuation.apply_pushes(
-        model,
-        data,
-        state.pushes,
-        {p.body for p in state.pushes} | set(state.perturbation),
-        state.perturbation,
-    )
+    pushed = {p.body for p in state.pushes} | set(state.perturbation)
+    if pushed:
+        actuation.apply_pushes(model, data, state.pushes, pushed, state.perturbation)
 
 
 def ground(
