@@ -49,15 +49,15 @@ PLUGIN_FAMILY = {
 SENSOR_FAMILY = {"converters/gazebo/sensor_sites.py", "converters/gazebo/sensors.py"}
 
 
-def _modules_run(action: Callable[[], object], *, bodies: bool = False) -> set[str]:
-    """Paths (from the repository root) of twin's modules that executed code during `action`;
-    `bodies`: module bodies (imports) count too."""
+def _modules_run(action: Callable[[], object]) -> set[str]:
+    """Paths (from the repository root) of twin's modules that executed code during `action`
+    (module bodies, that is imports, aside)."""
     root = f"{ROOT}/"
     seen: set[str] = set()
 
     def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
         code = frame.f_code
-        if event == "call" and (bodies or code.co_name != "<module>"):
+        if event == "call" and code.co_name != "<module>":
             seen.add(code.co_filename)
 
     sys.setprofile(profile)
@@ -97,5 +97,5 @@ def test_a_description_that_declares_a_family_runs_it(
     path = tmp_path / "robot.urdf"
     path.write_text(robot)
     world = World()
-    ran = _modules_run(_spawn(world, path, "robot"), bodies=True)
+    ran = _modules_run(_spawn(world, path, "robot"))
     assert expected in ran, f"{expected} did not run: {sorted(ran & family)}"
