@@ -109,3 +109,16 @@ def test_a_toy_command_in_one_module_has_typer_help_and_usage_errors(
     bad = _twin(toy_tree, tmp_path, "toy", "--scale", "abc")
     assert bad.returncode == 2 and "Invalid value for '--scale'" in bad.stderr, bad.stderr
     assert not (tmp_path / "default.sock").exists(), "a usage error must not start a world"
+
+
+def test_a_second_function_under_a_registered_name_is_refused() -> None:
+    from twin_cli.cli.registry import DuplicateCommandError, command, world_commands
+
+    pause = world_commands()["pause"].action
+
+    def other_pause(*, world: str) -> None:
+        """Would shadow `twin pause`."""
+
+    with pytest.raises(DuplicateCommandError, match=r"`twin pause` is registered twice: by "):
+        command("pause", help="Pause.")(other_pause)
+    assert world_commands()["pause"].action is pause
