@@ -16,7 +16,7 @@ Units are SI: [m], [m/s], [m/s²], [rad], [N m], [Hz]; `math.inf` is "no limit".
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import asdict, dataclass, fields, is_dataclass
 from typing import Any
 
 # Defaults of gazebo_ros_diff_drive (ROS 2 `Load`, ROS 1 `getParameter` defaults).
@@ -33,6 +33,8 @@ model's velocity at every world update."""
 
 
 def _plain(value: Any) -> Any:
+    if is_dataclass(value) and not isinstance(value, type):
+        return asdict(value)
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
@@ -47,6 +49,29 @@ class _Record:
         """Plain values for JSON; `kind` names the record's family."""
         out = {f.name: _plain(getattr(self, f.name)) for f in fields(self)}  # type: ignore[arg-type]
         return {"kind": type(self).__name__, **out}
+
+
+@dataclass(frozen=True)
+class GzNames:
+    """The tags a gz-sim drive system (DiffDrive, AckermannSteering, MecanumDrive) names its
+    topics and frames with, as written ("" where left out: the system then builds the name from
+    its model's name when it loads, `/model/<model>/cmd_vel`, `<model>/odom`, so the name is made
+    where the model's name is known: twin names the model after its entity).
+
+    Attributes:
+        topic: `<topic>` (cmd_vel); sub_topic: AckermannSteering's `<sub_topic>` (cmd_vel at
+        `/model/<model>/<sub_topic>`); odom_topic: `<odom_topic>`; tf_topic: `<tf_topic>`;
+        frame_id, child_frame_id: the odometry's frames; canonical_link: the model's canonical
+        link (the default child frame is `<model>/<canonical_link>`).
+    """
+
+    topic: str = ""
+    sub_topic: str = ""
+    odom_topic: str = ""
+    tf_topic: str = ""
+    frame_id: str = ""
+    child_frame_id: str = ""
+    canonical_link: str = ""
 
 
 @dataclass(frozen=True)
@@ -86,6 +111,7 @@ class DiffDrive(_Record):
     command_timeout: float = 0.0
     odom_topic: str = "odom"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -129,6 +155,7 @@ class AckermannDrive(_Record):
     family: str = "gazebo_ros_ackermann_drive"
     angular_is_steering: bool = True
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -207,6 +234,7 @@ class HolonomicDrive(_Record):
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:

@@ -7,10 +7,13 @@
 - `/tf_static`: fixed joints (lumped links too), latched (transient local), republished whole
   whenever the set of entities changes (tf2's static broadcaster does the same).
 - `/<entity>/joint_states` sensor_msgs/JointState: position, velocity, actuator effort, as
-  `World.joint_states`; `/<entity>/robot_description` std_msgs/String, the URDF after xacro,
-  latched; `/<entity>/odom` (or the name its drive gives it) nav_msgs/Odometry for floating
-  bases (pose in `world` or the diff drive's odometry frame, twist in the root link's frame, as
-  ROS defines it).
+  `World.joint_states`, for an entity with joints that move (a static model has none);
+  `/<entity>/robot_description` std_msgs/String, the URDF after xacro, latched;
+  `/<entity>/odom` (or the name its drive gives it: gz-sim's `/model/<entity>/odometry`)
+  nav_msgs/Odometry for floating bases (pose in `world` or the drive's odometry frame, twist
+  in the root link's frame, as ROS defines it); a gz-sim drive system's `/model/<entity>/tf`
+  (or its `<tf_topic>`) tf2_msgs/TFMessage, the odometry's one transform, as ros_gz_bridge
+  hands on the system's Pose_V.
 Every stamp is sim time. Messages are rosbags objects; `Message.cdr` encodes them. This
 module names the topics and builds the latched messages; `live_messages` refills the per-sample
 ones.
@@ -62,11 +65,14 @@ def topics(layout: Layout) -> list[Topic]:
     """Every topic of the layout's entities, world-wide ones first."""
     out = [CLOCK, TF, TF_STATIC]
     for e in layout.entities:
-        out.append(Topic(f"{namespace(e.name)}/joint_states", ros.JOINT_STATE))
+        if e.joint_names:
+            out.append(Topic(f"{namespace(e.name)}/joint_states", ros.JOINT_STATE))
         if e.description:
             out.append(Topic(f"{namespace(e.name)}/robot_description", ros.STRING, latched=True))
         if e.free_qpos >= 0:
             out.append(Topic(e.odom_topic, ros.ODOMETRY))
+        if e.free_qpos >= 0 and e.tf_topic:
+            out.append(Topic(e.tf_topic, ros.TF))
     return out
 
 
