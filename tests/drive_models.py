@@ -289,6 +289,26 @@ def sdf_ackermann(plugin: str) -> str:
     return f'<sdf version="1.8"><model name="car">{body}{plugin}</model></sdf>'
 
 
+def gz_vehicle(tags: str = "") -> str:
+    """gz-sim's diff_drive example's `vehicle_blue` at this module's size: `sdf_diff_drive` with
+    a `chassis` link and gz-sim's DiffDrive, its topic and frame `tags` added."""
+    plugin = (
+        '<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">'
+        "<left_joint>wheel_left_joint</left_joint><right_joint>wheel_right_joint</right_joint>"
+        f"<wheel_separation>{TRACK}</wheel_separation><wheel_radius>{R}</wheel_radius>"
+        f"{tags}</plugin>"
+    )
+    return sdf_diff_drive(plugin, model="vehicle_blue", base="chassis")
+
+
+STATIC_GROUND = (
+    '<sdf version="1.8"><model name="ground_plane"><static>true</static><link name="link">'
+    '<collision name="c"><geometry><box><size>1 1 0.1</size></box></geometry></collision>'
+    "</link></model></sdf>"
+)
+"""A static model: no joint moves, nothing of it is published."""
+
+
 ARM_INERTIAL = (
     '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" '
     'iyz="0"/></inertial>'

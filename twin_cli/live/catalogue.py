@@ -2,7 +2,7 @@
 
 A recording of the world holds exactly these topics (`twin_cli.record.topics`, and each sensor's
 `twin_cli.record.sensor_messages.spec_topic`), so a topic listed live is the one a bag holds:
-`/clock`, `/tf`, `/tf_static`, and per entity `joint_states` (joints that move),
+`/clock`, `/tf`, `/tf_static`, and per entity `joint_states` (anything that moves),
 `robot_description` (URDF sources), `odom` (floating bases, under its drive's name for it:
 gz-sim's `/model/<entity>/odometry`, with its `/model/<entity>/tf`) and one topic per
 sensor. Rates are in Hz of sim time: the state topics are sampled at STATE_RATE (`twin
@@ -93,11 +93,10 @@ def live_topics(world: World) -> list[LiveTopic]:
 
 
 def _has_joints(world: World, name: str) -> bool:
-    """Whether the entity has a joint its joint_states would carry (any but a free joint)."""
-    import mujoco
-
-    types = world.model.jnt_type[world.index_of(name).joints]
-    return bool((types != mujoco.mjtJoint.mjJNT_FREE).any())
+    """Whether anything of the entity moves: a joint (its free joint too). A static or welded
+    model has none, and no joint_states; a free body's are empty, as joint_state_publisher's
+    for a URDF without movable joints."""
+    return len(world.index_of(name).joints) > 0
 
 
 def find_topic(world: World, name: str) -> LiveTopic:

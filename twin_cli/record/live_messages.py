@@ -21,7 +21,7 @@ from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.layout import EntityLayout, Layout, MovingEdges
 from twin_cli.record.sampler import Samples
-from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
+from twin_cli.record.topics import CLOCK, TF, Message, moves, transform_stamped
 
 # conj(q) ⊗ r as a matrix product M(q) r: M's entries are q's components, permuted and signed.
 _CONJ_LEFT_INDEX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
@@ -114,7 +114,7 @@ class LiveMessages:
         self._tf = T[ros.TF](transforms=transforms)
         self._tf_cdr = ros.Reencoder(self._tf, ros.TF)
         entities = layout.entities
-        self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities if e.joint_names]
+        self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities if moves(e)]
         self._odometry = [
             _Odometry(T, layout, e, self._stamp) for e in entities if e.free_qpos >= 0
         ]

@@ -3,7 +3,8 @@ cmd_vel on `/model/<model>/cmd_vel`, odometry on `/model/<model>/odometry` and i
 `/model/<model>/tf`, or the topics `<topic>`, `<odom_topic>` and `<tf_topic>` give (a relative
 name rooted at `/`, as gz-transport roots it); frames `<model>/odom` → `<model>/<canonical link>`
 or `<frame_id>` → `<child_frame_id>` as written, never prefixed twice. The model is the entity:
-gz-sim names a model as it is spawned. A model without joints that move lists no joint_states.
+gz-sim names a model as it is spawned. A static model (no joint, nothing moves) lists no
+joint_states.
 
 The robot is gz-sim's diff_drive example's shape (`vehicle_blue`: a chassis link, two wheels and
 casters) at the drive tests' size; the bags are read back with rosbags (`record_helpers`).
@@ -28,28 +29,12 @@ TWIST = "geometry_msgs/msg/Twist"
 ODOMETRY = "nav_msgs/msg/Odometry"
 TF = "tf2_msgs/msg/TFMessage"
 POSE_TOL = 1e-12  # [m] the tf topic's transform and the odometry are one pose, one route
-GROUND = (
-    '<sdf version="1.8"><model name="ground_plane"><static>true</static><link name="link">'
-    '<collision name="c"><geometry><box><size>1 1 0.1</size></box></geometry></collision>'
-    "</link></model></sdf>"
-)
-
-
-def vehicle(tags: str = "") -> str:
-    """`vehicle_blue` with gz-sim's DiffDrive and its topic and frame `tags`."""
-    plugin = (
-        '<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">'
-        "<left_joint>wheel_left_joint</left_joint><right_joint>wheel_right_joint</right_joint>"
-        f"<wheel_separation>{dm.TRACK}</wheel_separation><wheel_radius>{dm.R}</wheel_radius>"
-        f"{tags}</plugin>"
-    )
-    return dm.sdf_diff_drive(plugin, model="vehicle_blue", base="chassis")
 
 
 def _world(tmp_path: Path, tags: str = "", names: tuple[str, ...] = ("vehicle_blue",)) -> World:
     path, ground = tmp_path / "vehicle_blue.sdf", tmp_path / "ground.sdf"
-    path.write_text(vehicle(tags))
-    ground.write_text(GROUND)
+    path.write_text(dm.gz_vehicle(tags))
+    ground.write_text(dm.STATIC_GROUND)
     world = World()
     for k, name in enumerate(names):
         world.spawn(SpawnRequest(str(path), on_ground=True), name=name, pose=Pose(y=2.0 * k))
@@ -171,7 +156,7 @@ def test_twin_odom_names_the_frames_for_the_entity(tmp_path: Path) -> None:
     assert (reply["odometry_frame"], reply["robot_base_frame"]) == ("rover/odom", "rover/chassis")
 
 
-def test_a_model_without_moving_joints_lists_no_joint_states(tmp_path: Path) -> None:
+def test_a_static_model_lists_no_joint_states(tmp_path: Path) -> None:
     """The static ground lists nothing of its own, and a bag holds no joint_states of it."""
     world = _world(tmp_path)
     listed = _listed(world)
