@@ -25,11 +25,11 @@ from converters.gazebo.drive_records import (
     AckermannDrive,
     DiffDrive,
     DriveRecord,
-    GzNames,
     HolonomicDrive,
     JointDrive,
     TricycleDrive,
 )
+from converters.gazebo.gz_names import gz_names
 from converters.gazebo.plugin_params import Params
 from converters.gazebo.trajectory_controller import read_joint_trajectory_controller
 from converters.gazebo.wheel_geometry import WheelGeometry
@@ -62,20 +62,6 @@ def _required(p: Params, tags: tuple[str, ...], default: str | None = None) -> t
     if default is not None:
         return (default,)
     raise GazeboTagError(p.source, "", f"plugin/{tags[0]}", "", "a wheel joint name")
-
-
-def gz_names(p: Params, ctx: ReadContext) -> GzNames:
-    """A gz-sim drive system's topic and frame tags as written (its defaults are made from the
-    model's name, which twin gives each entity: `twin_cli.control.drive_names`)."""
-    return GzNames(
-        topic=p.text("", "topic"),
-        sub_topic=p.text("", "sub_topic"),
-        odom_topic=p.text("", "odom_topic"),
-        tf_topic=p.text("", "tf_topic"),
-        frame_id=p.text("", "frame_id"),
-        child_frame_id=p.text("", "child_frame_id"),
-        canonical_link=ctx.base_link,
-    )
 
 
 def read_ros_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
@@ -139,7 +125,7 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         max_linear_velocity=p.number(math.inf, "max_linear_velocity", "max_velocity"),
         max_angular_velocity=p.number(math.inf, "max_angular_velocity"),
-        gz=gz_names(p, ctx),
+        gz=gz_names(p, ctx.base_link),
     )
 
 
@@ -205,7 +191,7 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         family="gz_ackermann_steering",
         angular_is_steering=False,
-        gz=gz_names(p, ctx),
+        gz=gz_names(p, ctx.base_link),
     )
 
 
@@ -277,7 +263,7 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
         max_linear_velocity=p.number(math.inf, "max_velocity"),
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
-        gz=gz_names(p, ctx),
+        gz=gz_names(p, ctx.base_link),
         notes=(
             "rollers: their 45° friction (fdir1, mu2) has no MuJoCo counterpart on a cylinder; "
             "the base is driven by its twist as planar move, the wheels spun to match",

@@ -19,6 +19,8 @@ import math
 from dataclasses import asdict, dataclass, fields, is_dataclass
 from typing import Any
 
+from converters.gazebo.gz_names import GzNames
+
 # Defaults of gazebo_ros_diff_drive (ROS 2 `Load`, ROS 1 `getParameter` defaults).
 DEFAULT_SEPARATION = 0.34  # [m]
 DEFAULT_DIAMETER = 0.15  # [m]
@@ -49,29 +51,6 @@ class _Record:
         """Plain values for JSON; `kind` names the record's family."""
         out = {f.name: _plain(getattr(self, f.name)) for f in fields(self)}  # type: ignore[arg-type]
         return {"kind": type(self).__name__, **out}
-
-
-@dataclass(frozen=True)
-class GzNames:
-    """The tags a gz-sim drive system (DiffDrive, AckermannSteering, MecanumDrive) names its
-    topics and frames with, as written ("" where left out: the system then builds the name from
-    its model's name when it loads, `/model/<model>/cmd_vel`, `<model>/odom`, so the name is made
-    where the model's name is known: twin names the model after its entity).
-
-    Attributes:
-        topic: `<topic>` (cmd_vel); sub_topic: AckermannSteering's `<sub_topic>` (cmd_vel at
-        `/model/<model>/<sub_topic>`); odom_topic: `<odom_topic>`; tf_topic: `<tf_topic>`;
-        frame_id, child_frame_id: the odometry's frames; canonical_link: the model's canonical
-        link (the default child frame is `<model>/<canonical_link>`).
-    """
-
-    topic: str = ""
-    sub_topic: str = ""
-    odom_topic: str = ""
-    tf_topic: str = ""
-    frame_id: str = ""
-    child_frame_id: str = ""
-    canonical_link: str = ""
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ GZ_ODOM_FRAME = "odom"  # the default frame_id's leaf: <model>/odom
 
 
 def gz_names_of(record: Any) -> Any:
-    """The gz-sim names of a drive record (`converters.gazebo.drive_records.GzNames`), or None
+    """The gz-sim names of a drive record (`converters.gazebo.gz_names.GzNames`), or None
     when it is not a gz-sim drive system."""
     return getattr(record, "gz", None)
 

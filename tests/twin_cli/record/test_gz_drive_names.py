@@ -164,3 +164,41 @@ def test_a_static_model_lists_no_joint_states(tmp_path: Path) -> None:
     assert not [name for name, row in listed.items() if row[1] == "ground_plane"], listed
     bag = _record(world, tmp_path / "static.mcap", steps=20)
     assert "/ground_plane/joint_states" not in bag and "/vehicle_blue/joint_states" in bag
+
+
+GZ_ACKERMANN = (
+    '<plugin filename="gz-sim-ackermann-steering-system" '
+    'name="gz::sim::systems::AckermannSteering"><left_joint>rear_left_joint</left_joint>'
+    "<right_joint>rear_right_joint</right_joint><left_steering_joint>left_steering_joint"
+    "</left_steering_joint><right_steering_joint>right_steering_joint</right_steering_joint>"
+    f"<wheel_base>{dm.WHEEL_BASE}</wheel_base><wheel_separation>{dm.TRACK}</wheel_separation>"
+    f"<wheel_radius>{dm.R}</wheel_radius><sub_topic>drive</sub_topic></plugin>"
+)
+GZ_MECANUM = (
+    '<plugin filename="gz-sim-mecanum-drive-system" name="gz::sim::systems::MecanumDrive">'
+    "<front_left_joint>left_front_joint</front_left_joint><front_right_joint>right_front_joint"
+    "</front_right_joint><back_left_joint>left_rear_joint</back_left_joint><back_right_joint>"
+    "right_rear_joint</back_right_joint><wheel_separation>0.3</wheel_separation><wheelbase>0.12"
+    f"</wheelbase><wheel_radius>{dm.R}</wheel_radius></plugin>"
+)
+
+
+def test_ackermann_steering_and_mecanum_drive_are_named_as_diff_drive(tmp_path: Path) -> None:
+    """AckermannSteering's `<sub_topic>` S takes cmd_vel on `/model/<model>/S`; MecanumDrive's
+    names are DiffDrive's (a URDF robot: its root link is `base_link`)."""
+    car, mover = tmp_path / "car.sdf", tmp_path / "mover.urdf"
+    car.write_text(dm.sdf_ackermann(GZ_ACKERMANN))
+    mover.write_text(dm.skid_steer_bot(GZ_MECANUM))
+    world = World()
+    world.spawn(SpawnRequest(str(car), on_ground=True), name="car")
+    world.spawn(SpawnRequest(str(mover), on_ground=True), name="mecanum", pose=Pose(y=2.0))
+    listed = _listed(world)
+    assert listed["/model/car/drive"] == (TWIST, "car", True)
+    assert listed["/model/mecanum/cmd_vel"] == (TWIST, "mecanum", True)
+    bag = _record(world, tmp_path / "families.mcap", steps=100)
+    for name in ("car", "mecanum"):
+        odometry = bag[f"/model/{name}/odometry"][-1][1]
+        frames = (odometry.header.frame_id, odometry.child_frame_id)
+        assert frames == (f"{name}/odom", f"{name}/base_link")
+        transform = bag[f"/model/{name}/tf"][-1][1].transforms[0]
+        assert (transform.header.frame_id, transform.child_frame_id) == frames
