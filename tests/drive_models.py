@@ -243,29 +243,30 @@ def _sdf_wheel(name: str, parent: str, xyz: str) -> str:
     )
 
 
-def _sdf_chassis(x: float, length: float = 0.5) -> str:
+def _sdf_chassis(x: float, length: float = 0.5, name: str = "base_link") -> str:
     return (
-        f'<link name="base_link"><inertial><pose>{x} 0 0.05 0 0 0</pose><mass>6</mass><inertia>'
+        f'<link name="{name}"><inertial><pose>{x} 0 0.05 0 0 0</pose><mass>6</mass><inertia>'
         "<ixx>0.05</ixx><iyy>0.05</iyy><izz>0.05</izz></inertia></inertial>"
         f'<collision name="body"><pose>{x} 0 0.06 0 0 0</pose><geometry><box><size>{length} 0.2 '
         "0.05</size></box></geometry></collision></link>"
     )
 
 
-def sdf_diff_drive(plugin: str) -> str:
-    """`two_wheel_base` as an SDF model: wheels `wheel_left_joint`/`wheel_right_joint` on the
-    origin's axle, frictionless casters fore and aft."""
+def sdf_diff_drive(plugin: str, model: str = "dd", base: str = "base_link") -> str:
+    """`two_wheel_base` as an SDF model named `model`: wheels `wheel_left_joint`/
+    `wheel_right_joint` on the origin's axle, frictionless casters fore and aft of link
+    `base`."""
     casters = "".join(
         f'<collision name="caster_{n}"><pose>{x} 0 0 0 0 0</pose><geometry><sphere><radius>{R}'
         "</radius></sphere></geometry><surface><friction><ode><mu>0</mu><mu2>0</mu2></ode>"
         "</friction></surface></collision>"
         for n, x in (("front", 0.12), ("rear", -0.12))
     )
-    chassis = _sdf_chassis(0.0, 0.3).replace("</link>", casters + "</link>", 1)
-    wheels = _sdf_wheel("wheel_left", "base_link", f"0 {TRACK / 2} 0") + _sdf_wheel(
-        "wheel_right", "base_link", f"0 {-TRACK / 2} 0"
+    chassis = _sdf_chassis(0.0, 0.3, base).replace("</link>", casters + "</link>", 1)
+    wheels = _sdf_wheel("wheel_left", base, f"0 {TRACK / 2} 0") + _sdf_wheel(
+        "wheel_right", base, f"0 {-TRACK / 2} 0"
     )
-    return f'<sdf version="1.8"><model name="dd">{chassis}{wheels}{plugin}</model></sdf>'
+    return f'<sdf version="1.8"><model name="{model}">{chassis}{wheels}{plugin}</model></sdf>'
 
 
 def sdf_ackermann(plugin: str) -> str:
@@ -286,6 +287,26 @@ def sdf_ackermann(plugin: str) -> str:
         parts.append(_sdf_wheel(f"front_{side}", f"{side}_knuckle", "0 0 0"))
     body = "".join(parts)
     return f'<sdf version="1.8"><model name="car">{body}{plugin}</model></sdf>'
+
+
+def gz_vehicle(tags: str = "") -> str:
+    """gz-sim's diff_drive example's `vehicle_blue` at this module's size: `sdf_diff_drive` with
+    a `chassis` link and gz-sim's DiffDrive, its topic and frame `tags` added."""
+    plugin = (
+        '<plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">'
+        "<left_joint>wheel_left_joint</left_joint><right_joint>wheel_right_joint</right_joint>"
+        f"<wheel_separation>{TRACK}</wheel_separation><wheel_radius>{R}</wheel_radius>"
+        f"{tags}</plugin>"
+    )
+    return sdf_diff_drive(plugin, model="vehicle_blue", base="chassis")
+
+
+STATIC_GROUND = (
+    '<sdf version="1.8"><model name="ground_plane"><static>true</static><link name="link">'
+    '<collision name="c"><geometry><box><size>1 1 0.1</size></box></geometry></collision>'
+    "</link></model></sdf>"
+)
+"""A static model: no joint moves, nothing of it is published."""
 
 
 ARM_INERTIAL = (

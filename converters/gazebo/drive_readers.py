@@ -29,6 +29,7 @@ from converters.gazebo.drive_records import (
     JointDrive,
     TricycleDrive,
 )
+from converters.gazebo.gz_names import gz_names
 from converters.gazebo.plugin_params import Params
 from converters.gazebo.trajectory_controller import read_joint_trajectory_controller
 from converters.gazebo.wheel_geometry import WheelGeometry
@@ -124,6 +125,7 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         max_linear_velocity=p.number(math.inf, "max_linear_velocity", "max_velocity"),
         max_angular_velocity=p.number(math.inf, "max_angular_velocity"),
+        gz=gz_names(p, ctx.base_link),
     )
 
 
@@ -189,6 +191,7 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         family="gz_ackermann_steering",
         angular_is_steering=False,
+        gz=gz_names(p, ctx.base_link),
     )
 
 
@@ -260,6 +263,7 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
         max_linear_velocity=p.number(math.inf, "max_velocity"),
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
+        gz=gz_names(p, ctx.base_link),
         notes=(
             "rollers: their 45° friction (fdir1, mu2) has no MuJoCo counterpart on a cylinder; "
             "the base is driven by its twist as planar move, the wheels spun to match",

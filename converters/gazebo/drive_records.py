@@ -16,8 +16,10 @@ Units are SI: [m], [m/s], [m/s²], [rad], [N m], [Hz]; `math.inf` is "no limit".
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import asdict, dataclass, fields, is_dataclass
 from typing import Any
+
+from converters.gazebo.gz_names import GzNames
 
 # Defaults of gazebo_ros_diff_drive (ROS 2 `Load`, ROS 1 `getParameter` defaults).
 DEFAULT_SEPARATION = 0.34  # [m]
@@ -33,6 +35,8 @@ model's velocity at every world update."""
 
 
 def _plain(value: Any) -> Any:
+    if is_dataclass(value) and not isinstance(value, type):
+        return asdict(value)
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
     if isinstance(value, float) and not math.isfinite(value):
@@ -86,6 +90,7 @@ class DiffDrive(_Record):
     command_timeout: float = 0.0
     odom_topic: str = "odom"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -129,6 +134,7 @@ class AckermannDrive(_Record):
     family: str = "gazebo_ros_ackermann_drive"
     angular_is_steering: bool = True
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:
@@ -207,6 +213,7 @@ class HolonomicDrive(_Record):
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
+    gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
 
     def wheel_joints(self) -> tuple[str, ...]:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
+from twin_cli.control.drive_names import reply_frames
 from twin_cli.control.kinematics import Pose2D, integrate_twist
 
 if TYPE_CHECKING:
@@ -210,14 +211,15 @@ class DriveController:
 
     def _message(self, position: list, rpy: list, linear: list, angular: list) -> dict[str, Any]:
         t = self.twist
+        odometry_frame, base_frame = reply_frames(self.entity, self.plugin)
         return {
             "entity": self.entity,
             "plugin": self.plugin.name,
             "family": self.plugin.family,
             "time": float(self.world.data.time),
             "source": self.plugin.odometry_source,
-            "odometry_frame": self.plugin.odometry_frame,
-            "robot_base_frame": self.plugin.robot_base_frame,
+            "odometry_frame": odometry_frame,
+            "robot_base_frame": base_frame,
             "pose": {"position": position, "rpy": rpy},
             "twist": {"linear": linear, "angular": angular},
             "command": {

@@ -8,10 +8,17 @@ fixed joints into their parent body and keeps each as a site named after the lin
 `world` link (the robot is welded instead), so each frame is anchored on a body of the compiled
 model with a constant offset, and a `world` link is placed from its joint's origin. A joint
 whose child moves against its parent (a body with a joint between them) goes on `/tf`, the
-others on `/tf_static`. The root link hangs from `world` or, for a mobile base with a diff-drive
+others on `/tf_static`. The root link hangs from `world` or, for a mobile base with a drive
 plugin, from the plugin's odometry frame (REP 105), itself fixed at `world` (the plugin's
 odometry source is the world pose). Entities without a URDF (MJCF, SDF) follow their model's
 body tree, sites as fixed frames. Sensor sites are frames only when a message names them.
+
+The prefix is applied once. A gazebo_ros plugin's odometry frame (`odom`) is one of the robot's
+names and gets it (`bot/odom`). A gz-sim drive system names its frames in full: `<frame_id>` and
+`<child_frame_id>` are kept as written, and its defaults `<model>/odom` and
+`<model>/<canonical link>` are the prefix's own form (`{entity}/`), so they are made as
+`<prefix>odom` and the root link's frame: exactly gz-sim's names with the default prefix, and
+the same frames as `/tf` with any other.
 """
 
 from __future__ import annotations
@@ -25,6 +32,7 @@ from functools import lru_cache
 from typing import TYPE_CHECKING
 
 from converters.gazebo.plugins import DIFF_DRIVE_FILES, DiffDrive
+from twin_cli.control.drive_names import GZ_ODOM_FRAME, gz_names_of, odom_topic, tf_topic
 from twin_cli.names import namespace
 
 if TYPE_CHECKING:
@@ -66,9 +74,11 @@ class Sources:
     Attributes:
         prefix: the frame prefix of its links (the template filled in).
         description: URDF text after xacro, or None (the model's body tree is used).
-        drive: (odometry frame, base frame) of its drive plugin, or None.
+        drive: (odometry frame, odometry's child frame) of its drive plugin in full, the child
+            "" for the root link's frame; or None (no drive).
         sensors: its sensors' frames.
         odom_topic: its odometry's topic (`odom_topic`), or "" (`/<entity>/odom`).
+        tf_topic: the topic its drive publishes the odometry's transform on, or "" (none).
     """
 
     prefix: str
@@ -76,6 +86,7 @@ class Sources:
     drive: tuple[str, str] | None = None
     sensors: tuple[SensorFrame, ...] = ()
     odom_topic: str = ""
+    tf_topic: str = ""
 
 
 def sources_of(world: World, name: str, template: str, description: str | None) -> Sources:
@@ -86,13 +97,27 @@ def sources_of(world: World, name: str, template: str, description: str | None) 
     sensors = tuple(
         SensorFrame(s.name, s.link, s.frame_id, not any(s.pose)) for s in record.sensors
     )
-    drive = record_frames(record.plugins)
-    if any(
-        isinstance(p, DiffDrive) and p.family == "gazebo_ros_diff_drive" for p in record.plugins
-    ):
-        drive = drive_frames(text)
-    topic = odom_topic(name, record.plugins)
-    return Sources(template.replace("{entity}", name), text, drive, sensors, topic)
+    prefix = template.replace("{entity}", name)
+    return Sources(
+        prefix, text, odometry_frames(record.plugins, text, prefix), sensors,
+        odom_topic(name, record.plugins), tf_topic(name, record.plugins),
+    )  # fmt: skip
+
+
+def odometry_frames(
+    plugins: Sequence[object], description: str | None, prefix: str
+) -> tuple[str, str] | None:
+    """(odometry frame, child frame) of the first drive among an entity's plugin records, in
+    full (the child "" for the root link's frame), or None: a gz-sim system's as the module
+    docstring says, another plugin's odometry frame under `prefix`."""
+    for plugin in plugins:
+        gz = gz_names_of(plugin)
+        if gz is not None:
+            return gz.frame_id or prefix + GZ_ODOM_FRAME, gz.child_frame_id
+    frames = record_frames(plugins)
+    if any(isinstance(p, DiffDrive) and p.family == "gazebo_ros_diff_drive" for p in plugins):
+        frames = drive_frames(description)
+    return None if frames is None else (prefix + frames[0], "")
 
 
 def unique_odom_topics(topics: dict[str, str]) -> dict[str, str]:
@@ -105,22 +130,6 @@ def unique_odom_topics(topics: dict[str, str]) -> dict[str, str]:
         out[name] = topic if topic not in seen else f"{namespace(name)}/odom"
         seen.add(out[name])
     return out
-
-
-def odom_topic(entity: str, plugins: Sequence[object]) -> str:
-    """The odometry's topic: as the first drive among the entity's plugin records names it
-    (a relative name under the entity's), else `/<entity>/odom`."""
-    for plugin in plugins:
-        topic = getattr(plugin, "odom_topic", None)
-        if topic:
-            return entity_topic(entity, topic)
-    return f"{namespace(entity)}/odom"
-
-
-def entity_topic(entity: str, topic: str) -> str:
-    """A topic a plugin names: absolute as it is, relative under the entity's name (twin's
-    namespace for each robot)."""
-    return topic if topic.startswith("/") else f"{namespace(entity)}/{topic.strip('/')}"
 
 
 def record_frames(plugins: Sequence[object]) -> tuple[str, str] | None:

@@ -23,6 +23,7 @@ from twin_cli.world.entities import EntityIndex, element_names
 
 _FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
 _IDENTITY_QUAT = np.array([1.0, 0.0, 0.0, 0.0])
+TF_TOPIC = "/tf"  # the world's tf topic: a drive's transform is among its own
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,8 @@ class EntityLayout:
         description: URDF text for `/<entity>/robot_description`, or None.
         ball_joints: positions in `joint_ids` of ball joints (JointState: angle and speed).
         odom_topic: its odometry's topic (its drive's name for it, else `/<entity>/odom`).
+        tf_topic: where its drive publishes the odometry's transform (gz-sim's drive systems'
+            `/model/<entity>/tf`), or "" (none).
     """
 
     name: str
@@ -49,6 +52,7 @@ class EntityLayout:
     description: str | None
     ball_joints: tuple[int, ...] = ()
     odom_topic: str = ""
+    tf_topic: str = ""
 
     @property
     def root_frame(self) -> str:
@@ -113,7 +117,8 @@ def make_layout(
     )
     entities = tuple(
         entity_layout(model, name, ix, entity_tree(model, names, name, ix, sources[name]),
-                      sources[name].description, odom.get(name, ""))
+                      sources[name].description, odom.get(name, ""),
+                      _drive_tf(sources[name].tf_topic, ix))
         for name, ix in index.items()
     )  # fmt: skip
     edges = [edge for e in entities for edge in e.tree.edges]
@@ -126,6 +131,11 @@ def make_layout(
     )
 
 
+def _drive_tf(topic: str, ix: EntityIndex) -> str:
+    """A floating base's drive tf topic; "" for none, or for `/tf` (whose transforms it has)."""
+    return topic if ix.free_qpos >= 0 and topic != TF_TOPIC else ""
+
+
 def entity_layout(
     model: mujoco.MjModel,
     name: str,
@@ -133,6 +143,7 @@ def entity_layout(
     tree: EntityTree,
     description: str | None,
     odom_topic: str = "",
+    tf_topic: str = "",
 ) -> EntityLayout:
     """One entity's layout (see EntityLayout)."""
     joints = np.array([j for j in ix.joints if model.jnt_type[j] != _FREE], dtype=np.int64)
@@ -148,6 +159,7 @@ def entity_layout(
         description=description,
         ball_joints=tuple(k for k, j in enumerate(joints) if is_ball(model, j)),
         odom_topic=odom_topic or f"{namespace(name)}/odom",
+        tf_topic=tf_topic,
     )
 
 

@@ -21,7 +21,7 @@ from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.layout import EntityLayout, Layout, MovingEdges
 from twin_cli.record.sampler import Samples
-from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
+from twin_cli.record.topics import CLOCK, TF, Message, moves, transform_stamped
 
 # conj(q) ⊗ r as a matrix product M(q) r: M's entries are q's components, permuted and signed.
 _CONJ_LEFT_INDEX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
@@ -114,9 +114,12 @@ class LiveMessages:
         self._tf = T[ros.TF](transforms=transforms)
         self._tf_cdr = ros.Reencoder(self._tf, ros.TF)
         entities = layout.entities
-        self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities]
+        self._joints = [_JointStates(T, layout, e, self._stamp) for e in entities if moves(e)]
         self._odometry = [
             _Odometry(T, layout, e, self._stamp) for e in entities if e.free_qpos >= 0
+        ]
+        self._drive_tf = [
+            _DriveTf(T, e, self._stamp) for e in entities if e.free_qpos >= 0 and e.tf_topic
         ]
 
     def messages(
@@ -132,6 +135,7 @@ class LiveMessages:
             self._transforms(samples, pos, quat),
             *(joints.messages(samples) for joints in self._joints),
             *(odometry.messages(samples, xmat) for odometry in self._odometry),
+            *(tf.messages(samples) for tf in self._drive_tf),
             strict=True,
         )
 
@@ -231,3 +235,24 @@ class _Odometry:
             v.x, v.y, v.z = vs
             w.x, w.y, w.z = ws
             yield Message(self._topic, ros.ODOMETRY, t, self._message, self._cdr)
+
+
+class _DriveTf:
+    """A gz-sim drive system's tf topic (`/model/<entity>/tf`): one transform, odometry frame →
+    its child, at the odometry's pose, as ros_gz_bridge hands on the system's Pose_V."""
+
+    def __init__(self, T: Any, e: EntityLayout, stamp: Any) -> None:
+        self._qpos, self._topic = e.free_qpos, e.tf_topic
+        transform = transform_stamped(stamp, e.odom_frame, e.root_frame, _ORIGIN, _IDENTITY)
+        self._translation = transform.transform.translation
+        self._rotation = transform.transform.rotation
+        self._message = T[ros.TF](transforms=[transform])
+        self._cdr = ros.Reencoder(self._message, ros.TF)
+
+    def messages(self, samples: Samples) -> Iterator[Message]:
+        """The root's pose in the odometry frame (fixed at the world) of each sample."""
+        v, q = self._translation, self._rotation
+        poses = samples.qpos[:, self._qpos : self._qpos + 7]
+        for t, pose in zip(samples.times.tolist(), poses.tolist(), strict=True):
+            v.x, v.y, v.z, q.w, q.x, q.y, q.z = pose
+            yield Message(self._topic, ros.TF, t, self._message, self._cdr)

@@ -115,7 +115,9 @@ def entity_tree(
     for root in roots:
         anchor = anchors.get(root, WORLD_ANCHOR)
         frames.setdefault(root, sources.prefix + root)
-        root_frame, odom_frame, root_edges = _root_edges(model, ix, sources, frames[root], anchor)
+        root_frame, odom_frame, root_edges = _root_edges(
+            model, ix, sources, frames[root], anchor, set(frames.values())
+        )
         edges += root_edges
     sensors = {s.name: sensor_frame(s, frames, sources.prefix) for s in sources.sensors}
     edges += _sensor_edges(model, names, name, sources, frames, anchors, sensors)
@@ -123,19 +125,29 @@ def entity_tree(
 
 
 def _root_edges(
-    model: mujoco.MjModel, ix: EntityIndex, sources: Sources, frame: str, anchor: Anchor
+    model: mujoco.MjModel,
+    ix: EntityIndex,
+    sources: Sources,
+    frame: str,
+    anchor: Anchor,
+    taken: set[str],
 ) -> tuple[str, str, list[Edge]]:
-    """world → the root link, or world → odometry frame → the root link of a mobile base."""
+    """world → the root link, or world → odometry frame → the root link of a mobile base.
+
+    Returns the odometry's child frame (the root link's, or the one its drive names: then a
+    fixed frame at the root link's, its parent in the tree), the odometry frame and the edges.
+    """
     if frame == WORLD_FRAME:  # a URDF `world` link with no prefix: the world itself
         return frame, WORLD_FRAME, []
     moving = moves(model, 0, anchor.body)
     if sources.drive is None or ix.free_qpos < 0:
         return frame, WORLD_FRAME, [Edge(WORLD_FRAME, frame, WORLD_ANCHOR, anchor, moving)]
-    odom = sources.prefix + sources.drive[0]
-    return frame, odom, [
-        Edge(WORLD_FRAME, odom, WORLD_ANCHOR, WORLD_ANCHOR, False),
-        Edge(odom, frame, WORLD_ANCHOR, anchor, moving),
-    ]  # fmt: skip
+    odom, child = sources.drive
+    edges = [Edge(WORLD_FRAME, odom, WORLD_ANCHOR, WORLD_ANCHOR, False)]
+    if child and child not in (frame, odom, WORLD_FRAME) and child not in taken:
+        edges.append(Edge(odom, child, WORLD_ANCHOR, anchor, moving))
+        return child, odom, [*edges, Edge(child, frame, anchor, anchor, False)]
+    return frame, odom, [*edges, Edge(odom, frame, WORLD_ANCHOR, anchor, moving)]
 
 
 def _urdf_links(

@@ -7,10 +7,14 @@
 - `/tf_static`: fixed joints (lumped links too), latched (transient local), republished whole
   whenever the set of entities changes (tf2's static broadcaster does the same).
 - `/<entity>/joint_states` sensor_msgs/JointState: position, velocity, actuator effort, as
-  `World.joint_states`; `/<entity>/robot_description` std_msgs/String, the URDF after xacro,
-  latched; `/<entity>/odom` (or the name its drive gives it) nav_msgs/Odometry for floating
-  bases (pose in `world` or the diff drive's odometry frame, twist in the root link's frame, as
-  ROS defines it).
+  `World.joint_states`, for an entity with a joint (a free body's are empty, as
+  joint_state_publisher's for a URDF without movable joints; a static model has none);
+  `/<entity>/robot_description` std_msgs/String, the URDF after xacro, latched;
+  `/<entity>/odom` (or the name its drive gives it: gz-sim's `/model/<entity>/odometry`)
+  nav_msgs/Odometry for floating bases (pose in `world` or the drive's odometry frame, twist
+  in the root link's frame, as ROS defines it); a gz-sim drive system's `/model/<entity>/tf`
+  (or its `<tf_topic>`) tf2_msgs/TFMessage, the odometry's one transform, as ros_gz_bridge
+  hands on the system's Pose_V.
 Every stamp is sim time. Messages are rosbags objects; `Message.cdr` encodes them. This
 module names the topics and builds the latched messages; `live_messages` refills the per-sample
 ones.
@@ -23,7 +27,7 @@ from typing import Any
 
 from twin_cli.names import namespace
 from twin_cli.record import messages as ros
-from twin_cli.record.layout import Layout
+from twin_cli.record.layout import EntityLayout, Layout
 
 
 @dataclass(frozen=True)
@@ -62,12 +66,21 @@ def topics(layout: Layout) -> list[Topic]:
     """Every topic of the layout's entities, world-wide ones first."""
     out = [CLOCK, TF, TF_STATIC]
     for e in layout.entities:
-        out.append(Topic(f"{namespace(e.name)}/joint_states", ros.JOINT_STATE))
+        if moves(e):
+            out.append(Topic(f"{namespace(e.name)}/joint_states", ros.JOINT_STATE))
         if e.description:
             out.append(Topic(f"{namespace(e.name)}/robot_description", ros.STRING, latched=True))
         if e.free_qpos >= 0:
             out.append(Topic(e.odom_topic, ros.ODOMETRY))
+        if e.free_qpos >= 0 and e.tf_topic:
+            out.append(Topic(e.tf_topic, ros.TF))
     return out
+
+
+def moves(e: EntityLayout) -> bool:
+    """Whether the entity has a joint (a free joint too): one without is static or welded, and
+    has no joint_states."""
+    return bool(e.joint_names) or e.free_qpos >= 0
 
 
 def latched_messages(layout: Layout, time: float) -> list[Message]:

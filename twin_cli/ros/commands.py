@@ -1,11 +1,12 @@
 """What a ROS 2 stack sends the twin: `cmd_vel` for each drive, and ros2_control's forward
 command controllers, acted on through the calls `twin drive` and `twin command` make.
 
-- Each entity with a drive gets one reader, of one type, on each cmd_vel topic its drive takes:
-  a Gazebo drive plugin's `/<entity>/cmd_vel` (or the name it gives) geometry_msgs/Twist, as
-  gazebo_ros' drive plugins (and ros_gz_bridge for gz-sim's) subscribe; a diff_drive_controller's
-  topic the type its `use_stamped_vel` chooses (`plugin_names`). A topic never carries two
-  types (`ros2 topic echo` refuses such a topic). The newest command goes to
+- Each entity with a drive gets one reader, of one type, on each cmd_vel topic its drive takes
+  (`twin_cli.control.drive_names`): a gazebo_ros drive plugin's `/<entity>/cmd_vel` (or the
+  name it gives) and a gz-sim drive system's `/model/<entity>/cmd_vel` (or its `<topic>`, the
+  name ros_gz_bridge bridges it under), geometry_msgs/Twist as both subscribe; a
+  diff_drive_controller's topic the type its `use_stamped_vel` chooses (`plugin_names`). A
+  topic never carries two types (`ros2 topic echo` refuses such a topic). The newest command goes to
   `twin_cli.control.drive` with no duration: like the plugins, a base keeps its last command.
 - Each entity whose joints offer a command mode (position, velocity, effort) gets
   `/<entity>/forward_<mode>_controller/commands` (std_msgs/Float64MultiArray, the controller
@@ -32,10 +33,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control import drive, follow_trajectory, trajectory_from_dict
+from twin_cli.control.drive_names import cmd_vel_topic
 from twin_cli.control.drives import CONTROLLERS
 from twin_cli.errors import InvalidRequestError, TwinError
+from twin_cli.live.catalogue import LiveTopic
 from twin_cli.names import namespace
-from twin_cli.record.frames import entity_topic
 from twin_cli.ros.graph import DEFAULT_QOS, FLOAT64_ARRAY, TWIST
 from twin_cli.ros.plugin_names import TRAJECTORY, Controller, plugin_names
 
@@ -79,8 +81,8 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     inputs = []
     if drives:
         kind, timeout = type(drives[0]).__name__, getattr(drives[0], "command_timeout", 0.0)
-        own = getattr(drives[0], "cmd_vel_topic", "")  # as the converter read its plugin
-        plugin = ((entity_topic(name, own) if own else f"{namespace(name)}/cmd_vel", TWIST),)
+        own = cmd_vel_topic(name, drives[0])  # as its plugin names it
+        plugin = ((own or f"{namespace(name)}/cmd_vel", TWIST),)
         topics = named.cmd_vel if named.cmd_vel and not own else plugin
         inputs += [
             Input(topic, message, drive=kind, timeout=timeout or None) for topic, message in topics
@@ -88,6 +90,18 @@ def _inputs(world: World, name: str) -> tuple[Input, ...]:
     if named.controllers:
         return (*inputs, *(_controller_input(c) for c in named.controllers))
     return (*inputs, *_default_controllers(name, world.joint_commands(name)))
+
+
+def with_commands(topics: list[LiveTopic], world: World) -> list[LiveTopic]:
+    """`topics` (`twin topics`' listing) with each entity's inputs after its own topics, marked
+    `command` (twin reads them; rate 0: they come when a node sends them)."""
+    inputs = entity_inputs(world)
+    out = [t for t in topics if not t.entity]
+    for entity in dict.fromkeys([*(t.entity for t in topics if t.entity), *inputs]):
+        out += [t for t in topics if t.entity == entity]
+        out += [LiveTopic(i.topic, i.type, 0.0, entity=entity, command=True)
+                for i in inputs.get(entity, ())]  # fmt: skip
+    return out
 
 
 def _base_dir(entity: Any) -> str:

@@ -15,24 +15,26 @@ from __future__ import annotations
 from typing import Any
 
 from twin_cli.record import messages as ros
-from twin_cli.record.topics import TF, Message
+from twin_cli.record.topics import TF, TF_STATIC, Message
 
 
 class RepeatFilter:
-    """The `/tf` messages a sink should send: each child frame once per stamp."""
+    """The `/tf` messages a sink should send: each child frame once per stamp (on `/tf` and on
+    every other tf topic that is not latched: a gz-sim drive system's `/model/<entity>/tf`,
+    which a user may remap onto `/tf`)."""
 
     def __init__(self) -> None:
-        self._stamps: dict[str, tuple[int, int]] = {}  # child frame → (sec, nanosec) sent
+        self._stamps: dict[tuple[str, str], tuple[int, int]] = {}  # (topic, child) → stamp sent
 
     def filter(self, message: Message) -> Message | None:
-        """`message` itself, a `/tf` message of its new transforms only, or None (nothing new).
-        Messages of other topics pass as they are."""
-        if message.topic != TF.name:
+        """`message` itself, a tf message of its new transforms only, or None (nothing new).
+        Messages of other types, and `/tf_static`, pass as they are."""
+        if message.type != TF.type or message.topic == TF_STATIC.name:
             return message
-        transforms = message.message.transforms
-        fresh = [t for t in transforms if self._stamps.get(t.child_frame_id) != _stamp(t)]
+        topic, transforms = message.topic, message.message.transforms
+        fresh = [t for t in transforms if self._stamps.get((topic, t.child_frame_id)) != _stamp(t)]
         for transform in fresh:
-            self._stamps[transform.child_frame_id] = _stamp(transform)
+            self._stamps[(topic, transform.child_frame_id)] = _stamp(transform)
         if len(fresh) == len(transforms):
             return message if fresh else None
         if not fresh:

@@ -31,10 +31,12 @@ QUEUE_LINES = 1000  # lines waiting for a slow reader; past that new ones are dr
 
 @router.get("/topics")
 def topics(world: WorldDep) -> list[dict]:
-    """Every topic the world offers: name, type, rate [Hz of sim time], latched, entity, sensor."""
+    """Every topic the world offers: name, type, rate [Hz of sim time], latched, entity, sensor,
+    and the command topics `twin serve --ros` reads (`command`)."""
     from twin_cli.live import live_topics
+    from twin_cli.ros.commands import with_commands
 
-    return [t.to_dict() for t in live_topics(world)]
+    return [t.to_dict() for t in with_commands(live_topics(world), world)]
 
 
 @router.get("/conversions")

@@ -94,6 +94,9 @@ def test_topics_lists_each_entitys_streams_as_a_recording_holds_them(world, tmp_
         assert (listed[name]["type"], listed[name]["rate"]) == (kind, rate), listed[name]
     assert "/rig/odom" not in listed, "a fixed base has no odometry"
     assert listed["/tf_static"]["latched"] and not listed["/tf"]["latched"]
+    drive = listed["/bot/cmd_vel"]  # an input `twin serve --ros` reads, listed after bot's topics
+    assert (drive["type"], drive["rate"], drive["command"]) == ("geometry_msgs/msg/Twist", 0, True)
+    assert not any(t["command"] for t in listed.values() if t["name"] in expected)
 
     out = tmp_path / "all.mcap"  # a recording holds the very same topics and types
     client.request("POST", "/record", body={"path": str(out), "rate": 100, "duration": 0.3})
@@ -106,11 +109,13 @@ def test_topics_lists_each_entitys_streams_as_a_recording_holds_them(world, tmp_
     with out.open("rb") as stream:
         summary = make_reader(stream).get_summary()
     recorded = {c.topic: summary.schemas[c.schema_id].name for c in summary.channels.values()}
-    assert recorded == {name: t["type"] for name, t in listed.items()}, "recorded ≠ listed"
+    sent = {name: t["type"] for name, t in listed.items() if not t["command"]}
+    assert recorded == sent, "recorded ≠ listed"
 
     piped = twin(world, "topics").stdout.splitlines()
     assert piped[0].split("\t") == ["topic", "type", "rate", "entity"], piped[0]
     assert "/box/imu\tsensor_msgs/msg/Imu\t200 Hz\tbox" in piped, piped
+    assert "/bot/cmd_vel\tgeometry_msgs/msg/Twist\tcommand (in)\tbot" in piped, piped
 
 
 def test_echo_stamps_follow_the_stated_rates(world):

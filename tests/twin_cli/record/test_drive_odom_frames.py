@@ -1,5 +1,6 @@
 """A recording's odometry frame comes from whichever drive the entity has: each drive record
-names its `odometry_frame` and `robot_base_frame`, as its plugin's tags (or defaults) say."""
+names its `odometry_frame`, as its plugin's tags (or defaults) say, under the entity's frame
+prefix; the odometry's child is the root link's frame."""
 
 from __future__ import annotations
 
@@ -32,11 +33,11 @@ def _sources(tmp_path: Path, text: str):  # noqa: ANN202
 
 
 def test_an_ackermann_base_records_its_plugins_odometry_frames(tmp_path: Path) -> None:
-    assert _sources(tmp_path, dm.ackermann_car(ACKERMANN)).drive == ("odom_car", "base_link")
+    assert _sources(tmp_path, dm.ackermann_car(ACKERMANN)).drive == ("r/odom_car", "")
 
 
 def test_a_planar_move_base_records_the_plugins_default_frames(tmp_path: Path) -> None:
-    assert _sources(tmp_path, dm.planar_base(PLANAR)).drive == ("odom", "base_footprint")
+    assert _sources(tmp_path, dm.planar_base(PLANAR)).drive == ("r/odom", "")
 
 
 def test_a_base_without_a_drive_has_no_odometry_frame(tmp_path: Path) -> None:

@@ -17,6 +17,7 @@ decoded by rosbags after the header.
 An ENTITY argument that starts with `/` is the whole topic (a name the robot's plugins gave).
 
 Usage: python ros_peer.py listen SECONDS ENTITY | drain SECONDS ENTITY | scan SECONDS TOPIC |
+    odometry SECONDS ODOM_TOPIC TF_TOPIC |
     drive ENTITY VX WZ SECONDS | drive_stamped ENTITY VX WZ SECONDS |
     forward ENTITY MODE SECONDS VALUE... | trajectory ENTITY JOINT POSITION AT |
     call SERVICE JSON_FIELDS
@@ -391,6 +392,37 @@ def listen(seconds: float, entity: str) -> dict:
     return {"messages": out, "types": types_seen}
 
 
+def odometry(seconds: float, odom_topic: str, tf_topic: str) -> dict:
+    """Odometry on `odom_topic`, TFMessages on `tf_topic`, `/tf` and `/tf_static` for `seconds`
+    of wall time after the first odometry (or FIRST_CLOCK_S without one), decoded by rosbags:
+    a gz-sim drive system's topics as ros_gz_bridge bridges them."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    dp = participant()
+    wanted = {
+        odom_topic: (Odometry, "nav_msgs/msg/Odometry", False),
+        tf_topic: (TFMessage, "tf2_msgs/msg/TFMessage", False),
+        "/tf": (TFMessage, "tf2_msgs/msg/TFMessage", False),
+        "/tf_static": (TFMessage, "tf2_msgs/msg/TFMessage", True),
+    }
+    readers = {
+        name: DataReader(dp, Topic(dp, "rt" + name, idl, qos=qos(latched)), qos=qos(latched))
+        for name, (idl, _, latched) in wanted.items()
+    }
+    out: dict[str, list] = {name: [] for name in wanted}
+    end, opened = time.monotonic() + FIRST_CLOCK_S + seconds, False
+    mask = SampleState.Any | ViewState.Any | InstanceState.Any
+    while time.monotonic() < end:
+        if not opened and out[odom_topic]:
+            opened, end = True, time.monotonic() + seconds
+        for name, reader in readers.items():
+            for cdr, info in ddspy_take(reader._ref, mask, 64):
+                if info.valid_data:
+                    message = store.deserialize_cdr(cdr, wanted[name][1])
+                    out[name].append(to_plain(message))
+        time.sleep(0.01)
+    return {"messages": out}
+
+
 def dds_name(entity: str, leaf: str) -> str:
     """The DDS topic of `/<entity>/<leaf>`, or of `entity` itself when it is a topic (`/a/b`)."""
     return "rt" + entity if entity.startswith("/") else f"rt/{entity}/{leaf}"
@@ -521,6 +553,8 @@ if __name__ == "__main__":
     elif sys.argv[1] == "trajectory":
         args = sys.argv[2], sys.argv[3], float(sys.argv[4]), float(sys.argv[5])
         result = trajectory(*args)
+    elif sys.argv[1] == "odometry":
+        result = odometry(float(sys.argv[2]), sys.argv[3], sys.argv[4])
     elif sys.argv[1] == "scan":
         result = scan(float(sys.argv[2]), sys.argv[3])
     elif sys.argv[1] == "call":

@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 from twin_cli.record import messages as ros
-from twin_cli.record.topics import CLOCK, TF, Message, transform_stamped
+from twin_cli.record.topics import CLOCK, TF, TF_STATIC, Message, transform_stamped
 from twin_cli.ros.tf_repeats import RepeatFilter
 
 
-def _tf(time: float, *children: str) -> Message:
+def _tf(time: float, *children: str, topic: str = TF.name) -> Message:
     stamp = ros.stamp(time)
     transforms = [
         transform_stamped(stamp, "world", child, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0])
         for child in children
     ]
-    return Message(TF.name, ros.TF, time, ros.types()[ros.TF](transforms=transforms))
+    return Message(topic, ros.TF, time, ros.types()[ros.TF](transforms=transforms))
 
 
 def _children(message: Message | None) -> list[str] | None:
@@ -38,3 +38,17 @@ def test_other_topics_pass_as_they_are() -> None:
     clock = Message(CLOCK.name, ros.CLOCK, 1.0, ros.types()[ros.CLOCK](clock=ros.stamp(1.0)))
     repeats = RepeatFilter()
     assert repeats.filter(clock) is clock and repeats.filter(clock) is clock
+
+
+def test_a_drive_tf_topic_goes_once_per_stamp_and_tf_static_as_it_is() -> None:
+    """A gz-sim drive system's `/model/<entity>/tf` is a tf topic of its own: its transform once
+    per stamp there, whatever `/tf` sent; `/tf_static` (latched, sent whole) always passes."""
+    drive = "/model/vehicle_blue/tf"
+    repeats = RepeatFilter()
+    assert _children(repeats.filter(_tf(1.0, "vehicle_blue/chassis"))) == ["vehicle_blue/chassis"]
+    first = repeats.filter(_tf(1.0, "vehicle_blue/chassis", topic=drive))
+    assert _children(first) == ["vehicle_blue/chassis"], "its own topic's first"
+    assert repeats.filter(_tf(1.0, "vehicle_blue/chassis", topic=drive)) is None, "a beat"
+    assert _children(repeats.filter(_tf(1.01, "vehicle_blue/chassis", topic=drive))) is not None
+    static = _tf(1.0, "vehicle_blue/wheel", topic=TF_STATIC.name)
+    assert repeats.filter(static) is static and repeats.filter(static) is static

@@ -52,6 +52,8 @@ def topics(ctx: typer.Context, world: WorldOpt = "default", json: JsonOpt = Fals
 
 
 def _rate(topic: dict[str, Any]) -> str:
+    if topic.get("command"):
+        return "command (in)"
     return "latched" if topic["latched"] else f"{topic['rate']:g} Hz"
 
 
