@@ -68,3 +68,18 @@ def test_the_swap_keeps_every_state_and_replaces_the_hull_by_the_parts(served, t
         f"bin geoms: {hull_geoms} as a hull, {_bin_geoms(world)} after, {rows[0]['parts']} parts"
     )
     assert [e.name for e in world.entities()] == ["box", "bin"], "spawn order kept"
+
+
+def test_a_batch_shares_one_decomposition_that_outlives_a_deleted_instance(served, tmp_path):
+    world = World()
+    urdf = bin_urdf(tmp_path)
+    world.spawn_batch(SpawnRequest(urdf), poses=[Pose(), Pose(x=1)], names=["a", "b"])
+    listed = {e.name: e.decomposition for e in world.entities()}
+    assert listed == {"a": "pending", "b": "pending"}, listed
+    world.delete("a")  # "b" still waits: the decomposition goes on
+    deadline = time.monotonic() + WAIT_S
+    while world.entities()[0].decomposition == "pending" and time.monotonic() < deadline:
+        time.sleep(0.1)
+    (left,) = world.entities()
+    assert left.name == "b" and left.decomposition == "done", left
+    assert left.hull_stand_ins == (), left
