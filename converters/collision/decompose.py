@@ -65,6 +65,7 @@ class Stop(enum.Enum):
 
     CPU = "cpu"  # spent its CPU budget: the same mesh and budget stop again on any machine
     WALL = "wall"  # passed the wall-clock backstop: a hang or an overloaded machine
+    DEFERRED = "deferred"  # never started: a later conversion decomposes it (`defer`)
 
 
 @dataclass(frozen=True)

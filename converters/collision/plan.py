@@ -148,7 +148,10 @@ class CollisionSettings:
     caps every hull and part (default: the preset's). `cpu_limit` is one mesh's CoACD budget
     [CPU s]; past it the mesh falls back to its hull. `wall_limit` [s] is the backstop against
     a hung worker (None: `decompose.WALL_BACKSTOP_FACTOR` times `cpu_limit`, at least
-    `decompose.WALL_BACKSTOP_MIN_S`).
+    `decompose.WALL_BACKSTOP_MIN_S`). `defer`: a mesh CoACD would decompose and the cache
+    does not hold gets its convex hull now, with `stopped` "deferred" in its report row, and
+    is not stored; a later conversion without `defer` decomposes it (a served world does that
+    in the background and swaps the result in).
     """
 
     mode: str = "auto"
@@ -165,6 +168,7 @@ class CollisionSettings:
     max_hull_vertices: int | None = None
     cpu_limit: float = field(default_factory=default_cpu_limit)
     wall_limit: float | None = None
+    defer: bool = False
 
 
 @dataclass(frozen=True)

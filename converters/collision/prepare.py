@@ -14,7 +14,8 @@ A hull standing in for a decomposition that did not finish is never stored, so e
 conversion tries again: a worker over its CPU budget (CPU time varies from run to run, by up
 to a third on a shared virtual machine, so a mesh near its budget may finish next time, and a
 larger budget must get the real parts), past the wall-clock backstop, or dead (out-of-memory
-kill, Ctrl-C).
+kill, Ctrl-C); nor is the hull given for a mesh left to a later conversion
+(`CollisionSettings.defer`, row `stopped` "deferred").
 """
 
 from __future__ import annotations
@@ -61,6 +62,8 @@ CPU_HINT = (
     " `twin convert`, a cheaper search (--coacd-preset fast, a larger --coacd-threshold) or"
     " --collision-link {link}=hull"
 )
+# Why a mesh left to a later conversion (`CollisionSettings.defer`) has its hull for now.
+DEFERRED = "CoACD decomposition not run yet (it runs in the background)"
 ROW_FIELDS = (
     "key",
     "link",
@@ -108,6 +111,10 @@ def prepare(
         for request in requests:
             plan, cached = _plan(request, settings)
             if plan is not None and plan.decision.mode is CollisionMode.COACD and cached is None:
+                if settings.defer:
+                    results[request.key], rows[request.key] = _deferred(plan)
+                    progress.advance(_label(rows[request.key]))
+                    continue
                 waiting.setdefault(plan.content_key, []).append(plan)
                 continue
             results[request.key], rows[request.key] = cached or _without_coacd(request, plan)
@@ -213,6 +220,13 @@ def _hull_parts(vertices: np.ndarray, cap: int) -> Pairs:
     except Exception:  # flat: qhull has nothing to wrap
         return []
     return [hull] if hulls.usable_part(*hull) else []
+
+
+def _deferred(plan: _Plan) -> tuple[Pairs, dict[str, Any]]:
+    """The hull standing in for a decomposition left for a later conversion (not stored)."""
+    parts = _hull_parts(plan.request.vertices, plan.params.max_ch_vertex)
+    row = _finish(plan, parts, DEFERRED, store_key=None, worker={"stopped": Stop.DEFERRED.value})
+    return parts, row
 
 
 def _from_outcome(plan: _Plan, outcome: DecomposeOutcome) -> tuple[Pairs, dict[str, Any]]:
@@ -334,6 +348,8 @@ def _report(
 
 def _hint(row: dict[str, Any], settings: CollisionSettings) -> str:
     """What to do about a fallback: for a spent CPU budget, the options that change it."""
+    if row.get("stopped") == Stop.DEFERRED.value:
+        return " until then (`twin list` shows when the decomposition is swapped in)"
     if row.get("stopped") == Stop.CPU.value:
         return CPU_HINT.format(limit=settings.cpu_limit, link=row["link"])
     return ""

@@ -50,7 +50,14 @@ def _arm_cpu_budget(seconds: float) -> None:
 
 
 def run(job_path: str, result_path: str) -> None:
-    """Decompose the mesh in `job_path` and write the parts to `result_path` (atomically)."""
+    """Decompose the mesh in `job_path` and write the parts to `result_path` (atomically).
+
+    The worker ends with the process that started it: a conversion killed in its bounded child
+    (a cancelled background decomposition, a world shutting down) leaves no CoACD running.
+    """
+    from converters.isolated.bounded_child import die_with_parent
+
+    die_with_parent()
     with np.load(job_path, allow_pickle=False) as job:
         vertices = np.asarray(job["vertices"], np.float64)
         faces = np.asarray(job["faces"], np.int32)

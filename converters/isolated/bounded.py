@@ -45,12 +45,13 @@ POLL_S = 0.1  # [s] how often a waiting caller looks at the stop flag
 @dataclass
 class Running:
     """One child at work: what it converts, when it started (`time.monotonic`), its process,
-    and the shared buffer it writes its stage to."""
+    the shared buffer it writes its stage to, and the event that cancels it (or None)."""
 
     subject: str
     started: float
     process: Any
     board: Any
+    cancel: threading.Event | None = None
 
     @property
     def stage(self) -> str:
@@ -58,7 +59,13 @@ class Running:
         return stages.read(self.board)
 
 
-def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str) -> Any:
+def run(
+    work: Callable[[Any], Any],
+    job: Any,
+    budget: XacroBudget,
+    subject: str,
+    cancel: threading.Event | None = None,
+) -> Any:
     """`work(job)` in a bounded child; its return value, or its error raised again here.
 
     Args:
@@ -66,10 +73,12 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
         job: its picklable argument.
         budget: time [s] and address space [MiB] for the child.
         subject: the file being converted, for messages.
+        cancel: once set, the child is killed and the call ends (a background conversion
+            nobody waits for any more).
 
     Raises:
         ConversionBudgetError: over time or memory; names the stage and the variable to raise.
-        ConversionStoppedError: `stop_all` was called meanwhile.
+        ConversionStoppedError: `stop_all` was called meanwhile, or `cancel` was set.
         ConversionError: any subclass the work raised, as the same class.
         RuntimeError: the work failed for another reason (a converter defect).
     """
@@ -89,7 +98,7 @@ def run(work: Callable[[Any], Any], job: Any, budget: XacroBudget, subject: str)
         name="twin-conversion",
     )
     process.daemon = True
-    running = Running(subject, time.monotonic(), process, board)
+    running = Running(subject, time.monotonic(), process, board, cancel)
     with _LOCK:
         if _STOPPING.is_set():
             raise ConversionStoppedError(subject)
@@ -170,7 +179,7 @@ def _wait(receive: Any, running: Running, budget: XacroBudget) -> tuple:
     """The child's one message (its result, or its error), or ("died",)."""
     deadline = running.started + budget.timeout_s
     while True:
-        if _STOPPING.is_set():
+        if _STOPPING.is_set() or (running.cancel is not None and running.cancel.is_set()):
             raise ConversionStoppedError(running.subject)
         left = deadline - time.monotonic()
         if left <= 0:

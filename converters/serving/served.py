@@ -11,6 +11,7 @@ without losing precision.
 from __future__ import annotations
 
 import multiprocessing
+import threading
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -45,7 +46,9 @@ class ConversionJob:
     read_roots: tuple[str, ...] | None = None
 
 
-def convert_served(job: ConversionJob, budget: XacroBudget) -> Conversion:
+def convert_served(
+    job: ConversionJob, budget: XacroBudget, cancel: threading.Event | None = None
+) -> Conversion:
     """`job` converted under `budget`, with the world's process reading no description file.
 
     It converts in this process when bounded conversions are not enabled here (`bounded.enable`:
@@ -53,12 +56,12 @@ def convert_served(job: ConversionJob, budget: XacroBudget) -> Conversion:
 
     Raises:
         ConversionBudgetError: over time or memory (which stage, how to raise the budget).
-        ConversionStoppedError: the world began shutting down meanwhile.
+        ConversionStoppedError: the world began shutting down, or `cancel` was set, meanwhile.
         ConversionError: any subclass the conversion raised.
     """
     if not bounded.enabled() or multiprocessing.current_process().daemon:
         return convert_job(job)
-    robot, report, reads = bounded.run(read_and_build, job, budget, job.source)
+    robot, report, reads = bounded.run(read_and_build, job, budget, job.source, cancel)
     with replay.replaying(reads):
         done = build_description(robot, job.options, Report(source=report.source))
     return replace(done, report=report)

@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import SpawnError
-from twin_cli.world import spawn
+from twin_cli.world import decomposing, spawn
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, check_finite, quat_multiply, rotate
 from twin_cli.world.queries import root_from_model
@@ -48,6 +48,7 @@ def delete(state: WorldState, name: str) -> None:
             b: w for b, w in state.perturbation.items() if not b.startswith(prefix)
         }
         commit(state, trial, built)
+        decomposing.forget(state, name)  # cancelled if no other entity waits for it
         count_delete(state)  # every RENEW_EVERY deletes: a fresh spec (bounded memory)
 
 

@@ -141,6 +141,20 @@ def mesh_keys(spec: mujoco.MjSpec, conversion: tuple) -> dict[str, str]:
     }
 
 
+def deferred_keys(loaded: LoadedSource) -> dict[str, str] | None:
+    """Mesh keys for a conversion whose hulls stand in for decompositions not run yet: apart
+    from the finished conversion's (same files, other meshes), equal for the same stand-ins."""
+    from twin_cli.world.values import deferred_meshes
+
+    if loaded.mesh_keys is None:
+        return None
+    salt = repr(deferred_meshes(loaded.report))
+    return {
+        name: hashlib.blake2b(f"{key}/deferred/{salt}".encode(), digest_size=12).hexdigest()
+        for name, key in loaded.mesh_keys.items()
+    }
+
+
 class ConversionCache:
     """Conversions by key, valid while their files' contents are unchanged (LRU, thread-safe)."""
 

@@ -19,6 +19,7 @@ import mujoco
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import (
     changes,
+    decomposing,
     driving,
     engine_threads,
     physics,
@@ -190,7 +191,8 @@ class World:
             return self._state.require(name)
 
     def entities(self) -> list[EntityInfo]:
-        """Every entity: name, source, root position [m], number of joints (free excluded)."""
+        """Every entity: name, source, root position [m], number of joints (free excluded),
+        hull stand-ins and its background decomposition's status (`EntityInfo`)."""
         state = self._state
         with self.lock:
             return [
@@ -200,6 +202,7 @@ class World:
                     self.get_pose(n).position(),
                     len(queries.joint_names(state.model, state.index[n], f"{n}/")),
                     hull_stand_ins(e.report),
+                    decomposing.status(state, n),
                 )
                 for n, e in state.entities.items()
             ]
@@ -342,8 +345,11 @@ class World:
         self._loop.start()
 
     def stop(self) -> None:
-        """Stops and joins the stepping thread."""
+        """Stops and joins the stepping thread, and cancels the background decompositions
+        (`decomposing.cancel_all`): a server stops a world it drops (exit, `twin load`)."""
         self._loop.stop()
+        with self.lock:
+            decomposing.cancel_all(self._state, "the world stopped before it was ready")
 
     @property
     def running(self) -> bool:

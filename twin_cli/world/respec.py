@@ -36,7 +36,7 @@ from twin_cli.world.sleeping import allow_actuated
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import scene_settings
 
-__all__ = ["RENEW_EVERY", "count_delete", "keep_spec", "model_bytes", "renew_spec"]
+__all__ = ["RENEW_EVERY", "count_delete", "fresh_spec", "keep_spec", "model_bytes", "renew_spec"]
 
 # Deletes between renewals. A renewal costs one compile of the world (a few ms for small
 # worlds); the memory it bounds is ~0.04-0.08 MiB a cycle, so at most ~2 MiB stays held.
@@ -77,7 +77,7 @@ def renew_spec(state: WorldState) -> bool:
     Returns whether the spec was replaced; model, data and entities are never touched. The
     caller holds the lock.
     """
-    fresh = _fresh_spec(state)
+    fresh = fresh_spec(state)
     if fresh is not None:
         add_friction_pairs(fresh)
     if fresh is None or not _compiles_to_model(state, fresh):
@@ -108,8 +108,14 @@ def _compiles_to_model(state: WorldState, spec: mujoco.MjSpec) -> bool:
     return model_bytes(candidate) == model_bytes(state.model)
 
 
-def _fresh_spec(state: WorldState) -> mujoco.MjSpec | None:
-    """The scene, the world's lights and settings, every entity re-attached in order."""
+Kept = tuple[mujoco.MjSpec, dict[str, str] | None]  # a spec as prepared, and its mesh keys
+
+
+def fresh_spec(state: WorldState, replaced: dict[str, Kept] | None = None) -> mujoco.MjSpec | None:
+    """The scene, the world's lights and settings, every entity re-attached in order, each
+    from its kept spec or from the one `replaced` gives for it (prepared as `keep_spec` keeps
+    them); None when an entity has no kept spec or no frame."""
+    replaced = replaced or {}
     if any(n not in state.kept_specs for n in state.entities):
         return None  # an entity spawned before this world kept specs: nothing to rebuild
     fresh = build_world_spec(scene_settings(state.settings))
@@ -122,7 +128,7 @@ def _fresh_spec(state: WorldState) -> mujoco.MjSpec | None:
         frame = state.spec.frame(f"{name}/")
         if frame is None:
             return None
-        kept, keys = state.kept_specs[name]
+        kept, keys = replaced.get(name) or state.kept_specs[name]
         child = kept.copy()
         adopt_world_globals(child, fresh)
         shared_meshes.prepare(child, fresh, keys)

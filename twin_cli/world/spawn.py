@@ -8,7 +8,8 @@ every later compile of the world fail.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+import threading
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -51,6 +52,8 @@ class LoadedSource:
         notes: what was done to the source that the user should hear (a scene's ground left out).
         cached: the conversion came from the server's cache (`conversion_cache`), unconverted.
         mesh_keys: mesh name → a key equal exactly for equal meshes (`shared_meshes`), or None.
+        deferred: convex hulls stand in for collision meshes whose CoACD decomposition was
+            left for the background (`decomposing`).
     """
 
     spec: mujoco.MjSpec
@@ -64,21 +67,24 @@ class LoadedSource:
     cached: bool = False
     mesh_keys: dict[str, str] | None = None
     plugins: tuple = ()  # converters.gazebo.drive_records records (URDF/SDF)
+    deferred: bool = False
 
 
-def load_source(request: SpawnRequest) -> LoadedSource:
+def load_source(request: SpawnRequest, *, defer: bool = False) -> LoadedSource:
     """Reads the request's URDF/xacro/SDF (through the converter), MJCF, text or MjSpec.
 
     The request's `env` (the caller's package search variables) goes over this process's. In a
     world server a description is read in a bounded child (`convert_bounded`); MJCF is
     MuJoCo's own parser, in this process. With `fixed_base` the converter welds a description's
-    root, and `fixed_base.weld_loaded` an MJCF's.
+    root, and `fixed_base.weld_loaded` an MJCF's. With `defer`, in a world server, a description
+    file's CoACD meshes that the collision cache lacks get their convex hulls for now
+    (`LoadedSource.deferred`; `decomposing` decomposes them in the background).
 
     Raises:
         SpawnError: the file is missing, of an unknown kind, or not valid MJCF.
         converters.ConversionError: the converter refused the description.
     """
-    loaded = _load(request)
+    loaded = _load(request, defer)
     if request.fixed_base and loaded.report is None:
         loaded = fixed_base.weld_loaded(loaded)
     servos.carry_exported_servos(loaded.spec)  # once per load, not per instance of a batch
@@ -93,7 +99,7 @@ def own_name(spec: mujoco.MjSpec) -> str:
     return "" if spec.modelname == MUJOCO_DEFAULT_NAME else spec.modelname
 
 
-def _load(request: SpawnRequest) -> LoadedSource:
+def _load(request: SpawnRequest, defer: bool) -> LoadedSource:
     if request.read_roots is not None:
         _check_confined(request)
     if request.xml is not None:
@@ -110,7 +116,7 @@ def _load(request: SpawnRequest) -> LoadedSource:
     if lower.endswith(MJCF_SUFFIXES):
         return _load_mjcf(path)
     if lower.endswith(URDF_SUFFIXES + SDF_SUFFIXES) or _sniff(path) in ("urdf", "sdf"):
-        return _load_description(path, request)
+        return _load_description(path, request, defer)
     if _sniff(path) == "mjcf":
         return _load_mjcf(path)
     kinds = ", ".join(URDF_SUFFIXES + SDF_SUFFIXES + MJCF_SUFFIXES)
@@ -119,8 +125,8 @@ def _load(request: SpawnRequest) -> LoadedSource:
     )
 
 
-def convert_options(request: SpawnRequest) -> ConvertOptions:
-    """The converter's options that the request sets."""
+def convert_options(request: SpawnRequest, *, defer: bool = False) -> ConvertOptions:
+    """The converter's options that the request sets (`defer`: `CollisionSettings.defer`)."""
     from converters.collision.plan import CollisionSettings
     from converters.isolated.budget import XacroBudget
     from converters.mjcf.builder import ConvertOptions
@@ -128,35 +134,57 @@ def convert_options(request: SpawnRequest) -> ConvertOptions:
     limit = request.coacd_cpu_limit
     return ConvertOptions(
         repair_inertia=request.repair_inertia,
-        collision=CollisionSettings() if limit is None else CollisionSettings(cpu_limit=limit),
+        collision=CollisionSettings(defer=defer)
+        if limit is None
+        else CollisionSettings(cpu_limit=limit, defer=defer),
         strict=request.strict,
         fixed_base=request.fixed_base,
         xacro_budget=XacroBudget.from_env(),  # a served xacro runs bounded, apart from the world
     )
 
 
-def convert_bounded(request: SpawnRequest, *, source: str, **given: str | None) -> Conversion:
+@dataclass(frozen=True)
+class Served:
+    """How a served conversion runs: `defer` CoACD (`CollisionSettings.defer`), `extra_s` [s]
+    of wall time over the served budget (`TWIN_CONVERT_TIMEOUT`), `cancel` to stop it."""
+
+    defer: bool = False
+    extra_s: float = 0.0
+    cancel: threading.Event | None = None
+
+
+def convert_bounded(
+    request: SpawnRequest,
+    *,
+    source: str,
+    served: Served | None = None,
+    **given: str | None,
+) -> Conversion:
     """The request's description converted in a bounded child process (`converters.serving.served`):
     whatever the description holds, the world keeps stepping and answering, and a conversion
     over `TWIN_CONVERT_TIMEOUT` / `TWIN_CONVERT_MEMORY` is stopped with what it was doing.
 
     Args:
         source: the file, or a name for a text.
+        served: how it is served (deferred CoACD, extra time, a cancel event); None: as given.
         given: `path=` a file, or `text=` and `base_dir=` a description sent as text.
     """
     from converters.isolated.budget import XacroBudget
     from converters.serving.served import ConversionJob, convert_served
 
+    served = served or Served()
     job = ConversionJob(
         source,
         args=tuple(sorted(request.args.items())),
         package_paths=tuple((k, str(v)) for k, v in sorted(request.package_paths.items())),
-        options=convert_options(request),
+        options=convert_options(request, defer=served.defer),
         env=resolving_env(request),
         read_roots=request.read_roots,
         **given,
     )
-    return convert_served(job, XacroBudget.from_env())
+    budget = XacroBudget.from_env()
+    budget = replace(budget, timeout_s=budget.timeout_s + served.extra_s)
+    return convert_served(job, budget, served.cancel)
 
 
 def resolving_env(request: SpawnRequest) -> dict[str, str] | None:
@@ -267,16 +295,27 @@ def strip_scene(spec: mujoco.MjSpec, label: str) -> str | None:
     )
 
 
-def _load_description(path: Path, request: SpawnRequest) -> LoadedSource:
-    """A converted file, from the conversion cache when no file it read has changed."""
-    from twin_cli.world.conversion_cache import CACHE, cache_key
+def _load_description(path: Path, request: SpawnRequest, defer: bool) -> LoadedSource:
+    """A converted file, from the conversion cache when no file it read has changed; with
+    `defer` in a world server, its CoACD meshes left for the background (`decomposing`)."""
+    from converters.isolated import bounded
+    from twin_cli.world.conversion_cache import CACHE, cache_key, deferred_keys
+    from twin_cli.world.values import deferred_meshes
 
     key = cache_key(path, request, resolving_env(request))
-    return CACHE.load(key, lambda: _convert_description(path, request))
+    defer = defer and bounded.enabled()
+    served = Served(defer=defer)
+    loaded = CACHE.load(key, lambda: convert_description(path, request, served))
+    if not (defer and deferred_meshes(loaded.report)):
+        return loaded
+    return replace(loaded, deferred=True, mesh_keys=deferred_keys(loaded))
 
 
-def _convert_description(path: Path, request: SpawnRequest) -> LoadedSource:
-    done = convert_bounded(request, source=str(path), path=str(path))
+def convert_description(
+    path: Path, request: SpawnRequest, served: Served | None = None
+) -> LoadedSource:
+    """The file converted in a bounded child (`convert_bounded`, as `served` says)."""
+    done = convert_bounded(request, source=str(path), served=served, path=str(path))
     spec, report = done.spec, done.report
     servos.carry_exported_servos(spec)  # cached with its servos: a later spawn pays nothing
     name = report.robot or own_name(spec) or path.name.split(".")[0]

@@ -16,7 +16,7 @@ import numpy as np
 
 from twin_cli.errors import EntityExistsError, InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest, as_request
-from twin_cli.world import placement, posture, shared_meshes, spawn
+from twin_cli.world import decomposing, placement, posture, shared_meshes, spawn
 from twin_cli.world.entities import Entity, EntityState, index_entities, rest_state, write_state
 from twin_cli.world.plugin_holds import hold_from_load
 from twin_cli.world.pose import Pose, check_finite
@@ -117,7 +117,8 @@ def spawn_one(
     the robot's own name is used, with `_1`, `_2`, … when taken. The entity starts at rest
     in its own initial configuration (its `home` key if it has one) with the request's
     `joints` written over it; mimic followers follow their leaders. That start is its spawn
-    state (what `reset` returns to). Returns once the entity is in the world.
+    state (what `reset` returns to). Returns once the entity is in the world; in a world server,
+    convex hulls may stand in for collision meshes still decomposing (`decomposing`).
 
     Raises:
         EntityExistsError: `name` is taken. SpawnError: unreadable source or compile error.
@@ -129,10 +130,12 @@ def spawn_one(
     request = as_request(request)
     if name is not None:
         spawn.check_entity_name(name)
-    loaded = spawn.load_source(request)
+    loaded = spawn.load_source(request, defer=True)
     with state.lock:
         name = name or free_name(state, safe_base(loaded.default_name))
-        return _spawn_loaded(state, [loaded], request, [name], [pose])[0]
+        result = _spawn_loaded(state, [loaded], request, [name], [pose])[0]
+        decomposing.start(state, loaded, request, [name])
+        return result
 
 
 def spawn_batch(
@@ -154,10 +157,13 @@ def spawn_batch(
         names = batch_names(spawn.check_entity_name(base), len(poses))
     if names is not None:
         check_batch(list(names), poses, list(state.entities))
-    loaded = spawn.load_source(request)
+    loaded = spawn.load_source(request, defer=True)
     names = list(names or batch_names(safe_base(loaded.default_name), len(poses)))
     copies = [replace(loaded, spec=loaded.spec.copy()) for _ in poses]
-    return _spawn_loaded(state, copies, request, names, poses)
+    with state.lock:
+        results = _spawn_loaded(state, copies, request, names, poses)
+        decomposing.start(state, loaded, request, names)
+        return results
 
 
 def spawn_specs(

@@ -21,6 +21,7 @@ from twin_cli.world.observers import Observers
 if TYPE_CHECKING:
     from converters.description import Light
     from twin_cli.world.actuation import JointCommand, Push
+    from twin_cli.world.decomposing import Decomposition
     from twin_cli.world.divergence import Divergence, SpeedBounds
     from twin_cli.world.entities import Entity, EntityIndex
     from twin_cli.world.loop import WorldLock
@@ -56,6 +57,8 @@ class WorldState:
         kept_specs: entity name → its spec as prepared for attaching, and its mesh keys.
         deletes_since_renewal, spec_renewals, spec_renewals_refused: spec renewal counters.
         file_notes: what a world file held that twin does not simulate.
+        decompositions: entity name → the background decomposition of its collision meshes
+            (`decomposing`), pending or finished; absent when it had none.
     """
 
     name: str
@@ -87,6 +90,7 @@ class WorldState:
     spec_renewals: int = 0
     spec_renewals_refused: int = 0
     file_notes: tuple[str, ...] = ()
+    decompositions: dict[str, Decomposition] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.scratch_state = np.empty(mujoco.mj_stateSize(self.model, STATE))

@@ -57,14 +57,16 @@ class SpawnResult:
 @dataclass(frozen=True)
 class EntityInfo:
     """One line of the entity list: name, source file, root position [m], joints (no free),
-    and the collision meshes whose convex hull stands in for their decomposition
-    (`hull_stand_ins`)."""
+    the collision meshes whose convex hull stands in for their decomposition
+    (`hull_stand_ins`), and where the background decomposition of its meshes is
+    (`decomposing`: "pending", "done", "failed" (the hulls stay), or None: it had none)."""
 
     name: str
     source: str
     position: tuple[float, float, float]
     n_joints: int
     hull_stand_ins: tuple[str, ...] = ()
+    decomposition: str | None = None
 
 
 def hull_stand_ins(report: dict | None) -> tuple[str, ...]:
@@ -76,6 +78,16 @@ def hull_stand_ins(report: dict | None) -> tuple[str, ...]:
         for row in rows
         if row.get("fallback")
     )
+
+
+DEFERRED_STOP = "deferred"  # a report row's `stopped` when CoACD was left for the background
+
+
+def deferred_meshes(report: dict | None) -> tuple[str, ...]:
+    """The keys of a converter report's collision meshes whose decomposition was left for the
+    background (`CollisionSettings.defer`)."""
+    rows = (report or {}).get("meshes", [])
+    return tuple(row["key"] for row in rows if row.get("stopped") == DEFERRED_STOP)
 
 
 @dataclass(frozen=True)

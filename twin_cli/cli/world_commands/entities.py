@@ -44,8 +44,11 @@ def list_(*, world: str, json: bool) -> None:
         return
     out.table(
         "entities",
-        ["name", "x", "y", "z", "joints", "source", "hull stand-ins"],
-        [[e["name"], *e["position"], e["n_joints"], e["source"], _stand_ins(e)] for e in rows],
+        ["name", "x", "y", "z", "joints", "source", "hull stand-ins", "decomposition"],
+        [
+            [e["name"], *e["position"], e["n_joints"], e["source"], _stand_ins(e), _state(e)]
+            for e in rows
+        ],
     )
     for e in rows:
         for mesh in e.get("hull_stand_ins", []):
@@ -57,6 +60,15 @@ def _stand_ins(entity: dict) -> str:
     decomposition ("-" for none); an older server sends no such field."""
     count = len(entity.get("hull_stand_ins", []))
     return str(count) if count else "-"
+
+
+DECOMPOSITION_STATES = {"pending": "pending", "done": "done", "failed": "failed (hull kept)"}
+
+
+def _state(entity: dict) -> str:
+    """Where the background decomposition of an entity's collision meshes is ("-": it had
+    none, or an older server)."""
+    return DECOMPOSITION_STATES.get(entity.get("decomposition") or "", "-")
 
 
 @command(

@@ -1,0 +1,49 @@
+"""A concave static bin (an open-topped box) as a mesh and a URDF, built from formulas: what a
+ball must rest on when its collision geometry is decomposed (the floor) or a hull (the rim)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+# Bin: an open-topped box, outer 300 x 300 x 200 mm, walls and floor 20 mm, centred on its
+# bounding box (floor top at BIN_FLOOR - BIN_OUTER[2] / 2 in the mesh frame) [m].
+BIN_OUTER = (0.30, 0.30, 0.20)
+BIN_WALL = 0.02
+BIN_FLOOR = 0.02
+
+
+def bin_mesh() -> tuple[np.ndarray, np.ndarray]:
+    """The closed bin (box minus its cavity, 28 triangles); (vertices [m], faces)."""
+    import trimesh
+
+    outer = trimesh.creation.box(BIN_OUTER)
+    cavity = trimesh.creation.box(
+        (BIN_OUTER[0] - 2 * BIN_WALL, BIN_OUTER[1] - 2 * BIN_WALL, BIN_OUTER[2])
+    )
+    cavity.apply_translation((0.0, 0.0, BIN_FLOOR))
+    mesh = outer.difference(cavity)
+    return np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64)
+
+
+def bin_urdf(directory, *, name: str = "bin") -> str:
+    """A static URDF (welded to `world`, bottom on z = 0) whose one link is the bin mesh, written
+    with its STL into `directory`; returns the URDF's path."""
+    import trimesh
+
+    trimesh.Trimesh(*bin_mesh(), process=False).export(directory / f"{name}.stl")
+    lift = BIN_OUTER[2] / 2
+    (directory / f"{name}.urdf").write_text(
+        f"""<robot name="{name}">
+  <link name="world"/>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="bin"/>
+    <origin xyz="0 0 {lift}"/></joint>
+  <link name="bin">
+    <inertial><mass value="2.0"/>
+      <inertia ixx="0.02" iyy="0.02" izz="0.03" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="{name}.stl"/></geometry></visual>
+    <collision><geometry><mesh filename="{name}.stl"/></geometry></collision>
+  </link>
+</robot>
+"""
+    )
+    return str(directory / f"{name}.urdf")
