@@ -155,7 +155,7 @@ def swap(state: WorldState, names: Sequence[str], loaded: spawn.LoadedSource) ->
     fresh = respec.fresh_spec(state, children)
     if fresh is None:
         raise ValueError("the world spec cannot be rebuilt")
-    built = rebuild(state, fresh, (), loaded.source)
+    built = rebuild(state, fresh, (), loaded.source, from_scratch=True)
     _check_layout(state, built[2], names)
     commit(state, fresh, built)
     for name in names:

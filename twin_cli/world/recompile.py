@@ -29,16 +29,32 @@ from twin_cli.world.state import STATE, WorldState
 Built = tuple[mujoco.MjModel, mujoco.MjData, dict[str, EntityIndex]]
 
 
-def rebuild(state: WorldState, trial: mujoco.MjSpec, new: Sequence[str], source: str) -> Built:
+def rebuild(
+    state: WorldState,
+    trial: mujoco.MjSpec,
+    new: Sequence[str],
+    source: str,
+    *,
+    from_scratch: bool = False,
+) -> Built:
     """Compiles `trial` into a new model and data carrying every existing entity's state;
     `new`: the entities being added (indexed too, and named if the compile fails).
+
+    `from_scratch`: `trial` was built anew (`respec.fresh_spec`), not copied from the world's
+    spec. MuJoCo's recompile carries state through the ids of the spec's last compile, which a
+    new spec never had (it read past the old arrays and crashed); such a spec is compiled on
+    its own and every entity's state moved by name, which is all the state a world has.
 
     Raises:
         SpawnError: the spec does not compile; the world is unchanged.
     """
     add_friction_pairs(trial)  # mu1/mu2 pairs with the world's geoms as they now are
     try:
-        model, data = trial.recompile(state.model, state.data)
+        if from_scratch:
+            model = trial.compile()
+            data = mujoco.MjData(model)
+        else:
+            model, data = trial.recompile(state.model, state.data)
     except (ValueError, RuntimeError) as exc:
         raise SpawnError(
             ", ".join(new) or "world",
