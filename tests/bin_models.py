@@ -1,7 +1,10 @@
 """A concave static bin (an open-topped box) as a mesh and a URDF, built from formulas: what a
-ball must rest on when its collision geometry is decomposed (the floor) or a hull (the rim)."""
+ball must rest on when its collision geometry is decomposed (the floor) or a hull (the rim);
+and that ball."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 
@@ -10,6 +13,7 @@ import numpy as np
 BIN_OUTER = (0.30, 0.30, 0.20)
 BIN_WALL = 0.02
 BIN_FLOOR = 0.02
+BALL_RADIUS = 0.03  # [m]
 
 
 def bin_mesh() -> tuple[np.ndarray, np.ndarray]:
@@ -47,3 +51,18 @@ def bin_urdf(directory, *, name: str = "bin") -> str:
 """
     )
     return str(directory / f"{name}.urdf")
+
+
+def ball_urdf(directory: Path) -> str:
+    """A 50 g solid ball of BALL_RADIUS as a URDF in `directory`; its path."""
+    mass = 0.05  # [kg]
+    inertia = 0.4 * mass * BALL_RADIUS**2  # solid sphere, 2/5 m r^2 [kg m^2]
+    (directory / "ball.urdf").write_text(
+        f"""<robot name="ball"><link name="ball">
+  <inertial><mass value="{mass}"/>
+    <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><sphere radius="{BALL_RADIUS}"/></geometry></collision>
+</link></robot>
+"""
+    )
+    return str(directory / "ball.urdf")

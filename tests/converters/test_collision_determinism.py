@@ -14,7 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
-from collision_models import BIN_FLOOR, BIN_OUTER, bin_urdf
+from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
 
 from converters.collision.plan import CollisionSettings
 
@@ -28,7 +28,6 @@ LOAD_SEARCH = {"preset": "fast", "threshold": 0.2}
 # machine the loaded run took 2.5 s.
 LOAD_CPU_LIMIT = 3.5
 BUSY_LOOPS = 2  # one per core of a 2-core machine
-BALL_RADIUS = 0.03  # [m]
 FLOOR_TOL = 0.010  # [m] ball rest height on the decomposed floor
 HULL_TOL = 0.002  # [m] ball rest height on the hull's top (a plane at the rim)
 
@@ -83,20 +82,6 @@ def test_bin_converted_idle_and_beside_busy_loops_is_byte_identical(tmp_path):
     )
 
 
-def _ball_urdf(directory: Path) -> str:
-    mass = 0.05  # [kg]
-    inertia = 0.4 * mass * BALL_RADIUS**2  # solid sphere, 2/5 m r^2 [kg m^2]
-    (directory / "ball.urdf").write_text(
-        f"""<robot name="ball"><link name="ball">
-  <inertial><mass value="{mass}"/>
-    <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/></inertial>
-  <collision><geometry><sphere radius="{BALL_RADIUS}"/></geometry></collision>
-</link></robot>
-"""
-    )
-    return str(directory / "ball.urdf")
-
-
 def _rest_height(urdf: str, ball: str, cpu_limit: float) -> tuple[float, tuple[str, ...]]:
     """Spawn the bin (default auto plan, `cpu_limit` [CPU s]) and drop the ball into its middle
     from 0.35 m; after 1.5 s return (ball centre height [m], the bin's hull stand-ins)."""
@@ -113,7 +98,7 @@ def _rest_height(urdf: str, ball: str, cpu_limit: float) -> tuple[float, tuple[s
 
 
 def test_ball_rests_on_the_bin_floor_and_on_the_hull_that_stands_in_for_it(tmp_path):
-    urdf, ball = bin_urdf(tmp_path), _ball_urdf(tmp_path)
+    urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
     # First a budget CoACD cannot finish in: the hull stands in, `twin list` says so, and the
     # ball rests on the hull's top (the rim plane). Then a budget it fits: the stand-in is not
     # reused, and the ball rests on the floor.

@@ -13,10 +13,9 @@ import time
 from pathlib import Path
 
 import pytest
-from bin_models import BIN_FLOOR, BIN_OUTER, bin_urdf
+from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
 from cli_world import twin_ok
 
-BALL_RADIUS = 0.03  # [m]
 DROP_Z = 0.35  # [m] the ball's centre at spawn, above the bin's rim (0.20 m)
 SETTLE_STEPS = 1500  # 1.5 s at the default 1 ms step: the ball falls 0.3 m and settles
 FLOOR_TOL = 0.010  # [m] ball rest height on the decomposed floor (the issue's ±10 mm)
@@ -30,20 +29,6 @@ WORKER = "converters.collision.worker"  # a CoACD worker process's command line
 def _private_cache(tmp_path, monkeypatch):
     """An empty collision cache for the server (it inherits this environment)."""
     monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
-
-
-def _ball_urdf(directory: Path) -> str:
-    mass = 0.05  # [kg]
-    inertia = 0.4 * mass * BALL_RADIUS**2  # solid sphere, 2/5 m r^2 [kg m^2]
-    (directory / "ball.urdf").write_text(
-        f"""<robot name="ball"><link name="ball">
-  <inertial><mass value="{mass}"/>
-    <inertia ixx="{inertia}" iyy="{inertia}" izz="{inertia}" ixy="0" ixz="0" iyz="0"/></inertial>
-  <collision><geometry><sphere radius="{BALL_RADIUS}"/></geometry></collision>
-</link></robot>
-"""
-    )
-    return str(directory / "ball.urdf")
 
 
 def _listed(runtime: Path, world: str) -> dict[str, dict]:
@@ -82,7 +67,7 @@ def _wait_while_pending(runtime: Path, world: str, name: str, client) -> tuple[d
 
 def test_a_served_bin_holds_the_ball_on_its_hull_then_on_its_floor(tmp_path, serve_world):
     world, runtime = "decomposing", tmp_path / "run"
-    urdf, ball = bin_urdf(tmp_path), _ball_urdf(tmp_path)
+    urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
     with serve_world(runtime, world) as (client, _):
         twin_ok(runtime, world, "pause")
         twin_ok(runtime, world, "spawn", ball, "--name", "ball", "-z", str(DROP_Z))
@@ -119,7 +104,7 @@ def test_a_served_bin_holds_the_ball_on_its_hull_then_on_its_floor(tmp_path, ser
 
 def test_a_failed_decomposition_keeps_the_hull_and_says_why(tmp_path, serve_world):
     world, runtime = "decomposing-fails", tmp_path / "run"
-    urdf, ball = bin_urdf(tmp_path), _ball_urdf(tmp_path)
+    urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
     with serve_world(runtime, world, "--coacd-cpu-limit", "0.2") as (client, _):
         twin_ok(runtime, world, "spawn", urdf, "--name", "bin")
         failed, _ = _wait_while_pending(runtime, world, "bin", client)
