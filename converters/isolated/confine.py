@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import site
 import sys
+import sysconfig
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -26,17 +27,20 @@ _ROOTS: ContextVar[tuple[tuple[str, ...], tuple[str, ...]] | None] = ContextVar(
     "converters_read_roots", default=None
 )  # (the folders given, all folders allowed)
 _WRITE_MODES = ("w", "a", "x", "+")
-# What the interpreter and the libraries read for themselves while converting (CPU counts).
-_SYSTEM = ("/proc/self/", "/sys/devices/system/cpu/", "/dev/null", "/dev/urandom")
+# What the libraries may read for themselves while converting (CPU counts), as real paths:
+# never `/proc/self/`, whose `root` and `cwd` links lead anywhere.
+_SYSTEM_FILES = ("/dev/null", "/dev/urandom")
+_SYSTEM_FOLDERS = ("/sys/devices/system/cpu/",)
 _installed: list[bool] = []
 
 
 @contextmanager
 def confined(roots: Sequence[str], also: Sequence[str] = ()) -> Iterator[None]:
     """Refuse, in this thread (or task) meanwhile, reading any file outside `roots` (besides
-    Python's own installation and the folders `also` names, such as a cache), with an
-    `OutsideRootsError` naming the file and `roots`: not an OSError, so no reader takes it
-    for a broken file and carries on."""
+    Python's standard library and site folders, the `converters` package and the folders
+    `also` names, such as a cache), with an `OutsideRootsError` naming the file and `roots`:
+    not an OSError, so no reader takes it for a broken file and carries on. Writes are not
+    watched: a conversion writes only its own cache, at paths no request names."""
     if not _installed:
         sys.addaudithook(_hook)
         _installed.append(True)
@@ -55,6 +59,8 @@ def inside(path: str | os.PathLike, roots: Sequence[str]) -> bool:
 
 
 def _hook(event: str, args: tuple) -> None:
+    """Raise `OutsideRootsError` for a read outside the current thread's folders; links and
+    `..` are resolved before the comparison."""
     if event not in ("open", READ_EVENT):
         return
     folders = _ROOTS.get()
@@ -66,9 +72,9 @@ def _hook(event: str, args: tuple) -> None:
     if isinstance(mode, int) and mode & (os.O_WRONLY | os.O_RDWR):
         return
     name = os.fsdecode(args[0])
-    if name.startswith(_SYSTEM):
-        return
     real = os.path.realpath(name)
+    if real in _SYSTEM_FILES or real.startswith(_SYSTEM_FOLDERS):
+        return
     if not any(real.startswith(r) for r in folders[1]):
         raise OutsideRootsError(name, folders[0])
 
@@ -78,9 +84,11 @@ def _folder(path: str | os.PathLike) -> str:
 
 
 def _own_folders() -> tuple[str, ...]:
-    """Python's installation, the site folders and the folder holding `converters` (its code
-    is imported lazily while converting)."""
-    folders = {sys.prefix, sys.base_prefix, sys.exec_prefix, site.getusersitepackages()}
-    folders |= set(site.getsitepackages())
-    folders.add(str(Path(__file__).resolve().parents[2]))
+    """Where the code a conversion imports lazily lives: Python's standard library, the site
+    folders and the `converters` package itself (not the folder above it, which in a checkout
+    is the whole repository)."""
+    paths = sysconfig.get_paths()
+    folders = {paths[k] for k in ("stdlib", "platstdlib", "purelib", "platlib") if k in paths}
+    folders |= set(site.getsitepackages()) | {site.getusersitepackages()}
+    folders.add(str(Path(__file__).resolve().parents[1]))
     return tuple(_folder(f) for f in folders)

@@ -189,7 +189,10 @@ def _from_config(ctx: SdfContext, include: Any, directory: Path) -> Path:
     config = directory / "model.config"
     if config.is_file():
         try:
-            files = etree.parse(str(config)).getroot().findall("sdf")
+            with open(config, "rb") as handle:  # Python's open: what confinement watches
+                text = handle.read()
+            parser = etree.XMLParser(resolve_entities=False, no_network=True)
+            files = etree.fromstring(text, parser).findall("sdf")
         except etree.XMLSyntaxError as exc:
             raise ctx.error(include, f"{config} is not valid XML ({exc.msg})", "fix it") from exc
         ranked = sorted(files, key=lambda f: version_tuple(f.get("version") or "0.0"), reverse=True)

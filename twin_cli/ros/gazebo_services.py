@@ -46,8 +46,7 @@ Vector = tuple[float, float, float]
 def spawn(world: World, request: Any) -> dict[str, Any]:
     try:
         pose = pose_in_world(world, request.initial_pose, request.reference_frame)
-        asked = SpawnRequest(xml=request.xml, read_roots=package_roots()).absolute()
-        result = world.spawn(asked, name=request.name or None, pose=pose)
+        result = world.spawn(peer_text(request.xml), name=request.name or None, pose=pose)
     except (TwinError, ConversionError) as exc:
         return {"success": False, "status_message": str(exc)}
     except Exception as exc:  # a caller must always get its answer
@@ -55,6 +54,14 @@ def spawn(world: World, request: Any) -> dict[str, Any]:
         return {"success": False, "status_message": f"spawn failed: {exc}"}
     log.info("spawned %s (/spawn_entity)", result.name)
     return {"success": True, "status_message": f"spawned entity [{result.name}]"}
+
+
+def peer_text(text: str) -> SpawnRequest:
+    """A DDS peer's description text as a spawn request confined to the world's package and
+    model paths; its relative paths start at the first of them (the server's own folder is not
+    the peer's, and may hold anything), or at `/` when there are none."""
+    roots = package_roots()
+    return SpawnRequest(xml=text, base_dir=roots[0] if roots else "/", read_roots=roots)
 
 
 def delete(world: World, request: Any) -> dict[str, Any]:

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 from converters.errors import ConversionError
 from twin_cli.errors import InvalidRequestError, TwinError
 from twin_cli.files.package_env import package_roots
-from twin_cli.ros.gazebo_services import pose_in_world
+from twin_cli.ros.gazebo_services import peer_text, pose_in_world
 from twin_cli.spawn_request import SpawnRequest
 
 if TYPE_CHECKING:
@@ -118,16 +118,15 @@ def _source(world: World, factory: Any) -> SpawnRequest:
             "entity_factory", f"sets {', '.join(given) or 'none'} of sdf, sdf_filename and "
             "clone_name", "set exactly one",
         )  # fmt: skip
-    roots = package_roots()  # a peer reads through the world's package and model paths only
     if factory.sdf:
-        return SpawnRequest(xml=factory.sdf, read_roots=roots).absolute()
+        return peer_text(factory.sdf)
     if factory.sdf_filename:
         if not Path(factory.sdf_filename).is_absolute():
             raise InvalidRequestError(
                 f"sdf_filename [{factory.sdf_filename}]", "is relative",
                 "give an absolute path: the server's folder is not the caller's",
             )  # fmt: skip
-        return SpawnRequest(factory.sdf_filename, read_roots=roots)
+        return SpawnRequest(factory.sdf_filename, read_roots=package_roots())
     return replace(world.entity(factory.clone_name).request)
 
 

@@ -256,9 +256,18 @@ def test_pause_unpause_and_resets_act_as_gazebos(served: Path) -> None:
 MJCF = '<mujoco model="m"><worldbody><body><geom size="0.1"/></body></worldbody></mujoco>'
 
 
-def _mesh_urdf(name: str, mesh: Path) -> str:
+def _mesh_urdf(name: str, mesh: Path | str) -> str:
+    """The cube with a mesh: a path as a file:// URI, a string as it is written."""
+    filename = f"file://{mesh}" if isinstance(mesh, Path) else mesh
     return URDF.replace('name="cube"', f'name="{name}"').replace(
-        '<box size="0.2 0.2 0.2"/>', f'<mesh filename="file://{mesh}"/>'
+        '<box size="0.2 0.2 0.2"/>', f'<mesh filename="{filename}"/>'
+    )
+
+
+def _include_sdf(directory: Path) -> str:
+    return (
+        f'<sdf version="1.9"><model name="peek"><include><uri>file://{directory}</uri>'
+        "</include></model></sdf>"
     )
 
 
@@ -284,14 +293,24 @@ def _write_box_stl(path: Path) -> Path:
 def test_a_peers_spawn_reads_only_the_worlds_package_and_model_paths(served: Path) -> None:
     """A DDS peer is not the server's user: its spawns (gazebo_ros' and ros_gz's) read files
     only under the world's package and model paths (here GZ_SIM_RESOURCE_PATH); a file or mesh
-    elsewhere, a link out of the path, or MJCF (which MuJoCo would read unwatched) is refused
-    with the reason, and the world is left as it was. The server's own user spawns them all."""
+    elsewhere, a link out of the path (`/proc/self/root` too), a model folder outside whose
+    model.config names a file inside, or MJCF (which MuJoCo would read unwatched) is refused
+    with the reason, and the world is left as it was; relative paths start at the first model
+    path, not the server's folder. The server's own user spawns them all."""
     root = served
-    inside = _write_box_stl(root / "models" / "crate" / "box.stl")
+    _write_box_stl(root / "models" / "crate" / "box.stl")
     secret = _write_box_stl(root / "private" / "secret.stl")
     (root / "private" / "bot.urdf").write_text(_mesh_urdf("bot", secret))
     (root / "models" / "link.urdf").symlink_to(root / "private" / "bot.urdf")
-    assert _create(root, name="crate", sdf=_mesh_urdf("crate", inside), pose=_pose(0, 9, 1))
+    (root / "models" / "box.sdf").write_text(BOX)
+    outside_model = root / "private" / "model"
+    outside_model.mkdir()
+    (outside_model / "model.config").write_text(
+        f'<model><name>m</name><sdf version="1.9">{root / "models" / "box.sdf"}</sdf></model>'
+    )
+    assert _create(
+        root, name="crate", sdf=_mesh_urdf("crate", "crate/box.stl"), pose=_pose(0, 9, 1)
+    )
     before = _names(root)
     spawn = {"name": "peek", "xml": _mesh_urdf("peek", secret), "pose": _pose(0, 8, 1)}
     refused = _call(root, "/spawn_entity", "spawn", spawn)
@@ -300,6 +319,9 @@ def test_a_peers_spawn_reads_only_the_worlds_package_and_model_paths(served: Pat
     assert str(secret) in message and "outside" in message and "GZ_SIM_RESOURCE_PATH" in message
     for bad in (
         {"sdf": _mesh_urdf("peek", secret)},  # a mesh outside
+        {"sdf": _mesh_urdf("peek", f"file:///proc/self/root{secret}")},  # through /proc
+        {"sdf": _mesh_urdf("peek", "../private/secret.stl")},  # relative, out of the path
+        {"sdf": _include_sdf(outside_model)},  # its model.config is outside
         {"sdf_filename": str(root / "private" / "bot.urdf")},  # a file outside
         {"sdf_filename": str(root / "models" / "link.urdf")},  # a link to one
         {"sdf": MJCF},
