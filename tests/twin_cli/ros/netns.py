@@ -17,6 +17,19 @@ import subprocess
 import time
 from collections.abc import Sequence
 
+# What decides a ROS 2 participant's reach: a test's namespace starts without the runner's.
+SCOPE_VARIABLES = (
+    "ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY",
+    "ROS_DISTRO", "CYCLONEDDS_URI", "FASTRTPS_DEFAULT_PROFILES_FILE", "RMW_IMPLEMENTATION",
+    "TWIN_WORLD",
+)  # fmt: skip
+
+
+def clean_env() -> dict[str, str]:
+    """This process's environment without SCOPE_VARIABLES."""
+    return {k: v for k, v in os.environ.items() if k not in SCOPE_VARIABLES}
+
+
 SETUP_TIMEOUT_S = 10.0  # [s] for `unshare` to leave this namespace
 LAN_ADDRESS = "10.77.0.1"  # eth0's address: a private network no test machine is on
 SETUP_LO = (

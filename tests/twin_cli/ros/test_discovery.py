@@ -36,11 +36,6 @@ pytestmark = pytest.mark.xdist_group("ros_discovery")
 HERE = Path(__file__).parent
 ROOT = HERE.parents[2]
 WORLD = "discovery"
-SCOPE_VARIABLES = (
-    "ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY",
-    "ROS_DISTRO", "CYCLONEDDS_URI", "FASTRTPS_DEFAULT_PROFILES_FILE", "RMW_IMPLEMENTATION",
-    "TWIN_WORLD",
-)  # fmt: skip
 SESSION_S = 2.5  # [s] each peer listens and drives
 VX = 0.3  # [m/s] the peer's Twist
 MIN_CLOCK = 50  # /clock samples in SESSION_S: 100 Hz of sim time in real time sends ~250, and
@@ -77,7 +72,7 @@ def _fastdds_python() -> str | None:
 
 
 def _env(variables: dict[str, str], **extra: str) -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if k not in SCOPE_VARIABLES}
+    env = netns.clean_env()
     return {**env, **variables, **extra}
 
 

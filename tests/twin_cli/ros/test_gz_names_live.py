@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 import time
 from collections.abc import Iterator
@@ -32,10 +31,6 @@ HERE = Path(__file__).parent
 ROOT = HERE.parents[2]
 
 WORLD = "gz_names"
-SCOPE_VARIABLES = (
-    "ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY",
-    "ROS_DISTRO", "CYCLONEDDS_URI", "TWIN_WORLD",
-)  # fmt: skip
 CMD_VEL, ODOMETRY, TF = (f"/model/vehicle_blue/{leaf}" for leaf in ("cmd_vel", "odometry", "tf"))
 VX, WZ = 0.2, 0.5  # [m/s, rad/s] the peer's Twist
 STEPS = 2000  # 2 s of sim time at the SDF default step, 1 ms
@@ -46,7 +41,7 @@ class Served:
     """`twin` commands and peer scripts run inside the namespace against its served world."""
 
     def __init__(self, ns: netns.Namespace, runtime: Path) -> None:
-        env = {k: v for k, v in os.environ.items() if k not in SCOPE_VARIABLES}
+        env = netns.clean_env()
         self.ns, self.env = ns, {**env, "TWIN_RUNTIME_DIR": str(runtime)}
 
     def __call__(self, *args: str) -> str:
