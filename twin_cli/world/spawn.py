@@ -235,8 +235,10 @@ def _check_confined(request: SpawnRequest) -> None:
     MuJoCo's own reader would open in this process unwatched.
 
     Raises:
-        SpawnError: it does not.
+        OutsideRootsError: the file is elsewhere.
+        SpawnError: it is MJCF.
     """
+    from converters.errors import OutsideRootsError
     from converters.formats import format_of
     from converters.isolated.confine import inside
 
@@ -244,11 +246,7 @@ def _check_confined(request: SpawnRequest) -> None:
     if isinstance(request.source, (str, Path)):
         path = Path(request.source)
         if not path.is_absolute() or not inside(path, roots):
-            raise SpawnError(
-                path.stem, str(path), "is outside the world's package and model paths",
-                f"a spawn over DDS reads only there ({_roots_text(roots)}); put the file on "
-                "GZ_SIM_RESOURCE_PATH or ROS_PACKAGE_PATH before `twin serve`, or use `twin spawn`",
-            )  # fmt: skip
+            raise OutsideRootsError(str(path), roots)  # as the conversion's own reads are
         if path.name.lower().endswith(MJCF_SUFFIXES) or _sniff(path) == "mjcf":
             raise SpawnError(path.stem, str(path), "is MJCF", CONFINED_FORMATS)
     elif request.xml is not None and format_of(request.xml) == "mjcf":
@@ -256,11 +254,6 @@ def _check_confined(request: SpawnRequest) -> None:
 
 
 CONFINED_FORMATS = "a spawn over DDS takes URDF or SDF, as Gazebo's services do; use `twin spawn`"
-
-
-def _roots_text(roots: tuple[str, ...], shown: int = 4) -> str:
-    listed = ", ".join(roots[:shown]) or "none: the server started without package paths"
-    return listed + (f" and {len(roots) - shown} more" if len(roots) > shown else "")
 
 
 def _load_mjcf(path: Path) -> LoadedSource:
