@@ -117,6 +117,32 @@ def test_a_placement_frame_the_model_lacks_is_one_error_naming_its_frames(tmp_pa
         world_from_sdf(path)
 
 
+@pytest.mark.parametrize(
+    "request_pose", [(0, 0, 0, 0, 0, 0), (2, -1, 0.5, 0, 0, HALF_PI), (-3, 4, 1, 0.3, -0.2, 2.5)]
+)
+def test_a_spawned_model_file_puts_its_model_frame_at_the_request_pose(
+    tmp_path, request_pose
+) -> None:
+    """gz-sim's create service sets a spawned model's pose to the request's, which replaces both
+    the file's own `<pose>` and the pose its `placement_frame` would give (libsdformat applies
+    that frame only where a world or model places the file: the include case above). `twin
+    spawn` always sends a pose (0 by default), as ros_gz_sim's create does."""
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import Pose, World
+
+    path = tmp_path / "stand.sdf"
+    path.write_text(STAND.replace('<model name="stand">', '<model name="stand" '
+                    'placement_frame="mark"><pose>7 0 3 0 0 1</pose>'))  # fmt: skip
+    world = World()
+    world.spawn(SpawnRequest(source=str(path)), name="s", pose=Pose(*request_pose))
+    where = X(*request_pose)
+    # body (0, 0, 0.5) and foot (0.1, 0, 0) turned 180° in the model frame, from STAND.
+    _assert_links(
+        world_link_poses(world),
+        {"s/body": where @ X(0, 0, 0.5), "s/foot": where @ X(0.1, 0, 0, 0, 0, PI)},
+    )
+
+
 # --- placement frames, libsdformat's own test world ---------------------------------------
 def _frames_model() -> dict[str, np.ndarray]:
     """Each frame of test_model_with_frames in its model frame, from the file's numbers."""
