@@ -171,6 +171,43 @@ def _blank(match: re.Match) -> str:
     return "\n" * match.group(0).count("\n")
 
 
+def _parse_as_tinyxml(text: str, source: str, first: Exception) -> Any:
+    """`text` parsed as sdformat's tinyxml2 reads it, which knows nothing of XML namespaces: a
+    prefix nobody declared (`<gz:policies>`, `gz:expressed_in=`, gz-sim's own example worlds)
+    or a name such as `gz::system_priority` is a plain name there. libxml2 reports those as
+    namespace errors and, recovering, keeps the name as written; any other error is refused.
+
+    Raises:
+        MalformedXMLError: an error tinyxml2 refuses too (the first one, at its line).
+    """
+    from lxml import etree
+
+    parser = etree.XMLParser(
+        remove_comments=True, resolve_entities=False, no_network=True, recover=True
+    )
+    try:
+        root = etree.fromstring(text.encode(), parser)
+    except etree.XMLSyntaxError as real:
+        line, column = real.position
+        raise MalformedXMLError(source, line, column, real.msg) from first
+    errors = [e for e in parser.error_log if e.domain_name != "NAMESPACE"]
+    if root is None or errors:
+        error = errors[0] if errors else parser.error_log.last_error
+        line, column = (error.line, error.column) if error is not None else (1, 0)
+        raise MalformedXMLError(source, line, column, error.message if error else "empty")
+    return root
+
+
+def _name_custom_parts(root: Any) -> None:
+    """Elements in a default namespace (no prefix) get their plain name. A prefixed element
+    keeps its qualified name (`{uri}name`, or `gz:name` when the prefix was never declared),
+    so no reader takes a custom element (`<gz:link>`) for an SDFormat one: libsdformat copies
+    custom elements and never reads them."""
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith("{") and not element.prefix:
+            element.tag = element.tag.split("}", 1)[1]
+
+
 def parse_document(text: str, source: str) -> Any:
     """The `<sdf>` root element of `text`, with line numbers; namespaces stripped.
 
@@ -184,14 +221,8 @@ def parse_document(text: str, source: str) -> Any:
     try:
         root = etree.fromstring(text.encode(), parser)
     except etree.XMLSyntaxError as exc:
-        try:  # what sdformat's tinyxml2 accepts and a strict parser does not
-            root = etree.fromstring(_as_tinyxml_reads(text).encode(), parser)
-        except etree.XMLSyntaxError as real:  # a problem tinyxml2 refuses too: name it
-            line, column = real.position
-            raise MalformedXMLError(source, line, column, real.msg) from exc
-    for element in root.iter():
-        if isinstance(element.tag, str) and element.tag.startswith("{"):
-            element.tag = element.tag.split("}", 1)[1]
+        root = _parse_as_tinyxml(_as_tinyxml_reads(text), source, exc)
+    _name_custom_parts(root)
     if root.tag != "sdf":
         raise SDFError(
             source,

@@ -307,3 +307,52 @@ def test_a_1_6_model_frame_named_like_its_link_becomes_name_frame(tmp_path) -> N
         np.testing.assert_allclose(
             data.site_xpos[model.site(site).id], expected, rtol=0, atol=TOL_M, err_msg=site
         )
+
+
+# --- names with a prefix: custom elements and gz-sim's undeclared `gz:` -------------------
+CUSTOM_PARTS = (  # as gz-sim's example worlds write them, no xmlns declared for gz
+    '<plugin filename="gz-sim-sensors-system" name="gz::sim::systems::Sensors">'
+    "<gz::system_priority>10</gz::system_priority></plugin>"
+    "<gz:policies><physics_engine_name>x</physics_engine_name></gz:policies>"
+)
+
+
+@pytest.mark.parametrize("declared", [False, True], ids=["undeclared_gz", "declared_gz"])
+def test_custom_elements_load_as_libsdformat_loads_them_and_are_never_read(
+    tmp_path, declared
+) -> None:
+    """tinyxml2 (libsdformat's parser) knows no namespaces: `<gz:policies>`, `gz:expressed_in=`
+    and `<gz::system_priority>` are plain names, undeclared as gz-sim's examples leave them.
+    libsdformat copies a prefixed (custom) element and never reads it, so `<gz:link>` inside a
+    model adds no link, declared or not; the model's own link is where its pose says."""
+    xmlns = ' xmlns:gz="http://gazebosim.org/schema"' if declared else ""
+    path = _world(
+        tmp_path,
+        f'{CUSTOM_PARTS}<model name="m"{xmlns}><pose>1 2 0.5 0 0 0</pose>'
+        f'<link name="body">{INERTIAL}<collision name="c"><geometry><box><size>0.2 0.2 0.2'
+        "</size></box></geometry><surface><friction><ode><mu>0.7</mu>"
+        '<fdir1 gz:expressed_in="body">1 0 0</fdir1></ode></friction></surface></collision>'
+        f'</link><gz:link name="ghost">{INERTIAL}</gz:link></model>',
+    )
+    world = world_from_sdf(path)
+    poses = world_link_poses(world)
+    assert sorted(poses) == ["m/body"], sorted(poses)
+    _assert_links(poses, {"m/body": X(1, 2, 0.5)})
+    box = next(g for g in range(world.model.ngeom) if world.model.geom(g).name.startswith("m/"))
+    assert world.model.geom_friction[box][0] == pytest.approx(0.7)
+
+
+@pytest.mark.parametrize(
+    ("text", "where"),
+    [
+        ('<model name="m"><link name="a"></model>', "mismatch"),
+        (f"{CUSTOM_PARTS}<gz:open>", "mismatch"),
+        ('<model name="m"><link name="a" name="b"/></model>', "redefined"),
+    ],
+    ids=["unclosed", "unclosed_custom", "repeated_attribute"],
+)
+def test_xml_tinyxml2_refuses_too_stays_refused_beside_custom_names(tmp_path, text, where) -> None:
+    from converters.errors import MalformedXMLError
+
+    with pytest.raises(MalformedXMLError, match=where):
+        world_from_sdf(_world(tmp_path, text))
