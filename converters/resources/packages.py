@@ -14,6 +14,7 @@ from converters.errors import (
     ResourceNotAFileError,
     ResourceNotFoundError,
 )
+from converters.resources.fuel import fuel_caches, fuel_file, is_web_uri
 from converters.resources.package_exports import MEDIA_PATH, MODEL_PATH, exported_paths
 
 # Environment variables searched, in order, as ROS 1 / ROS 2 / Gazebo users set them.
@@ -178,6 +179,11 @@ class PackageResolver:
                 name, _, rest = uri[len(scheme) :].partition("/")
                 root = self.find_package(name, uri=uri, element=element, model=model)
                 return root / rest
+        if is_web_uri(uri):
+            cached = fuel_file(uri, self.env)
+            if cached is None:
+                raise WebResourceError(uri, element, fuel_caches(self.env))
+            return cached
         if uri.startswith("file://"):
             uri = uri[len("file://") :]
         path = Path(uri).expanduser()
@@ -197,3 +203,19 @@ class ResourceSearchError(ResourceNotFoundError):
         self.uri = uri
         self.path = tried[0]
         self.tried = tried
+
+
+class WebResourceError(ResourceNotFoundError):
+    """A resource named by a web address: a Gazebo Fuel model's file the local Fuel cache
+    lacks, or another site's (gz-sim downloads both; twin never does)."""
+
+    def __init__(self, uri: str, element: str, caches: list[Path]) -> None:
+        ConversionError.__init__(
+            self,
+            f"{uri!r} used by {element} is on the web and not in the local Fuel cache "
+            f"({', '.join(str(c) for c in caches)}); twin does not download\n"
+            f"fix: run `gz fuel download -u '{uri.split('/files/')[0]}'` where there is "
+            "internet, or copy the file beside the description and name it by a relative path",
+        )
+        self.uri = uri
+        self.path = uri

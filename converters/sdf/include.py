@@ -14,6 +14,7 @@ from typing import Any
 from urllib.parse import unquote
 
 from converters.errors import PackageNotFoundError
+from converters.resources.fuel import fuel_caches
 from converters.resources.packages import MODEL_ENVS
 from converters.sdf.document import (
     INCLUDED_SOURCE,
@@ -144,7 +145,7 @@ def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
     at = parts.index("models")
     host, owner, name = parts[0], parts[at - 1], parts[at + 1]
     version = parts[at + 2] if len(parts) > at + 2 and parts[at + 2].isdigit() else None
-    for cache in _fuel_caches(ctx.resolver.env):
+    for cache in fuel_caches(ctx.resolver.env):
         versions = cache / host / owner.lower() / "models" / name.lower()
         found = sorted(
             (d for d in versions.glob("*") if d.is_dir() and d.name.isdigit()),
@@ -159,19 +160,10 @@ def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
     raise ctx.error(
         include,
         f"{uri} is a Gazebo Fuel model that is not in the local Fuel cache "
-        f"({', '.join(str(c) for c in _fuel_caches(ctx.resolver.env))}); twin does not download",
+        f"({', '.join(str(c) for c in fuel_caches(ctx.resolver.env))}); twin does not download",
         f"run `gz fuel download -u '{uri}'` where there is internet, or put the model in a "
         "directory on GZ_SIM_RESOURCE_PATH and write model://NAME",
     )
-
-
-def _fuel_caches(env: Any) -> list[Path]:
-    """Where Gazebo keeps downloaded Fuel models: GZ_FUEL_CACHE_PATH (of the environment the
-    resolver uses), else ~/.gz/fuel (and Ignition's ~/.ignition/fuel)."""
-    if env.get("GZ_FUEL_CACHE_PATH"):
-        return [Path(env["GZ_FUEL_CACHE_PATH"]).expanduser()]
-    home = Path.home()
-    return [home / ".gz" / "fuel", home / ".ignition" / "fuel"]
 
 
 def _shipped(uri: str) -> Path | None:

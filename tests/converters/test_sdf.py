@@ -280,3 +280,41 @@ def test_fuel_models_come_from_the_local_fuel_cache_or_twins_own(tmp_path, monke
     assert [light.name for light in world.lights] == ["sun"]
     with pytest.raises(SDFError, match=r"Cafe Table is a Gazebo Fuel model .*`gz fuel download"):
         read_sdf_world(_fuel_world("Cafe Table"), "w", tmp_path)
+
+
+@pytest.mark.parametrize("version", ["1", "tip"])
+def test_a_mesh_named_by_its_fuel_address_comes_from_the_local_fuel_cache(
+    tmp_path, monkeypatch, version
+):
+    """gz-sim's examples name a Fuel model's mesh by its web address
+    (`https://HOST/1.0/OWNER/models/NAME/VERSION/files/REL`); gz-sim keeps the download at
+    `HOST/owner/models/name/VERSION/REL` in its cache, and twin reads it from there."""
+    import trimesh
+
+    cache = tmp_path / "fuel"
+    monkeypatch.setenv("GZ_FUEL_CACHE_PATH", str(cache))
+    meshes = cache / "fuel.gazebosim.org" / "openrobotics" / "models" / "pump" / "1" / "meshes"
+    meshes.mkdir(parents=True)
+    trimesh.creation.box(extents=(0.4, 0.2, 0.6)).export(meshes / "pump.stl")
+    address = f"{FUEL}/Pump/{version}/files/meshes/pump.stl"
+    text = (
+        '<sdf version="1.8"><world name="w"><model name="pump"><static>true</static>'
+        f"<link name='l'><collision name='c'><geometry><mesh><uri>{address}</uri></mesh>"
+        "</geometry></collision></link></model></world></sdf>"
+    )
+    from twin_cli.world.sdf_world import world_from_sdf
+
+    path = tmp_path / "w.sdf"
+    path.write_text(text)
+    model = world_from_sdf(path).model
+    (geom,) = [g for g in range(model.ngeom) if model.geom(g).name.startswith("pump/")]
+    mesh = model.geom_dataid[geom]
+    start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+    vertices = model.mesh_vert[start : start + count]
+    # MuJoCo turns a mesh onto its principal axes: the box's extents, in any order.
+    extents = sorted(vertices.max(axis=0) - vertices.min(axis=0))
+    assert extents == pytest.approx([0.2, 0.4, 0.6], abs=1e-6)
+    with pytest.raises(Exception, match=r"(?s)is on the web and not in the local Fuel cache.*"
+                       r"gz fuel download -u '.*/models/Other/1'"):  # fmt: skip
+        path.write_text(text.replace("/Pump/" + version, "/Other/1"))
+        world_from_sdf(path)
