@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +17,7 @@ from converters.description import (
     Link,
     LinkExtension,
     Material,
+    Surface,
     Visual,
 )
 from converters.errors import PackageNotFoundError, ResourceNotFoundError
@@ -50,9 +52,33 @@ def read_link(
         collisions.append(Collision(pose, geometry, c.get("name")))
         if c.find("surface") is not None or c.find("max_contacts") is not None:
             surface, _ = read_surface(c, ctx.values(c))
+            surface = _fdir1_in_collision(graph, c, prefix, X_M_L @ pose, surface)
             surfaces.append(InlineSurface(name, index, surface))
     link = Link(name, _inertial(ctx, element, name), visuals, tuple(collisions))
     return link, _extension(ctx, element, name), tuple(surfaces)
+
+
+def _fdir1_in_collision(
+    graph: PoseGraph, collision: Any, prefix: str, X_M_C: np.ndarray, surface: Surface
+) -> Surface:
+    """`surface` with `fdir1` in the collision frame. gz-physics reads a `gz:expressed_in`
+    attribute on `<fdir1>` (gz-sim's mecanum example writes `expressed_in="chassis"`) as the
+    frame the direction is written in; without it the direction is the collision's own."""
+    element = collision.find("surface/friction/ode/fdir1")
+    if surface.fdir1 is None or element is None:
+        return surface
+    frame = next((v for k, v in element.attrib.items() if _local(k) == "expressed_in"), None)
+    if not frame:
+        return surface
+    X_M_F = graph.pose(scoped(frame.strip(), prefix), element)
+    R_C_F = X_M_C[:3, :3].T @ X_M_F[:3, :3]
+    return replace(surface, fdir1=tuple(float(v) for v in R_C_F @ np.array(surface.fdir1)))
+
+
+def _local(key: str) -> str:
+    """An attribute's name without its prefix: `gz:expressed_in` and `{uri}expressed_in` (a
+    declared prefix) alike."""
+    return key.rsplit("}", 1)[-1].rsplit(":", 1)[-1]
 
 
 def _part_pose(ctx: SdfContext, graph: PoseGraph, element: Any, prefix: str, X_M_L: np.ndarray):

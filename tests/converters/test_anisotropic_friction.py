@@ -321,3 +321,40 @@ def test_a_plate_welded_to_the_world_makes_no_contact_with_the_ground(tmp_path: 
     world.spawn(path, name="plate", pose=Pose(z=0.005))  # its lower half in the ground
     world.step(10)
     assert world.data.ncon == 0, f"{world.data.ncon} contacts between static bodies"
+
+
+def _sdf_wheel(fdir1_attributes: str, xmlns: str = "") -> str:
+    """The wheel above in SDF: the cylinder rolled 90° so its axis (the axle) is the link's y;
+    fdir1 '0 1 0' with `fdir1_attributes`."""
+    return f"""<sdf version="1.9"><model name="wheel"{xmlns}><link name="wheel"><inertial>
+<mass>1</mass><inertia><ixx>0.0007</ixx><iyy>0.00125</iyy><izz>0.0007</izz></inertia></inertial>
+<collision name="c"><pose>0 0 0 1.5707963267948966 0 0</pose><geometry><cylinder>
+<radius>0.05</radius><length>0.04</length></cylinder></geometry><surface><friction><ode>
+<mu>0.3</mu><mu2>1</mu2><fdir1{fdir1_attributes}>0 1 0</fdir1></ode></friction></surface>
+</collision></link></model></sdf>"""
+
+
+@pytest.mark.parametrize(
+    ("attributes", "xmlns", "along_axle"),
+    [
+        (' gz:expressed_in="wheel"', "", True),
+        (' gz:expressed_in="wheel"', ' xmlns:gz="http://gazebosim.org/schema"', True),
+        (' gz:expressed_in="__model__"', "", True),
+        ("", "", False),
+    ],
+    ids=["link_frame", "link_frame_declared", "model_frame", "collision_frame"],
+)
+def test_fdir1_expressed_in_another_frame_is_turned_into_the_collisions(
+    tmp_path: Path, attributes: str, xmlns: str, along_axle: bool
+):
+    """gz-physics reads `<fdir1 gz:expressed_in="F">` in frame F: '0 1 0' in the link (or model)
+    frame is the axle, so μ1 acts along it as for the URDF wheel's '0 0 1'; in the collision's
+    own frame (no attribute) '0 1 0' lies across the axle and is reported as approximated."""
+    path = tmp_path / "wheel.sdf"
+    path.write_text(_sdf_wheel(attributes, xmlns))
+    spec, report = convert(path)
+    paired = any(n.name.startswith("anisotropic_friction:") for n in spec.numerics)
+    found = [e for e in report.entries if e.tag == "mu2"]
+    assert paired == along_axle, [e.detail for e in found]
+    if not along_axle:
+        assert "not along the cylinder's axis" in found[0].detail, found[0].detail
