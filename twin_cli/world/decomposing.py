@@ -14,6 +14,11 @@ waiting entity's spec replaced by the decomposed one (`respec.fresh_spec`, entit
 order, frames where they are) and recompiled, every entity's state carried over by name, as a
 spawn of another entity does. Nothing runs per step.
 
+A description sent as text is converted again from the text the request keeps. Spawns of
+one conversion (equal `job_key`: the conversion cache's key, or the text's digest) share one
+job while it is pending: a second spawn of a file still decomposing waits for the first's job
+and is swapped by it, so CoACD runs once.
+
 Each entity's `Decomposition` says where it is: pending, done (no hull stands in any more),
 or failed (a hull stays: CoACD over its budget, crashed, or the conversion failed; the entity's
 report rows say why). A delete of every entity waiting for a decomposition cancels it: its
@@ -22,6 +27,7 @@ child and CoACD workers are killed.
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import threading
 from collections.abc import Sequence
@@ -45,11 +51,13 @@ PENDING, DONE, FAILED = "pending", "done", "failed"
 @dataclass(eq=False)
 class Decomposition:
     """One background decomposition: the spawn's source and request, the mesh keys it
-    decomposes, where it is (`status`), why it failed (`detail`), and its cancel event."""
+    decomposes, what it converts (`key`, `job_key`), where it is (`status`), why it failed
+    (`detail`), and its cancel event."""
 
     source: str
     request: SpawnRequest
     meshes: tuple[str, ...]
+    key: tuple = ()
     status: str = PENDING
     detail: str = ""
     cancel: threading.Event = field(default_factory=threading.Event)
@@ -59,14 +67,41 @@ def start(
     state: WorldState, loaded: spawn.LoadedSource, request: SpawnRequest, names: Sequence[str]
 ) -> None:
     """Starts decomposing a deferred spawn's meshes for entities `names` (lock held; they are
-    in the world); nothing when `loaded` deferred nothing."""
+    in the world), or lets them wait for a pending job of the same conversion; nothing when
+    `loaded` deferred nothing."""
     if not loaded.deferred:
         return
-    job = Decomposition(loaded.source, request, deferred_meshes(loaded.report))
+    key = job_key(request)
+    job = next((j for j in state.decompositions.values() if j.key == key and _open(j)), None)
+    if job is None:
+        job = Decomposition(loaded.source, request, deferred_meshes(loaded.report), key)
+        _launch(state, [job], names[0])
     for name in names:
         state.decompositions[name] = job
+
+
+def job_key(request: SpawnRequest) -> tuple:
+    """What a spawn's conversion is, besides its files' contents: equal for two spawns that
+    convert alike (a file: the conversion cache's key; a text: its digest and base folder)."""
+    from twin_cli.world.conversion_cache import cache_key
+
+    env = spawn.resolving_env(request)
+    if request.xml is None:
+        return cache_key(Path(request.source).expanduser().resolve(), request, env)
+    digest = hashlib.blake2b(request.xml.encode(), digest_size=20).hexdigest()
+    return (*cache_key(Path(request.base_dir or "."), request, env), digest)
+
+
+def _open(job: Decomposition) -> bool:
+    """Whether another entity may still wait for `job`: pending and not cancelled (a job
+    whose entities were all deleted is cancelled, though its thread may not have seen it)."""
+    return job.status == PENDING and not job.cancel.is_set()
+
+
+def _launch(state: WorldState, jobs: Sequence[Decomposition], label: str) -> None:
+    """Runs `jobs` one after another on a thread of their own."""
     thread = threading.Thread(
-        target=_run, args=(state, job), name=f"twin-decompose-{names[0]}", daemon=True
+        target=_run_all, args=(state, jobs), name=f"twin-decompose-{label}", daemon=True
     )
     thread.start()
 
@@ -104,6 +139,13 @@ def backstop_s(request: SpawnRequest, meshes: int) -> float:
     return meshes * Limits.for_cpu(cpu).wall
 
 
+def _run_all(state: WorldState, jobs: Sequence[Decomposition]) -> None:
+    """The thread: each job not cancelled meanwhile, in turn."""
+    for job in jobs:
+        if not job.cancel.is_set():
+            _run(state, job)
+
+
 def _run(state: WorldState, job: Decomposition) -> None:
     """The thread: convert in full, then swap the result in, or say why not."""
     try:
@@ -129,13 +171,14 @@ def _run(state: WorldState, job: Decomposition) -> None:
 
 
 def _convert(job: Decomposition) -> spawn.LoadedSource:
-    """The full conversion, from (and into) the conversion cache."""
-    from twin_cli.world.conversion_cache import CACHE, cache_key
+    """The full conversion: a text's, or a file's from (and into) the conversion cache."""
+    from twin_cli.world.conversion_cache import CACHE
 
-    path = Path(job.source)
     served = spawn.Served(extra_s=backstop_s(job.request, len(job.meshes)), cancel=job.cancel)
-    key = cache_key(path, job.request, spawn.resolving_env(job.request))
-    return CACHE.load(key, lambda: spawn.convert_description(path, job.request, served))
+    if job.request.xml is not None:
+        return spawn.convert_text(job.request, served)
+    path = Path(job.source)
+    return CACHE.load(job.key, lambda: spawn.convert_description(path, job.request, served))
 
 
 def _waiting(state: WorldState, job: Decomposition) -> list[str]:
@@ -160,7 +203,8 @@ def swap(state: WorldState, names: Sequence[str], loaded: spawn.LoadedSource) ->
     commit(state, fresh, built)
     for name in names:
         respec.keep_spec(state, name, *children[name])
-        state.entities[name] = replace(state.entities[name], report=loaded.report)
+        # a text's MJCF (what a save writes) is the decomposed one now
+        state.entities[name] = replace(state.entities[name], report=loaded.report, xml=loaded.xml)
 
 
 def _check_layout(state: WorldState, index: dict, names: Sequence[str]) -> None:

@@ -77,7 +77,7 @@ def load_source(request: SpawnRequest, *, defer: bool = False) -> LoadedSource:
     world server a description is read in a bounded child (`convert_bounded`); MJCF is
     MuJoCo's own parser, in this process. With `fixed_base` the converter welds a description's
     root, and `fixed_base.weld_loaded` an MJCF's. With `defer`, in a world server, a description
-    file's CoACD meshes that the collision cache lacks get their convex hulls for now
+    file's or text's CoACD meshes that the collision cache lacks get their convex hulls for now
     (`LoadedSource.deferred`; `decomposing` decomposes them in the background).
 
     Raises:
@@ -103,7 +103,7 @@ def _load(request: SpawnRequest, defer: bool) -> LoadedSource:
     if request.read_roots is not None:
         _check_confined(request)
     if request.xml is not None:
-        return _load_text(request)
+        return _load_text(request, defer)
     if isinstance(request.source, mujoco.MjSpec):
         spec = request.source.copy()
         return LoadedSource(spec, "<MjSpec>", None, xml_or_none(spec), own_name(spec) or "model")
@@ -204,9 +204,12 @@ def _sniff(path: Path) -> str | None:
         return None
 
 
-def _load_text(request: SpawnRequest) -> LoadedSource:
-    """A description sent as text: MJCF is loaded as is, URDF and SDF are converted."""
+def _load_text(request: SpawnRequest, defer: bool) -> LoadedSource:
+    """A description sent as text: MJCF is loaded as is, URDF and SDF are converted (`defer`:
+    as `_load_description`)."""
     from converters.formats import format_of
+    from converters.isolated import bounded
+    from twin_cli.world.values import deferred_meshes
 
     text, label = request.xml or "", request.label
     if format_of(text) == "mjcf":
@@ -215,12 +218,20 @@ def _load_text(request: SpawnRequest) -> LoadedSource:
         except ValueError as exc:
             raise SpawnError(label, label, f"not valid MJCF ({exc})", "fix it") from exc
         return LoadedSource(spec, label, None, text, own_name(spec) or "model")
+    loaded = convert_text(request, Served(defer=defer and bounded.enabled()))
+    return replace(loaded, deferred=bool(deferred_meshes(loaded.report)))
+
+
+def convert_text(request: SpawnRequest, served: Served | None = None) -> LoadedSource:
+    """The request's URDF or SDF text converted in a bounded child (`convert_bounded`)."""
     base_dir = str(request.base_dir) if request.base_dir is not None else None
-    done = convert_bounded(request, source=label, text=text, base_dir=base_dir)
+    done = convert_bounded(
+        request, source=request.label, served=served, text=request.xml, base_dir=base_dir
+    )
     name = done.report.robot or "model"
     return LoadedSource(
         done.spec,
-        label,
+        request.label,
         done.report.to_dict(),
         xml_or_none(done.spec),
         name,

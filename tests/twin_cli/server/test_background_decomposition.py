@@ -1,20 +1,23 @@
 """A served world steps while a spawned mesh decomposes, then swaps the decomposition in.
 
 A real `twin serve` and the `twin` command, real CoACD on a concave static bin (`bin_models`).
-Oracles: the bin's rim (the top of its convex hull) and floor heights, on which a ball of known
-radius must rest before and after the swap; the sim clock, which must advance while the
-decomposition is pending; the server's own CoACD worker processes, which a delete must end.
+Oracles: the bin's rim (the top of its convex
+hull) and floor heights, on which a ball of known radius must rest before and after the swap;
+the sim clock, which must advance while the decomposition is pending; the server's own CoACD
+worker processes, which a delete must end and of which one file's spawns start one.
 """
 
 from __future__ import annotations
 
 import json
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
 from cli_world import twin_ok
+from coacd_workers import alive, workers
 
 DROP_Z = 0.35  # [m] the ball's centre at spawn, above the bin's rim (0.20 m)
 SETTLE_STEPS = 1500  # 1.5 s at the default 1 ms step: the ball falls 0.3 m and settles
@@ -22,7 +25,6 @@ FLOOR_TOL = 0.010  # [m] ball rest height on the decomposed floor (the issue's Â
 HULL_TOL = 0.002  # [m] ball rest height on the hull's top, a plane at the rim
 WAIT_S = 180.0  # [s] for the bin's decomposition on a loaded 2-core machine (3 CPU s idle)
 POLL_S = 0.2  # [s]
-WORKER = "converters.collision.worker"  # a CoACD worker process's command line
 
 
 @pytest.fixture(autouse=True)
@@ -117,42 +119,6 @@ def test_a_failed_decomposition_keeps_the_hull_and_says_why(tmp_path, serve_worl
         assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
 
 
-def _descendants(pid: int) -> dict[int, str]:
-    """Every process under `pid`: pid â†’ command line."""
-    parents: dict[int, int] = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
-    found, frontier = {}, [pid]
-    while frontier:
-        parent = frontier.pop()
-        for child, of in parents.items():
-            if of == parent and child not in found:
-                try:
-                    found[child] = (Path("/proc") / str(child) / "cmdline").read_text()
-                except OSError:
-                    continue
-                frontier.append(child)
-    return found
-
-
-def _workers(pid: int) -> list[int]:
-    return [p for p, line in _descendants(pid).items() if WORKER in line.replace("\0", " ")]
-
-
-def _alive(pid: int) -> bool:
-    """Whether process `pid` runs (a zombie, dead but not yet reaped, does not)."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return False
-    return stat.rsplit(")", 1)[1].split()[0] != "Z"
-
-
 def test_a_delete_during_decomposition_cancels_it_and_the_world_steps_on(
     tmp_path, serve_world, monkeypatch
 ):
@@ -165,21 +131,46 @@ def test_a_delete_during_decomposition_cancels_it_and_the_world_steps_on(
         twin_ok(runtime, world, "spawn", urdf, "--name", "bin")
         assert _listed(runtime, world)["bin"]["decomposition"] == "pending"
         deadline = time.monotonic() + WAIT_S
-        while not _workers(server.pid) and time.monotonic() < deadline:
+        while not workers(server.pid) and time.monotonic() < deadline:
             time.sleep(POLL_S)
-        workers = _workers(server.pid)
-        assert workers, "no CoACD worker under the server"
+        started = workers(server.pid)
+        assert started, "no CoACD worker under the server"
         before = _sim_time(client)
         time.sleep(1.0)
         after = _sim_time(client)
         assert after - before > 0.5, f"sim time {before:.3f} -> {after:.3f} s in 1 s of wall time"
         twin_ok(runtime, world, "delete", "bin")
         deadline = time.monotonic() + 10.0
-        while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        while any(alive(p) for p in started) and time.monotonic() < deadline:
             time.sleep(POLL_S)
-        left = [p for p in workers if _alive(p)]
+        left = [p for p in started if alive(p)]
         assert not left, f"CoACD workers {left} outlived the delete"
         assert client.request("GET", "/conversions") == [], "a conversion still runs"
         assert "bin" not in _listed(runtime, world)
         twin_ok(runtime, world, "spawn", urdf, "--name", "bin")  # the name is free again
         assert _listed(runtime, world)["bin"]["decomposition"] == "pending"
+
+
+def test_two_spawns_of_one_file_at_once_run_coacd_once(tmp_path, serve_world):
+    world, runtime = "decomposing-twice", tmp_path / "run"
+    urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
+    with serve_world(runtime, world) as (client, server):
+        with ThreadPoolExecutor(2) as pool:
+            spawns = [
+                pool.submit(twin_ok, runtime, world, "spawn", urdf, "--name", name, "-x", x)
+                for name, x in (("a", "0"), ("b", "1"))
+            ]
+            for each in spawns:
+                each.result()
+        twin_ok(runtime, world, "spawn", ball, "--name", "ball", "-x", "1", "-z", str(DROP_Z))
+        most, deadline = 0, time.monotonic() + WAIT_S
+        while time.monotonic() < deadline:
+            most = max(most, len(workers(server.pid)))
+            rows = {row["name"]: row for row in client.entities()}
+            if rows["a"]["decomposition"] != "pending" and rows["b"]["decomposition"] != "pending":
+                break
+            time.sleep(0.05)
+        assert (rows["a"]["decomposition"], rows["b"]["decomposition"]) == ("done", "done"), rows
+        assert most == 1, f"{most} CoACD workers at once for one file"
+        on_floor = _settled_ball_z(runtime, world)  # in "b", swapped by "a"'s job
+        assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor

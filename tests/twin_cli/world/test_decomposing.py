@@ -3,16 +3,20 @@
 A World whose conversions are bounded as in a server (`bounded.enable`), not stepping, so that
 nothing but the swap can change its state between two reads. Real CoACD on the concave bin
 (`bin_models`); oracles: the state before the swap (bit for bit), the bin's geoms (its hull,
-then CoACD's parts), and the report rows.
+then CoACD's parts), the report rows, a ball's rest height (the hull's top, then the bin's
+floor), and the CoACD worker processes that run (one per decomposition).
 """
 
 from __future__ import annotations
 
+import os
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
-from bin_models import bin_urdf
+from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
+from coacd_workers import alive, workers
 
 from converters.isolated import bounded
 from twin_cli.spawn_request import SpawnRequest
@@ -20,6 +24,11 @@ from twin_cli.world import World
 from twin_cli.world.pose import Pose
 
 WAIT_S = 180.0  # [s] for the bin's decomposition on a loaded 2-core machine (3 CPU s idle)
+DROP_Z = 0.35  # [m] the ball's centre at spawn, above the bin's rim (0.20 m)
+SETTLE_STEPS = 1500  # 1.5 s at the default 1 ms step: the ball falls 0.3 m and settles
+FLOOR_TOL = 0.010  # [m] ball rest height on the decomposed floor (the issue's ±10 mm)
+HULL_TOL = 0.002  # [m] ball rest height on the hull's top, a plane at the rim
+SECOND_JOB_S = 3.0  # [s] a second job's child and worker start within 1 s on a loaded machine
 BOX = """<robot name="box"><link name="box">
   <inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>
   </inertial><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
@@ -83,3 +92,65 @@ def test_a_batch_shares_one_decomposition_that_outlives_a_deleted_instance(serve
     (left,) = world.entities()
     assert left.name == "b" and left.decomposition == "done", left
     assert left.hull_stand_ins == (), left
+
+
+def _wait_while_pending(world: World, name: str) -> str:
+    """Where entity `name`'s decomposition is once it is no longer pending (or WAIT_S)."""
+    deadline = time.monotonic() + WAIT_S
+    while time.monotonic() < deadline:
+        status = {e.name: e.decomposition for e in world.entities()}[name]
+        if status != "pending":
+            return status
+        time.sleep(0.1)
+    return "pending"
+
+
+def _settled_ball_z(world: World) -> float:
+    """The ball's centre height [m] after SETTLE_STEPS more steps."""
+    world.step(SETTLE_STEPS)
+    return world.get_pose("ball").z
+
+
+def test_a_text_description_spawns_with_its_hull_and_is_swapped(served, tmp_path):
+    text = Path(bin_urdf(tmp_path)).read_text()  # its mesh is found from base_dir
+    world = World()
+    world.spawn(SpawnRequest(xml=text, base_dir=str(tmp_path)), name="bin")
+    listed = world.entities()[0]
+    assert listed.decomposition == "pending" and len(listed.hull_stand_ins) == 1, listed
+    hull_xml = world.entity("bin").xml.count("<geom")  # what a save writes
+    world.spawn(SpawnRequest(ball_urdf(tmp_path)), name="ball", pose=Pose(z=DROP_Z))
+    on_hull = _settled_ball_z(world)
+    assert world.entities()[0].decomposition == "pending", "swapped before the ball was measured"
+    assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
+    assert _wait_while_pending(world, "bin") == "done", world.entities()[0]
+    rows = world.entity("bin").report["meshes"]
+    assert [row["mode"] for row in rows] == ["coacd"] and _bin_geoms(world) == rows[0]["parts"]
+    on_floor = _settled_ball_z(world)
+    assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+    parts_xml = world.entity("bin").xml.count("<geom")
+    assert parts_xml - hull_xml == rows[0]["parts"] - 1, f"geoms saved: {hull_xml}, {parts_xml}"
+
+
+def test_two_spawns_of_one_file_share_one_decomposition(served, tmp_path, monkeypatch):
+    # A CoACD worker that hangs (the test hook) keeps the decomposition pending: long enough
+    # to count the workers that two spawns of the same file start.
+    monkeypatch.setenv("TWIN_TEST_COACD_FAULT", "hang:*")
+    world, urdf = World(), bin_urdf(tmp_path)
+    world.spawn(SpawnRequest(urdf), name="a")
+    world.spawn(SpawnRequest(urdf), name="b", pose=Pose(x=1))
+    deadline = time.monotonic() + WAIT_S
+    while not workers(os.getpid()) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(SECOND_JOB_S)
+    running = workers(os.getpid())
+    listed = {e.name: e.decomposition for e in world.entities()}
+    assert len(running) == 1, f"{len(running)} CoACD workers for one file"
+    assert listed == {"a": "pending", "b": "pending"}, listed
+    world.delete("a")  # "b" waits for the same job: it goes on
+    time.sleep(0.5)
+    assert all(alive(p) for p in running), "the shared decomposition ended with the first entity"
+    world.delete("b")
+    deadline = time.monotonic() + 10.0
+    while any(alive(p) for p in running) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(alive(p) for p in running), "the CoACD worker outlived both entities"
