@@ -66,3 +66,34 @@ def ball_urdf(directory: Path) -> str:
 """
     )
     return str(directory / "ball.urdf")
+
+
+def bin_world(directory: Path, *, drop_z: float, bins: int = 1) -> str:
+    """An SDF world file in `directory` with `bins` static bins (models `bin`, `bin_1`, …, 1 m
+    apart along x, bottoms on z = 0, one STL beside the file) and the ball (BALL_RADIUS, 50 g)
+    as a model at height `drop_z` [m] above the first bin's centre; returns its path."""
+    import trimesh
+
+    trimesh.Trimesh(*bin_mesh(), process=False).export(directory / "bin.stl")
+    mass = 0.05  # [kg]
+    inertia = 0.4 * mass * BALL_RADIUS**2  # solid sphere, 2/5 m r^2 [kg m^2]
+    models = "".join(
+        f"""  <model name="{"bin" if k == 0 else f"bin_{k}"}"><static>true</static>
+    <pose>{k} 0 {BIN_OUTER[2] / 2} 0 0 0</pose>
+    <link name="bin"><collision name="c"><geometry><mesh><uri>bin.stl</uri></mesh></geometry>
+    </collision></link></model>
+"""
+        for k in range(bins)
+    )
+    (directory / "bin.world").write_text(
+        f"""<?xml version="1.0"?>
+<sdf version="1.9"><world name="bin">
+{models}  <model name="ball"><pose>0 0 {drop_z} 0 0 0</pose><link name="ball">
+    <inertial><mass>{mass}</mass><inertia><ixx>{inertia}</ixx><iyy>{inertia}</iyy>
+      <izz>{inertia}</izz></inertia></inertial>
+    <collision name="c"><geometry><sphere><radius>{BALL_RADIUS}</radius></sphere></geometry>
+    </collision></link></model>
+</world></sdf>
+"""
+    )
+    return str(directory / "bin.world")

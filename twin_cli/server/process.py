@@ -230,6 +230,7 @@ def serve(opts: ServeOptions) -> None:
     tcp = parse_tcp(opts.tcp) if opts.tcp else None
     token = secrets.token_urlsafe(32) if tcp else None
     with owned_world(paths, opts.background), run_recorded(paths, opts) as autosave_file:
+        _bound_conversions()  # before the world file: its models' CoACD goes to the background
         world = build_world(opts)
         app = create_app(
             world,
@@ -269,20 +270,25 @@ def serve(opts: ServeOptions) -> None:
             log.info("world [%s] stopped", opts.world)
 
 
-def _end_conversions_on_exit(server: Any) -> None:
-    """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every conversion
-    still running: the requests waiting on them end, and the process with them. Conversions
-    are bounded from now on (`converters.isolated.bounded.enable`): their fork server starts now, so
-    that the first spawn finds it warm."""
-    import threading
-
+def _bound_conversions() -> None:
+    """Conversions are bounded from now on (`converters.isolated.bounded.enable`): their fork
+    server starts now, so that the first spawn finds it warm, and a world file's models leave
+    their CoACD meshes to the background (`world.world_models`)."""
     from converters.isolated import bounded
-    from converters.urdf.xacro_worker import stop_all
 
     try:
         bounded.enable()
     except (OSError, RuntimeError, ValueError) as exc:  # no fork server: convert here, as before
         log.warning("conversions run in the server process: %s", exc)
+
+
+def _end_conversions_on_exit(server: Any) -> None:
+    """Once the server is asked to exit (twin stop, SIGTERM, Ctrl-C), stop every conversion
+    still running: the requests waiting on them end, and the process with them."""
+    import threading
+
+    from converters.isolated import bounded
+    from converters.urdf.xacro_worker import stop_all
 
     def watch() -> None:
         while not server.should_exit:

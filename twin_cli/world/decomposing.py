@@ -17,7 +17,9 @@ spawn of another entity does. Nothing runs per step.
 A description sent as text is converted again from the text the request keeps. Spawns of
 one conversion (equal `job_key`: the conversion cache's key, or the text's digest) share one
 job while it is pending: a second spawn of a file still decomposing waits for the first's job
-and is swapped by it, so CoACD runs once.
+and is swapped by it, so CoACD runs once. A world file's models (`start_models`) each have a
+job of their own, run one after another on one thread (`world_models` converts each in full),
+and each model is swapped in as soon as its own is ready.
 
 Each entity's `Decomposition` says where it is: pending, done (no hull stands in any more),
 or failed (a hull stays: CoACD over its budget, crashed, or the conversion failed; the entity's
@@ -30,7 +32,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -48,16 +50,20 @@ log = logging.getLogger(__name__)
 PENDING, DONE, FAILED = "pending", "done", "failed"
 
 
+Convert = Callable[[spawn.Served], spawn.LoadedSource]  # a full conversion, run as served
+
+
 @dataclass(eq=False)
 class Decomposition:
     """One background decomposition: the spawn's source and request, the mesh keys it
-    decomposes, what it converts (`key`, `job_key`), where it is (`status`), why it failed
-    (`detail`), and its cancel event."""
+    decomposes, what it converts (`key`, `job_key`), how (`convert`; None: the request's
+    description again), where it is (`status`), why it failed (`detail`), its cancel event."""
 
     source: str
     request: SpawnRequest
     meshes: tuple[str, ...]
     key: tuple = ()
+    convert: Convert | None = None
     status: str = PENDING
     detail: str = ""
     cancel: threading.Event = field(default_factory=threading.Event)
@@ -78,6 +84,22 @@ def start(
         _launch(state, [job], names[0])
     for name in names:
         state.decompositions[name] = job
+
+
+def start_models(
+    state: WorldState, models: Sequence[tuple[str, spawn.LoadedSource, Convert]]
+) -> None:
+    """Starts decomposing a world file's deferred models, (entity name, what was loaded, its
+    full conversion) each, one after another on one thread (lock held; they are in the world)."""
+    jobs = []
+    for name, loaded, convert in models:
+        if loaded.deferred:
+            meshes = deferred_meshes(loaded.report)
+            job = Decomposition(loaded.source, SpawnRequest(), meshes, (loaded.source,), convert)
+            state.decompositions[name] = job
+            jobs.append(job)
+    if jobs:
+        _launch(state, jobs, "world")
 
 
 def job_key(request: SpawnRequest) -> tuple:
@@ -171,10 +193,13 @@ def _run(state: WorldState, job: Decomposition) -> None:
 
 
 def _convert(job: Decomposition) -> spawn.LoadedSource:
-    """The full conversion: a text's, or a file's from (and into) the conversion cache."""
+    """The full conversion: `job.convert`, a text's, or a file's from (and into) the
+    conversion cache."""
     from twin_cli.world.conversion_cache import CACHE
 
     served = spawn.Served(extra_s=backstop_s(job.request, len(job.meshes)), cancel=job.cancel)
+    if job.convert is not None:
+        return job.convert(served)
     if job.request.xml is not None:
         return spawn.convert_text(job.request, served)
     path = Path(job.source)
@@ -203,7 +228,7 @@ def swap(state: WorldState, names: Sequence[str], loaded: spawn.LoadedSource) ->
     commit(state, fresh, built)
     for name in names:
         respec.keep_spec(state, name, *children[name])
-        # a text's MJCF (what a save writes) is the decomposed one now
+        # a text's or a world model's MJCF (what a save writes) is the decomposed one now
         state.entities[name] = replace(state.entities[name], report=loaded.report, xml=loaded.xml)
 
 

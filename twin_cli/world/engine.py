@@ -132,10 +132,13 @@ class World:
         return spawning.spawn_batch(self._state, request, poses=poses, names=names, base=base)
 
     def spawn_specs(
-        self, items: Sequence[tuple[mujoco.MjSpec | LoadedSource, str, Pose]]
+        self,
+        items: Sequence[tuple[mujoco.MjSpec | LoadedSource, str, Pose]],
+        redo: Mapping[str, Any] | None = None,
     ) -> list[SpawnResult]:
-        """Adds a world file's models in one compile (`spawning.spawn_specs`)."""
-        return spawning.spawn_specs(self._state, items)
+        """Adds a world file's models in one compile, their decompositions left for the
+        background where `redo` gives a model's full conversion (`spawning.spawn_specs`)."""
+        return spawning.spawn_specs(self._state, items, redo)
 
     def delete(self, name: str) -> None:
         """Removes entity `name`; the others keep their exact state."""

@@ -9,20 +9,22 @@ after the model at its pose, so `twin list`, `twin pose` and `twin delete` know 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from twin_cli.files import input_files
+from twin_cli.world import world_models
 from twin_cli.world.engine import World
 from twin_cli.world.pose import Pose
 from twin_cli.world.values import WorldSettings
 
 if TYPE_CHECKING:
-    from converters.pipeline import Conversion
+    from converters.description.world import PlacedModel
     from converters.report import Report
-    from twin_cli.world.spawn import LoadedSource
 
 # Suffixes of Gazebo world files (`twin serve`, `twin load`).
 WORLD_SUFFIXES = (".sdf", ".world")
@@ -44,9 +46,6 @@ def world_from_sdf(
         SpawnError, EntityExistsError: a model cannot be placed.
     """
     from converters.errors import InputFileError
-    from converters.mjcf.builder import ConvertOptions
-    from converters.mjcf.heightfields import add_height_fields
-    from converters.pipeline import build_description
     from converters.report import Report
     from converters.resources.packages import PackageResolver
     from converters.sdf import read_sdf_world
@@ -70,37 +69,36 @@ def world_from_sdf(
     )
     world = World(settings, name=name)
     world.set_lights(description.lights)
-    items, notes = [], _notes(report, "")
-    for placed in description.models:
-        # One model's non-physical inertia does not refuse a world: Gazebo loads the AWS
-        # worlds' furniture with such inertias (mostly static, where inertia is never used),
-        # and so does twin, repaired and said (`file_notes`).
-        options = ConvertOptions(repair_inertia=True)
-        done = build_description(placed.robot, options)
-        add_height_fields(done.spec, placed.robot, done.report)  # terrain: static height fields
-        items.append((_converted(path, done), placed.robot.name, pose_of(placed.pose)))
-        notes += _notes(done.report, f"model '{placed.robot.name}': ")
+    items, notes, redo = _models(path, description.models, package_paths)
     if items:
-        world.spawn_specs(items)  # one compile for all of them
-    world.file_notes = tuple(notes)
+        world.spawn_specs(items, redo)  # one compile for all of them
+    world.file_notes = (*_notes(report, ""), *notes)
     return world
 
 
-def _converted(path: str | Path, done: Conversion) -> LoadedSource:
-    """A world model as a converted source: its file and model name as the entity's source
-    (`twin list`, saves), with its sensors and drive plugins."""
-    from twin_cli.world.spawn import LoadedSource, xml_or_none
+def _models(
+    path: Path, models: Sequence[PlacedModel], package_paths: dict[str, str] | None
+) -> tuple:
+    """Each model converted, as (loaded source, name, pose); the conversion notes; and, for a
+    served world (`bounded.enabled`), model name → its full conversion (`world_models`) when
+    hulls stand in for its decomposition for now."""
+    from converters.isolated import bounded
 
-    name = done.description.name
-    return LoadedSource(
-        done.spec,
-        f"{Path(path).resolve()}#{name}",
-        done.report.to_dict(),
-        xml_or_none(done.spec),
-        name,
-        sensors=done.sensors,
-        plugins=done.plugins,
-    )
+    items, notes, redo = [], [], {}
+    convert = world_models.options(defer=bounded.enabled())
+    packages = tuple(sorted((package_paths or {}).items()))
+    for placed in models:
+        name = placed.robot.name
+        done = world_models.build(placed.robot, convert)
+        loaded = world_models.loaded(path, done)
+        items.append((loaded, name, pose_of(placed.pose)))
+        notes += _notes(done.report, f"model '{name}': ")
+        if loaded.deferred:
+            full = world_models.options(defer=False)
+            redo[name] = partial(
+                world_models.convert_in_full, world_models.ModelJob(str(path), packages, name, full)
+            )
+    return items, notes, redo
 
 
 def _notes(report: Report, prefix: str) -> list[str]:

@@ -8,7 +8,7 @@ conversion does not stall the stepping loop.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import mujoco
@@ -167,17 +167,26 @@ def spawn_batch(
 
 
 def spawn_specs(
-    state: WorldState, items: Sequence[tuple[mujoco.MjSpec | spawn.LoadedSource, str, Pose]]
+    state: WorldState,
+    items: Sequence[tuple[mujoco.MjSpec | spawn.LoadedSource, str, Pose]],
+    redo: Mapping[str, decomposing.Convert] | None = None,
 ) -> list[SpawnResult]:
     """Adds one entity per (model, name, pose) in one compile of the world: a world file's
     models, each an MjSpec or an already converted source (which keeps its file, sensors and
     plugins). One spawn each would compile the world once per model, a cost that grows with
-    the square of their number (800 boxes: 77 s). All or nothing, as `spawn_batch`."""
+    the square of their number (800 boxes: 77 s). All or nothing, as `spawn_batch`. `redo`:
+    entity name → its full conversion, for each model whose hulls stand in for decompositions
+    (`decomposing.start_models`)."""
     names = [spawn.check_entity_name(name) for _, name, _ in items]
     poses = [pose for _, _, pose in items]
     loaded = [_loaded(model) for model, _, _ in items]
     requests = [SpawnRequest(source=one.spec) for one in loaded]
-    return _spawn_loaded(state, loaded, requests, names, poses)
+    with state.lock:
+        results = _spawn_loaded(state, loaded, requests, names, poses)
+        redo = redo or {}
+        later = [(n, one, redo[n]) for n, one in zip(names, loaded, strict=True) if n in redo]
+        decomposing.start_models(state, later)
+        return results
 
 
 def _loaded(model: mujoco.MjSpec | spawn.LoadedSource) -> spawn.LoadedSource:

@@ -1,7 +1,7 @@
 """A served world steps while a spawned mesh decomposes, then swaps the decomposition in.
 
-A real `twin serve` and the `twin` command, real CoACD on a concave static bin (`bin_models`).
-Oracles: the bin's rim (the top of its convex
+A real `twin serve` and the `twin` command, real CoACD on a concave static bin (`bin_models`),
+spawned or a model of the served world file. Oracles: the bin's rim (the top of its convex
 hull) and floor heights, on which a ball of known radius must rest before and after the swap;
 the sim clock, which must advance while the decomposition is pending; the server's own CoACD
 worker processes, which a delete must end and of which one file's spawns start one.
@@ -15,7 +15,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
-from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
+from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf, bin_world
 from cli_world import twin_ok
 from coacd_workers import alive, workers
 
@@ -151,6 +151,32 @@ def test_a_delete_during_decomposition_cancels_it_and_the_world_steps_on(
         assert _listed(runtime, world)["bin"]["decomposition"] == "pending"
 
 
+def test_a_served_world_file_starts_with_the_hull_then_swaps_the_bin(tmp_path, serve_world):
+    world, runtime = "decomposing-world", tmp_path / "run"
+    world_file = bin_world(tmp_path, drop_z=DROP_Z)
+    started = time.monotonic()
+    with serve_world(runtime, world, world_file, "--paused") as (client, _):
+        ready_s = time.monotonic() - started
+        # Straight through the API (milliseconds), so that CoACD (3 CPU s) is still at work.
+        client.step(SETTLE_STEPS)
+        on_hull = float(client.pose("ball")["z"])
+        listed = {row["name"]: row for row in client.entities()}["bin"]
+        assert listed["decomposition"] == "pending", f"not pending when measured: {listed}"
+        assert len(listed["hull_stand_ins"]) == 1, f"listed: {listed}"
+        assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
+        twin_ok(runtime, world, "resume")
+        done, times = _wait_while_pending(runtime, world, "bin", client)
+        swapped_s = time.monotonic() - started
+        assert done["decomposition"] == "done" and done["hull_stand_ins"] == [], f"row: {done}"
+        assert len(times) < 2 or times[-1] > times[0], f"sim time stood still: {times}"
+        on_floor = _settled_ball_z(runtime, world)
+        assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+    print(
+        f"served in {ready_s:.1f} s, swapped {swapped_s:.1f} s after start; ball on hull "
+        f"{on_hull:.4f} m, on floor {on_floor:.4f} m"
+    )
+
+
 def test_two_spawns_of_one_file_at_once_run_coacd_once(tmp_path, serve_world):
     world, runtime = "decomposing-twice", tmp_path / "run"
     urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
@@ -173,4 +199,15 @@ def test_two_spawns_of_one_file_at_once_run_coacd_once(tmp_path, serve_world):
         assert (rows["a"]["decomposition"], rows["b"]["decomposition"]) == ("done", "done"), rows
         assert most == 1, f"{most} CoACD workers at once for one file"
         on_floor = _settled_ball_z(runtime, world)  # in "b", swapped by "a"'s job
+        assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+
+
+def test_twin_load_of_a_world_file_swaps_its_bin_in_later(tmp_path, serve_world):
+    world, runtime = "decomposing-load", tmp_path / "run"
+    world_file = bin_world(tmp_path, drop_z=DROP_Z)
+    with serve_world(runtime, world, "--paused") as (client, _):
+        twin_ok(runtime, world, "load", world_file)
+        done, _ = _wait_while_pending(runtime, world, "bin", client)
+        assert done["decomposition"] == "done" and done["hull_stand_ins"] == [], f"row: {done}"
+        on_floor = _settled_ball_z(runtime, world)
         assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor

@@ -15,13 +15,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf
+from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf, bin_world
 from coacd_workers import alive, workers
 
 from converters.isolated import bounded
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 from twin_cli.world.pose import Pose
+from twin_cli.world.sdf_world import world_from_sdf
 
 WAIT_S = 180.0  # [s] for the bin's decomposition on a loaded 2-core machine (3 CPU s idle)
 DROP_Z = 0.35  # [m] the ball's centre at spawn, above the bin's rim (0.20 m)
@@ -154,3 +155,22 @@ def test_two_spawns_of_one_file_share_one_decomposition(served, tmp_path, monkey
     while any(alive(p) for p in running) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not any(alive(p) for p in running), "the CoACD worker outlived both entities"
+
+
+def test_a_served_world_files_models_are_swapped_in_one_by_one(served, tmp_path):
+    world = world_from_sdf(bin_world(tmp_path, drop_z=DROP_Z, bins=2))
+    listed = {e.name: (e.decomposition, len(e.hull_stand_ins)) for e in world.entities()}
+    assert listed == {"bin": ("pending", 1), "bin_1": ("pending", 1), "ball": (None, 0)}, listed
+    on_hull = _settled_ball_z(world)
+    assert world.entities()[0].decomposition == "pending", "swapped before the ball was measured"
+    assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
+    assert _wait_while_pending(world, "bin") == "done", world.entities()
+    assert _wait_while_pending(world, "bin_1") == "done", world.entities()
+    for name in ("bin", "bin_1"):
+        rows = world.entity(name).report["meshes"]
+        assert [row["mode"] for row in rows] == ["coacd"], rows
+        with world.lock:
+            geoms = world.model.geom_contype[world.index_of(name).geoms]
+        assert np.count_nonzero(geoms) == rows[0]["parts"] >= 5, (name, rows)
+    on_floor = _settled_ball_z(world)
+    assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
