@@ -1,16 +1,18 @@
 """A spawn runs only the code its description needs: the modules of twin it executes, counted.
 
-`sys.setprofile` sees every Python call during one in-process `World.spawn` of the bundled
-humanoid (xacro, conversion, build, compile, commit). A module counts when a function, method,
-comprehension or class body of it runs; its module body alone (an import) does not. The plugin
-families (drives, wheels, multicopter, controllers) and the sensor family run only for a
-description that declares a plugin or a sensor, which the control cases show the count sees.
+Each count is of one cold in-process `World.spawn` (xacro, conversion, build, compile, commit) in
+a fresh interpreter (`footprint_probe`), which must report a conversion-cache miss: a cache hit or
+a module an earlier test imported would lower the count by accident. The plugin families (drives,
+wheels, multicopter, controllers) and the sensor family run only for a description that declares
+a plugin or a sensor, which the control cases show the count sees.
 """
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
 import sys
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -18,15 +20,12 @@ from drive_models import SKID_STEER_ROS1, skid_steer_bot
 from sensor_models import imu_box
 
 from scenarios import HUMANOID
-from twin_cli.spawn_request import SpawnRequest
-from twin_cli.world import World
 
 ROOT = Path(__file__).resolve().parents[3]
-OURS = ("twin_cli/", "converters/")
-# Modules the humanoid's spawn ran in, measured: 85 before plugin and sensor families were
-# looked up from the description, 70 after. A new module on the path must be needed (raise
+# Modules a cold spawn of the humanoid ran in, measured: 85 before plugin and sensor families
+# were looked up from the description, 71 after. A new module on the path must be needed (raise
 # this, saying why) or imported from what the description declares.
-HUMANOID_BOUND = 70
+HUMANOID_BOUND = 71
 PLUGIN_FAMILY = {
     f"converters/gazebo/{name}.py"
     for name in (
@@ -49,34 +48,33 @@ PLUGIN_FAMILY = {
 SENSOR_FAMILY = {"converters/gazebo/sensor_sites.py", "converters/gazebo/sensors.py"}
 
 
-def _modules_run(action: Callable[[], object]) -> set[str]:
-    """Paths (from the repository root) of twin's modules that executed code during `action`
-    (module bodies, that is imports, aside)."""
-    root = f"{ROOT}/"
-    seen: set[str] = set()
-
-    def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
-        code = frame.f_code
-        if event == "call" and code.co_name != "<module>":
-            seen.add(code.co_filename)
-
-    sys.setprofile(profile)
-    try:
-        action()
-    finally:
-        sys.setprofile(None)
-    return {f[len(root) :] for f in seen if f.startswith(root) and f[len(root) :].startswith(OURS)}
+PROBE = Path(__file__).with_name("footprint_probe.py")
+PROBE_TIMEOUT_S = 120  # [s] a cold spawn of the humanoid takes ~3 s on 2 busy cores
 
 
-def _spawn(world: World, source: Path, name: str) -> Callable[[], object]:
-    return lambda: world.spawn(SpawnRequest(source=str(source)), name=name)
+def _cold_spawn(source: Path) -> set[str]:
+    """The modules one spawn of `source` ran, in a fresh interpreter whose conversion cache
+    missed once and never hit (so the conversion ran)."""
+    paths = [str(ROOT), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
+    done = subprocess.run(
+        [sys.executable, str(PROBE), str(source)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=PROBE_TIMEOUT_S,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    found = json.loads(done.stdout.splitlines()[-1])
+    assert "robot" in found["entities"]
+    assert (found["misses"], found["hits"]) == (1, 0), f"not a cold conversion: {found}"
+    return set(found["modules"])
 
 
 def test_a_humanoid_spawn_runs_a_bounded_set_of_modules_and_no_plugin_or_sensor_code() -> None:
-    world = World()
-    ran = _modules_run(_spawn(world, HUMANOID, "humanoid"))
+    ran = _cold_spawn(HUMANOID)
     print(f"{len(ran)} modules:\n" + "\n".join(sorted(ran)))
-    assert "humanoid" in world.entity_names()
     assert len(ran) <= HUMANOID_BOUND, f"{len(ran)} modules ran (bound {HUMANOID_BOUND})"
     families = {m for m in (PLUGIN_FAMILY | SENSOR_FAMILY) if m in ran}
     assert not families, f"a humanoid declares no plugin or sensor, yet {sorted(families)} ran"
@@ -96,6 +94,5 @@ def test_a_description_that_declares_a_family_runs_it(
     """The count sees a family run when the description asks for it (so the test above can fail)."""
     path = tmp_path / "robot.urdf"
     path.write_text(robot)
-    world = World()
-    ran = _modules_run(_spawn(world, path, "robot"))
+    ran = _cold_spawn(path)
     assert expected in ran, f"{expected} did not run: {sorted(ran & family)}"
