@@ -223,14 +223,16 @@ def read_build_files(robot: RobotDescription, options: ConvertOptions | None = N
         ConversionError: what `build_description` raises before or while reading.
     """
     from converters.mjcf.builder import read_build_inputs
-    from converters.mjcf.heightfields import read_height_images
 
     options = options or ConvertOptions()
     scratch = Report(source=robot.source)  # the build says all of it again
     check_references(robot, options, scratch)
     check_joints(robot)
     read_build_inputs(robot, options, scratch)
-    read_height_images(robot, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base)
+    if declares_heightmap(robot):
+        from converters.mjcf.heightfields import read_height_images
+
+        read_height_images(robot, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base)
     if robot.gazebo.plugins:
         from converters.gazebo.plugins import read_plugin_files
 
@@ -243,7 +245,6 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
-    from converters.mjcf.heightfields import add_height_fields
     from converters.mjcf.passive_motors import add_passive_motors
 
     options = options or ConvertOptions()
@@ -254,14 +255,36 @@ def build_description(
     check_joints(robot)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
-    add_height_fields(
-        spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
-    )  # SDF terrain
+    _add_height_fields(spec, robot, options, report)
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = _add_sensors(spec, robot, provenance, report)
     plugins = _add_plugins(spec, robot, report)
     add_passive_motors(spec, robot, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)
+
+
+def declares_heightmap(robot: RobotDescription) -> bool:
+    """Whether a collision of `robot` is a `<heightmap>` (SDF terrain)."""
+    from converters.mjcf.geometry import HEIGHTMAP
+
+    return any(
+        c.geometry is not None and c.geometry.shape == HEIGHTMAP
+        for link in robot.links
+        for c in link.collisions
+    )
+
+
+def _add_height_fields(
+    spec: mujoco.MjSpec, robot: RobotDescription, options: ConvertOptions, report: Report
+) -> None:
+    """SDF terrain as height fields; `heightfields` is imported only if the robot has one."""
+    if not declares_heightmap(robot):
+        return
+    from converters.mjcf.heightfields import add_height_fields
+
+    add_height_fields(
+        spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
+    )
 
 
 def _add_sensors(

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from converters.isolated import bounded, replay
+from converters.isolated import bounded
 from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
 from converters.pipeline import (
@@ -71,6 +71,8 @@ def convert_served(
     """
     if not bounded.enabled() or multiprocessing.current_process().daemon:
         return convert_job(job)
+    from converters.isolated import replay
+
     robot, report, reads = bounded.run(read_job, job, budget, job.source, cancel)
     with replay.replaying(reads):
         return build_description(robot, job.options, report)
@@ -79,6 +81,8 @@ def convert_served(
 def read_job(job: ConversionJob) -> tuple[Any, Report, dict]:
     """The child's work: the robot description, the report so far and the log of every file
     its build reads (`read_build_files`), read in `job.read_roots` only."""
+    from converters.isolated import replay
+
     with replay.recording() as log, _confined(job):
         robot, report = _read(job)
         read_build_files(robot, job.options)

@@ -213,9 +213,11 @@ def test_an_error_in_the_child_comes_back_as_its_own_class(tmp_path):
     assert "missing.stl" in str(caught.value) and "arm" in str(caught.value), str(caught.value)
 
 
-def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path):
+def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path, monkeypatch):
     """64 MiB of address space is less than the interpreter already maps: the first large
-    allocation fails, and the error says which budget and how to raise it."""
+    allocation fails, and the error says which budget and how to raise it. The mesh cache is
+    empty, so the child reads the mesh itself."""
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
     robot = _robot(tmp_path)
     with pytest.raises(ConversionBudgetError) as caught:
         convert_served(_job(robot), XacroBudget(60, 64))
