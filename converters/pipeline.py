@@ -139,6 +139,23 @@ def convert_full(
     Raises:
         ConversionError: any subclass, with file/link/joint and the fix in its message.
     """
+    options = options or ConvertOptions()
+    robot, report = read_file(
+        path, args=args, package_paths=package_paths, options=options, env=env
+    )
+    return build_description(robot, options, report)
+
+
+def read_file(
+    path: str | Path,
+    *,
+    args: Mapping[str, str] | None = None,
+    package_paths: Mapping[str, str | Path] | None = None,
+    options: ConvertOptions | None = None,
+    env: Mapping[str, str] | None = None,
+) -> tuple[RobotDescription, Report]:
+    """The robot description of a model file (xacro expanded, URDF or SDF parsed) and the report
+    so far: `convert_full` up to the build, with the same arguments."""
     path = Path(path)
     resolver = PackageResolver.create(path, package_paths, env)
     report = Report(source=str(path))
@@ -147,7 +164,7 @@ def convert_full(
     robot = read_robot(
         text, str(path), path.resolve().parent, resolver, report, as_written=options.as_written
     )
-    return build_description(robot, options, report)
+    return robot, report
 
 
 def convert_text(
@@ -167,12 +184,60 @@ def convert_text(
         base_dir: where relative mesh paths start (default: the working directory).
         package_paths, options, env: as for `convert_full`.
     """
+    options = options or ConvertOptions()
+    robot, report = read_text(
+        text,
+        source=source,
+        base_dir=base_dir,
+        package_paths=package_paths,
+        options=options,
+        env=env,
+    )
+    return build_description(robot, options, report)
+
+
+def read_text(
+    text: str,
+    *,
+    source: str = "<text>",
+    base_dir: str | Path | None = None,
+    package_paths: Mapping[str, str | Path] | None = None,
+    options: ConvertOptions | None = None,
+    env: Mapping[str, str] | None = None,
+) -> tuple[RobotDescription, Report]:
+    """`convert_text` up to the build: the robot description and the report so far."""
     directory = Path(base_dir or Path.cwd()).resolve()
     resolver = PackageResolver.create(directory / "description", package_paths, env)
     report = Report(source=source)
     options = options or ConvertOptions()
     robot = read_robot(text, source, directory, resolver, report, as_written=options.as_written)
-    return build_description(robot, options, report)
+    return robot, report
+
+
+def read_build_files(robot: RobotDescription, options: ConvertOptions | None = None) -> None:
+    """Read every file `build_description` of `robot` reads (meshes, collision parts with their
+    hulls and CoACD, height images, controller parameter files) and make no MjSpec: under
+    `converters.isolated.replay.recording`, another process builds the spec from the log.
+
+    Raises:
+        ConversionError: what `build_description` raises before or while reading.
+    """
+    from converters.mjcf.builder import read_build_inputs
+
+    options = options or ConvertOptions()
+    scratch = Report(source=robot.source)  # the build says all of it again
+    check_references(robot, options, scratch)
+    check_joints(robot)
+    read_build_inputs(robot, options, scratch)
+    if declares_heightmap(robot):
+        from converters.mjcf.heightfields import read_height_images
+
+        read_height_images(robot, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base)
+    if robot.gazebo.plugins:
+        from converters.gazebo.plugins import read_plugin_files
+
+        base = Path(robot.base_dir) if robot.base_dir else None
+        read_plugin_files(robot.gazebo.plugins, robot.source, base)
 
 
 def build_description(
@@ -180,7 +245,6 @@ def build_description(
 ) -> Conversion:
     """Description → MjSpec, then Gazebo's semantics on it (the stages after any reader)."""
     from converters.gazebo.apply import apply_gazebo
-    from converters.mjcf.heightfields import add_height_fields
     from converters.mjcf.passive_motors import add_passive_motors
 
     options = options or ConvertOptions()
@@ -191,14 +255,36 @@ def build_description(
     check_joints(robot)
     provenance = Provenance()
     spec = build_spec(robot, options=options, report=report, provenance=provenance)
-    add_height_fields(
-        spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
-    )  # SDF terrain
+    _add_height_fields(spec, robot, options, report)
     apply_gazebo(spec, robot.gazebo, provenance, report)
     sensors = _add_sensors(spec, robot, provenance, report)
     plugins = _add_plugins(spec, robot, report)
     add_passive_motors(spec, robot, report)
     return Conversion(spec, report, provenance, robot, sensors, plugins)
+
+
+def declares_heightmap(robot: RobotDescription) -> bool:
+    """Whether a collision of `robot` is a `<heightmap>` (SDF terrain)."""
+    from converters.mjcf.geometry import HEIGHTMAP
+
+    return any(
+        c.geometry is not None and c.geometry.shape == HEIGHTMAP
+        for link in robot.links
+        for c in link.collisions
+    )
+
+
+def _add_height_fields(
+    spec: mujoco.MjSpec, robot: RobotDescription, options: ConvertOptions, report: Report
+) -> None:
+    """SDF terrain as height fields; `heightfields` is imported only if the robot has one."""
+    if not declares_heightmap(robot):
+        return
+    from converters.mjcf.heightfields import add_height_fields
+
+    add_height_fields(
+        spec, robot, report, keep_fixed=options.keep_fixed, fixed_base=options.fixed_base
+    )
 
 
 def _add_sensors(

@@ -388,19 +388,25 @@ def prepare_collision_meshes(
     check_settings(settings)
     by_key = {r.key: r for r in requests}
 
-    def compute() -> dict[str, list[MeshPart]]:
+    def compute() -> tuple[dict[str, list[MeshPart]], Report]:
         stage(f"preparing {len(requests)} collision meshes (hulls, CoACD)", own_progress=True)
-        return prepare(requests, settings, report)
+        found = Report()
+        return prepare(requests, settings, found), found
 
-    def pack(parts: dict[str, list[MeshPart]]) -> dict[str, list[MeshPart | None]]:
+    def pack(value: tuple[dict[str, list[MeshPart]], Report]) -> tuple[dict, Report]:
         """A part that is its request's own mesh is kept as None: the builder shares it."""
+        parts, found = value
         return {
             k: [None if p.vertices is by_key[k].vertices else p for p in v]
             for k, v in parts.items()
-        }
+        }, found
 
-    def unpack(kept: dict[str, list[MeshPart | None]]) -> dict[str, list[MeshPart]]:
+    def unpack(kept: tuple[dict, Report]) -> tuple[dict[str, list[MeshPart]], Report]:
         whole = {k: MeshPart(r.vertices, r.faces) for k, r in by_key.items()}
-        return {k: [whole[k] if p is None else p for p in v] for k, v in kept.items()}
+        return {k: [whole[k] if p is None else p for p in v] for k, v in kept[0].items()}, kept[1]
 
-    return read_once("collision", tuple(by_key), compute, pack=pack, unpack=unpack)
+    parts, found = read_once("collision", tuple(by_key), compute, pack=pack, unpack=unpack)
+    report.entries.extend(found.entries)  # what was read is said again where it is replayed
+    report.meshes.extend(found.meshes)
+    report.summary.update(found.summary)
+    return parts

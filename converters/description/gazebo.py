@@ -71,6 +71,11 @@ class Surface:
     def is_empty(self) -> bool:
         return all(getattr(self, f.name) is None for f in dataclasses.fields(self))
 
+    @property
+    def declares_bitmask(self) -> bool:
+        """Whether a `category_bitmask` or `collide_bitmask` is given."""
+        return self.category_bitmask is not None or self.collide_bitmask is not None
+
 
 @dataclass(frozen=True)
 class LinkExtension:

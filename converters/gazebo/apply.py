@@ -117,8 +117,9 @@ def _apply_surface(
     geom.priority = friction_priority(mu)
     if mu <= 0.0:  # Gazebo's μ 0 is frictionless; a zero-width friction pyramid is singular
         geom.condim = 1
-    bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
-    if bits is not None:
+    if surface.declares_bitmask:  # `collide_bits` runs only for a surface that has one
+        bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
+        assert bits is not None
         geom.contype, geom.conaffinity = bits.contype, bits.conaffinity
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
@@ -219,9 +220,10 @@ def _report_surface(subject: str, surface: Surface, report: Report) -> None:
 
 
 def _report_bitmasks(subject: str, surface: Surface, report: Report) -> None:
-    bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
-    if bits is None:
+    if not surface.declares_bitmask:
         return
+    bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
+    assert bits is not None
     text = collide_bits.describe(bits)
     classic = surface.category_bitmask is not None and bits.category != bits.collide
     if classic:

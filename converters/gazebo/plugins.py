@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 from converters.description import CONTROL_PLUGINS
 from converters.description.gazebo import Blob
 from converters.gazebo.controller_drives import read_controller_drives
+from converters.gazebo.controller_yaml import load_parameters, parameter_files
 from converters.gazebo.drive_motors import add_drive_motors
 from converters.gazebo.drive_notes import drive_notes
 from converters.gazebo.drive_readers import READERS, ReadContext, plugin_key
@@ -171,6 +172,16 @@ def read_plugins(
             if rotor is not None:
                 out.append(rotor)
     return tuple(out)
+
+
+def read_plugin_files(blobs: tuple[Blob, ...], source: str, base: Path | None = None) -> None:
+    """Read the files `read_plugins` reads (a ros2_control plugin's parameter files), for a
+    served conversion's reading stage; `source` and `base` as for `read_plugins`."""
+    folder = base if base is not None else Path(source).parent
+    for blob in blobs:
+        if plugin_kind(blob) == "command_interfaces":
+            for path in parameter_files(blob.xml, folder):
+                load_parameters(path)
 
 
 def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:

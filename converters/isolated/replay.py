@@ -1,12 +1,12 @@
-"""What a conversion read from files (meshes, collision parts, height images), kept so that the
-same MjSpec can be built again in another process without reading anything.
+"""What a conversion read from files (meshes, collision parts, height images, controller files),
+kept so that the MjSpec can be built in another process without reading anything.
 
-A served conversion reads and builds in a bounded child process (`converters.isolated.bounded`),
-but an MjSpec cannot leave a process losslessly: `to_xml` rounds every number to about 7 digits
-and took 0.2-0.4 s for a small robot. So the child sends the robot description and this log of its
-reads, and the world builds the spec from them (a warm build of a corpus robot takes < 0.1 s) with
-every read answered from the log. A read the log does not hold is a defect, never a fallback to
-the file: the world process must not parse a file.
+A served conversion reads in a bounded child process (`converters.isolated.bounded`), and an
+MjSpec could not leave a process losslessly anyway: `to_xml` rounds every number to about 7
+digits and took 0.2-0.4 s for a small robot. So the child sends the robot description and this
+log of its reads, and the world builds the spec from them (a warm build of a corpus robot takes
+< 0.03 s) with every read answered from the log. A read the log does not hold is a defect,
+never a fallback to the file: the world process must not parse a file.
 """
 
 from __future__ import annotations

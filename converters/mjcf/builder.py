@@ -88,6 +88,43 @@ def new_spec(name: str) -> mujoco.MjSpec:
     return spec
 
 
+@dataclass(frozen=True)
+class BuildPlan:
+    """What the builder works out from a description before it makes an MjSpec: the bodies,
+    the geoms with their meshes read, and the inertias."""
+
+    bodies: BodyPlan
+    geoms: list[GeomPlan]
+    inertias: dict[str, inr.Inertia]
+
+
+def plan_build(robot: RobotDescription, options: ConvertOptions, report: Report) -> BuildPlan:
+    """The body plan, geoms (meshes read) and inertias of `robot`.
+
+    Raises:
+        InertiaError, MeshError: as `build_spec`.
+    """
+    plan = plan_bodies(
+        robot,
+        preserved=robot.gazebo.preserved_joints,
+        keep_fixed=options.keep_fixed,
+        static=robot.gazebo.static,
+    )
+    if options.fixed_base:
+        plan = weld_base(plan, report)
+    geoms = plan_geoms(robot, plan, report)
+    inertias = body_inertias(robot, plan, geoms, options.repair_inertia, report)
+    return BuildPlan(plan, geoms, inertias)
+
+
+def read_build_inputs(robot: RobotDescription, options: ConvertOptions, report: Report) -> None:
+    """Read every file `build_spec` reads (meshes, then collision parts: hulls and CoACD) and
+    stop before making an MjSpec: under `converters.isolated.replay.recording`, another
+    process builds the same spec from the log."""
+    planned = plan_build(robot, options, report)
+    _collision_parts(planned.geoms, options.collision, report)
+
+
 def build_spec(
     robot: RobotDescription,
     *,
@@ -104,16 +141,8 @@ def build_spec(
     Raises:
         InertiaError, MeshError, URDFStructureError (a mimic of a joint that cannot move).
     """
-    plan = plan_bodies(
-        robot,
-        preserved=robot.gazebo.preserved_joints,
-        keep_fixed=options.keep_fixed,
-        static=robot.gazebo.static,
-    )
-    if options.fixed_base:
-        plan = weld_base(plan, report)
-    geoms = plan_geoms(robot, plan, report)
-    inertias = body_inertias(robot, plan, geoms, options.repair_inertia, report)
+    planned = plan_build(robot, options, report)
+    plan, geoms, inertias = planned.bodies, planned.geoms, planned.inertias
     spec = new_spec(robot.name)
     bodies, joints = _add_bodies(spec, plan, inertias, report, provenance)
     _add_sites(bodies, plan, robot)

@@ -45,6 +45,39 @@ def add_height_fields(
     returns how many. Ones already in the spec are kept as they are. `keep_fixed` and
     `fixed_base` are the build's options: the body plan must be the builder's, so that a
     heightmap on a root welded by `--fixed-base` counts as static."""
+    found = _heightmaps(robot, keep_fixed, fixed_base)
+    if not found:
+        return 0
+    report.entries[:] = [e for e in report.entries if e.tag != HEIGHTMAP]
+    added = 0
+    for link, index, collision, placement in found:
+        subject = f"link '{link}' collision {index}"
+        if placement is None:
+            report.warn(subject, "a heightmap on a moving link is left out (MuJoCo's are static)")
+        elif spec.geom(f"{link}_collision_{index}") is None:
+            _add_one(spec, f"{link}_collision_{index}", placement, collision, report, subject)
+            added += 1
+    return added
+
+
+def read_height_images(
+    robot: RobotDescription, *, keep_fixed: bool = False, fixed_base: bool = False
+) -> None:
+    """Read the images `add_height_fields` reads (a served conversion's reading stage).
+
+    Raises:
+        InputFileError: an image that cannot be a height map.
+    """
+    for _, _, collision, placement in _heightmaps(robot, keep_fixed, fixed_base):
+        if placement is not None:
+            assert collision.geometry is not None and collision.geometry.mesh is not None
+            _heights(collision.geometry.mesh, collision.geometry.size[2])
+
+
+def _heightmaps(
+    robot: RobotDescription, keep_fixed: bool, fixed_base: bool
+) -> list[tuple[str, int, Collision, LinkPlacement | None]]:
+    """(link, index, collision, placement: None on a moving body) of each heightmap."""
     found = [
         (link.name, index, c)
         for link in robot.links
@@ -52,7 +85,7 @@ def add_height_fields(
         if c.geometry is not None and c.geometry.shape == HEIGHTMAP
     ]
     if not found:
-        return 0
+        return []
     plan = plan_bodies(
         robot,
         preserved=robot.gazebo.preserved_joints,
@@ -62,16 +95,11 @@ def add_height_fields(
     if fixed_base:  # reported once already, by the builder
         plan = weld_base(plan, Report())
     static = static_bodies(plan)
-    report.entries[:] = [e for e in report.entries if e.tag != HEIGHTMAP]
-    added = 0
+    out = []
     for link, index, collision in found:
-        subject, placement = f"link '{link}' collision {index}", plan.placements[link]
-        if placement.body not in static:
-            report.warn(subject, "a heightmap on a moving link is left out (MuJoCo's are static)")
-        elif spec.geom(f"{link}_collision_{index}") is None:
-            _add_one(spec, f"{link}_collision_{index}", placement, collision, report, subject)
-            added += 1
-    return added
+        placement = plan.placements[link]
+        out.append((link, index, collision, placement if placement.body in static else None))
+    return out
 
 
 def _add_one(

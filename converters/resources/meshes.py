@@ -47,7 +47,7 @@ class MeshCache:
 def load_mesh(path: Path, link: str) -> MeshData:
     """A mesh file's triangles in metres: from the mesh store when these bytes were loaded
     before, else read with trimesh (and stored); from the read log when a bounded conversion's
-    spec is built again (`converters.isolated.replay`).
+    spec is built in its caller (`converters.isolated.replay`).
 
     Raises:
         MeshError: the file cannot be parsed or holds no triangles.

@@ -1,4 +1,4 @@
-"""A world server's conversions: read and built in a bounded child, the spec built again here
-from what the child read (`served`), and what that child imports before it forks (`warm`)."""
+"""A world server's conversions: read in a bounded child, the spec built once here from what the
+child read (`served`), and what that child imports before it forks (`warm`)."""
 
 __all__: list[str] = []  # its modules are imported by name

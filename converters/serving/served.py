@@ -1,25 +1,35 @@
-"""A conversion a running world asks for: read in a bounded child, built again in the caller.
+"""A conversion a running world asks for: read in a bounded child, built once in the caller.
 
 The child (`converters.isolated.bounded`) does everything that touches the description's files or
 could run away on them: xacro (in its own sandboxed grandchild), URDF/SDF parsing, mesh reading,
-collision hulls and CoACD, and the build. It sends back the robot description, the report and the
-log of what it read (`converters.isolated.replay`); the caller builds the MjSpec from those
-without opening a file (< 0.1 s for a corpus robot), since an MjSpec itself cannot cross processes
-without losing precision.
+collision hulls and CoACD, height images, controller parameter files; it makes no MjSpec. It
+sends back the robot description, the report so far and the log of what it read
+(`converters.isolated.replay`); the caller builds the MjSpec from those without opening a file
+(< 0.03 s for a corpus robot), since an MjSpec itself cannot cross processes without losing
+precision. The build compiles nothing for a robot without plugins; the world compiles the robot
+in its own process in any case.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import threading
-from dataclasses import dataclass, replace
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from converters.isolated import bounded, replay
+from converters.isolated import bounded
 from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
-from converters.pipeline import Conversion, build_description, convert_full, convert_text
+from converters.pipeline import (
+    Conversion,
+    build_description,
+    read_build_files,
+    read_file,
+    read_text,
+)
 from converters.report import Report
 
 
@@ -61,34 +71,48 @@ def convert_served(
     """
     if not bounded.enabled() or multiprocessing.current_process().daemon:
         return convert_job(job)
-    robot, report, reads = bounded.run(read_and_build, job, budget, job.source, cancel)
+    from converters.isolated import replay
+
+    robot, report, reads = bounded.run(read_job, job, budget, job.source, cancel)
     with replay.replaying(reads):
-        done = build_description(robot, job.options, Report(source=report.source))
-    return replace(done, report=report)
+        return build_description(robot, job.options, report)
 
 
-def read_and_build(job: ConversionJob) -> tuple[Any, Report, dict]:
-    """The child's work: convert, keeping the description, the report and the read log."""
-    with replay.recording() as log:
-        done = convert_job(job)
-    return done.description, done.report, log.entries
+def read_job(job: ConversionJob) -> tuple[Any, Report, dict]:
+    """The child's work: the robot description, the report so far and the log of every file
+    its build reads (`read_build_files`), read in `job.read_roots` only."""
+    from converters.isolated import replay
+
+    with replay.recording() as log, _confined(job):
+        robot, report = _read(job)
+        read_build_files(robot, job.options)
+    return robot, report, log.entries
 
 
 def convert_job(job: ConversionJob) -> Conversion:
     """The conversion `job` describes, in this process (reading only in `job.read_roots`)."""
+    with _confined(job):
+        robot, report = _read(job)
+        return build_description(robot, job.options, report)
+
+
+@contextmanager
+def _confined(job: ConversionJob) -> Iterator[None]:
+    """Reads confined to `job.read_roots` and the collision cache meanwhile (if it has any)."""
     if job.read_roots is None:
-        return _convert(job)
+        yield
+        return
     from converters.collision.cache import cache_root
     from converters.isolated.confine import confined
 
     with confined(job.read_roots, also=(str(cache_root()),)):  # collision parts are read there
-        return _convert(job)
+        yield
 
 
-def _convert(job: ConversionJob) -> Conversion:
+def _read(job: ConversionJob) -> tuple[Any, Report]:
     packages = dict(job.package_paths)
     if job.text is not None:
-        return convert_text(
+        return read_text(
             job.text,
             source=job.source,
             base_dir=job.base_dir,
@@ -96,7 +120,7 @@ def _convert(job: ConversionJob) -> Conversion:
             options=job.options,
             env=job.env,
         )
-    return convert_full(
+    return read_file(
         Path(job.path or job.source),
         args=dict(job.args),
         package_paths=packages,

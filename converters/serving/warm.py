@@ -14,6 +14,7 @@ import converters.description.references
 import converters.gazebo.apply
 import converters.gazebo.plugins
 import converters.gazebo.sensor_sites
+import converters.isolated.replay
 import converters.mjcf.heightfields
 import converters.mjcf.passive_motors
 import converters.sdf

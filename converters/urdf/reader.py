@@ -89,8 +89,16 @@ def parse_urdf(
         gazebo=gazebo,
         actuated=_named_joints(root, ("transmission", "ros2_control")),
         text=text,
-        controls=read_controls(root, source),
+        controls=_controls(root, source),
     )
+
+
+def _controls(root: ET.Element, source: str) -> tuple:
+    """The joints' declared command interfaces (`urdf.control`), read only if the URDF has a
+    `<ros2_control>` or `<transmission>`."""
+    if root.find(".//ros2_control") is None and root.find(".//transmission") is None:
+        return ()
+    return read_controls(root, source)
 
 
 def _floats(element: ET.Element | None, attribute: str, default: tuple[float, ...]) -> tuple:

@@ -1,4 +1,4 @@
-"""A served conversion (read in a bounded child, built again from its read log) gives the same
+"""A served conversion (read in a bounded child, built once from its read log) gives the same
 model as one in this process, opens no description file here, and stays inside its budget."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from converters.isolated import bounded
 from converters.isolated.bounded_child import READ_EVENT
 from converters.isolated.budget import XacroBudget
 from converters.mjcf.builder import ConvertOptions
-from converters.serving.served import ConversionJob, convert_job, convert_served
+from converters.serving.served import ConversionJob, convert_job, convert_served, read_job
 from tests.corpus_registry import CORPUS, PACKAGES_ROOT, needs_corpus, package_paths
 
 CUBE_OBJ = "\n".join(
@@ -97,6 +97,99 @@ def test_a_served_conversion_builds_the_same_model_and_reads_no_file_here(tmp_pa
     assert [s.name for s in served.sensors] == [s.name for s in here.sensors]
 
 
+def _calls(action, names: set[str]) -> dict[str, int]:
+    """How often each function of `names` (converter functions, by name) ran during `action`."""
+    counts = dict.fromkeys(names, 0)
+
+    def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
+        code = frame.f_code
+        if event == "call" and code.co_name in counts and "converters" in code.co_filename:
+            counts[code.co_name] += 1
+
+    sys.setprofile(profile)
+    try:
+        action()
+    finally:
+        sys.setprofile(None)
+    return counts
+
+
+def test_the_child_reads_without_building_and_the_caller_builds_once(tmp_path, monkeypatch):
+    """The child's work (`read_job`, run here to watch it) reads the meshes and prepares the
+    collision parts but makes no MjSpec; what it sends back builds the same model as a
+    conversion in this process, and a served conversion makes one MjSpec here."""
+    from converters.isolated import replay
+    from converters.pipeline import build_description
+
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+    job = _job(_robot(tmp_path))
+    builds = {"new_spec", "build_spec", "build_description"}
+    sent: list[tuple] = []
+    ran = _calls(lambda: sent.append(read_job(job)), builds | {"load_mesh", "compute"})
+    assert {k: ran[k] for k in builds} == dict.fromkeys(builds, 0), f"the child built: {ran}"
+    assert ran["load_mesh"] >= 1 and ran["compute"] == 1, f"the child did not read: {ran}"
+    robot, report, reads = sent[0]
+    assert {e[0] for e in reads} == {"mesh", "collision"}, sorted(reads)
+    with replay.replaying(reads):
+        built = build_description(robot, job.options, report)
+    same = mjb(built.spec) == mjb(convert_job(job).spec)
+    assert same, "the model built from what the child sent differs from one built here"
+    ran = _calls(lambda: convert_served(job, XacroBudget(60, 4096)), {"new_spec"})
+    assert ran == {"new_spec": 1}, f"a served conversion made {ran['new_spec']} MjSpecs here"
+
+
+def _heightmap_terrain(folder: Path) -> Path:
+    from PIL import Image
+
+    image = np.zeros((9, 9), np.uint8)
+    image[:, 5:] = 255
+    Image.fromarray(image).save(folder / "terrain.png")
+    path = folder / "terrain.sdf"
+    path.write_text(
+        '<sdf version="1.6"><model name="terrain"><static>true</static><link name="l">'
+        '<collision name="c"><geometry><heightmap><uri>terrain.png</uri><size>4 4 2</size>'
+        "</heightmap></geometry></collision></link></model></sdf>"
+    )
+    return path
+
+
+def _ros2_control_base(folder: Path) -> Path:
+    import drive_models as dm
+
+    left, right = ("wheel_left_joint",), ("wheel_right_joint",)
+    robot = dm.with_diff_drive_controller(dm.two_wheel_base(dm.ROS2_CONTROL), left, right, folder)
+    path = folder / "base.urdf"
+    path.write_text(robot)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("make", "read"),
+    [(_heightmap_terrain, "terrain.png"), (_ros2_control_base, "controllers.yaml")],
+    ids=["heightmap image", "controller parameter file"],
+)
+def test_the_builds_other_reads_come_from_the_child(tmp_path, make, read):
+    """A height image and a ros2_control parameter file are read by the child too: the served
+    model and drives equal this process's, and the world's process opens neither."""
+    path = make(tmp_path)
+    job = _job(path)
+    here = convert_job(job)
+    opened: list[str] = []
+
+    def hook(event: str, args: tuple) -> None:
+        if event == "open" and isinstance(args[0], str) and args[0].startswith(str(tmp_path)):
+            opened.append(args[0])
+
+    sys.addaudithook(hook)
+    served = convert_served(job, XacroBudget(60, 4096))
+    done_reading = list(opened)
+    same = mjb(served.spec) == mjb(here.spec)
+    assert same, f"{read}: the served model differs"
+    assert served.plugins == here.plugins, f"{read}: the served drives differ"
+    assert served.report.to_dict()["entries"] == here.report.to_dict()["entries"]
+    assert done_reading == [], f"the world's process opened description files: {done_reading}"
+
+
 @needs_corpus
 @pytest.mark.parametrize("robot_id", ["turtlebot3_burger", "ur5e"])
 def test_a_served_corpus_robot_compiles_to_the_same_model(robot_id):
@@ -120,9 +213,11 @@ def test_an_error_in_the_child_comes_back_as_its_own_class(tmp_path):
     assert "missing.stl" in str(caught.value) and "arm" in str(caught.value), str(caught.value)
 
 
-def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path):
+def test_a_conversion_over_its_memory_budget_names_the_variable(tmp_path, monkeypatch):
     """64 MiB of address space is less than the interpreter already maps: the first large
-    allocation fails, and the error says which budget and how to raise it."""
+    allocation fails, and the error says which budget and how to raise it. The mesh cache is
+    empty, so the child reads the mesh itself."""
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
     robot = _robot(tmp_path)
     with pytest.raises(ConversionBudgetError) as caught:
         convert_served(_job(robot), XacroBudget(60, 64))

@@ -16,7 +16,7 @@ import numpy as np
 
 from twin_cli.errors import EntityExistsError, InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest, as_request
-from twin_cli.world import decomposing, placement, posture, shared_meshes, spawn
+from twin_cli.world import placement, posture, shared_meshes, spawn
 from twin_cli.world.entities import Entity, EntityState, index_entities, rest_state, write_state
 from twin_cli.world.plugin_holds import hold_from_load
 from twin_cli.world.pose import Pose, check_finite
@@ -134,7 +134,7 @@ def spawn_one(
     with state.lock:
         name = name or free_name(state, safe_base(loaded.default_name))
         result = _spawn_loaded(state, [loaded], request, [name], [pose])[0]
-        decomposing.start(state, loaded, request, [name])
+        _decompose_deferred(state, loaded, request, [name])
         return result
 
 
@@ -162,8 +162,20 @@ def spawn_batch(
     copies = [replace(loaded, spec=loaded.spec.copy()) for _ in poses]
     with state.lock:
         results = _spawn_loaded(state, copies, request, names, poses)
-        decomposing.start(state, loaded, request, names)
+        _decompose_deferred(state, loaded, request, names)
         return results
+
+
+def _decompose_deferred(
+    state: WorldState, loaded: spawn.LoadedSource, request: SpawnRequest, names: list[str]
+) -> None:
+    """Start the background CoACD of a load whose hulls stand in for it (`decomposing`, imported
+    only then)."""
+    if not loaded.deferred:
+        return
+    from twin_cli.world import decomposing
+
+    decomposing.start(state, loaded, request, names)
 
 
 def spawn_specs(
