@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
@@ -24,6 +25,9 @@ from twin_cli.world.recompile import Built, commit, ground, rebuild
 from twin_cli.world.respec import keep_spec
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import SpawnResult
+
+if TYPE_CHECKING:
+    from twin_cli.world import decomposing
 
 MAX_BATCH = 1000  # instances per request: a guard against a runaway script, not a model limit
 
@@ -197,7 +201,10 @@ def spawn_specs(
         results = _spawn_loaded(state, loaded, requests, names, poses)
         redo = redo or {}
         later = [(n, one, redo[n]) for n, one in zip(names, loaded, strict=True) if n in redo]
-        decomposing.start_models(state, later)
+        if later:
+            from twin_cli.world import decomposing
+
+            decomposing.start_models(state, later)
         return results
 
 
