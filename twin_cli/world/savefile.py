@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from dataclasses import asdict, fields, replace
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,7 @@ from twin_cli.files import input_files
 from twin_cli.files.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.actuation import JointCommand, Push
+from twin_cli.world.decomposing import PENDING
 from twin_cli.world.engine import World
 from twin_cli.world.entities import Entity, EntityState
 from twin_cli.world.pose import Pose
@@ -33,6 +35,7 @@ from twin_cli.world.values import WorldSettings
 FORMAT = "twin-world"
 VERSION = 1
 SAVED_BY_TWIN = "give a file written by `twin save`"
+DECOMPOSITION_POLL_S = 0.1  # [s] how often a save looks whether a decomposition it waits for ended
 
 
 def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
@@ -43,6 +46,7 @@ def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
         WorldFileError: an entity spawned from an MjSpec cannot be written as MJCF, the folder
             is not writable, or the file is someone else's.
     """
+    _await_decompositions(world)
     snap = world.snapshot()
     document = {
         "format": FORMAT,
@@ -59,6 +63,19 @@ def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
         "state": snap.state.tolist(),
     }
     _write_atomically(Path(path), json.dumps(document), force)
+
+
+def _await_decompositions(world: World) -> None:
+    """Waits for the background decompositions of entities saved as MJCF (a description given
+    as text, a world file's model): a load spawns that MJCF as it is, so a convex hull standing
+    in when it was written would stay for good. An entity spawned from a file needs no wait, as
+    a load converts its file again. Each job ends by itself: swapped in, failed (its CPU budget
+    or wall-clock backstop, the hull kept), or cancelled by a delete or a stop."""
+    while any(
+        info.decomposition == PENDING and world.entity(info.name).xml is not None
+        for info in world.entities()
+    ):
+        time.sleep(DECOMPOSITION_POLL_S)
 
 
 def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:

@@ -174,3 +174,24 @@ def test_a_served_world_files_models_are_swapped_in_one_by_one(served, tmp_path)
         assert np.count_nonzero(geoms) == rows[0]["parts"] >= 5, (name, rows)
     on_floor = _settled_ball_z(world)
     assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+
+
+def test_a_save_during_a_text_decomposition_waits_and_writes_the_parts(served, tmp_path):
+    """A text's entity is saved as MJCF, which a load spawns as it is: a save while its
+    decomposition is pending waits for it, so the saved bin has CoACD's parts and a loaded
+    world's ball rests on the bin's floor, not on a hull kept for good."""
+    from twin_cli.world import savefile
+
+    text = Path(bin_urdf(tmp_path)).read_text()
+    world = World()
+    world.spawn(SpawnRequest(xml=text, base_dir=str(tmp_path)), name="bin")
+    assert world.entities()[0].decomposition == "pending"
+    path = tmp_path / "world.json"
+    savefile.save(world, path)
+    assert world.entities()[0].decomposition == "done", world.entities()[0]
+    parts = world.entity("bin").report["meshes"][0]["parts"]
+    loaded = savefile.load(path)
+    assert _bin_geoms(loaded) == parts > 1, (_bin_geoms(loaded), parts)
+    loaded.spawn(SpawnRequest(ball_urdf(tmp_path)), name="ball", pose=Pose(z=DROP_Z))
+    on_floor = _settled_ball_z(loaded)
+    assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
