@@ -102,10 +102,7 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
                 "restore into a world that spawned the same sources in the same order",
             )
         records = {  # all checked before any is replaced: a bad one changes nothing
-            e.name: replace(
-                e, spawn_state=typed_like(state.entities[e.name].spawn_state, e.spawn_state)
-            )
-            for e in snapshot.entities
+            e.name: _restored(state.entities[e.name], e) for e in snapshot.entities
         }
         state.entities.update(records)
         mujoco.mj_setState(state.model, state.data, np.asarray(snapshot.state, float), STATE)
@@ -117,3 +114,17 @@ def restore(state: WorldState, snapshot: WorldSnapshot) -> None:
         release_commands(state, state.model, state.data, dropped)
         reapply_commands(state, state.model, state.data, fresh=False)
         state.pushes = list(snapshot.pushes)
+
+
+def _restored(now: Entity, saved: Entity) -> Entity:
+    """The record a restore leaves: what the snapshot owns (source, request, pose, spawn state)
+    on the world's own record of what it compiled (report, MJCF, description, sensors,
+    plugins). A decomposition swapped in after the snapshot was taken (a `twin load` whose
+    background CoACD lands before the saved state is written) keeps its report and MJCF."""
+    return replace(
+        now,
+        source=saved.source,
+        request=saved.request,
+        pose=saved.pose,
+        spawn_state=typed_like(now.spawn_state, saved.spawn_state),
+    )

@@ -195,3 +195,22 @@ def test_a_save_during_a_text_decomposition_waits_and_writes_the_parts(served, t
     loaded.spawn(SpawnRequest(ball_urdf(tmp_path)), name="ball", pose=Pose(z=DROP_Z))
     on_floor = _settled_ball_z(loaded)
     assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+
+
+def test_a_restore_after_the_swap_keeps_the_decomposed_record(served, tmp_path):
+    """A `twin load` respawns its entities (a file's bin decomposes in the background) and then
+    writes the saved state: a swap that lands between the two must not be undone. The same
+    order made deterministic: a snapshot while pending, the swap, then the restore. The record
+    keeps CoACD's report (no hull listed) and the world its parts; the state is the saved one."""
+    world = World()
+    world.spawn(SpawnRequest(bin_urdf(tmp_path)), name="bin")
+    assert world.entities()[0].decomposition == "pending"
+    before = world.snapshot()
+    assert _wait_while_pending(world, "bin") == "done", world.entities()[0]
+    parts = world.entity("bin").report["meshes"][0]["parts"]
+    world.restore(before)
+    listed = world.entities()[0]
+    assert listed.hull_stand_ins == () and listed.decomposition == "done", listed
+    assert world.entity("bin").report["meshes"][0]["mode"] == "coacd"
+    assert _bin_geoms(world) == parts > 1
+    assert np.array_equal(world.snapshot().state, before.state)
