@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from twin_cli.errors import SpawnError
-from twin_cli.world import decomposing, spawn
+from twin_cli.world import attach, decomposing
 from twin_cli.world.entities import EntityIndex
 from twin_cli.world.pose import Pose, check_finite, quat_multiply, rotate
 from twin_cli.world.queries import root_from_model
@@ -34,7 +34,7 @@ def delete(state: WorldState, name: str) -> None:
     with state.lock:
         state.require(name)
         trial = state.spec.copy()
-        spawn.remove_entity(trial, name)
+        attach.remove_entity(trial, name)
         entity = state.entities.pop(name)
         try:
             built = rebuild(state, trial, (), entity.source)
@@ -75,7 +75,7 @@ def set_pose(state: WorldState, name: str, pose: Pose) -> None:
         ix = state.require(name)
         if ix.free_qpos < 0:
             trial = state.spec.copy()
-            spawn.move_frame(trial, name, pose)
+            attach.move_frame(trial, name, pose)
             built = rebuild(state, trial, (), state.entities[name].source)  # may fail
             state.entities[name] = replace(state.entities[name], pose=pose)
             commit(state, trial, built)
@@ -139,7 +139,7 @@ def _move_free_links(state: WorldState, name: str, ix: EntityIndex, pose: Pose) 
     old, qpos = state.entities[name].pose, state.data.qpos
     w, x, y, z = old.quat()
     turn = quat_multiply(pose.quat(), (w, -x, -y, -z))
-    for at in spawn.free_offsets(state.model, ix):
+    for at in attach.free_offsets(state.model, ix):
         a = int(ix.qpos[at])
         offset = (
             float(qpos[a] - old.x),

@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from twin_cli.spawn_request import SpawnRequest
-from twin_cli.world import respec, spawn
+from twin_cli.world import attach, respec, spawn
 from twin_cli.world.recompile import commit, rebuild
 from twin_cli.world.values import DEFERRED_STOP, deferred_meshes, hull_stand_ins
 
@@ -218,7 +218,7 @@ def swap(state: WorldState, names: Sequence[str], loaded: spawn.LoadedSource) ->
     children = {}
     for name in names:
         child = loaded.spec.copy()
-        spawn.prepare_child(child, state.spec)
+        attach.prepare_child(child, state.spec)
         children[name] = (child, loaded.mesh_keys)
     fresh = respec.fresh_spec(state, children)
     if fresh is None:

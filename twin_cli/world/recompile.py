@@ -17,7 +17,7 @@ import numpy as np
 from converters.gazebo.friction_pairs import add_friction_pairs
 from converters.mjcf.lowest_point import collision_geoms, lowest_point
 from twin_cli.errors import SpawnError
-from twin_cli.world import actuation, placement, spawn
+from twin_cli.world import actuation, attach, placement
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.driving import reapply_commands
 from twin_cli.world.engine_threads import install_pool
@@ -105,8 +105,8 @@ def ground(
     pose = replace(pose, z=pose.z - low)
     if ix.free_qpos >= 0:
         q = q.copy()
-        for at in spawn.free_offsets(model, ix):  # every free link, not only the root
+        for at in attach.free_offsets(model, ix):  # every free link, not only the root
             q[at + 2] -= low
         return pose, q, built
-    spawn.move_frame(state.spec, name, pose)
+    attach.move_frame(state.spec, name, pose)
     return pose, q, rebuild(state, state.spec, [name], "on-ground placement")

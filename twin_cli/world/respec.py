@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from converters.gazebo.friction_pairs import add_friction_pairs
-from twin_cli.world import shared_meshes, spawn
+from twin_cli.world import attach, shared_meshes
 from twin_cli.world.contacts import cap_contact_stiffness
 from twin_cli.world.driving import reapply_commands
 from twin_cli.world.pose import Pose
@@ -132,7 +132,7 @@ def fresh_spec(state: WorldState, replaced: dict[str, Kept] | None = None) -> mu
         child = kept.copy()
         adopt_world_globals(child, fresh)
         shared_meshes.prepare(child, fresh, keys)
-        spawn.attach(fresh, child, name, Pose())
+        attach.attach(fresh, child, name, Pose())
         fresh.frame(f"{name}/").pos = frame.pos  # the frame as it is (on-ground, moves)
         fresh.frame(f"{name}/").quat = frame.quat
     return fresh

@@ -17,7 +17,7 @@ import numpy as np
 
 from twin_cli.errors import EntityExistsError, InvalidRequestError, SpawnError
 from twin_cli.spawn_request import SpawnRequest, as_request
-from twin_cli.world import placement, posture, shared_meshes, spawn
+from twin_cli.world import attach, placement, posture, shared_meshes, spawn
 from twin_cli.world.entities import Entity, EntityState, index_entities, rest_state, write_state
 from twin_cli.world.plugin_holds import hold_from_load
 from twin_cli.world.pose import Pose, check_finite
@@ -250,7 +250,7 @@ def _spawn_loaded(
                 results.append(SpawnResult(n, one.source, warnings, one.report, one.cached))
         except BaseException:
             for n in names:
-                spawn.remove_entity(state.spec, n)
+                attach.remove_entity(state.spec, n)
             raise
         state.entities.update(records)  # nothing is recorded until everything succeeded
         commit(state, state.spec, (model, data, index))
@@ -263,10 +263,10 @@ def _attach(
 ) -> np.ndarray | None:
     """Attaches the loaded spec to the world spec as `name`; returns its home qpos or None."""
     try:
-        home = spawn.prepare_child(loaded.spec, state.spec)
+        home = attach.prepare_child(loaded.spec, state.spec)
         keep_spec(state, name, loaded.spec, loaded.mesh_keys)  # for renew_spec
         shared_meshes.prepare(loaded.spec, state.spec, loaded.mesh_keys)
-        spawn.attach(state.spec, loaded.spec, name, pose)
+        attach.attach(state.spec, loaded.spec, name, pose)
     except ValueError as exc:
         raise SpawnError(
             name, loaded.source, f"cannot be attached ({exc})", "fix the model"
@@ -289,7 +289,7 @@ def _seed(
     for request, n, pose, home in zip(requests, names, poses, homes, strict=True):
         ix = index[n]
         targets = posture.joint_targets(model, ix.joints, f"{n}/", dict(request.joints), n)
-        q = posture.apply_targets(spawn.initial_qpos(model, ix, home, pose), ix.qpos, targets)
+        q = posture.apply_targets(attach.initial_qpos(model, ix, home, pose), ix.qpos, targets)
         if request.on_ground:  # a fixed base moves its frame: a recompile, layouts kept
             pose, q, (model, data, _) = ground(state, (model, data, index), n, pose, q)
             index = index_entities(model, kept + list(names))
