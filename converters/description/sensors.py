@@ -9,6 +9,7 @@ are SI: angles [rad], ranges [m], rates [Hz]; a `Noise` is in the unit of the va
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 # Prefix of the MuJoCo site (and camera) that marks a sensor's frame: `sensor:<name>`.
 SITE_PREFIX = "sensor:"
@@ -49,6 +50,16 @@ class Noise:
     def active(self) -> bool:
         return self.type != "none"
 
+    def summary(self) -> str:
+        """One phrase for reports: its type, mean and stddev, or "none"."""
+        if not self.active:
+            return "none"
+        return f"{self.type} mean {self.mean:g} stddev {self.stddev:g}"
+
+
+def _stddevs(noises: tuple[Noise, ...]) -> str:
+    return ", ".join(f"{n.stddev:g}" for n in noises if n.active) or "none"
+
 
 NO_NOISE = Noise()
 NO_NOISE3 = (NO_NOISE, NO_NOISE, NO_NOISE)
@@ -69,7 +80,12 @@ class SensorSpec:
         frame_id: the frame named in its ROS plugin (`frameName`, `frame_name`), else the link.
         where: file and element it was written in, for reports.
         body: the MuJoCo body carrying the sensor's site (the link's body after lumping).
+
+    Class attribute `native`: the `NATIVE_PARTS` key of the MuJoCo sensors its site carries
+    ("" for none). A kind says in `details` what it became, for the conversion report.
     """
+
+    native: ClassVar[str] = ""
 
     name: str
     type: str
@@ -87,6 +103,10 @@ class SensorSpec:
         """The MuJoCo site at the sensor's frame (prefixed with `<entity>/` once spawned)."""
         return SITE_PREFIX + self.name
 
+    def details(self) -> str:
+        """What the sensor became, its values and noise, for the conversion report."""
+        return ""
+
 
 @dataclass(frozen=True)
 class ImuSpec(SensorSpec):
@@ -95,6 +115,11 @@ class ImuSpec(SensorSpec):
     angular_velocity_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     linear_acceleration_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     enable_orientation: bool = True
+    native: ClassVar[str] = "imu"
+
+    def details(self) -> str:
+        noisy = _stddevs(self.angular_velocity_noise + self.linear_acceleration_noise)
+        return f"orientation, angular velocity, specific force; noise stddev {noisy}"
 
 
 @dataclass(frozen=True)
@@ -126,6 +151,13 @@ class RaySpec(SensorSpec):
     def vertical_rays(self) -> int:
         return max(1, round(self.vertical_samples * self.vertical_resolution))
 
+    def details(self) -> str:
+        return (
+            f"{self.horizontal_rays}×{self.vertical_rays} MuJoCo rays, "
+            f"{self.horizontal_min_angle:g}..{self.horizontal_max_angle:g} rad, "
+            f"range {self.range_min:g}..{self.range_max:g} m; noise {self.noise.summary()}"
+        )
+
 
 @dataclass(frozen=True)
 class ContactSpec(SensorSpec):
@@ -137,6 +169,9 @@ class ContactSpec(SensorSpec):
 
     collision: str = ""
     geoms: tuple[str, ...] = ()
+
+    def details(self) -> str:
+        return f"contacts of {len(self.geoms)} collision geoms"
 
 
 @dataclass(frozen=True)
@@ -157,6 +192,14 @@ class ForceTorqueSpec(SensorSpec):
     parent_body: str = ""
     force_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     torque_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
+    native: ClassVar[str] = "force_torque"
+
+    def details(self) -> str:
+        noisy = _stddevs(self.force_noise + self.torque_noise)
+        return (
+            f"wrench of joint '{self.joint}' in the {self.frame} frame, "
+            f"{self.measure_direction}; noise stddev {noisy}"
+        )
 
 
 @dataclass(frozen=True)
@@ -175,3 +218,11 @@ class CameraSpec(SensorSpec):
     image_format: str = "R8G8B8"
     depth: bool = False
     noise: Noise = NO_NOISE
+
+    def details(self) -> str:
+        kind = "depth" if self.depth else "colour"
+        return (
+            f"{kind} image {self.width}×{self.height}, hfov {self.horizontal_fov:g} rad, "
+            f"clip {self.near:g}..{self.far:g} m (offscreen rendering: needs MUJOCO_GL=egl "
+            "or osmesa; image noise not simulated)"
+        )

@@ -21,14 +21,11 @@ from converters.description.sensors import (
     NATIVE_PARTS,
     CameraSpec,
     ForceTorqueSpec,
-    ImuSpec,
-    Noise,
-    RaySpec,
     SensorSpec,
 )
 from converters.description.transforms import pose_matrix
 from converters.errors import InputFileError
-from converters.gazebo.sensors import KINDS, Placement, read_sensor
+from converters.gazebo.sensors import Placement, kind_of, read_sensor
 from converters.provenance import Provenance
 from converters.report import Report
 
@@ -38,7 +35,6 @@ if TYPE_CHECKING:
 SITE_GROUP = 5  # the group of the builder's frame sites (lumped links, SDF frames)
 # Gazebo camera axes (x forward, y left, z up) in MuJoCo camera axes (x right, y up, z back).
 R_SENSOR_CAMERA = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-NATIVE_KIND = {ImuSpec: "imu", ForceTorqueSpec: "force_torque"}  # keys of NATIVE_PARTS
 
 
 def add_sensors(
@@ -61,7 +57,7 @@ def add_sensors(
     """
     found: list[SensorSpec] = []
     for blob, placement, subject in _candidates(robot, provenance, report):
-        if (blob.kind or "").lower() not in KINDS:
+        if kind_of(blob.kind) is None:
             report.ignored(subject, f"sensor type '{blob.kind}' is not simulated", tag="sensor")
             continue
         sensor = read_sensor(blob, placement)
@@ -151,7 +147,7 @@ def _add_native(spec: mujoco.MjSpec, sensor: SensorSpec) -> None:
     """
     import mujoco
 
-    kind_name = NATIVE_KIND.get(type(sensor), "")
+    kind_name = sensor.native
     history = {}
     if kind_name == "imu":
         period = 1.0 / sensor.update_rate if sensor.update_rate > 0 else 0.0
@@ -200,38 +196,4 @@ def describe(sensor: SensorSpec) -> str:
     """One report line: what the sensor became, its rate and its noise."""
     rate = f"{sensor.update_rate:g} Hz" if sensor.update_rate > 0 else "every physics step"
     head = f"<sensor type='{sensor.type}'> → site '{sensor.site}' at {rate}"
-    return f"{head}; {_details(sensor)}"
-
-
-def _details(sensor: SensorSpec) -> str:
-    if isinstance(sensor, ImuSpec):
-        noisy = sensor.angular_velocity_noise + sensor.linear_acceleration_noise
-        stddevs = ", ".join(f"{n.stddev:g}" for n in noisy if n.active) or "none"
-        return f"orientation, angular velocity, specific force; noise stddev {stddevs}"
-    if isinstance(sensor, RaySpec):
-        return (
-            f"{sensor.horizontal_rays}×{sensor.vertical_rays} MuJoCo rays, "
-            f"{sensor.horizontal_min_angle:g}..{sensor.horizontal_max_angle:g} rad, "
-            f"range {sensor.range_min:g}..{sensor.range_max:g} m; noise {_noise(sensor.noise)}"
-        )
-    if isinstance(sensor, ForceTorqueSpec):
-        noisy = sensor.force_noise + sensor.torque_noise
-        stddevs = ", ".join(f"{n.stddev:g}" for n in noisy if n.active) or "none"
-        return (
-            f"wrench of joint '{sensor.joint}' in the {sensor.frame} frame, "
-            f"{sensor.measure_direction}; noise stddev {stddevs}"
-        )
-    if isinstance(sensor, CameraSpec):
-        kind = "depth" if sensor.depth else "colour"
-        return (
-            f"{kind} image {sensor.width}×{sensor.height}, hfov {sensor.horizontal_fov:g} rad, "
-            f"clip {sensor.near:g}..{sensor.far:g} m (offscreen rendering: needs MUJOCO_GL=egl "
-            "or osmesa; image noise not simulated)"
-        )
-    return f"contacts of {len(getattr(sensor, 'geoms', ()))} collision geoms"
-
-
-def _noise(noise: Noise) -> str:
-    if not noise.active:
-        return "none"
-    return f"{noise.type} mean {noise.mean:g} stddev {noise.stddev:g}"
+    return f"{head}; {sensor.details()}"

@@ -6,15 +6,22 @@ topic and frame conventions of the gazebo_ros plugins (ROS 1 `topicName`/`frameN
 `<ros><remapping>~/out:=scan</remapping>` and `frame_name`). Both SDF 1.5's IMU noise
 (`<imu><noise><rate>/<accel>`, one model for all axes) and 1.6+'s per-axis noise are read.
 Pure: no MuJoCo here; `converters.gazebo.sensor_sites` places the records in the spec.
+
+Each kind's reader registers itself with `@sensor_kind(kind, *gazebo_types)`: the kinds below,
+and one module per further kind in `converters.gazebo.sensor_kinds` (found by scanning it), so
+a new kind is one module there with its `SensorSpec` subclass and its reader.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import importlib
+import pkgutil
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from functools import cache
+from typing import Any, TypeVar
 
 from converters.description.gazebo import Blob
 from converters.description.sensors import (
@@ -30,21 +37,9 @@ from converters.description.sensors import (
 )
 from converters.gazebo.tags import ValueContext, read_bool, read_float, read_int
 
-# Gazebo sensor type → the kind twin simulates (Gazebo Classic names, then gz-sim's).
-KINDS = {
-    "imu": "imu",
-    "ray": "ray",
-    "gpu_ray": "ray",
-    "lidar": "ray",
-    "gpu_lidar": "ray",
-    "contact": "contact",
-    "force_torque": "force_torque",
-    "camera": "camera",
-    "depth": "camera",
-    "depth_camera": "camera",
-    "rgbd_camera": "camera",
-    "wideanglecamera": "camera",
-}
+# The package whose modules add sensor kinds (one module per kind, each calling `sensor_kind`),
+# imported the first time a sensor type is looked up.
+KIND_PACKAGE = "converters.gazebo.sensor_kinds"
 DEPTH_TYPES = frozenset({"depth", "depth_camera", "rgbd_camera"})
 AXES = ("x", "y", "z")
 # Plugin children naming the topic (gazebo_ros ROS 1 plugins) and the frame (both ROS versions).
@@ -65,7 +60,42 @@ class Placement:
     geoms: tuple[str, ...] = ()
 
 
-class _Reader:
+Read = Callable[["SensorReader", dict[str, Any], Placement], SensorSpec]
+R = TypeVar("R", bound=Read)
+_KINDS: dict[str, str] = {}  # Gazebo sensor type (lower case) → the kind twin simulates
+_READERS: dict[str, Read] = {}  # kind → its reader
+
+
+def sensor_kind(kind: str, *gazebo_types: str) -> Callable[[R], R]:
+    """Registers the decorated reader as kind `kind`, read from `<sensor type=...>` of each of
+    `gazebo_types` (Gazebo Classic's and gz-sim's names).
+
+    The reader takes the element (`SensorReader`), the values every sensor has (`SensorSpec`'s
+    fields, by name) and its `Placement`, and returns the kind's `SensorSpec` subclass.
+    """
+
+    def register(read: R) -> R:
+        _READERS[kind] = read
+        _KINDS.update({t.lower(): kind for t in gazebo_types})
+        return read
+
+    return register
+
+
+@cache
+def _load_kinds() -> None:
+    package = importlib.import_module(KIND_PACKAGE)
+    for module in pkgutil.iter_modules(package.__path__):
+        importlib.import_module(f"{KIND_PACKAGE}.{module.name}")
+
+
+def kind_of(gazebo_type: str | None) -> str | None:
+    """The kind twin simulates a `<sensor type=...>` as, or None when it simulates none."""
+    _load_kinds()
+    return _KINDS.get((gazebo_type or "").lower())
+
+
+class SensorReader:
     """Typed lookups inside one `<sensor>` element, failing with file, sensor and tag."""
 
     def __init__(self, el: ET.Element, blob: Blob, link: str) -> None:
@@ -113,21 +143,23 @@ class _Reader:
 
 
 def read_sensor(blob: Blob, placement: Placement) -> SensorSpec:
-    """The typed record of one sensor blob of a known kind (see `KINDS`).
+    """The typed record of one sensor blob of a known kind (see `kind_of`).
 
     Raises:
         GazeboTagError: a value is not a number/boolean where SDF wants one (names the file,
             link, sensor and tag).
-        KeyError: `blob.kind` is not in `KINDS` (callers report those as ignored instead).
+        KeyError: `blob.kind` is no registered type (callers report those as ignored instead).
     """
     el = ET.fromstring(blob.xml)
-    reader = _Reader(el, blob, placement.link)
-    kind = KINDS[(blob.kind or "").lower()]
+    reader = SensorReader(el, blob, placement.link)
+    kind = kind_of(blob.kind)
+    if kind is None:
+        raise KeyError(blob.kind)
     common = _common(reader, blob, placement)
-    return READERS[kind](reader, common, placement)
+    return _READERS[kind](reader, common, placement)
 
 
-def _common(reader: _Reader, blob: Blob, placement: Placement) -> dict[str, Any]:
+def _common(reader: SensorReader, blob: Blob, placement: Placement) -> dict[str, Any]:
     topic, frame_id = _ros_names(reader.el)
     return {
         "name": blob.name or f"{placement.link}_{blob.kind}",
@@ -160,7 +192,8 @@ def _ros_names(el: ET.Element) -> tuple[str, str]:
     return topic, frame
 
 
-def _read_imu(reader: _Reader, common: dict[str, Any], placement: Placement) -> ImuSpec:
+@sensor_kind("imu", "imu")
+def _read_imu(reader: SensorReader, common: dict[str, Any], placement: Placement) -> ImuSpec:
     imu = reader.el.find("imu")
     angular, linear = NO_NOISE3, NO_NOISE3
     orientation = True
@@ -177,7 +210,7 @@ def _read_imu(reader: _Reader, common: dict[str, Any], placement: Placement) -> 
 
 
 def _axes_noise(
-    reader: _Reader, imu: ET.Element, group: str, legacy: str
+    reader: SensorReader, imu: ET.Element, group: str, legacy: str
 ) -> tuple[Noise, Noise, Noise]:
     """Per-axis noise (1.6+: `<group><x><noise>`), else SDF 1.5's `<noise><legacy>` for all."""
     old = imu.find(f"noise/{legacy}")
@@ -189,7 +222,8 @@ def _axes_noise(
     return (x, y, z)
 
 
-def _read_ray(reader: _Reader, common: dict[str, Any], placement: Placement) -> RaySpec:
+@sensor_kind("ray", "ray", "gpu_ray", "lidar", "gpu_lidar")
+def _read_ray(reader: SensorReader, common: dict[str, Any], placement: Placement) -> RaySpec:
     ray = reader.el.find("ray")
     ray = ray if ray is not None else reader.el.find("lidar")
     if ray is None:
@@ -211,14 +245,18 @@ def _read_ray(reader: _Reader, common: dict[str, Any], placement: Placement) -> 
     )
 
 
-def _read_contact(reader: _Reader, common: dict[str, Any], placement: Placement) -> ContactSpec:
+@sensor_kind("contact", "contact")
+def _read_contact(
+    reader: SensorReader, common: dict[str, Any], placement: Placement
+) -> ContactSpec:
     collision = reader.text("contact/collision")
     common = {**common, "topic": common["topic"] or reader.text("contact/topic")}
     return ContactSpec(**common, collision=collision, geoms=placement.geoms)
 
 
+@sensor_kind("force_torque", "force_torque")
 def _read_force_torque(
-    reader: _Reader, common: dict[str, Any], placement: Placement
+    reader: SensorReader, common: dict[str, Any], placement: Placement
 ) -> ForceTorqueSpec:
     frame = reader.text("force_torque/frame", "child").lower()
     direction = reader.text("force_torque/measure_direction", "child_to_parent").lower()
@@ -249,13 +287,13 @@ def _read_force_torque(
     )
 
 
-def _group_noise(reader: _Reader, el: ET.Element, group: str) -> tuple[Noise, Noise, Noise]:
+def _group_noise(reader: SensorReader, el: ET.Element, group: str) -> tuple[Noise, Noise, Noise]:
     """SDF 1.6+ per-axis noise of a vector (`<force><x><noise>`, ...)."""
     x, y, z = (reader.noise(el.find(f"{group}/{axis}/noise")) for axis in AXES)
     return (x, y, z)
 
 
-def _plugin_noise(reader: _Reader) -> tuple[Noise, Noise, Noise]:
+def _plugin_noise(reader: SensorReader) -> tuple[Noise, Noise, Noise]:
     """The gazebo_ros F/T plugin's `<gaussianNoise>` (ROS 1) or `<gaussian_noise>` (ROS 2):
     a zero-mean Gaussian of that standard deviation on every axis, as the plugin adds it."""
     for plugin in reader.el.findall("plugin"):
@@ -267,7 +305,8 @@ def _plugin_noise(reader: _Reader) -> tuple[Noise, Noise, Noise]:
     return NO_NOISE3
 
 
-def _read_camera(reader: _Reader, common: dict[str, Any], placement: Placement) -> CameraSpec:
+@sensor_kind("camera", "camera", "depth", "depth_camera", "rgbd_camera", "wideanglecamera")
+def _read_camera(reader: SensorReader, common: dict[str, Any], placement: Placement) -> CameraSpec:
     camera = reader.el.find("camera")
     if camera is None:
         return CameraSpec(**common, depth=common["type"].lower() in DEPTH_TYPES)
@@ -289,12 +328,3 @@ def _read_camera(reader: _Reader, common: dict[str, Any], placement: Placement) 
         depth=common["type"].lower() in DEPTH_TYPES,
         noise=reader.noise(camera.find("noise")),
     )
-
-
-READERS: dict[str, Callable[[_Reader, dict[str, Any], Placement], SensorSpec]] = {
-    "imu": _read_imu,
-    "ray": _read_ray,
-    "contact": _read_contact,
-    "force_torque": _read_force_torque,
-    "camera": _read_camera,
-}

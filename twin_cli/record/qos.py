@@ -14,10 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from twin_cli.record.sensor_messages import SPEC_TYPES
+from twin_cli.record.sensor_messages import sensor_types
 from twin_cli.record.topics import Topic
-
-SENSOR_TYPES = frozenset(SPEC_TYPES.values())
 
 
 @dataclass(frozen=True)
@@ -38,4 +36,4 @@ def qos_of(topic: Topic) -> Qos:
     """The QoS ROS's own publisher of `topic` offers (see module docstring)."""
     if topic.latched:
         return LATCHED_QOS
-    return SENSOR_QOS if topic.type in SENSOR_TYPES else DEFAULT_QOS
+    return SENSOR_QOS if topic.type in sensor_types() else DEFAULT_QOS

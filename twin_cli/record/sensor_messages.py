@@ -6,11 +6,20 @@ sensor_msgs/Image (rgb8, or 32FC1 metres as gazebo_ros' depth camera; little-end
 The contact types are gazebo_msgs', which rosbags lacks (`contact_types` registers them).
 Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name); images go to
 `/<entity>/<topic>/image_raw`, as gazebo_ros' cameras publish them.
+
+Each kind's builder registers itself with `@ros_message(SpecType, ReadingType, ros_type)`: the
+kinds below, and one module per further kind in `twin_cli.record.sensor_kinds` (imported the
+first time a type is looked up), so a new kind's message is one module there.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import importlib
+import pkgutil
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -39,54 +48,97 @@ IMU = "sensor_msgs/msg/Imu"
 SCAN = "sensor_msgs/msg/LaserScan"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 IMAGE = "sensor_msgs/msg/Image"
-TYPES = {
-    ImuReading: IMU,
-    ScanReading: SCAN,
-    WrenchReading: WRENCH,
-    ContactReading: CONTACTS,
-    ImageReading: IMAGE,
-}
-# The same types by the sensor's record, so a sensor's topic is named before any reading.
-SPEC_TYPES = {
-    ImuSpec: IMU,
-    RaySpec: SCAN,
-    ForceTorqueSpec: WRENCH,
-    ContactSpec: CONTACTS,
-    CameraSpec: IMAGE,
-}
+KIND_PACKAGE = "twin_cli.record.sensor_kinds"  # its modules register further kinds' messages
 PIXEL_BYTES = {"rgb8": 3, "32FC1": 4}
 _UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
 
 
+Build = Callable[[Any, Any, Any], Any]  # (message classes, std_msgs Header, reading) → message
+B = TypeVar("B", bound=Build)
+
+
+@dataclass(frozen=True)
+class SensorMessage:
+    """One kind's message: its ROS type, its builder and the suffix of its topic."""
+
+    ros_type: str
+    build: Build
+    suffix: str = ""
+
+
+_BY_SPEC: dict[type, SensorMessage] = {}
+_BY_READING: dict[type, SensorMessage] = {}
+_BY_ROS_TYPE: dict[str, SensorMessage] = {}
+
+
+def ros_message(
+    spec_type: type, reading_type: type, ros_type: str, *, suffix: str = ""
+) -> Callable[[B], B]:
+    """Registers the decorated builder as the message of a sensor kind.
+
+    Args:
+        spec_type: the kind's record (`SensorSpec` subclass), so its topic is named before
+            any reading; reading_type: its `Reading` subclass.
+        ros_type: `pkg/msg/Type` of rosbags' typestore (`messages.typestore`).
+        suffix: appended to the topic (`/image_raw` for images).
+
+    The builder takes the message classes (`messages.types()`), the stamped header and the
+    reading, and returns the message.
+    """
+
+    def register(build: B) -> B:
+        entry = SensorMessage(ros_type, build, suffix)
+        _BY_SPEC[spec_type] = _BY_READING[reading_type] = _BY_ROS_TYPE[ros_type] = entry
+        return build
+
+    return register
+
+
+@cache
+def _load_kinds() -> None:
+    package = importlib.import_module(KIND_PACKAGE)
+    for module in pkgutil.iter_modules(package.__path__):
+        importlib.import_module(f"{KIND_PACKAGE}.{module.name}")
+
+
+def sensor_types() -> frozenset[str]:
+    """The ROS types of every registered sensor message (offered with sensor QoS)."""
+    _load_kinds()
+    return frozenset(_BY_ROS_TYPE)
+
+
 def sensor_topic(entity: str, name: str, topic: str, reading: Reading) -> Topic | None:
     """The topic of one sensor's readings (None: a kind that is not published)."""
-    return _named(entity, name, topic, TYPES.get(type(reading)))
+    _load_kinds()
+    return _named(entity, name, topic, _BY_READING.get(type(reading)))
 
 
 def spec_topic(entity: str, spec: SensorSpec) -> Topic | None:
     """The topic a sensor's readings will go to, from its record (None: not published)."""
-    return _named(entity, spec.name, spec.topic, SPEC_TYPES.get(type(spec)))
+    _load_kinds()
+    return _named(entity, spec.name, spec.topic, _BY_SPEC.get(type(spec)))
 
 
-def _named(entity: str, name: str, topic: str, kind: str | None) -> Topic | None:
+def _named(entity: str, name: str, topic: str, kind: SensorMessage | None) -> Topic | None:
     if kind is None:
         return None
-    suffix = "/image_raw" if kind == IMAGE else ""  # as gazebo_ros' cameras (image_transport)
-    return Topic(f"{namespace(entity)}/{(topic or name).strip('/')}{suffix}", kind)
+    return Topic(f"{namespace(entity)}/{(topic or name).strip('/')}{kind.suffix}", kind.ros_type)
 
 
 def sensor_message(topic: Topic, reading: Reading) -> Message:
     """The ROS message of `reading` on `topic`, stamped with its sim time."""
+    _load_kinds()
     T = ros.types()
     header = T["std_msgs/msg/Header"](stamp=ros.stamp(reading.time), frame_id=reading.frame_id)
-    build = {IMU: _imu, SCAN: _scan, WRENCH: _wrench, CONTACTS: _contacts, IMAGE: _image}
-    return Message(topic.name, topic.type, reading.time, build[topic.type](T, header, reading))
+    build = _BY_ROS_TYPE[topic.type].build
+    return Message(topic.name, topic.type, reading.time, build(T, header, reading))
 
 
 def _vector(T: Any, v: Any) -> Any:
     return T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
 
 
+@ros_message(ImuSpec, ImuReading, IMU)
 def _imu(T: Any, header: Any, r: ImuReading) -> Any:
     x, y, z, w = (float(c) for c in r.orientation)
     return T[IMU](
@@ -100,6 +152,7 @@ def _imu(T: Any, header: Any, r: ImuReading) -> Any:
     )
 
 
+@ros_message(RaySpec, ScanReading, SCAN)
 def _scan(T: Any, header: Any, r: ScanReading) -> Any:
     row = len(r.ranges) // max(1, r.vertical_count)
     return T[SCAN](
@@ -116,11 +169,13 @@ def _scan(T: Any, header: Any, r: ScanReading) -> Any:
     )
 
 
+@ros_message(ForceTorqueSpec, WrenchReading, WRENCH)
 def _wrench(T: Any, header: Any, r: WrenchReading) -> Any:
     wrench = T["geometry_msgs/msg/Wrench"](force=_vector(T, r.force), torque=_vector(T, r.torque))
     return T[WRENCH](header=header, wrench=wrench)
 
 
+@ros_message(ContactSpec, ContactReading, CONTACTS)
 def _contacts(T: Any, header: Any, r: ContactReading) -> Any:
     zero = (0.0, 0.0, 0.0)
     states = []
@@ -141,6 +196,7 @@ def _contacts(T: Any, header: Any, r: ContactReading) -> Any:
     return T[CONTACTS](header=header, states=states)
 
 
+@ros_message(CameraSpec, ImageReading, IMAGE, suffix="/image_raw")  # as gazebo_ros' cameras
 def _image(T: Any, header: Any, r: ImageReading) -> Any:
     return T[IMAGE](
         header=header,

@@ -26,7 +26,6 @@ from twin_cli.record.qos import (  # noqa: F401 (the bridge's modules take them 
     DEFAULT_QOS,
     LATCHED_QOS,
     SENSOR_QOS,
-    SENSOR_TYPES,
     Qos,
     qos_of,
 )

@@ -4,9 +4,10 @@ A consumer of the world (like the recorder): it reads the engine's state under i
 computes outside it; the world never imports it. Modules: `suite` (all sensors of an entity,
 update rates; `capture` then `complete` for recorders, which take every reading: see
 `twin_cli.record.sensor_feed`), `snapshot` (state copy and its dynamics), `history` (past
-samples MuJoCo keeps), `imu`, `ray`, `contact`, `force_torque`, `camera` (one sensor type
-each), `noise` (Gazebo's Gaussian noise, seeded), `readings` (what each reports), `frames`
-(finding a sensor's elements by name).
+samples MuJoCo keeps), `registry` (which class simulates each kind), `kinds/` (`imu`, `ray`,
+`contact`, `force_torque`, `camera`: one sensor kind each, found by scanning), `noise`
+(Gazebo's Gaussian noise, seeded), `readings` (what each reports), `frames` (finding a
+sensor's elements by name).
 """
 
 from __future__ import annotations

@@ -19,36 +19,17 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from converters.description.sensors import (
-    CameraSpec,
-    ContactSpec,
-    ForceTorqueSpec,
-    ImuSpec,
-    RaySpec,
-    SensorSpec,
-)
+from converters.description.sensors import SensorSpec
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
-from twin_cli.sensors.camera import CameraSensor
-from twin_cli.sensors.contact import ContactSensor
-from twin_cli.sensors.force_torque import ForceTorqueSensor
-from twin_cli.sensors.imu import ImuSensor
 from twin_cli.sensors.noise import sensor_rng
-from twin_cli.sensors.ray import RaySensor
 from twin_cli.sensors.readings import Reading
+from twin_cli.sensors.registry import is_kinematic, sensor_class
 from twin_cli.sensors.snapshot import STATE, Evaluator, Snapshot, take
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
     from twin_cli.world.entities import Entity
 
-SENSOR_TYPES: dict[type, Any] = {
-    ImuSpec: ImuSensor,
-    RaySpec: RaySensor,
-    ContactSpec: ContactSensor,
-    ForceTorqueSpec: ForceTorqueSensor,
-    CameraSpec: CameraSensor,
-}
-KINEMATIC = (RaySpec, CameraSpec)  # sensors that read poses only
 DUE_TOLERANCE = 1e-9  # [s] sim time accumulates rounding (0.2 != 200 * 0.001)
 
 
@@ -93,7 +74,7 @@ class SensorSuite:
         self._model: mujoco.MjModel | None = None
         self.specs: dict[str, SensorSpec] = {s.name: s for s in record.sensors}
         self._sensors = {
-            name: SENSOR_TYPES[type(spec)](spec, self.entity, sensor_rng(self.seed, name))
+            name: sensor_class(type(spec))(spec, self.entity, sensor_rng(self.seed, name))
             for name, spec in self.specs.items()
         }
         self._readings: dict[str, Reading] = {}
@@ -250,7 +231,7 @@ class SensorSuite:
     ) -> dict[str, Reading]:
         # Rays and cameras need poses only (mj_kinematics, a few µs); the others need the
         # forward dynamics of the whole world (measured: ~30 µs with a humanoid in it).
-        dynamics = any(not isinstance(self.specs[n], KINEMATIC) for n in due)
+        dynamics = any(not is_kinematic(self.specs[n]) for n in due)
         data = self._evaluator.evaluate(snapshot, dynamics=dynamics)
         model, out = snapshot.model, {}
         for name in due:

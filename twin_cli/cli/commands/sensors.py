@@ -19,6 +19,7 @@ from twin_cli.cli.output import Output
 
 MAX_POLL_HZ = 50.0  # [Hz] of wall time: a human reads; a recording samples in the server
 ONCE_HZ = 10.0  # [Hz] poll rate when no sensor states a rate
+HEADER = ("sensor", "type", "time", "frame_id")  # what every reading has (`Reading`)
 
 
 def sensors(
@@ -104,7 +105,17 @@ def summary(reading: dict[str, Any]) -> str:
         return f"{len(reading['states'])} contacts, total force {_vec(reading['total_force'])} N"
     if "torque" in reading:
         return f"force {_vec(reading['force'])} N  torque {_vec(reading['torque'])} N m"
-    return f"{reading.get('width')}×{reading.get('height')} {reading.get('encoding')} image"
+    if "encoding" in reading:
+        return f"{reading['width']}×{reading['height']} {reading['encoding']} image"
+    values = {k: v for k, v in reading.items() if k not in HEADER}
+    return "  ".join(f"{k} {_value(v)}" for k, v in values.items())
+
+
+def _value(value: Any) -> str:
+    """A value of a reading of another kind: numbers to 4 significant digits."""
+    if isinstance(value, list):
+        return "(" + " ".join(_value(v) for v in value) + ")"
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def _vec(values: list[float]) -> str:

@@ -32,7 +32,7 @@ from twin_cli.validate.scenario import Scenario
 if TYPE_CHECKING:
     import mujoco
 
-    from twin_cli.sensors.imu import ImuSensor
+    from twin_cli.sensors.kinds.imu import ImuSensor
 
 QUANTITIES = (("specific force", "m/s²", slice(0, 3)), ("angular velocity", "rad/s", slice(3, 6)))
 

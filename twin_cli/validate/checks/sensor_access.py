@@ -43,9 +43,9 @@ def no_sensor(check: str, kind: str, robot: RobotUnderTest) -> CheckResult:
 def bound(run: ScenarioRun, spec: SensorSpec) -> Any:
     """The twin sensor simulating `spec` on the run's robot, bound to its world's model."""
     from twin_cli.sensors.noise import sensor_rng
-    from twin_cli.sensors.suite import SENSOR_TYPES
+    from twin_cli.sensors.registry import sensor_class
 
-    sensor = SENSOR_TYPES[type(spec)](spec, run.entity, sensor_rng(0, spec.name))
+    sensor = sensor_class(type(spec))(spec, run.entity, sensor_rng(0, spec.name))
     sensor.bind(run.world.model)
     return sensor
 

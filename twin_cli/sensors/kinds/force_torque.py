@@ -25,11 +25,13 @@ from converters.description.sensors import NATIVE_PARTS, ForceTorqueSpec
 from twin_cli.sensors.frames import body_id, native_slice, site_id
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import WrenchReading
+from twin_cli.sensors.registry import sensor_for
 
 if TYPE_CHECKING:
     import mujoco
 
 
+@sensor_for(ForceTorqueSpec)
 class ForceTorqueSensor:
     """One `<sensor type="force_torque">` on a joint of an entity."""
 

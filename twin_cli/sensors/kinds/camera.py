@@ -28,10 +28,12 @@ from converters.description.sensors import CameraSpec
 from twin_cli.errors import InvalidRequestError
 from twin_cli.sensors.frames import element_id
 from twin_cli.sensors.readings import ImageReading
+from twin_cli.sensors.registry import sensor_for
 
 DEPTH_NEAR = 0.01  # [m] near plane a depth camera is rendered from (gz-rendering's default)
 
 
+@sensor_for(CameraSpec, kinematic=True)
 class CameraSensor:
     """One camera (`camera`, `depth`, `rgbd_camera`, ...) of an entity."""
 

@@ -22,6 +22,7 @@ from converters.description.sensors import RaySpec
 from twin_cli.sensors.frames import body_id, entity_bodies, site_id
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import ScanReading
+from twin_cli.sensors.registry import sensor_for
 
 VISUAL_GROUP = 2  # converters.mjcf.builder.VISUAL_GROUP: visual-only geoms
 GEOM_GROUPS = np.array([g != VISUAL_GROUP for g in range(6)], dtype=np.uint8)
@@ -48,6 +49,7 @@ def ray_directions(spec: RaySpec) -> np.ndarray:
     return dirs.reshape(-1, 3)
 
 
+@sensor_for(RaySpec, kinematic=True)
 class RaySensor:
     """One lidar of an entity."""
 

@@ -25,10 +25,12 @@ from twin_cli.sensors.frames import native_ids, native_slice, site_id
 from twin_cli.sensors.history import SensorHistory
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import ImuReading
+from twin_cli.sensors.registry import sensor_for
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)  # x y z w: what an IMU without orientation reports
 
 
+@sensor_for(ImuSpec)
 class ImuSensor:
     """One `<sensor type="imu">` of an entity."""
 

@@ -15,8 +15,10 @@ import numpy as np
 from converters.description.sensors import ContactSpec
 from twin_cli.sensors.frames import element_id
 from twin_cli.sensors.readings import ContactReading, ContactState
+from twin_cli.sensors.registry import sensor_for
 
 
+@sensor_for(ContactSpec)
 class ContactSensor:
     """One `<sensor type="contact">` of an entity."""
 
