@@ -35,6 +35,8 @@ def fuel_file(uri: str, env: Mapping[str, str]) -> Path | None:
     if not 0 < at < files - 1:
         return None
     host, owner, name, rest = parts[0], parts[at - 1], parts[at + 1], parts[files + 1 :]
+    if any(p in (".", "..") or "/" in p or "\\" in p for p in (host, owner, name, *rest)):
+        return None  # a web address names nothing outside its model's folder
     version = parts[at + 2] if files > at + 2 else "tip"
     for cache in fuel_caches(env):
         model = cache / host / owner.lower() / "models" / name.lower()

@@ -140,7 +140,8 @@ def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
     the local Fuel cache, where `gz fuel download` and Gazebo put it; Gazebo's own ground plane
     and sun fall back to the ones twin ships. twin never downloads."""
     parts = [unquote(p) for p in uri.split("://", 1)[1].split("/") if p]
-    if "models" not in parts[1:-1]:
+    unsafe = any(p in (".", "..") or "/" in p or "\\" in p for p in parts)
+    if "models" not in parts[1:-1] or unsafe:
         raise ctx.error(include, f"{uri} is not a Fuel model URI", "write model://NAME")
     at = parts.index("models")
     host, owner, name = parts[0], parts[at - 1], parts[at + 1]

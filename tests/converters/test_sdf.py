@@ -318,3 +318,34 @@ def test_a_mesh_named_by_its_fuel_address_comes_from_the_local_fuel_cache(
                        r"gz fuel download -u '.*/models/Other/1'"):  # fmt: skip
         path.write_text(text.replace("/Pump/" + version, "/Other/1"))
         world_from_sdf(path)
+
+
+@pytest.mark.parametrize(
+    "address",
+    [
+        f"{FUEL}/Pump/1/files/../../../../../secret.stl",
+        f"{FUEL}/Pump/1/files/meshes%2F..%2F..%2F..%2Fsecret.stl",
+        f"{FUEL}/../1/files/secret.stl",
+    ],
+    ids=["dotdot", "encoded_slash", "dotdot_name"],
+)
+def test_a_fuel_address_never_reads_outside_its_model_in_the_cache(tmp_path, monkeypatch, address):
+    """A file planted next to the cache, where `..` in an address would lead, is not read: the
+    address is refused as one not in the cache, naming it."""
+    import trimesh
+
+    cache = tmp_path / "fuel"
+    monkeypatch.setenv("GZ_FUEL_CACHE_PATH", str(cache))
+    (cache / "fuel.gazebosim.org" / "openrobotics" / "models" / "pump" / "1").mkdir(parents=True)
+    for planted in (tmp_path, cache, cache / "fuel.gazebosim.org"):
+        trimesh.creation.box().export(planted / "secret.stl")
+    path = tmp_path / "w.sdf"
+    path.write_text(
+        '<sdf version="1.8"><world name="w"><model name="p"><static>true</static>'
+        f"<link name='l'><collision name='c'><geometry><mesh><uri>{address}</uri></mesh>"
+        "</geometry></collision></link></model></world></sdf>"
+    )
+    from twin_cli.world.sdf_world import world_from_sdf
+
+    with pytest.raises(Exception, match=r"is on the web and not in the local Fuel cache"):
+        world_from_sdf(path)
