@@ -12,12 +12,12 @@ takes.
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 from typing import Any, TypeVar
+
+from twin_cli.lazy import import_modules
 
 PACKAGE = "twin_cli.cli.world_commands"  # every module in it is imported by `world_commands`
 
@@ -110,8 +110,6 @@ def world_commands() -> dict[str, Command]:
     That order is the package's `ORDER`; a command it does not name follows those it names,
     in the order they were registered (modules are imported alphabetically).
     """
-    package = importlib.import_module(PACKAGE)
-    for module in pkgutil.iter_modules(package.__path__):
-        importlib.import_module(f"{PACKAGE}.{module.name}")
+    package = import_modules(PACKAGE)
     rank = {name: i for i, name in enumerate(package.ORDER)}
     return dict(sorted(_REGISTERED.items(), key=lambda item: rank.get(item[0], len(rank))))

@@ -14,8 +14,6 @@ first time a type is looked up), so a new kind's message is one module there.
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
@@ -31,6 +29,7 @@ from converters.description.sensors import (
     RaySpec,
     SensorSpec,
 )
+from twin_cli.lazy import import_modules
 from twin_cli.names import namespace
 from twin_cli.record import messages as ros
 from twin_cli.record.contact_types import CONTACTS
@@ -96,9 +95,7 @@ def ros_message(
 
 @cache
 def _load_kinds() -> None:
-    package = importlib.import_module(KIND_PACKAGE)
-    for module in pkgutil.iter_modules(package.__path__):
-        importlib.import_module(f"{KIND_PACKAGE}.{module.name}")
+    import_modules(KIND_PACKAGE)
 
 
 def sensor_types() -> frozenset[str]:

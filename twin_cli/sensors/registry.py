@@ -12,11 +12,11 @@ and `reading(values, time)`; those with a kept history add `latest`, `samples_si
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Callable
 from functools import cache
 from typing import Any, TypeVar
+
+from twin_cli.lazy import import_modules
 
 PACKAGE = "twin_cli.sensors.kinds"  # every module in it is imported by `sensor_class`
 
@@ -45,9 +45,7 @@ def sensor_for(spec_type: type, *, kinematic: bool = False) -> Callable[[T], T]:
 
 @cache
 def _load() -> None:
-    package = importlib.import_module(PACKAGE)
-    for module in pkgutil.iter_modules(package.__path__):
-        importlib.import_module(f"{PACKAGE}.{module.name}")
+    import_modules(PACKAGE)
 
 
 def sensor_class(spec_type: type) -> Any:
