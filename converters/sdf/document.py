@@ -159,16 +159,37 @@ def _as_tinyxml_reads(text: str) -> str:
     and an XML declaration after a leading comment (gazebo-classic's `cafe.world`). Comments
     keep their line breaks, so error positions stay on their lines."""
     text = _COMMENT.sub(lambda m: "<!--" + "\n" * m.group(1).count("\n") + "-->", text)
-    text = text.lstrip()  # tinyxml2 also takes blank lines before the declaration
-    if text.startswith("<?xml") and "?>" in text:  # the one declaration allowed: keep it
-        end = text.index("?>") + 2
-        return text[:end] + _DECLARATION.sub(_blank, text[end:])
+    stripped = text.lstrip()  # tinyxml2 also takes blank lines before the declaration
+    if stripped.startswith("<?xml") and "?>" in stripped:  # the one declaration allowed
+        end = stripped.index("?>") + 2
+        lead = "\n" * text[: len(text) - len(stripped)].count("\n")  # kept after it: lines
+        return stripped[:end] + lead + _DECLARATION.sub(_blank, stripped[end:])
     return _DECLARATION.sub(_blank, text)
 
 
 def _blank(match: re.Match) -> str:
     """A removed span's line breaks, so the lines after it keep their numbers."""
     return "\n" * match.group(0).count("\n")
+
+
+def _check_well_formed(text: str, source: str, first: Exception) -> None:
+    """Refuses what is not well-formed XML 1.0 when names are read as plain names, as tinyxml2
+    reads them: expat without namespace processing, strict (content after the root element,
+    unclosed tags, repeated attributes, undefined entities), external entities never read.
+    libxml2's recovery alone let content after the root pass once a namespace error was found.
+
+    Raises:
+        MalformedXMLError: where expat stops.
+    """
+    from xml.parsers import expat
+
+    parser = expat.ParserCreate()
+    parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
+    try:
+        parser.Parse(text.encode(), True)
+    except expat.ExpatError as exc:
+        message = expat.ErrorString(exc.code) if exc.code is not None else str(exc)
+        raise MalformedXMLError(source, exc.lineno, exc.offset + 1, message) from first
 
 
 def _parse_as_tinyxml(text: str, source: str, first: Exception) -> Any:
@@ -182,6 +203,7 @@ def _parse_as_tinyxml(text: str, source: str, first: Exception) -> Any:
     """
     from lxml import etree
 
+    _check_well_formed(text, source, first)
     parser = etree.XMLParser(
         remove_comments=True, resolve_entities=False, no_network=True, recover=True
     )

@@ -347,12 +347,27 @@ def test_custom_elements_load_as_libsdformat_loads_them_and_are_never_read(
     [
         ('<model name="m"><link name="a"></model>', "mismatch"),
         (f"{CUSTOM_PARTS}<gz:open>", "mismatch"),
-        ('<model name="m"><link name="a" name="b"/></model>', "redefined"),
+        ('<model name="m"><link name="a" name="b"/></model>', "redefined|duplicate"),
+        (f'{CUSTOM_PARTS}</world></sdf><sdf version="1.9"><world name="x">', "junk after"),
     ],
-    ids=["unclosed", "unclosed_custom", "repeated_attribute"],
+    ids=["unclosed", "unclosed_custom", "repeated_attribute", "content_after_the_root"],
 )
 def test_xml_tinyxml2_refuses_too_stays_refused_beside_custom_names(tmp_path, text, where) -> None:
     from converters.errors import MalformedXMLError
 
     with pytest.raises(MalformedXMLError, match=where):
         world_from_sdf(_world(tmp_path, text))
+
+
+def test_errors_after_blank_lines_and_custom_names_name_their_own_line(tmp_path) -> None:
+    """Blank lines before the XML declaration (tinyxml2 takes them) keep every line's number:
+    the repeated attribute is on line 8 of the file."""
+    path = tmp_path / "world.sdf"
+    path.write_text(
+        '\n\n\n<?xml version="1.0"?>\n<sdf version="1.9">\n<world name="w">\n<gz:x/>\n'
+        '<model name="a" name="b"/></world></sdf>\n'
+    )
+    from converters.errors import MalformedXMLError
+
+    with pytest.raises(MalformedXMLError, match=r"world\.sdf:8:"):
+        world_from_sdf(path)
