@@ -46,7 +46,7 @@ class Autosaver:
         from twin_cli.world import savefile
 
         try:
-            savefile.save(self._current(), self.path)
+            savefile.save(self._current(), self.path, wait_s=0.0)  # the next one has the parts
         except Exception as exc:  # noqa: BLE001 - an autosave must never take the world down
             message = f"{type(exc).__name__}: {exc}"
             if message != self._last_error:

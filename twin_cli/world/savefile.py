@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from converters.errors import ConversionError
-from twin_cli.errors import InvalidRequestError, TwinError, WorldFileError
+from twin_cli.errors import EntityNotFoundError, InvalidRequestError, TwinError, WorldFileError
 from twin_cli.files import input_files
 from twin_cli.files.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
@@ -36,17 +36,23 @@ FORMAT = "twin-world"
 VERSION = 1
 SAVED_BY_TWIN = "give a file written by `twin save`"
 DECOMPOSITION_POLL_S = 0.1  # [s] how often a save looks whether a decomposition it waits for ended
+# [s] longest a save waits for those decompositions before it writes the hulls that stand in
+# (a bin of 3 CPU s of CoACD took 3-9 s on 2 busy cores; a load then decomposes nothing again)
+SAVE_WAIT_S = 60.0
 
 
-def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
+def save(
+    world: World, path: str | os.PathLike, *, force: bool = False, wait_s: float = SAVE_WAIT_S
+) -> None:
     """Writes `world`'s snapshot to `path` atomically; an existing file that is not a twin save
-    is replaced only with `force`.
+    is replaced only with `force`. Waits up to `wait_s` [s] for the background decompositions
+    of entities saved as MJCF (`_await_decompositions`); an autosave, which runs again, waits 0.
 
     Raises:
         WorldFileError: an entity spawned from an MjSpec cannot be written as MJCF, the folder
             is not writable, or the file is someone else's.
     """
-    _await_decompositions(world)
+    _await_decompositions(world, wait_s)
     snap = world.snapshot()
     document = {
         "format": FORMAT,
@@ -65,17 +71,29 @@ def save(world: World, path: str | os.PathLike, *, force: bool = False) -> None:
     _write_atomically(Path(path), json.dumps(document), force)
 
 
-def _await_decompositions(world: World) -> None:
-    """Waits for the background decompositions of entities saved as MJCF (a description given
-    as text, a world file's model): a load spawns that MJCF as it is, so a convex hull standing
-    in when it was written would stay for good. An entity spawned from a file needs no wait, as
-    a load converts its file again. Each job ends by itself: swapped in, failed (its CPU budget
-    or wall-clock backstop, the hull kept), or cancelled by a delete or a stop."""
-    while any(
-        info.decomposition == PENDING and world.entity(info.name).xml is not None
-        for info in world.entities()
-    ):
+def _await_decompositions(world: World, wait_s: float) -> None:
+    """Waits up to `wait_s` for the background decompositions of entities saved as MJCF (a
+    description given as text, a world file's model): a load spawns that MJCF as it is, so a
+    convex hull standing in when it was written would stay. An entity spawned from a file needs
+    no wait, as a load converts its file again. Each job ends by itself (swapped in, failed with
+    the hull kept, cancelled by a delete or a stop); past `wait_s` the hulls are written."""
+    deadline = time.monotonic() + wait_s
+    while time.monotonic() < deadline and _waiting(world):
         time.sleep(DECOMPOSITION_POLL_S)
+
+
+def _waiting(world: World) -> bool:
+    """Whether an entity saved as MJCF still waits for its decomposition (one deleted
+    meanwhile does not)."""
+    for info in world.entities():
+        if info.decomposition != PENDING:
+            continue
+        try:
+            if world.entity(info.name).xml is not None:
+                return True
+        except EntityNotFoundError:
+            continue
+    return False
 
 
 def _entity_dict(entity: Entity, path: str | os.PathLike) -> dict[str, Any]:

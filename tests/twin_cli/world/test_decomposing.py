@@ -187,7 +187,7 @@ def test_a_save_during_a_text_decomposition_waits_and_writes_the_parts(served, t
     world.spawn(SpawnRequest(xml=text, base_dir=str(tmp_path)), name="bin")
     assert world.entities()[0].decomposition == "pending"
     path = tmp_path / "world.json"
-    savefile.save(world, path)
+    savefile.save(world, path, wait_s=WAIT_S)
     assert world.entities()[0].decomposition == "done", world.entities()[0]
     parts = world.entity("bin").report["meshes"][0]["parts"]
     loaded = savefile.load(path)
@@ -214,3 +214,23 @@ def test_a_restore_after_the_swap_keeps_the_decomposed_record(served, tmp_path):
     assert world.entity("bin").report["meshes"][0]["mode"] == "coacd"
     assert _bin_geoms(world) == parts > 1
     assert np.array_equal(world.snapshot().state, before.state)
+
+
+@pytest.mark.parametrize("wait_s", [0.0, 1.0])
+def test_a_save_waits_no_longer_than_it_is_given(served, tmp_path, monkeypatch, wait_s):
+    """A hung CoACD worker keeps a text bin pending: a save given `wait_s` (0 for an autosave,
+    which runs again) returns after about that long and writes the hull that stands in, so a
+    save never hangs on a decomposition."""
+    from twin_cli.world import savefile
+
+    monkeypatch.setenv("TWIN_TEST_COACD_FAULT", "hang:*")
+    text = Path(bin_urdf(tmp_path)).read_text()
+    world = World()
+    world.spawn(SpawnRequest(xml=text, base_dir=str(tmp_path)), name="bin")
+    start = time.monotonic()
+    savefile.save(world, tmp_path / "world.json", wait_s=wait_s)
+    took = time.monotonic() - start
+    assert wait_s <= took < wait_s + 1.0, f"{took:.2f} s for a wait of {wait_s} s"
+    assert world.entities()[0].decomposition == "pending"
+    assert (tmp_path / "world.json").stat().st_size > 0
+    world.delete("bin")  # ends the hung worker
