@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import unquote
 
-from converters.errors import PackageNotFoundError
+from converters.errors import MalformedXMLError, PackageNotFoundError
 from converters.resources.fuel import fuel_caches
 from converters.resources.packages import MODEL_ENVS
 from converters.sdf.document import (
@@ -80,7 +80,12 @@ def included_element(ctx: SdfContext, include: Any) -> Any:
     if not uri:
         raise ctx.error(include, "has no <uri>", "write <uri>model://NAME</uri>")
     path = _model_file(ctx, include, uri)
-    root = parse_document(path.read_text(), str(path))
+    try:
+        root = parse_document(path.read_text(), str(path))
+    except MalformedXMLError as exc:
+        raise ctx.error(
+            include, f"includes {path}, which is not well-formed XML ({exc})", "include an SDF file"
+        ) from exc
     element = next((c for c in root if isinstance(c.tag, str) and c.tag in INCLUDABLE), None)
     if element is None:
         raise ctx.error(include, f"{path} holds no <model> or <light>", "include a model file")
