@@ -15,16 +15,10 @@ from typing import ClassVar
 SITE_PREFIX = "sensor:"
 # SDF `<noise><type>` values twin simulates (noise.sdf); "none" draws nothing.
 NOISE_TYPES = ("none", "gaussian", "gaussian_quantized")
-# MuJoCo's own sensors (mjtSensor names) on the site of a sensor kind, by part: the built model
-# names them `sensor:<name>:<part>`, in this order, so their values are one slice of sensordata.
-NATIVE_PARTS: dict[str, tuple[tuple[str, str], ...]] = {
-    "imu": (
-        ("quat", "mjSENS_FRAMEQUAT"),
-        ("gyro", "mjSENS_GYRO"),
-        ("accel", "mjSENS_ACCELEROMETER"),
-    ),
-    "force_torque": (("force", "mjSENS_FORCE"), ("torque", "mjSENS_TORQUE")),
-}
+# (part, mjtSensor name) of MuJoCo's own sensors on a sensor's site (`SensorSpec.native_parts`):
+# the built model names them `sensor:<name>:<part>`, in this order, so their values are one slice
+# of sensordata.
+Parts = tuple[tuple[str, str], ...]
 # Samples an IMU's native sensors keep in MuJoCo's sensor history (`nsample`), computed at the
 # IMU's update period (`interval`): a recorder reads them in one look every few dozen periods.
 HISTORY_SAMPLES = 100
@@ -81,11 +75,14 @@ class SensorSpec:
         where: file and element it was written in, for reports.
         body: the MuJoCo body carrying the sensor's site (the link's body after lumping).
 
-    Class attribute `native`: the `NATIVE_PARTS` key of the MuJoCo sensors its site carries
-    ("" for none). A kind says in `details` what it became, for the conversion report.
+    Class attributes: `native_parts`, the MuJoCo sensors its site carries, (part, mjtSensor
+    name) in sensordata order (none by default); `native_history`, whether MuJoCo computes them
+    only at its update period and keeps `HISTORY_SAMPLES` of them. A kind says in `details`
+    what it became, for the conversion report.
     """
 
-    native: ClassVar[str] = ""
+    native_parts: ClassVar[Parts] = ()
+    native_history: ClassVar[bool] = False
 
     name: str
     type: str
@@ -115,7 +112,12 @@ class ImuSpec(SensorSpec):
     angular_velocity_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     linear_acceleration_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     enable_orientation: bool = True
-    native: ClassVar[str] = "imu"
+    native_parts: ClassVar[Parts] = (
+        ("quat", "mjSENS_FRAMEQUAT"),
+        ("gyro", "mjSENS_GYRO"),
+        ("accel", "mjSENS_ACCELEROMETER"),
+    )
+    native_history: ClassVar[bool] = True
 
     def details(self) -> str:
         noisy = _stddevs(self.angular_velocity_noise + self.linear_acceleration_noise)
@@ -192,7 +194,7 @@ class ForceTorqueSpec(SensorSpec):
     parent_body: str = ""
     force_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
     torque_noise: tuple[Noise, Noise, Noise] = NO_NOISE3
-    native: ClassVar[str] = "force_torque"
+    native_parts: ClassVar[Parts] = (("force", "mjSENS_FORCE"), ("torque", "mjSENS_TORQUE"))
 
     def details(self) -> str:
         noisy = _stddevs(self.force_noise + self.torque_noise)

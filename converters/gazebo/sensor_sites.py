@@ -18,7 +18,6 @@ from converters.description import RobotDescription
 from converters.description.gazebo import Blob
 from converters.description.sensors import (
     HISTORY_SAMPLES,
-    NATIVE_PARTS,
     CameraSpec,
     ForceTorqueSpec,
     SensorSpec,
@@ -140,19 +139,18 @@ def _add_native(spec: mujoco.MjSpec, sensor: SensorSpec) -> None:
     the world's lock) instead of evaluating the world's dynamics again per reading. MuJoCo's
     accelerometer is the specific force a − g (+g up at rest) and its force/torque sensors are
     the child body's interaction wrench at the site, in the site frame: what the twin sensors
-    report (`twin_cli.sensors.native`).
-    An IMU's are computed only at its update period (`interval`) and keep their last
-    HISTORY_SAMPLES samples with their times (`nsample`), so a recorder reads every sample in
-    one look instead of stopping the stepping at each period (`twin_cli.sensors.history`).
+    report (`twin_cli.sensors.kinds`).
+    An IMU's (`native_history`) are computed only at its update period (`interval`) and keep
+    their last HISTORY_SAMPLES samples with their times (`nsample`), so a recorder reads every
+    sample in one look instead of stopping the stepping at each period (`sensors.history`).
     """
     import mujoco
 
-    kind_name = sensor.native
     history = {}
-    if kind_name == "imu":
+    if sensor.native_history:
         period = 1.0 / sensor.update_rate if sensor.update_rate > 0 else 0.0
         history = {"nsample": HISTORY_SAMPLES, "interval": [period, 0.0]}
-    for part, kind in NATIVE_PARTS.get(kind_name, ()):
+    for part, kind in sensor.native_parts:
         spec.add_sensor(
             name=f"{sensor.site}:{part}",
             type=getattr(mujoco.mjtSensor, kind),

@@ -1,20 +1,18 @@
 """Read a `<sensor>` element (kept verbatim as a `Blob`) into a typed sensor record.
 
-Follows SDFormat's `sensor.sdf` and its children (`imu.sdf`, `ray.sdf`/`lidar.sdf`,
-`contact.sdf`, `force_torque.sdf`, `camera.sdf`, `noise.sdf`) with their defaults, and the
-topic and frame conventions of the gazebo_ros plugins (ROS 1 `topicName`/`frameName`, ROS 2
-`<ros><remapping>~/out:=scan</remapping>` and `frame_name`). Both SDF 1.5's IMU noise
-(`<imu><noise><rate>/<accel>`, one model for all axes) and 1.6+'s per-axis noise are read.
-Pure: no MuJoCo here; `converters.gazebo.sensor_sites` places the records in the spec.
+Follows SDFormat's `sensor.sdf` and `noise.sdf` with their defaults, and the topic and frame
+conventions of the gazebo_ros plugins (ROS 1 `topicName`/`frameName`, ROS 2
+`<ros><remapping>~/out:=scan</remapping>` and `frame_name`). Pure: no MuJoCo here;
+`converters.gazebo.sensor_sites` places the records in the spec.
 
-Each kind's reader registers itself with `@sensor_kind(kind, *gazebo_types)`: the kinds below,
-and one module per further kind in `converters.gazebo.sensor_kinds` (found by scanning it), so
-a new kind is one module there with its `SensorSpec` subclass and its reader.
+Each kind's reader registers itself with `@sensor_kind(kind, *gazebo_types)` in its own module
+of `converters.gazebo.sensor_kinds` (`imu`, `ray`, `contact`, `force_torque`, `camera`, and any
+module added there), found by scanning that package the first time a type is looked up; this
+module reads what every sensor has.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 import pkgutil
 import xml.etree.ElementTree as ET
@@ -24,28 +22,16 @@ from functools import cache
 from typing import Any, TypeVar
 
 from converters.description.gazebo import Blob
-from converters.description.sensors import (
-    NO_NOISE3,
-    NOISE_TYPES,
-    CameraSpec,
-    ContactSpec,
-    ForceTorqueSpec,
-    ImuSpec,
-    Noise,
-    RaySpec,
-    SensorSpec,
-)
+from converters.description.sensors import NOISE_TYPES, Noise, SensorSpec
 from converters.gazebo.tags import ValueContext, read_bool, read_float, read_int
 
 # The package whose modules add sensor kinds (one module per kind, each calling `sensor_kind`),
 # imported the first time a sensor type is looked up.
 KIND_PACKAGE = "converters.gazebo.sensor_kinds"
-DEPTH_TYPES = frozenset({"depth", "depth_camera", "rgbd_camera"})
 AXES = ("x", "y", "z")
 # Plugin children naming the topic (gazebo_ros ROS 1 plugins) and the frame (both ROS versions).
 TOPIC_TAGS = ("topicName", "bumperTopicName", "topic_name")
 FRAME_TAGS = ("frameName", "frame_name")
-PLUGIN_NOISE_TAGS = ("gaussianNoise", "gaussian_noise")  # gazebo_ros F/T plugins, [N] and [N m]
 
 
 @dataclass(frozen=True)
@@ -141,6 +127,11 @@ class SensorReader:
         values = {f: self.number(f, 0.0, el) for f in fields}
         return Noise(kind, **values)
 
+    def vector_noise(self, el: ET.Element, group: str) -> tuple[Noise, Noise, Noise]:
+        """SDF 1.6+ noise per axis of a vector inside `el` (`<group><x><noise>`, y, z)."""
+        x, y, z = (self.noise(el.find(f"{group}/{axis}/noise")) for axis in AXES)
+        return (x, y, z)
+
 
 def read_sensor(blob: Blob, placement: Placement) -> SensorSpec:
     """The typed record of one sensor blob of a known kind (see `kind_of`).
@@ -190,141 +181,3 @@ def _ros_names(el: ET.Element) -> tuple[str, str]:
         if topic and namespace and not topic.startswith("/"):
             topic = f"/{namespace}/{topic}"
     return topic, frame
-
-
-@sensor_kind("imu", "imu")
-def _read_imu(reader: SensorReader, common: dict[str, Any], placement: Placement) -> ImuSpec:
-    imu = reader.el.find("imu")
-    angular, linear = NO_NOISE3, NO_NOISE3
-    orientation = True
-    if imu is not None:
-        angular = _axes_noise(reader, imu, "angular_velocity", "rate")
-        linear = _axes_noise(reader, imu, "linear_acceleration", "accel")
-        orientation = reader.flag("imu/enable_orientation", True)
-    return ImuSpec(
-        **common,
-        angular_velocity_noise=angular,
-        linear_acceleration_noise=linear,
-        enable_orientation=orientation,
-    )
-
-
-def _axes_noise(
-    reader: SensorReader, imu: ET.Element, group: str, legacy: str
-) -> tuple[Noise, Noise, Noise]:
-    """Per-axis noise (1.6+: `<group><x><noise>`), else SDF 1.5's `<noise><legacy>` for all."""
-    old = imu.find(f"noise/{legacy}")
-    if old is not None:
-        kind = reader.text("noise/type", "gaussian", imu).lower()
-        shared = dataclasses.replace(reader.noise(old), type=kind)
-        return (shared, shared, shared)
-    x, y, z = (reader.noise(imu.find(f"{group}/{axis}/noise")) for axis in AXES)
-    return (x, y, z)
-
-
-@sensor_kind("ray", "ray", "gpu_ray", "lidar", "gpu_lidar")
-def _read_ray(reader: SensorReader, common: dict[str, Any], placement: Placement) -> RaySpec:
-    ray = reader.el.find("ray")
-    ray = ray if ray is not None else reader.el.find("lidar")
-    if ray is None:
-        return RaySpec(**common)
-    values: dict[str, Any] = {}
-    for direction, samples in (("horizontal", 640), ("vertical", 1)):
-        path = f"scan/{direction}/"
-        values[f"{direction}_samples"] = reader.integer(path + "samples", samples, ray)
-        values[f"{direction}_resolution"] = reader.number(path + "resolution", 1.0, ray)
-        values[f"{direction}_min_angle"] = reader.number(path + "min_angle", 0.0, ray)
-        values[f"{direction}_max_angle"] = reader.number(path + "max_angle", 0.0, ray)
-    return RaySpec(
-        **common,
-        **values,
-        range_min=reader.number("range/min", 0.0, ray),
-        range_max=reader.number("range/max", 0.0, ray),
-        range_resolution=reader.number("range/resolution", 0.0, ray),
-        noise=reader.noise(ray.find("noise")),
-    )
-
-
-@sensor_kind("contact", "contact")
-def _read_contact(
-    reader: SensorReader, common: dict[str, Any], placement: Placement
-) -> ContactSpec:
-    collision = reader.text("contact/collision")
-    common = {**common, "topic": common["topic"] or reader.text("contact/topic")}
-    return ContactSpec(**common, collision=collision, geoms=placement.geoms)
-
-
-@sensor_kind("force_torque", "force_torque")
-def _read_force_torque(
-    reader: SensorReader, common: dict[str, Any], placement: Placement
-) -> ForceTorqueSpec:
-    frame = reader.text("force_torque/frame", "child").lower()
-    direction = reader.text("force_torque/measure_direction", "child_to_parent").lower()
-    for tag, value, allowed in (
-        ("frame", frame, ("child", "parent", "sensor")),
-        ("measure_direction", direction, ("child_to_parent", "parent_to_child")),
-    ):
-        if value not in allowed:
-            raise reader.ctx.fail(
-                f"{reader.prefix} force_torque/{tag}", value, " or ".join(allowed)
-            )
-    ft = reader.el.find("force_torque")
-    force, torque = NO_NOISE3, NO_NOISE3
-    if ft is not None:
-        force = _group_noise(reader, ft, "force")
-        torque = _group_noise(reader, ft, "torque")
-    if not any(n.active for n in force + torque):
-        force = torque = _plugin_noise(reader)
-    return ForceTorqueSpec(
-        **common,
-        joint=placement.joint,
-        frame=frame,
-        measure_direction=direction,
-        child_body=placement.body,
-        parent_body=placement.parent_body,
-        force_noise=force,
-        torque_noise=torque,
-    )
-
-
-def _group_noise(reader: SensorReader, el: ET.Element, group: str) -> tuple[Noise, Noise, Noise]:
-    """SDF 1.6+ per-axis noise of a vector (`<force><x><noise>`, ...)."""
-    x, y, z = (reader.noise(el.find(f"{group}/{axis}/noise")) for axis in AXES)
-    return (x, y, z)
-
-
-def _plugin_noise(reader: SensorReader) -> tuple[Noise, Noise, Noise]:
-    """The gazebo_ros F/T plugin's `<gaussianNoise>` (ROS 1) or `<gaussian_noise>` (ROS 2):
-    a zero-mean Gaussian of that standard deviation on every axis, as the plugin adds it."""
-    for plugin in reader.el.findall("plugin"):
-        for tag in PLUGIN_NOISE_TAGS:
-            stddev = reader.number(tag, 0.0, plugin)
-            if stddev > 0.0:
-                noise = Noise("gaussian", stddev=stddev)
-                return (noise, noise, noise)
-    return NO_NOISE3
-
-
-@sensor_kind("camera", "camera", "depth", "depth_camera", "rgbd_camera", "wideanglecamera")
-def _read_camera(reader: SensorReader, common: dict[str, Any], placement: Placement) -> CameraSpec:
-    camera = reader.el.find("camera")
-    if camera is None:
-        return CameraSpec(**common, depth=common["type"].lower() in DEPTH_TYPES)
-    near = reader.number("clip/near", 0.1, camera)
-    far = reader.number("clip/far", 100.0, camera)
-    if not 0.0 < near < far:
-        expected = "0 < near < far (metres)"
-        raise reader.ctx.fail(
-            f"{reader.prefix} camera/clip", f"near {near:g} far {far:g}", expected
-        )
-    return CameraSpec(
-        **common,
-        width=reader.integer("image/width", 320, camera),
-        height=reader.integer("image/height", 240, camera),
-        horizontal_fov=reader.number("horizontal_fov", 1.047, camera),
-        near=near,
-        far=far,
-        image_format=reader.text("image/format", "R8G8B8", camera),
-        depth=common["type"].lower() in DEPTH_TYPES,
-        noise=reader.noise(camera.find("noise")),
-    )

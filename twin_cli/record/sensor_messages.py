@@ -1,15 +1,11 @@
-"""Sensor readings (`twin_cli.sensors`) as the ROS messages gazebo_ros sensor plugins publish.
+"""Sensor readings (`twin_cli.sensors`) as ROS messages, as gazebo_ros sensor plugins publish them.
 
-IMU → sensor_msgs/Imu, ray → sensor_msgs/LaserScan (one row: the first vertical row), force/torque
-→ geometry_msgs/WrenchStamped, contact/bumper → gazebo_msgs/ContactsState, camera and depth →
-sensor_msgs/Image (rgb8, or 32FC1 metres as gazebo_ros' depth camera; little-endian rows).
-The contact types are gazebo_msgs', which rosbags lacks (`contact_types` registers them).
-Topics are `/<entity>/<topic>` with the sensor's `<topic>` (or its name); images go to
-`/<entity>/<topic>/image_raw`, as gazebo_ros' cameras publish them.
-
-Each kind's builder registers itself with `@ros_message(SpecType, ReadingType, ros_type)`: the
-kinds below, and one module per further kind in `twin_cli.record.sensor_kinds` (imported the
-first time a type is looked up), so a new kind's message is one module there.
+Each kind's builder registers itself with `@ros_message(SpecType, ReadingType, ros_type)` in its
+own module of `twin_cli.record.sensor_kinds` (`imu` → sensor_msgs/Imu, `ray` →
+sensor_msgs/LaserScan, `force_torque` → geometry_msgs/WrenchStamped, `contact` →
+gazebo_msgs/ContactsState, `camera` → sensor_msgs/Image, and any module added there), imported
+the first time a type is looked up. Topics are `/<entity>/<topic>` with the sensor's `<topic>`
+(or its name), plus the kind's suffix (`/image_raw` for images, as gazebo_ros' cameras).
 """
 
 from __future__ import annotations
@@ -19,37 +15,14 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Any, TypeVar
 
-import numpy as np
-
-from converters.description.sensors import (
-    CameraSpec,
-    ContactSpec,
-    ForceTorqueSpec,
-    ImuSpec,
-    RaySpec,
-    SensorSpec,
-)
+from converters.description.sensors import SensorSpec
 from twin_cli.lazy import import_modules
 from twin_cli.names import namespace
 from twin_cli.record import messages as ros
-from twin_cli.record.contact_types import CONTACTS
 from twin_cli.record.topics import Message, Topic
-from twin_cli.sensors import (
-    ContactReading,
-    ImageReading,
-    ImuReading,
-    Reading,
-    ScanReading,
-    WrenchReading,
-)
+from twin_cli.sensors import Reading
 
-IMU = "sensor_msgs/msg/Imu"
-SCAN = "sensor_msgs/msg/LaserScan"
-WRENCH = "geometry_msgs/msg/WrenchStamped"
-IMAGE = "sensor_msgs/msg/Image"
-KIND_PACKAGE = "twin_cli.record.sensor_kinds"  # its modules register further kinds' messages
-PIXEL_BYTES = {"rgb8": 3, "32FC1": 4}
-_UNKNOWN_COVARIANCE = np.zeros(9)  # sensor_msgs: all zeros = "covariance unknown"
+KIND_PACKAGE = "twin_cli.record.sensor_kinds"  # each of its modules registers one kind's message
 
 
 Build = Callable[[Any, Any, Any], Any]  # (message classes, std_msgs Header, reading) → message
@@ -131,76 +104,6 @@ def sensor_message(topic: Topic, reading: Reading) -> Message:
     return Message(topic.name, topic.type, reading.time, build(T, header, reading))
 
 
-def _vector(T: Any, v: Any) -> Any:
+def vector3(T: Any, v: Any) -> Any:
+    """A geometry_msgs/Vector3 of the first three values of `v`, for the kinds' builders."""
     return T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
-
-
-@ros_message(ImuSpec, ImuReading, IMU)
-def _imu(T: Any, header: Any, r: ImuReading) -> Any:
-    x, y, z, w = (float(c) for c in r.orientation)
-    return T[IMU](
-        header=header,
-        orientation=T["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
-        orientation_covariance=_UNKNOWN_COVARIANCE,
-        angular_velocity=_vector(T, r.angular_velocity),
-        angular_velocity_covariance=_UNKNOWN_COVARIANCE,
-        linear_acceleration=_vector(T, r.linear_acceleration),
-        linear_acceleration_covariance=_UNKNOWN_COVARIANCE,
-    )
-
-
-@ros_message(RaySpec, ScanReading, SCAN)
-def _scan(T: Any, header: Any, r: ScanReading) -> Any:
-    row = len(r.ranges) // max(1, r.vertical_count)
-    return T[SCAN](
-        header=header,
-        angle_min=r.angle_min,
-        angle_max=r.angle_max,
-        angle_increment=r.angle_increment,
-        time_increment=0.0,
-        scan_time=r.scan_time,
-        range_min=r.range_min,
-        range_max=r.range_max,
-        ranges=np.asarray(r.ranges[:row], dtype=np.float32),
-        intensities=np.zeros(0, dtype=np.float32),
-    )
-
-
-@ros_message(ForceTorqueSpec, WrenchReading, WRENCH)
-def _wrench(T: Any, header: Any, r: WrenchReading) -> Any:
-    wrench = T["geometry_msgs/msg/Wrench"](force=_vector(T, r.force), torque=_vector(T, r.torque))
-    return T[WRENCH](header=header, wrench=wrench)
-
-
-@ros_message(ContactSpec, ContactReading, CONTACTS)
-def _contacts(T: Any, header: Any, r: ContactReading) -> Any:
-    zero = (0.0, 0.0, 0.0)
-    states = []
-    for c in r.states:
-        wrench = T["geometry_msgs/msg/Wrench"](force=_vector(T, c.force), torque=_vector(T, zero))
-        states.append(
-            T["gazebo_msgs/msg/ContactState"](
-                info=f"{c.collision1} touches {c.collision2}",
-                collision1_name=c.collision1,
-                collision2_name=c.collision2,
-                wrenches=[wrench],
-                total_wrench=wrench,
-                contact_positions=[_vector(T, c.position)],
-                contact_normals=[_vector(T, c.normal)],
-                depths=np.array([c.depth]),
-            )
-        )
-    return T[CONTACTS](header=header, states=states)
-
-
-@ros_message(CameraSpec, ImageReading, IMAGE, suffix="/image_raw")  # as gazebo_ros' cameras
-def _image(T: Any, header: Any, r: ImageReading) -> Any:
-    return T[IMAGE](
-        header=header,
-        height=r.height,
-        width=r.width,
-        encoding=r.encoding,
-        is_bigendian=0,
-        step=r.width * PIXEL_BYTES[r.encoding],
-        data=np.frombuffer(r.data, dtype=np.uint8),
-    )

@@ -52,7 +52,7 @@ def native_slice(
 ) -> slice | None:
     """Where the MuJoCo sensors `<entity>/<site>:<part>` of one twin sensor sit in sensordata.
 
-    The converter adds them in `parts` order (`converters.description.sensors.NATIVE_PARTS`);
+    The converter adds them in `parts` order (the `native_parts` of the sensor's record);
     None when the model lacks one (a model built before they existed: computed instead).
     """
     ids = native_ids(model, entity, site, parts)

@@ -1,7 +1,8 @@
-"""Sensor kinds beyond the built-in ones: one module per kind, each found by scanning this package.
+"""Sensor kinds the converter reads, one module per kind, each found by scanning this package.
 
-A module here defines its `SensorSpec` subclass (the values its `<sensor>` element gives) and
-its reader under `@sensor_kind(kind, *gazebo_types)` (`converters.gazebo.sensors`); nothing
-else in the converter lists kinds. The package is imported only when a description declares a
-sensor.
+A module here registers its reader with `@sensor_kind(kind, *gazebo_types)`
+(`converters.gazebo.sensors`) and, for a kind of its own, defines its `SensorSpec` subclass
+beside it (the built-in kinds' records are in `converters.description.sensors`, where the
+neutral description's other types are). Nothing else in the converter lists kinds. The package
+is imported only when a description declares a sensor.
 """

@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 from twin_cli.record import messages as ros
-from twin_cli.record.sensor_messages import IMU, SCAN
+from twin_cli.record.sensor_kinds.imu import IMU
+from twin_cli.record.sensor_kinds.ray import SCAN
 from twin_cli.record.topics import CLOCK, TF, TF_STATIC, Topic
 from twin_cli.ros.graph import (
     DEFAULT_QOS,

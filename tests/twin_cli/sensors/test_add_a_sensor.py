@@ -5,7 +5,7 @@ record and reader of `<sensor type="toy_height">` (`converters/gazebo/sensor_kin
 world's sensor and its reading (`twin_cli/sensors/kinds/`) and its ROS message, sensor_msgs/Range
 (`twin_cli/record/sensor_kinds/`). A real World then spawns boxes resting on the ground that
 declare one, and the sensor's reading is checked against where the physics put the box; the
-topic `twin topics` lists and the message a recording writes come from the same registries.
+topic `twin topics` lists and the messages a recording writes come from the same registries.
 """
 
 from __future__ import annotations
@@ -132,12 +132,16 @@ HALF_HEIGHTS = (0.05, 0.2, 0.5)  # [m]
 # another face (0.15 m off) or still falling from its 5 mm drop.
 SINK = 1e-4
 FLOAT32 = 1e-7  # relative precision of a float32 (sensor_msgs/Range's fields), 2^-23 rounded up
+RATE = 50.0  # [Hz] the sensor's `<update_rate>`
+STAMP = 2e-9  # [s] a stamp is whole nanoseconds: 1 ns of rounding at each end of a period
+RECORDED_STEPS = 200  # 0.2 s of 1 ms steps recorded: 10 or 11 periods of 1/RATE
 PROBE = """
 import json, sys
 from pathlib import Path
 from twin_cli.cli.commands.sensors import summary
+from rosbags.highlevel import AnyReader
 from twin_cli.live.catalogue import live_topics
-from twin_cli.record import messages
+from twin_cli.record import BagRecording, messages
 from twin_cli.record.qos import SENSOR_QOS, qos_of
 from twin_cli.record.sensor_messages import sensor_message, sensor_topic
 from twin_cli.sensors import SensorSuite
@@ -154,6 +158,19 @@ for h, high in json.loads(sys.argv[1]):
     topic = sensor_topic("box", "height", "height", reading)
     message = sensor_message(topic, reading)
     listed = [(t.name, t.type, t.rate) for t in live_topics(world) if t.sensor == "height"]
+    bag = Path(sys.argv[2]) / f"box{len(out)}.mcap"
+    recording = BagRecording(world, bag).start()
+    for _ in range(int(sys.argv[5]) // 5):
+        world.step(5)
+    assert recording.stop().error is None
+    with AnyReader([bag]) as bag_reader:
+        wanted = [c for c in bag_reader.connections if c.topic == topic.name]
+        recorded = [
+            (c.msgtype, stamp.sec + stamp.nanosec * 1e-9, m.range)
+            for c, _, raw in bag_reader.messages(connections=wanted)
+            for m in [bag_reader.deserialize(raw, c.msgtype)]
+            for stamp in [m.header.stamp]
+        ]
     out.append({
         "h": h, "reading": reading.to_dict(), "z": float(world.data.body("box/b").xpos[2]),
         "topic": [topic.name, topic.type], "sensor_qos": qos_of(topic) == SENSOR_QOS,
@@ -161,6 +178,8 @@ for h, high in json.loads(sys.argv[1]):
             messages.encode(message.message, topic.type), topic.type).range,
         "listed": listed,
         "summary": summary(reading.to_dict()),
+        "recorded": recorded,
+        "z_after": float(world.data.body("box/b").xpos[2]),
     })
 print(json.dumps(out))
 """
@@ -198,7 +217,7 @@ def test_a_toy_sensor_kind_in_three_modules_reads_a_resting_box(
 ) -> None:
     cases = [(h, 2.0) for h in HALF_HEIGHTS] + [(0.5, 0.3)]  # the last one clips at 0.3 m
     env = {**os.environ, "PYTHONPATH": f"{toy_tree}{os.pathsep}{ROOT}"}
-    args = [json.dumps(cases), str(tmp_path), BOX, str(OFFSET)]
+    args = [json.dumps(cases), str(tmp_path), BOX, str(OFFSET), str(RECORDED_STEPS)]
     done = subprocess.run(
         [sys.executable, "-c", PROBE, *args],
         cwd=toy_tree,
@@ -223,3 +242,14 @@ def test_a_toy_sensor_kind_in_three_modules_reads_a_resting_box(
         assert found["sensor_qos"], "a sensor topic is offered with SensorDataQoS"
         assert found["decoded"] == pytest.approx(reading["range"], rel=FLOAT32), found
         assert found["summary"].startswith(f"range {reading['range']:.4g}  min_range 0.02")
+        # a recording of the resting box: one Range a period, each where the box rests (within
+        # SINK, which also covers the float32 rounding of a range below 2 m: 1.2e-7 m)
+        recorded = found["recorded"]
+        assert len(recorded) >= RECORDED_STEPS / 1000 * RATE, found
+        stamps = [stamp for _, stamp, _ in recorded]
+        steps = [b - a for a, b in zip(stamps[:-1], stamps[1:], strict=True)]
+        assert all(abs(d - 1 / RATE) <= STAMP for d in steps), stamps
+        assert {msgtype for msgtype, _, _ in recorded} == {"sensor_msgs/msg/Range"}
+        assert h - SINK < found["z_after"] <= h + 1e-6, found
+        for _, _, value in recorded:
+            assert value == pytest.approx(min(found["z_after"] + OFFSET, high), abs=SINK), found

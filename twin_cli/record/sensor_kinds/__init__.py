@@ -1,5 +1,6 @@
-"""ROS messages of sensor kinds beyond the built-in ones: one module per kind, found by scanning.
+"""The ROS message of each sensor kind, one module per kind, found by scanning this package.
 
 A module here registers its builder with `@ros_message(SpecType, ReadingType, ros_type)`
-(`twin_cli.record.sensor_messages`); the built-in kinds' builders are in that module.
+(`twin_cli.record.sensor_messages`): `imu`, `ray`, `force_torque`, `contact`, `camera`, and
+any module added here. Nothing else in the recorder lists kinds.
 """

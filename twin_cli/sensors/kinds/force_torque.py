@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from converters.description.sensors import NATIVE_PARTS, ForceTorqueSpec
+from converters.description.sensors import ForceTorqueSpec
 from twin_cli.sensors.frames import body_id, native_slice, site_id
 from twin_cli.sensors.noise import NoiseSampler
 from twin_cli.sensors.readings import WrenchReading
@@ -47,7 +47,7 @@ class ForceTorqueSensor:
         self.site = site_id(model, self.entity, self.spec.site)
         self.child = body_id(model, self.entity, self.spec.child_body)
         self.parent = body_id(model, self.entity, self.spec.parent_body)
-        parts = NATIVE_PARTS["force_torque"]
+        parts = self.spec.native_parts
         self.native = native_slice(model, self.entity, self.spec.site, parts)
 
     def capture(self, data: mujoco.MjData) -> np.ndarray | None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from converters.description.sensors import NATIVE_PARTS, ImuSpec
+from converters.description.sensors import ImuSpec
 from twin_cli.sensors.frames import native_ids, native_slice, site_id
 from twin_cli.sensors.history import SensorHistory
 from twin_cli.sensors.noise import NoiseSampler
@@ -47,7 +47,7 @@ class ImuSensor:
 
     def bind(self, model: mujoco.MjModel) -> None:
         self.site = site_id(model, self.entity, self.spec.site)
-        parts = NATIVE_PARTS["imu"]
+        parts = self.spec.native_parts
         self.native = native_slice(model, self.entity, self.spec.site, parts)
         ids = native_ids(model, self.entity, self.spec.site, parts)
         self.history = SensorHistory.of(model, ids) if self.native is not None else None
