@@ -4,10 +4,11 @@ As a served world loads (`converters.isolated.bounded` enabled), each model's Co
 the collision cache lacks get their convex hulls (`CollisionSettings.defer`), so the world
 starts at once; `decomposing` then converts each such model in full with `convert_in_full` and
 swaps it in. A world model has no file of its own, so the full conversion reads the world file
-again in a bounded child, builds the model of that name, and sends back its description,
-report and read log (`converters.isolated.replay`); the world's process builds the spec from
-them without opening a file, as any served conversion does, and a cancel kills the child and
-its CoACD workers.
+again in a bounded child, reads every file the model of that name builds from
+(`converters.pipeline.read_build_files`) and sends back its description and read log
+(`converters.isolated.replay`); the world's process builds the spec once from them without
+opening a file, as any served conversion does, and a cancel kills the child and its CoACD
+workers.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from converters.mjcf.builder import ConvertOptions
     from converters.pipeline import Conversion
-    from converters.report import Report
     from twin_cli.world.spawn import LoadedSource, Served
 
 
@@ -47,14 +47,12 @@ def options(*, defer: bool) -> ConvertOptions:
     return ConvertOptions(repair_inertia=True, collision=CollisionSettings(defer=defer))
 
 
-def build(robot: Any, convert: ConvertOptions, report: Report | None = None) -> Conversion:
-    """One model of a world, with its height fields (terrain), as MjSpec and report."""
-    from converters.mjcf.heightfields import add_height_fields
+def build(robot: Any, convert: ConvertOptions) -> Conversion:
+    """One model of a world (its terrain as static height fields, as any build) as MjSpec and
+    report."""
     from converters.pipeline import build_description
 
-    done = build_description(robot, convert, report)
-    add_height_fields(done.spec, robot, done.report)  # terrain: static height fields
-    return done
+    return build_description(robot, convert)
 
 
 def loaded(path: str | Path, done: Conversion) -> LoadedSource:
@@ -78,8 +76,8 @@ def loaded(path: str | Path, done: Conversion) -> LoadedSource:
 
 
 def convert_in_full(job: ModelJob, served: Served) -> LoadedSource:
-    """`job`'s model converted in full in a bounded child (time: the served budget plus
-    `served.extra_s`; `served.cancel` kills it).
+    """`job`'s model converted in full: read in a bounded child (time: the served budget plus
+    `served.extra_s`; `served.cancel` kills it), built here once from its read log.
 
     Raises:
         converters.ConversionError: the world file or the model cannot be read any more.
@@ -87,21 +85,21 @@ def convert_in_full(job: ModelJob, served: Served) -> LoadedSource:
     """
     from converters.isolated import bounded, replay
     from converters.isolated.budget import XacroBudget
-    from converters.report import Report
 
     budget = XacroBudget.from_env()
     budget = replace(budget, timeout_s=budget.timeout_s + served.extra_s)
     subject = f"{job.path}#{job.name}"
-    robot, report, reads = bounded.run(read_and_build, job, budget, subject, served.cancel)
+    robot, reads = bounded.run(read_model, job, budget, subject, served.cancel)
     with replay.replaying(reads):
-        done = build(robot, job.options, Report(source=report.source))
-    return loaded(job.path, replace(done, report=report))
+        return loaded(job.path, build(robot, job.options))
 
 
-def read_and_build(job: ModelJob) -> tuple[Any, Report, dict]:
-    """The child's work: read the world file, build the model named, keep the read log."""
+def read_model(job: ModelJob) -> tuple[Any, dict]:
+    """The child's work: read the world file, then every file the model named builds from, and
+    keep the read log; no MjSpec is made here."""
     from converters.errors import InputFileError
     from converters.isolated import replay
+    from converters.pipeline import read_build_files
     from converters.report import Report
     from converters.resources.packages import PackageResolver
     from converters.sdf import read_sdf_world
@@ -115,5 +113,5 @@ def read_and_build(job: ModelJob) -> tuple[Any, Report, dict]:
         robots = [placed.robot for placed in world.models if placed.robot.name == job.name]
         if not robots:
             raise InputFileError(str(path), f"has no model '{job.name}' now", "load it again")
-        done = build(robots[0], job.options)
-    return done.description, done.report, log.entries
+        read_build_files(robots[0], job.options)
+    return robots[0], log.entries

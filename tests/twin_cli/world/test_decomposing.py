@@ -234,3 +234,45 @@ def test_a_save_waits_no_longer_than_it_is_given(served, tmp_path, monkeypatch, 
     assert world.entities()[0].decomposition == "pending"
     assert (tmp_path / "world.json").stat().st_size > 0
     world.delete("bin")  # ends the hung worker
+
+
+def test_a_world_models_child_reads_and_the_world_builds_it_once(tmp_path, monkeypatch):
+    """A world model's full conversion reads in its child (`read_model`, run here to watch
+    it): the bin's mesh and its CoACD parts, and no MjSpec; the world builds the same model
+    from what the child sends as it would build it here, and `convert_in_full` makes one
+    MjSpec in the world's process."""
+    import sys
+
+    from converters.isolated import replay
+    from twin_cli.world import world_models
+    from twin_cli.world.spawn import Served
+
+    monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
+    path = bin_world(tmp_path, drop_z=DROP_Z)
+    job = world_models.ModelJob(str(path), (), "bin", world_models.options(defer=False))
+    counts = {"new_spec": 0, "load_mesh": 0, "compute": 0}
+
+    def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
+        code = frame.f_code
+        if event == "call" and code.co_name in counts and "converters" in code.co_filename:
+            counts[code.co_name] += 1
+
+    sys.setprofile(profile)
+    try:
+        robot, reads = world_models.read_model(job)
+    finally:
+        sys.setprofile(None)
+    assert counts["new_spec"] == 0, f"the child built: {counts}"
+    assert counts["load_mesh"] >= 1 and counts["compute"] == 1, f"nothing read: {counts}"
+    with replay.replaying(reads):
+        sent = world_models.build(robot, job.options).spec.compile()
+    here = world_models.build(robot, job.options).spec.compile()
+    assert sent.ngeom == here.ngeom > 2, (sent.ngeom, here.ngeom)  # CoACD's parts, not a hull
+    np.testing.assert_array_equal(sent.geom_size, here.geom_size)
+    counts.update(new_spec=0)
+    sys.setprofile(profile)
+    try:
+        world_models.convert_in_full(job, Served())
+    finally:
+        sys.setprofile(None)
+    assert counts["new_spec"] == 1, f"{counts['new_spec']} MjSpecs made in the world's process"
