@@ -8,7 +8,6 @@ lazy-import list and the command's own test), so the command touches three files
 
 from __future__ import annotations
 
-import filecmp
 import os
 import re
 import shutil
@@ -17,6 +16,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from source_trees import changed_files
 
 ROOT = Path(__file__).resolve().parents[3]
 TOY = '''"""`twin toy`: the world's gravity along z, a worked example of a world command."""
@@ -48,15 +48,6 @@ def toy(*, scale: float, world: str, json: bool) -> None:
 MOON_Z = -1.62  # [m/s^2] the server's `moon` preset, exact as sent back
 
 
-def _changed_files(left: Path, right: Path) -> list[str]:
-    """Files added, removed or different between two trees (caches left out)."""
-    compared = filecmp.dircmp(left, right, ignore=["__pycache__"])
-    found = [*compared.left_only, *compared.right_only, *compared.diff_files]
-    for sub in compared.common_dirs:
-        found += [f"{sub}/{name}" for name in _changed_files(left / sub, right / sub)]
-    return found
-
-
 def _twin(tree: Path, runtime_dir: Path, *args: str) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": f"{tree}{os.pathsep}{ROOT}", "COLUMNS": "200"}
     env.update(TWIN_RUNTIME_DIR=str(runtime_dir))
@@ -81,7 +72,7 @@ def toy_tree(tmp_path: Path) -> Path:
     tree = tmp_path / "tree"
     shutil.copytree(ROOT / "twin_cli", tree / "twin_cli", ignore=shutil.ignore_patterns("*.pyc"))
     (tree / "twin_cli/cli/world_commands/toy.py").write_text(TOY)
-    assert _changed_files(ROOT / "twin_cli", tree / "twin_cli") == ["cli/world_commands/toy.py"]
+    assert changed_files(ROOT / "twin_cli", tree / "twin_cli") == ["cli/world_commands/toy.py"]
     return tree
 
 

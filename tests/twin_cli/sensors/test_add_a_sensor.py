@@ -10,7 +10,6 @@ topic `twin topics` lists and the messages a recording writes come from the same
 
 from __future__ import annotations
 
-import filecmp
 import json
 import os
 import shutil
@@ -19,6 +18,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from source_trees import changed_files
 
 ROOT = Path(__file__).resolve().parents[3]
 CONVERTER = '''"""`<sensor type="toy_height">`: its frame's height above the ground z = 0 [m]."""
@@ -185,15 +185,6 @@ print(json.dumps(out))
 """
 
 
-def _changed_files(left: Path, right: Path) -> list[str]:
-    """Files added, removed or different between two trees (caches left out)."""
-    compared = filecmp.dircmp(left, right, ignore=["__pycache__"])
-    found = [*compared.left_only, *compared.right_only, *compared.diff_files]
-    for sub in compared.common_dirs:
-        found += [f"{sub}/{name}" for name in _changed_files(left / sub, right / sub)]
-    return found
-
-
 @pytest.fixture()
 def toy_tree(tmp_path: Path) -> Path:
     """A copy of `converters` and `twin_cli` with the toy kind's three modules, and only those."""
@@ -206,7 +197,7 @@ def toy_tree(tmp_path: Path) -> Path:
     changed = sorted(
         f"{package}/{name}"
         for package in ("converters", "twin_cli")
-        for name in _changed_files(ROOT / package, tree / package)
+        for name in changed_files(ROOT / package, tree / package)
     )
     assert changed == sorted(FILES), changed
     return tree
