@@ -67,6 +67,26 @@ def _wait_while_pending(runtime: Path, world: str, name: str, client) -> tuple[d
     raise AssertionError(f"{name} still decomposing after {WAIT_S:g} s")
 
 
+def _assert_on_its_hull(listed: dict, on_hull: float) -> None:
+    """The bin is listed pending with one hull standing in, and the ball rests on that hull's
+    top (the rim plus the ball's radius)."""
+    assert listed["decomposition"] == "pending", f"swapped before the ball was measured: {listed}"
+    assert len(listed["hull_stand_ins"]) == 1, f"listed: {listed}"
+    assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
+
+
+def _resume_until_on_its_floor(runtime, world: str, client) -> tuple[list[float], float]:
+    """Resumes the world, waits for the bin's swap, checks that no hull stands in any more and
+    that the ball settles on the bin's floor; returns the sim times seen while waiting and the
+    ball's height [m]."""
+    twin_ok(runtime, world, "resume")
+    done, times = _wait_while_pending(runtime, world, "bin", client)
+    assert done["decomposition"] == "done" and done["hull_stand_ins"] == [], f"row: {done}"
+    on_floor = _settled_ball_z(runtime, world)
+    assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
+    return times, on_floor
+
+
 def test_a_served_bin_holds_the_ball_on_its_hull_then_on_its_floor(tmp_path, serve_world):
     world, runtime = "decomposing", tmp_path / "run"
     urdf, ball = bin_urdf(tmp_path), ball_urdf(tmp_path)
@@ -80,18 +100,9 @@ def test_a_served_bin_holds_the_ball_on_its_hull_then_on_its_floor(tmp_path, ser
         # the ball settles on what stands in for the bin, then `twin list` says what that was.
         client.step(SETTLE_STEPS)
         on_hull = float(client.pose("ball")["z"])
-        listed = _listed(runtime, world)["bin"]
-        assert listed["decomposition"] == "pending", (
-            f"swapped before the ball was measured: {listed}"
-        )
-        assert len(listed["hull_stand_ins"]) == 1, f"listed: {listed}"
-        assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
-        twin_ok(runtime, world, "resume")
-        done, times = _wait_while_pending(runtime, world, "bin", client)
+        _assert_on_its_hull(_listed(runtime, world)["bin"], on_hull)
+        times, on_floor = _resume_until_on_its_floor(runtime, world, client)
         waited_s = time.monotonic() - started
-        assert done["decomposition"] == "done" and done["hull_stand_ins"] == [], f"row: {done}"
-        on_floor = _settled_ball_z(runtime, world)
-        assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
         assert "done" in twin_ok(runtime, world, "list")
         twin_ok(runtime, world, "spawn", urdf, "--name", "again", "-x", "1")
         again = _listed(runtime, world)["again"]
@@ -160,17 +171,10 @@ def test_a_served_world_file_starts_with_the_hull_then_swaps_the_bin(tmp_path, s
         # Straight through the API (milliseconds), so that CoACD (3 CPU s) is still at work.
         client.step(SETTLE_STEPS)
         on_hull = float(client.pose("ball")["z"])
-        listed = {row["name"]: row for row in client.entities()}["bin"]
-        assert listed["decomposition"] == "pending", f"not pending when measured: {listed}"
-        assert len(listed["hull_stand_ins"]) == 1, f"listed: {listed}"
-        assert on_hull == pytest.approx(BIN_OUTER[2] + BALL_RADIUS, abs=HULL_TOL), on_hull
-        twin_ok(runtime, world, "resume")
-        done, times = _wait_while_pending(runtime, world, "bin", client)
+        _assert_on_its_hull({row["name"]: row for row in client.entities()}["bin"], on_hull)
+        times, on_floor = _resume_until_on_its_floor(runtime, world, client)
         swapped_s = time.monotonic() - started
-        assert done["decomposition"] == "done" and done["hull_stand_ins"] == [], f"row: {done}"
         assert len(times) < 2 or times[-1] > times[0], f"sim time stood still: {times}"
-        on_floor = _settled_ball_z(runtime, world)
-        assert on_floor == pytest.approx(BIN_FLOOR + BALL_RADIUS, abs=FLOOR_TOL), on_floor
     print(
         f"served in {ready_s:.1f} s, swapped {swapped_s:.1f} s after start; ball on hull "
         f"{on_hull:.4f} m, on floor {on_floor:.4f} m"
