@@ -9,12 +9,12 @@ world loads without a Gazebo install.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
-from urllib.parse import unquote
 
 from converters.errors import MalformedXMLError, PackageNotFoundError
-from converters.resources.fuel import fuel_caches
+from converters.resources.fuel import cached_model, fuel_caches, parse_address
 from converters.resources.packages import MODEL_ENVS
 from converters.sdf.document import (
     INCLUDED_SOURCE,
@@ -144,22 +144,15 @@ def _fuel_model(ctx: SdfContext, include: Any, uri: str) -> Path:
     """A Gazebo Fuel model (`https://fuel.gazebosim.org/1.0/OWNER/models/NAME[/VERSION]`) from
     the local Fuel cache, where `gz fuel download` and Gazebo put it; Gazebo's own ground plane
     and sun fall back to the ones twin ships. twin never downloads."""
-    parts = [unquote(p) for p in uri.split("://", 1)[1].split("/") if p]
-    unsafe = any(p in (".", "..") or "/" in p or "\\" in p for p in parts)
-    if "models" not in parts[1:-1] or unsafe:
+    address = parse_address(uri)
+    if address is None:
         raise ctx.error(include, f"{uri} is not a Fuel model URI", "write model://NAME")
-    at = parts.index("models")
-    host, owner, name = parts[0], parts[at - 1], parts[at + 1]
-    version = parts[at + 2] if len(parts) > at + 2 and parts[at + 2].isdigit() else None
-    for cache in fuel_caches(ctx.resolver.env):
-        versions = cache / host / owner.lower() / "models" / name.lower()
-        found = sorted(
-            (d for d in versions.glob("*") if d.is_dir() and d.name.isdigit()),
-            key=lambda d: int(d.name),
-        )
-        chosen = [d for d in found if version is None or d.name == version]
-        if chosen:
-            return _from_config(ctx, include, chosen[-1])
+    if not (address.version or "").isdigit():  # an include's other last segment: the newest
+        address = replace(address, version=None)
+    cached = cached_model(address, ctx.resolver.env)
+    if cached is not None:
+        return _from_config(ctx, include, cached)
+    name = address.name
     shipped = SHIPPED_MODELS / name.lower().replace(" ", "_")
     if name.lower() in FUEL_SHIPPED and shipped.is_dir():
         return _from_config(ctx, include, shipped)
