@@ -10,6 +10,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from call_counts import converter_calls
 
 from converters.errors import ConversionBudgetError, ResourceNotFoundError
 from converters.isolated import bounded
@@ -97,23 +98,6 @@ def test_a_served_conversion_builds_the_same_model_and_reads_no_file_here(tmp_pa
     assert [s.name for s in served.sensors] == [s.name for s in here.sensors]
 
 
-def _calls(action, names: set[str]) -> dict[str, int]:
-    """How often each function of `names` (converter functions, by name) ran during `action`."""
-    counts = dict.fromkeys(names, 0)
-
-    def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
-        code = frame.f_code
-        if event == "call" and code.co_name in counts and "converters" in code.co_filename:
-            counts[code.co_name] += 1
-
-    sys.setprofile(profile)
-    try:
-        action()
-    finally:
-        sys.setprofile(None)
-    return counts
-
-
 def test_the_child_reads_without_building_and_the_caller_builds_once(tmp_path, monkeypatch):
     """The child's work (`read_job`, run here to watch it) reads the meshes and prepares the
     collision parts but makes no MjSpec; what it sends back builds the same model as a
@@ -125,7 +109,7 @@ def test_the_child_reads_without_building_and_the_caller_builds_once(tmp_path, m
     job = _job(_robot(tmp_path))
     builds = {"new_spec", "build_spec", "build_description"}
     sent: list[tuple] = []
-    ran = _calls(lambda: sent.append(read_job(job)), builds | {"load_mesh", "compute"})
+    ran = converter_calls(lambda: sent.append(read_job(job)), builds | {"load_mesh", "compute"})
     assert {k: ran[k] for k in builds} == dict.fromkeys(builds, 0), f"the child built: {ran}"
     assert ran["load_mesh"] >= 1 and ran["compute"] == 1, f"the child did not read: {ran}"
     robot, report, reads = sent[0]
@@ -134,7 +118,7 @@ def test_the_child_reads_without_building_and_the_caller_builds_once(tmp_path, m
         built = build_description(robot, job.options, report)
     same = mjb(built.spec) == mjb(convert_job(job).spec)
     assert same, "the model built from what the child sent differs from one built here"
-    ran = _calls(lambda: convert_served(job, XacroBudget(60, 4096)), {"new_spec"})
+    ran = converter_calls(lambda: convert_served(job, XacroBudget(60, 4096)), {"new_spec"})
     assert ran == {"new_spec": 1}, f"a served conversion made {ran['new_spec']} MjSpecs here"
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from bin_models import BALL_RADIUS, BIN_FLOOR, BIN_OUTER, ball_urdf, bin_urdf, bin_world
+from call_counts import converter_calls
 from coacd_workers import alive, workers
 
 from converters.isolated import bounded
@@ -241,8 +242,6 @@ def test_a_world_models_child_reads_and_the_world_builds_it_once(tmp_path, monke
     it): the bin's mesh and its CoACD parts, and no MjSpec; the world builds the same model
     from what the child sends as it would build it here, and `convert_in_full` makes one
     MjSpec in the world's process."""
-    import sys
-
     from converters.isolated import replay
     from twin_cli.world import world_models
     from twin_cli.world.spawn import Served
@@ -250,18 +249,11 @@ def test_a_world_models_child_reads_and_the_world_builds_it_once(tmp_path, monke
     monkeypatch.setenv("TWIN_CACHE_DIR", str(tmp_path / "cache"))
     path = bin_world(tmp_path, drop_z=DROP_Z)
     job = world_models.ModelJob(str(path), (), "bin", world_models.options(defer=False))
-    counts = {"new_spec": 0, "load_mesh": 0, "compute": 0}
-
-    def profile(frame, event, arg) -> None:  # noqa: ARG001 (sys.setprofile's signature)
-        code = frame.f_code
-        if event == "call" and code.co_name in counts and "converters" in code.co_filename:
-            counts[code.co_name] += 1
-
-    sys.setprofile(profile)
-    try:
-        robot, reads = world_models.read_model(job)
-    finally:
-        sys.setprofile(None)
+    sent_back: list[tuple] = []
+    counts = converter_calls(
+        lambda: sent_back.append(world_models.read_model(job)), {"new_spec", "load_mesh", "compute"}
+    )
+    robot, reads = sent_back[0]
     assert counts["new_spec"] == 0, f"the child built: {counts}"
     assert counts["load_mesh"] >= 1 and counts["compute"] == 1, f"nothing read: {counts}"
     with replay.replaying(reads):
@@ -269,10 +261,5 @@ def test_a_world_models_child_reads_and_the_world_builds_it_once(tmp_path, monke
     here = world_models.build(robot, job.options).spec.compile()
     assert sent.ngeom == here.ngeom > 2, (sent.ngeom, here.ngeom)  # CoACD's parts, not a hull
     np.testing.assert_array_equal(sent.geom_size, here.geom_size)
-    counts.update(new_spec=0)
-    sys.setprofile(profile)
-    try:
-        world_models.convert_in_full(job, Served())
-    finally:
-        sys.setprofile(None)
+    counts = converter_calls(lambda: world_models.convert_in_full(job, Served()), {"new_spec"})
     assert counts["new_spec"] == 1, f"{counts['new_spec']} MjSpecs made in the world's process"
