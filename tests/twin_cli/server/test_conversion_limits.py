@@ -16,6 +16,8 @@ from pathlib import Path
 
 from tests.big_meshes import write_grid_obj
 from tests.cli_world import twin_in, twin_ok
+from twin_cli.server.client import Client
+from twin_cli.server.runtime import RUNTIME_ENV
 
 WORLD = "limits"
 BUDGET_S = 2.0  # [s] reading the mesh below alone takes longer (~3 s, trimesh on OBJ text)
@@ -63,11 +65,14 @@ def test_a_huge_mesh_is_stopped_at_its_budget_while_the_world_answers(tmp_path, 
     spawn = _spawn_in_background(runtime, robot)
     time.sleep(0.8)  # the client has started and the child is reading the mesh
     assert spawn.poll() is None, "the spawn ended before the world could be asked"
-    for _ in range(2):
-        start = time.monotonic()
-        twin_ok(runtime, WORLD, "stats", "-d", "0")
-        took = time.monotonic() - start
-        assert took < 1.0, f"twin stats took {took:.2f} s while a conversion ran"
+    # Asked in this process: a `twin stats` process's start-up on a busy runner is not the server's.
+    monkeypatch.setenv(RUNTIME_ENV, str(runtime))
+    with Client(WORLD) as client:
+        for _ in range(2):
+            start = time.monotonic()
+            client.stats()
+            took = time.monotonic() - start
+            assert took < 1.0, f"GET /stats took {took:.2f} s while a conversion ran"
     _, err = spawn.communicate(timeout=60)
     assert spawn.returncode == 2 and "Traceback" not in err, err
     for part in (f"took over {BUDGET_S:g} s", "TWIN_CONVERT_TIMEOUT", f"reading mesh {mesh}"):
