@@ -56,8 +56,6 @@ NOT_RUN = {
     "tf_frame_prefix": "frames are prefixed with the entity's name",
     "linear.x.max_acceleration_reverse": "reversing is bounded as driving forward",
     "linear.x.max_deceleration_reverse": "reversing is bounded as driving forward",
-    "linear.x.min_velocity": "the twist is clipped symmetrically at max_velocity",
-    "angular.z.min_velocity": "the twist is clipped symmetrically at max_velocity",
     "preserve_turning_radius": "v and ω are bounded each on its own, as Humble's controller",
     "linear.x.max_jerk": "no jerk limit",
     "angular.z.max_jerk": "no jerk limit",
@@ -154,6 +152,7 @@ def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -
         robot_base_frame=str(parameter(params, "base_frame_id", "base_link")),
         max_linear_velocity=_limit(params, "linear.x", "velocity", where, name, flags, math.inf),
         max_angular_velocity=_limit(params, "angular.z", "velocity", where, name, flags, math.inf),
+        min_velocities=_min_velocities(params, where, name, flags),
         command_timeout=timeout,
         notes=tuple(notes),
     )
@@ -218,6 +217,24 @@ def _number(params: dict, key: str, path: str, controller: str) -> float | None:
             f"write a plain number for {key} under its ros__parameters",
         )
     return None if math.isnan(value) else float(value)
+
+
+def _min_velocities(
+    params: dict, path: str, controller: str, flags: bool
+) -> tuple[float, float] | None:
+    """linear.x and angular.z `min_velocity` (signed) where a velocity limit applies and one is
+    given, else -max_velocity (the speed limiter's default); None when neither is given."""
+    lows: list[float] = []
+    given_any = False
+    for axis in ("linear.x", "angular.z"):
+        top = _limit(params, axis, "velocity", path, controller, flags, math.inf)
+        given = _number(params, f"{axis}.min_velocity", path, controller)
+        if math.isfinite(top) and given is not None and math.isfinite(given):
+            lows.append(given)
+            given_any = True
+        else:
+            lows.append(-top)
+    return (lows[0], lows[1]) if given_any else None
 
 
 def _twist_acceleration(

@@ -139,7 +139,11 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         max_linear_velocity=p.number(math.inf, "max_linear_velocity", "max_velocity"),
-        max_angular_velocity=p.number(math.inf, "max_angular_velocity"),
+        max_angular_velocity=p.number(math.inf, "max_angular_velocity", "max_velocity"),
+        min_velocities=(  # a bound no tag sets is none, as in its SpeedLimiters
+            p.number(-math.inf, "min_linear_velocity", "min_velocity", signed=True),
+            p.number(-math.inf, "min_angular_velocity", "min_velocity", signed=True),
+        ),
         gz=gz_names(p, ctx.base_link),
     )
 

@@ -16,7 +16,6 @@ controller's `wheel_separation_multiplier`, as on the real robot.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control.drive_base import DriveController
@@ -48,9 +47,10 @@ class DiffDriveController(DriveController):
     def goal_twist(self) -> tuple[float, float]:
         """The commanded (v [m/s], ω [rad/s]) after the plugin's speed limits."""
         p = self.plugin
+        lows = p.min_velocities or (-p.max_linear_velocity, -p.max_angular_velocity)
         return (
-            _clip(self.twist.linear, p.max_linear_velocity),
-            _clip(self.twist.angular, p.max_angular_velocity),
+            min(max(self.twist.linear, lows[0]), p.max_linear_velocity),
+            min(max(self.twist.angular, lows[1]), p.max_angular_velocity),
         )
 
     def goals(self) -> tuple[float, float]:
@@ -129,7 +129,3 @@ class DiffDriveController(DriveController):
     def command_reply(self) -> dict[str, Any]:
         left, right = self.goals()
         return {"wheel_speeds": {"left": left / self.radius, "right": right / self.radius}}
-
-
-def _clip(value: float, limit: float) -> float:
-    return value if math.isinf(limit) else max(-limit, min(limit, value))

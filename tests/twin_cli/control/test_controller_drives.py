@@ -309,13 +309,16 @@ ANGULAR_LIMITS = (
         (ANGULAR_LIMITS, 0.0, 1.0, 3.0, 4.0),
         # v rises at 1.5 m/s² and falls at the given 0.5 m/s²: 1.17 m, then 0.09 m more
         ("    linear.x.min_acceleration: -0.5\n", 0.3, 0.0, 0.3 * (4.0 - 0.1), 0.3 * 3.9 + 0.09),
+        # reversing is clamped at the given linear.x.min_velocity, not at -max_velocity
+        ("    linear.x.min_velocity: -0.1\n", -0.3, 0.0, -0.1 * (4.0 - 0.1 / 3.0), -0.4),
     ],
 )
 def test_the_controllers_speed_limiters_bound_v_and_w_each(
     tmp_path: Path, extra: str, linear: float, angular: float, at_end: float, after_stop: float
 ) -> None:
     """diff_drive_controller's speed limiters bound the change of linear.x and of angular.z,
-    each between min_acceleration (signed; unset: -max_acceleration) and max_acceleration.
+    each between min_acceleration (signed; unset: -max_acceleration) and max_acceleration, and
+    the speeds between min_velocity (unset: -max_velocity) and max_velocity.
     Oracle: those ramps in closed form, the heading [rad] (in place) or the distance [m] at the
     end of a 4 s command and 2.5 s later; bound: 2 % as the drive families' path bound."""
     from twin_cli.control import drive

@@ -103,3 +103,27 @@ def test_the_yaw_rate_changes_within_its_own_bounds(
     message = f"{turned:.4f} rad of {expected}"
     assert turned == pytest.approx(expected, rel=PATH_TOLERANCE), message
     assert abs(along) < 0.01, "in place"
+
+
+@pytest.mark.parametrize(
+    ("limits", "linear", "expected"),
+    [
+        ("<max_linear_velocity>0.2</max_linear_velocity>", 0.3, 0.2 * T),
+        ("<max_linear_velocity>0.2</max_linear_velocity>", -0.3, -0.3 * T),  # no min: none
+        ("<max_velocity>0.2</max_velocity><min_velocity>-0.1</min_velocity>", -0.3, -0.1 * T),
+    ],
+)
+def test_speed_bounds_are_signed_and_an_unset_one_is_none(
+    tmp_path: Path, limits: str, linear: float, expected: float
+) -> None:
+    """gz-sim clamps v between min_linear_velocity and max_linear_velocity (min_velocity and
+    max_velocity set both of v's and ω's), and a bound no tag sets is none: a base whose
+    maximum is 0.2 m/s reverses at the 0.3 m/s asked."""
+    along, _ = _run(tmp_path, limits, linear, 0.0)
+    assert along == pytest.approx(expected, rel=PATH_TOLERANCE), f"{along:.4f} m of {expected}"
+
+
+def test_max_velocity_bounds_the_yaw_rate_too(tmp_path: Path) -> None:
+    """`max_velocity` 0.5 caps ω at 0.5 rad/s as well: 2 rad in 4 s for 1 rad/s asked."""
+    _, turned = _run(tmp_path, "<max_velocity>0.5</max_velocity>", 0.0, 1.0)
+    assert turned == pytest.approx(0.5 * T, rel=PATH_TOLERANCE), f"{turned:.4f} rad"
