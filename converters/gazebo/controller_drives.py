@@ -54,14 +54,9 @@ NOT_RUN = {
     "enable_odom_tf": "`twin serve --ros` always publishes the odom frame in /tf",
     "tf_frame_prefix_enable": "frames are prefixed with the entity's name",
     "tf_frame_prefix": "frames are prefixed with the entity's name",
-    "angular.z.max_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",
-    "linear.x.min_acceleration": "the wheels ramp symmetrically at linear.x.max_acceleration",
-    "angular.z.min_acceleration": "the wheels ramp at linear.x.max_acceleration at the rim",
-    "linear.x.max_deceleration": "the wheels ramp symmetrically at linear.x.max_acceleration",
-    "linear.x.max_acceleration_reverse": "the wheels ramp at linear.x.max_acceleration",
-    "linear.x.max_deceleration_reverse": "the wheels ramp at linear.x.max_acceleration",
-    "linear.x.min_velocity": "the twist is clipped symmetrically at max_velocity",
-    "angular.z.min_velocity": "the twist is clipped symmetrically at max_velocity",
+    "linear.x.max_acceleration_reverse": "reversing is bounded as driving forward",
+    "linear.x.max_deceleration_reverse": "reversing is bounded as driving forward",
+    "preserve_turning_radius": "v and ω are bounded each on its own, as Humble's controller",
     "linear.x.max_jerk": "no jerk limit",
     "angular.z.max_jerk": "no jerk limit",
     "velocity_rolling_window_size": "odometry is not averaged over a window",
@@ -148,7 +143,8 @@ def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -
         wheel_separation=separation,
         wheel_diameter=radius * (multipliers[0] + multipliers[1]),
         max_wheel_torque=math.inf,  # the speed is set; the joint's own motor bounds it
-        max_wheel_acceleration=_limit(params, "linear.x", "acceleration", where, name, flags),
+        max_wheel_acceleration=0.0,  # the twist is bounded instead
+        twist_acceleration=_twist_acceleration(params, where, name, flags),
         odometry_source="encoder",
         update_rate=rate,
         family=FAMILY,
@@ -156,6 +152,7 @@ def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -
         robot_base_frame=str(parameter(params, "base_frame_id", "base_link")),
         max_linear_velocity=_limit(params, "linear.x", "velocity", where, name, flags, math.inf),
         max_angular_velocity=_limit(params, "angular.z", "velocity", where, name, flags, math.inf),
+        min_velocities=_min_velocities(params, where, name, flags),
         command_timeout=timeout,
         notes=tuple(notes),
     )
@@ -220,6 +217,48 @@ def _number(params: dict, key: str, path: str, controller: str) -> float | None:
             f"write a plain number for {key} under its ros__parameters",
         )
     return None if math.isnan(value) else float(value)
+
+
+def _min_velocities(
+    params: dict, path: str, controller: str, flags: bool
+) -> tuple[float, float] | None:
+    """linear.x and angular.z `min_velocity` (signed) where a velocity limit applies and one is
+    given, else -max_velocity (the speed limiter's default); None when neither is given."""
+    lows: list[float] = []
+    given_any = False
+    for axis in ("linear.x", "angular.z"):
+        top = _limit(params, axis, "velocity", path, controller, flags, math.inf)
+        given = _number(params, f"{axis}.min_velocity", path, controller)
+        if math.isfinite(top) and given is not None and math.isfinite(given):
+            lows.append(given)
+            given_any = True
+        else:
+            lows.append(-top)
+    return (lows[0], lows[1]) if given_any else None
+
+
+def _twist_acceleration(
+    params: dict, path: str, controller: str, flags: bool
+) -> tuple[float, float, float, float]:
+    """(min, max) change of linear.x [m/s²], then of angular.z [rad/s²], as the controller's
+    speed limiters bound its command: where `max_acceleration` limits (`_limit`), from
+    `min_acceleration` (signed), else `-max_deceleration` (Jazzy's name), else -max; no limit:
+    ±inf."""
+    bounds: list[float] = []
+    for axis in ("linear.x", "angular.z"):
+        top = _limit(params, axis, "acceleration", path, controller, flags, math.inf)
+        low = -math.inf
+        if math.isfinite(top):
+            given = _number(params, f"{axis}.min_acceleration", path, controller)
+            slowing = _number(params, f"{axis}.max_deceleration", path, controller)
+            if given is not None and math.isfinite(given):
+                low = given
+            elif slowing is not None and math.isfinite(slowing):
+                low = -abs(slowing)
+            else:
+                low = -top
+        bounds += [low, top]
+    return bounds[0], bounds[1], bounds[2], bounds[3]
 
 
 def _limit(

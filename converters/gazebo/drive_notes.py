@@ -59,6 +59,10 @@ USED: dict[str, set[str]] = {
         "wheel_radius",
         "max_linear_acceleration",
         "max_acceleration",
+        "min_linear_acceleration",
+        "min_acceleration",
+        "max_angular_acceleration",
+        "min_angular_acceleration",
         "frame_id",
         "child_frame_id",
         "max_linear_velocity",
@@ -154,8 +158,8 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
         "turns as commanded (a track multiplier it learns, within 0.5-5)",
     ),
     "gz-sim-diff-drive-system": (
-        "max_linear_acceleration applied at the wheel rims; wheels as velocity servos without a "
-        "force bound (gz-sim sets their velocity)",
+        "speed and acceleration limits on the commanded twist, as its SpeedLimiters apply them; "
+        "wheels as velocity servos without a force bound (gz-sim sets their velocity)",
     ),
     "gazebo_ros_ackermann_drive": (
         "rear wheels as velocity servos at their no-slip speeds (the plugin's one PID force on "

@@ -106,6 +106,20 @@ def read_skid_steer(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
     )
 
 
+def gz_twist_acceleration(p: Params) -> tuple[float, float, float, float]:
+    """gz-sim's DiffDrive acceleration bounds, as its SpeedLimiters take them: (min, max) of the
+    linear [m/s²], then of the angular [rad/s²] command's change, signed (a deceleration bound
+    is negative); `min_acceleration`/`max_acceleration` set both, the `_linear_`/`_angular_`
+    tags win, and a bound no tag sets is none (±inf): with `max_linear_acceleration` alone the
+    base speeds up at that rate and stops at once."""
+    return (
+        p.number(-math.inf, "min_linear_acceleration", "min_acceleration", signed=True),
+        p.number(math.inf, "max_linear_acceleration", "max_acceleration", signed=True),
+        p.number(-math.inf, "min_angular_acceleration", "min_acceleration", signed=True),
+        p.number(math.inf, "max_angular_acceleration", "max_acceleration", signed=True),
+    )
+
+
 def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
     """gz-sim DiffDrive: velocity commands on every left/right joint, odometry from the
     wheels' positions, speed and acceleration limits on the body twist."""
@@ -117,14 +131,19 @@ def read_gz_diff_drive(p: Params, blob: Blob, ctx: ReadContext) -> DiffDrive:
         wheel_separation=p.number(1.0, "wheel_separation"),
         wheel_diameter=2.0 * p.number(0.2, "wheel_radius"),
         max_wheel_torque=math.inf,
-        max_wheel_acceleration=p.number(0.0, "max_linear_acceleration", "max_acceleration"),
+        max_wheel_acceleration=0.0,
+        twist_acceleration=gz_twist_acceleration(p),
         odometry_source="encoder",
         update_rate=EVERY_STEP,
         family="gz_diff_drive",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),
         robot_base_frame=p.text(f"{ctx.model}/{ctx.base_link}", "child_frame_id"),
         max_linear_velocity=p.number(math.inf, "max_linear_velocity", "max_velocity"),
-        max_angular_velocity=p.number(math.inf, "max_angular_velocity"),
+        max_angular_velocity=p.number(math.inf, "max_angular_velocity", "max_velocity"),
+        min_velocities=(  # a bound no tag sets is none, as in its SpeedLimiters
+            p.number(-math.inf, "min_linear_velocity", "min_velocity", signed=True),
+            p.number(-math.inf, "min_angular_velocity", "min_velocity", signed=True),
+        ),
         gz=gz_names(p, ctx.base_link),
     )
 

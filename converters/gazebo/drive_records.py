@@ -66,6 +66,13 @@ class DiffDrive(_Record):
         step). family: the plugin (`gazebo_ros_diff_drive`, `gazebo_ros_skid_steer_drive`,
         `gz_diff_drive`, `vendor:<filename>`); odometry_frame, robot_base_frame: the odometry's
         frame names; max_linear_velocity [m/s], max_angular_velocity [rad/s] (gz-sim's limits);
+        min_velocities: the lowest (signed) linear [m/s] and angular [rad/s] command, where the
+        plugin bounds them apart from the highest (gz-sim's `min_*_velocity`, unset: none; a
+        controller's `min_velocity`); None: the negated maxima;
+        twist_acceleration: the bounds (min, max) on the commanded forward speed's change
+        [m/s²] and then on the yaw rate's [rad/s²], ±inf where none, for a plugin that limits
+        the body twist before it turns it into wheel speeds (gz-sim's SpeedLimiter); None: the
+        wheels' rims ramp at max_wheel_acceleration instead (gazebo_ros' diff drive);
         command_timeout [s]: how long a ROS cmd_vel holds (diff_drive_controller's
         cmd_vel_timeout; 0: until the next); odom_topic: the odometry's ROS topic as the plugin
         names it (relative: under the entity's name); notes: what was approximated or ignored,
@@ -87,6 +94,8 @@ class DiffDrive(_Record):
     robot_base_frame: str = "base_footprint"
     max_linear_velocity: float = math.inf
     max_angular_velocity: float = math.inf
+    min_velocities: tuple[float, float] | None = None
+    twist_acceleration: tuple[float, float, float, float] | None = None
     command_timeout: float = 0.0
     odom_topic: str = "odom"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)

@@ -19,7 +19,10 @@ from converters.resources.packages import PackageResolver
 _LOCK = threading.Lock()
 
 XACRO_SUFFIXES = (".xacro",)
-XACRO_MARKERS = ("<xacro:",)  # in a file with another suffix: written in xacro
+XACRO_MARKERS = ("<xacro:",) + tuple(  # in a file with another suffix: written in xacro
+    f"$({name}" for name in ("find ", "arg ", "env ", "optenv ", "eval ", "dirname)")
+)
+"""Tags and substitution args (xacro's `$(...)`: what only xacro evaluates in a file's text)."""
 FOUND: contextvars.ContextVar[dict[str, str]] = contextvars.ContextVar("xacro_found")
 """Packages `$(find)` resolved in the current expansion: name → directory (for messages)."""
 
@@ -40,15 +43,17 @@ class XacroResult:
 
 
 def needs_xacro(path: Path) -> bool:
-    """True for `.xacro` files (incl. `.urdf.xacro`) and for any other file written in xacro.
+    """True for files named `.xacro` anywhere in their suffixes (`.urdf.xacro`, `.xacro.urdf`)
+    and for any other file written in xacro.
 
     ROS launch files run xacro on whatever file they are given, so packages ship xacro under
-    other names (gz_ros2_control_demos' `test_pendulum_effort.xacro.urdf`); such a file uses
-    xacro's tags. The namespace declaration alone does not count: URDFs that xacro already
-    expanded keep it, and some carry text placeholders (turtlebot3's `${namespace}`, which its
-    launch file replaces) that xacro would refuse.
+    other names (gz_ros2_control_demos' `test_diff_drive.xacro.urdf`); such a file uses xacro's
+    tags or only its substitution args (a `$(find pkg)` path in a `<parameters>` tag). The
+    namespace declaration alone does not count: URDFs that xacro already expanded keep it, and
+    some carry text placeholders (turtlebot3's `${namespace}`, which its launch file replaces)
+    that xacro would refuse.
     """
-    if path.suffix.lower() in XACRO_SUFFIXES:
+    if any(suffix.lower() in XACRO_SUFFIXES for suffix in path.suffixes):
         return True
     try:
         text = path.read_text(errors="replace")

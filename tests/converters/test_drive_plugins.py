@@ -101,7 +101,8 @@ ROWS = [
             "wheel_separation": 1.0,  # gz-sim's default
             "wheel_diameter": 0.1,
             "max_wheel_torque": None,  # velocity commands: unbounded
-            "max_wheel_acceleration": 2.0,
+            "max_wheel_acceleration": 0.0,  # the twist is bounded, not the rims
+            "twist_acceleration": [None, 2.0, None, None],  # unset bounds: none
             "odometry_source": "encoder",
             "odometry_frame": "dd/odom",
             "robot_base_frame": "dd/base_link",

@@ -2,7 +2,8 @@
 
 gazebo_ros' diff drive and skid steer, gz-sim's DiffDrive, ros2_control's diff_drive_controller
 and vendor diff drives share one open-loop rule: each update ramps the wheels' rim speeds
-v ∓ ω·b/2 towards the command (`kinematics.ramp`, the plugin's `max_wheel_acceleration`), b the
+v ∓ ω·b/2 towards the command (`kinematics.ramp`, the plugin's `max_wheel_acceleration`; gz-sim's
+DiffDrive bounds the change of v and of ω instead, `kinematics.limit_change`), b the
 plugin's wheel separation (times the controller's `wheel_separation_multiplier`, already in the
 record), and writes them over the radius as velocity targets through the world's joint command
 API (a velocity servo whose force is capped at the wheel motor's ±`max_wheel_torque`, Gazebo's
@@ -15,11 +16,10 @@ controller's `wheel_separation_multiplier`, as on the real robot.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control.drive_base import DriveController
-from twin_cli.control.kinematics import body_twist, ramp, rim_speeds
+from twin_cli.control.kinematics import body_twist, limit_change, ramp, rim_speeds
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import DiffDrive
@@ -41,14 +41,21 @@ class DiffDriveController(DriveController):
     def __init__(self, world: World, entity: str, plugin: DiffDrive) -> None:
         self.radius = plugin.wheel_diameter / 2.0
         self.rims = (0.0, 0.0)  # rim speeds [m/s] the ramp has reached and last wrote
+        self.limited = (0.0, 0.0)  # the twist (v, ω) a twist-limiting plugin last allowed
         super().__init__(world, entity, plugin)
+
+    def goal_twist(self) -> tuple[float, float]:
+        """The commanded (v [m/s], ω [rad/s]) after the plugin's speed limits."""
+        p = self.plugin
+        lows = p.min_velocities or (-p.max_linear_velocity, -p.max_angular_velocity)
+        return (
+            min(max(self.twist.linear, lows[0]), p.max_linear_velocity),
+            min(max(self.twist.angular, lows[1]), p.max_angular_velocity),
+        )
 
     def goals(self) -> tuple[float, float]:
         """The commanded rim speeds [m/s], after the plugin's speed limits."""
-        p = self.plugin
-        v = _clip(self.twist.linear, p.max_linear_velocity)
-        w = _clip(self.twist.angular, p.max_angular_velocity)
-        return rim_speeds(v, w, p.wheel_separation)
+        return rim_speeds(*self.goal_twist(), self.plugin.wheel_separation)
 
     @property
     def separation(self) -> float:
@@ -57,11 +64,24 @@ class DiffDriveController(DriveController):
 
     def _reset_targets(self) -> None:
         self.rims = (0.0, 0.0)
+        self.limited = (0.0, 0.0)
 
     def _apply(self, dt: float, force: bool) -> None:
-        goals = self.goals()
-        accel = self.plugin.max_wheel_acceleration
-        rims = (ramp(self.rims[0], goals[0], accel, dt), ramp(self.rims[1], goals[1], accel, dt))
+        bounds = self.plugin.twist_acceleration
+        if bounds is None:
+            goals = self.goals()
+            accel = self.plugin.max_wheel_acceleration
+            rims = (
+                ramp(self.rims[0], goals[0], accel, dt),
+                ramp(self.rims[1], goals[1], accel, dt),
+            )
+        else:  # the twist's speed limiter (gz-sim): v and ω each bounded on their own
+            goal, last = self.goal_twist(), self.limited
+            self.limited = (
+                limit_change(last[0], goal[0], bounds[0], bounds[1], dt),
+                limit_change(last[1], goal[1], bounds[2], bounds[3], dt),
+            )
+            rims = rim_speeds(*self.limited, self.plugin.wheel_separation)
         if rims != self.rims or force:  # a held command costs nothing
             self.rims = rims
             targets = {j: rims[0] / self.radius for j in self.plugin.left_joints}
@@ -109,7 +129,3 @@ class DiffDriveController(DriveController):
     def command_reply(self) -> dict[str, Any]:
         left, right = self.goals()
         return {"wheel_speeds": {"left": left / self.radius, "right": right / self.radius}}
-
-
-def _clip(value: float, limit: float) -> float:
-    return value if math.isinf(limit) else max(-limit, min(limit, value))

@@ -26,6 +26,11 @@ if TYPE_CHECKING:
     from twin_cli.world.entities import Entity
 
 
+STOP_SLACK = 1e-9
+"""[s] sim time a command's end may pass unseen: data.time sums the step, so an update on the
+end's instant reads it a few ulps either side."""
+
+
 def update_rate(declared: float, timestep: float) -> float:
     """The rate [Hz] a plugin that declares `declared` [Hz] updates at in a world stepped every
     `timestep` [s]: every step for 0 ("as fast as possible") or a period shorter than a step."""
@@ -103,7 +108,13 @@ class DriveController:
         self.last_time = float(self.world.data.time)
 
     def command(self, twist: Twist, duration: float | None) -> None:
-        """Holds `twist` for `duration` [s] of sim time (None: until replaced)."""
+        """Holds `twist` for `duration` [s] of sim time (None: until replaced).
+
+        Given between steps, the command reaches the plugin at its next update, as a cmd_vel
+        does in Gazebo; its end is a stop that reaches it the same way, at the first update
+        after `duration` has passed, so a plugin at any rate runs the command for `duration`
+        (stopped at the update the duration ends on, a 10 Hz drive ran it 0.1 s short).
+        """
         with self.world.lock:
             self.twist = twist
             now = float(self.world.data.time)
@@ -145,7 +156,7 @@ class DriveController:
         dt, self.last_time = now - self.last_time, now
         if self.plugin.odometry_source == "encoder" and dt > 0:
             self.encoder = integrate_twist(self.encoder, *self._encoder_motion(dt), 1.0)
-        if now >= self.until - 1e-9:
+        if now > self.until + STOP_SLACK:  # the stop reaches the plugin as a cmd_vel would
             self.twist, self.until = STOP, math.inf
         force = self.updates == 0 or self.world.commands() != self._written
         self._apply(dt, force)

@@ -38,6 +38,15 @@ def ramp(current: float, target: float, acceleration: float, dt: float) -> float
     return current + math.copysign(step, target - current)
 
 
+def limit_change(current: float, target: float, lowest: float, highest: float, dt: float) -> float:
+    """`target`, its change from `current` bounded to [lowest·dt, highest·dt] (signed rates: a
+    deceleration bound is negative; ±inf: none), as a speed limiter bounds a command."""
+    change = target - current
+    if lowest * dt <= change <= highest * dt:
+        return target  # exactly: the controller compares what it writes with what it wrote
+    return current + min(max(change, lowest * dt), highest * dt)
+
+
 def body_twist(left: float, right: float, radius: float, separation: float) -> tuple[float, float]:
     """Forward speed [m/s] and yaw rate [rad/s] from wheel joint speeds [rad/s]."""
     v_left, v_right = left * radius, right * radius

@@ -79,7 +79,8 @@ def test_the_controllers_parameters_become_the_drive(tmp_path: Path) -> None:
     assert drive.wheel_separation == pytest.approx(0.25 * 1.2, rel=1e-12), "× the multiplier"
     assert drive.wheel_diameter == pytest.approx(0.1, rel=1e-12)
     assert (drive.max_linear_velocity, drive.max_angular_velocity) == (0.4, 2.0)
-    assert drive.max_wheel_acceleration == 1.5 and drive.update_rate == 50
+    assert drive.update_rate == 50 and drive.max_wheel_acceleration == 0.0
+    assert drive.twist_acceleration == (-1.5, 1.5, -math.inf, math.inf), "min is -max"
     assert (drive.odometry_frame, drive.robot_base_frame) == ("odom_demo", "base_footprint")
     assert drive.family == "diff_drive_controller" and drive.odometry_source == "encoder"
     details = [e.detail for e in done.report.entries]
@@ -257,3 +258,85 @@ def test_wheel_interface_min_max_does_not_clip_the_controllers_speeds(
         asked = reply["applied"]["wheel_speeds"][side]
         assert asked == pytest.approx(6.0, rel=1e-9), reply
         assert speeds[wheel] == pytest.approx(asked, rel=0.02), f"{wheel} at {speeds[wheel]:.3f}"
+
+
+@pytest.mark.parametrize("name", ["base.xacro.urdf", "base.urdf"])
+def test_a_file_whose_only_xacro_is_a_find_is_expanded_and_drives(
+    tmp_path: Path, name: str
+) -> None:
+    """A description written as gz_ros2_control's demos write theirs: no `<xacro:` tag, its
+    parameter file named by `$(find pkg)/config/...` and the xacro namespace declared (under a
+    `.xacro.urdf` name, and under a plain `.urdf` one). ROS launch files run xacro on it, so the
+    file is found in the package and the base drives 1.5 m in 5 s at 0.3 m/s (the rims ramp at
+    1.5 m/s² for 0.2 s each way, which cancel; 2 % as the drive families' path bound)."""
+    from twin_cli.control import drive
+    from twin_cli.spawn_request import SpawnRequest
+    from twin_cli.world import World
+
+    package = tmp_path / "demo_pkg"
+    (package / "config").mkdir(parents=True)
+    (package / "config" / "ddc.yaml").write_text(
+        YAML.replace("max_velocity: 0.4", "max_velocity: 1")
+    )
+    text = _base(tmp_path, yaml=None).read_text()
+    text = text.replace("<parameters>ddc.yaml", "<parameters>$(find demo_pkg)/config/ddc.yaml")
+    text = text.replace("<robot ", '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" ', 1)
+    (tmp_path / "elsewhere").mkdir()
+    path = tmp_path / "elsewhere" / name
+    path.write_text(text)
+    done = convert_full(path, package_paths={"demo_pkg": package})
+    assert [p.family for p in done.plugins if isinstance(p, DiffDrive)] == ["diff_drive_controller"]
+    world = World()
+    request = SpawnRequest(str(path), package_paths={"demo_pkg": str(package)}, on_ground=True)
+    world.spawn(request, name="base")
+    world.step(300)
+    start = world.get_pose("base").x
+    drive(world, "base", 0.3, 0.0, 5.0)
+    world.step(5600)
+    moved = world.get_pose("base").x - start
+    assert moved == pytest.approx(1.5, rel=0.02), f"drove {moved:.4f} m of 1.5"
+
+
+ANGULAR_LIMITS = (
+    "    angular.z.has_acceleration_limits: true\n    angular.z.max_acceleration: 0.5\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("extra", "linear", "angular", "at_end", "after_stop"),
+    [
+        # ω rises at 0.5 rad/s² for 2 s: 3 rad at the end of 4 s at 1 rad/s, and falls at -max
+        (ANGULAR_LIMITS, 0.0, 1.0, 3.0, 4.0),
+        # v rises at 1.5 m/s² and falls at the given 0.5 m/s²: 1.17 m, then 0.09 m more
+        ("    linear.x.min_acceleration: -0.5\n", 0.3, 0.0, 0.3 * (4.0 - 0.1), 0.3 * 3.9 + 0.09),
+        # reversing is clamped at the given linear.x.min_velocity, not at -max_velocity
+        ("    linear.x.min_velocity: -0.1\n", -0.3, 0.0, -0.1 * (4.0 - 0.1 / 3.0), -0.4),
+    ],
+)
+def test_the_controllers_speed_limiters_bound_v_and_w_each(
+    tmp_path: Path, extra: str, linear: float, angular: float, at_end: float, after_stop: float
+) -> None:
+    """diff_drive_controller's speed limiters bound the change of linear.x and of angular.z,
+    each between min_acceleration (signed; unset: -max_acceleration) and max_acceleration, and
+    the speeds between min_velocity (unset: -max_velocity) and max_velocity.
+    Oracle: those ramps in closed form, the heading [rad] (in place) or the distance [m] at the
+    end of a 4 s command and 2.5 s later; bound: 2 % as the drive families' path bound."""
+    from twin_cli.control import drive
+
+    yaml = YAML.replace("max_velocity: 0.4", "max_velocity: 1.0").replace(
+        "    angular.z.max_velocity: 2.0\n", f"    angular.z.max_velocity: 2.0\n{extra}"
+    )
+    robot = dm.settled_base(tmp_path, _base(tmp_path, yaml).read_text())
+    start = robot.get_pose("base")
+
+    def progress() -> float:
+        end = robot.get_pose("base")
+        return end.x - start.x if angular == 0 else math.remainder(end.yaw - start.yaw, 2 * math.pi)
+
+    drive(robot, "base", linear, angular, 4.0)
+    robot.step(4000)
+    first = progress()
+    robot.step(2500)
+    total = progress() if angular == 0 else first + math.remainder(progress() - first, 2 * math.pi)
+    assert first == pytest.approx(at_end, rel=0.02), f"{first:.4f} at the end of the command"
+    assert total == pytest.approx(after_stop, rel=0.02), f"{total:.4f} after the stop"

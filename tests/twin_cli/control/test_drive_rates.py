@@ -93,3 +93,28 @@ def test_a_gz_diff_drive_with_slow_odometry_drives_its_path(tmp_path: Path) -> N
     end = world.get_pose("base")
     driven = math.hypot(end.x - start.x, end.y - start.y)
     assert driven == pytest.approx(1.05, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 1.05"
+
+
+@pytest.mark.parametrize(
+    ("plugin", "controller_rate"),
+    [
+        (_ros_diff("<update_rate>10</update_rate>").replace("0.2</max", "0</max"), 0.0),
+        (_ros_diff("<update_rate>20</update_rate>").replace("0.2</max", "0</max"), 0.0),
+        (dm.ROS2_CONTROL, 10.0),
+    ],
+    ids=["ros_10", "ros_20", "ros2_control_10"],
+)
+def test_a_slow_drive_holds_a_timed_command_for_its_whole_duration(
+    tmp_path: Path, plugin: str, controller_rate: float
+) -> None:
+    """0.3 m/s for 2 s at 10 or 20 updates a second drives 0.6 m. The command reaches the
+    plugin at its next update, as a cmd_vel does in Gazebo, and so does the stop at the end of
+    the duration: the wheels turn for 2 s. Stopped at the update the duration ends on, they
+    turned one update less (0.57 m at 10 Hz, 5 % short)."""
+    world = _world(tmp_path, plugin, controller_rate)
+    start = world.get_pose("base")
+    drive(world, "base", 0.3, duration=2.0)
+    world.step(3000)
+    end = world.get_pose("base")
+    driven = math.hypot(end.x - start.x, end.y - start.y)
+    assert driven == pytest.approx(0.6, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 0.6"
