@@ -3,10 +3,12 @@ and a holonomic base gets a planar velocity servo on its root link.
 
 Gazebo's drive plugins command their joints directly (a joint velocity with `fmax`, a force, a
 position) whatever `<transmission>` or `<ros2_control>` says, so their joints need a motor even
-without those tags. A joint that already has one keeps it (its tags decide its modes; a gz-sim
-joint controller's PID replaces the gains of a motor no tag configured); a new one offers only the
-mode the plugin uses, bounded by the plugin's torque (unbounded when the plugin sets velocities
-directly, as gz-sim's systems do).
+without those tags. A joint whose tags gave it a motor keeps it (its tags decide its modes); a
+new one, or the untagged torque motor of a joint with an effort limit, offers only the mode the
+plugin uses, with the plugin's gains (a gz-sim joint controller's PID), bounded by the plugin's
+torque (by the joint's limit when the plugin sets velocities directly, as gz-sim's systems do;
+unbounded without one). Left untagged, such a wheel ran on the world's generic velocity servo,
+whose integral takes seconds to carry its robot: a turtlebot3 gz-sim model turned 59 % short.
 
 Planar move (and MecanumDrive, whose rollers MuJoCo cannot model) drives the base's planar twist.
 Gazebo's planar move overwrites the model's velocity every step; twin gives the root link three
