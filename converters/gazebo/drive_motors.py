@@ -3,10 +3,12 @@ and a holonomic base gets a planar velocity servo on its root link.
 
 Gazebo's drive plugins command their joints directly (a joint velocity with `fmax`, a force, a
 position) whatever `<transmission>` or `<ros2_control>` says, so their joints need a motor even
-without those tags. A joint that already has one keeps it (its tags decide its modes; a gz-sim
-joint controller's PID replaces the gains of a motor no tag configured); a new one offers only the
-mode the plugin uses, bounded by the plugin's torque (unbounded when the plugin sets velocities
-directly, as gz-sim's systems do).
+without those tags. A joint whose tags gave it a motor keeps it (its tags decide its modes); a
+new one, or the untagged torque motor of a joint with an effort limit, offers only the mode the
+plugin uses, with the plugin's gains (a gz-sim joint controller's PID), bounded by the plugin's
+torque (by the joint's limit when the plugin sets velocities directly, as gz-sim's systems do;
+unbounded without one). Left untagged, such a wheel ran on the world's generic velocity servo,
+whose integral takes seconds to carry its robot: a turtlebot3 gz-sim model turned 59 % short.
 
 Planar move (and MecanumDrive, whose rollers MuJoCo cannot model) drives the base's planar twist.
 Gazebo's planar move overwrites the model's velocity every step; twin gives the root link three
@@ -118,7 +120,9 @@ def add_drive_motors(
                 _motor(spec, joint, effort)
                 set_control_record(spec, joint, _record(record, mode, pid))
                 driven.add(joint)
-            elif pid and _untagged(spec, joint):
+            elif _untagged(spec, joint):
+                if not isinstance(record, JointDrive | TrajectoryDrive):
+                    _bound(spec, joint, effort)
                 set_control_record(spec, joint, _record(record, mode, pid))
         if isinstance(record, HolonomicDrive):
             _planar_servos(spec, record)
@@ -129,11 +133,27 @@ def add_drive_motors(
 
 
 def _untagged(spec: mujoco.MjSpec, joint: str) -> bool:
-    """Whether `joint`'s motor is the builder's default (no control tag): a gz-sim joint
-    controller's own PID then decides its gains, as the system drives the joint's force."""
+    """Whether `joint`'s motor is the builder's default (no control tag, e.g. the torque motor
+    of a joint with an effort limit): the plugin that commands the joint then decides its mode
+    and gains (a gz-sim joint controller's own PID), as it would for a joint without a motor."""
     text = spec.text(CONTROL_TEXT)
     records = json.loads(text.data) if text is not None else {}
     return records.get(joint, {}).get("source") == "default"
+
+
+def _bound(spec: mujoco.MjSpec, joint: str, effort: float) -> None:
+    """A wheel drive's own torque bound (gazebo_ros' `fmax`, which replaces the joint motor's
+    bound in ODE) replaces the joint's effort limit on the motor it already has; a drive that
+    sets velocities (unbounded here: gz-sim's) leaves the joint's limit, which Gazebo's velocity
+    command obeys. Joint controllers' forces stay within the joint's limit as well."""
+    import mujoco
+
+    if not math.isfinite(effort):
+        return
+    for motor in spec.actuators:
+        if motor.target == joint and motor.trntype == mujoco.mjtTrn.mjTRN_JOINT:
+            motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            motor.ctrlrange = np.array([-effort, effort])
 
 
 def _motor(spec: mujoco.MjSpec, joint: str, effort: float) -> None:
