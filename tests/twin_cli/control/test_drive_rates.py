@@ -82,16 +82,20 @@ def test_a_drive_updates_at_its_plugins_rate(
             assert changes == per_second, f"{changes} new wheel targets in 1 s"
 
 
+def _distance_driven(world: World, duration: float) -> float:
+    """[m] from the start to where the base is 1 s after 0.3 m/s for `duration` seconds."""
+    start = world.get_pose("base")
+    drive(world, "base", 0.3, duration=duration)
+    world.step(round((duration + 1.0) / world.model.opt.timestep))
+    end = world.get_pose("base")
+    return math.hypot(end.x - start.x, end.y - start.y)
+
+
 def test_a_gz_diff_drive_with_slow_odometry_drives_its_path(tmp_path: Path) -> None:
     """gz-sim's DiffDrive sets its wheels' speeds at every step whatever its odometry rate: at
     0.3 m/s for 3.5 s it drives 1.05 m (2 %); updates at the odometry's 1 Hz would stop it at a
     whole second, 0.9 or 1.2 m."""
-    world = _world(tmp_path, GZ_DIFF_SLOW_ODOM)
-    start = world.get_pose("base")
-    drive(world, "base", 0.3, duration=3.5)
-    world.step(4000)
-    end = world.get_pose("base")
-    driven = math.hypot(end.x - start.x, end.y - start.y)
+    driven = _distance_driven(_world(tmp_path, GZ_DIFF_SLOW_ODOM), duration=3.5)
     assert driven == pytest.approx(1.05, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 1.05"
 
 
@@ -111,10 +115,5 @@ def test_a_slow_drive_holds_a_timed_command_for_its_whole_duration(
     plugin at its next update, as a cmd_vel does in Gazebo, and so does the stop at the end of
     the duration: the wheels turn for 2 s. Stopped at the update the duration ends on, they
     turned one update less (0.57 m at 10 Hz, 5 % short)."""
-    world = _world(tmp_path, plugin, controller_rate)
-    start = world.get_pose("base")
-    drive(world, "base", 0.3, duration=2.0)
-    world.step(3000)
-    end = world.get_pose("base")
-    driven = math.hypot(end.x - start.x, end.y - start.y)
+    driven = _distance_driven(_world(tmp_path, plugin, controller_rate), duration=2.0)
     assert driven == pytest.approx(0.6, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 0.6"
