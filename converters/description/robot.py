@@ -115,12 +115,16 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """Joint limits: position lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s]."""
+    """Joint limits: position lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s].
+
+    `defaulted` names the bounds the file left out and its format's default filled in (URDF
+    reads a missing `lower` or `upper` of a revolute or prismatic joint as 0)."""
 
     lower: float | None = None
     upper: float | None = None
     effort: float | None = None
     velocity: float | None = None
+    defaulted: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

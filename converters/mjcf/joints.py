@@ -86,6 +86,7 @@ def _limited(
     _dynamics(mj, joint)
     lower, upper = _bounds(joint)
     locked = locked_value(joint)
+    _report_defaulted(joint, report)
     if locked is not None:
         mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
         report.mapped(
@@ -99,12 +100,48 @@ def _limited(
         home = min(max(0.0, lower), upper)
         return [MjJointPlan(joint.name, joint.name, joint.kind, (lower, upper), (home,))]
     mj.limited = mujoco.mjtLimited.mjLIMITED_FALSE
+    unusable = _unusable_limit(joint, lower, upper)
+    if unusable:
+        problem, fix = unusable
+        report.warn(f"joint '{joint.name}'", f"{problem}; left unlimited; {fix}")
+    return [MjJointPlan(joint.name, joint.name, joint.kind, None, (0.0,))]
+
+
+def _report_defaulted(joint: Joint, report: Report) -> None:
+    """Says which bounds URDF's default of 0 filled in: a joint held at 0, or turning one way
+    only, is rarely what the author meant, though it is what Gazebo loads."""
+    if joint.limit is None or not joint.limit.defaulted:
+        return
+    missing = " and ".join(joint.limit.defaulted)
     report.warn(
         f"joint '{joint.name}'",
-        f"{joint.kind} joint without a usable <limit> "
-        f"(lower={lower}, upper={upper}); left unlimited",
+        f"<limit> has no {missing}: URDF reads a missing bound as 0, so the range is "
+        f"[{joint.limit.lower:g}, {joint.limit.upper:g}] {UNITS[joint.kind]}, as in Gazebo; "
+        'give lower and upper, or use type="continuous" for a joint without limits',
     )
-    return [MjJointPlan(joint.name, joint.name, joint.kind, None, (0.0,))]
+
+
+def _unusable_limit(
+    joint: Joint, lower: float | None, upper: float | None
+) -> tuple[str, str] | None:
+    """(Why a joint's limits cannot bound it, the fix), or None when it is unlimited as its file
+    says (an SDF axis without `<limit>`, or with SDF's ±1e16, is unlimited by default)."""
+    unit = UNITS[joint.kind]
+    if joint.limit is None:
+        return (
+            f"{joint.kind} joint without <limit>: URDF requires one (ROS's URDF parser "
+            "refuses the file)",
+            "give lower, upper, effort and velocity",
+        )
+    if lower is None and upper is None:
+        return None
+    if lower is None or upper is None:
+        side, value = ("upper", upper) if lower is None else ("lower", lower)
+        return (
+            f"only a {side} limit ({value:g} {unit}): MuJoCo limits both sides or none",
+            "give the other bound",
+        )
+    return f"lower {lower:g} > upper {upper:g} {unit}", "swap them"
 
 
 def locked_value(joint: Joint) -> float | None:

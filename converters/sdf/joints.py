@@ -125,10 +125,11 @@ def _axis(
     return vec3(R_C_axis @ xyz)
 
 
-def _limit(ctx: SdfContext, axis: Any, kind: str) -> Limit | None:
+def _limit(ctx: SdfContext, axis: Any, kind: str) -> Limit:
+    """The axis's `<limit>`; without one, SDF's defaults: no position, effort or speed bound."""
     limit = None if axis is None else axis.find("limit")
     if limit is None:
-        return None
+        return Limit()
 
     def bound(tag: str, default: float) -> float | None:
         value = ctx.number(limit, tag, default)

@@ -40,6 +40,7 @@ from converters.urdf.xml_checks import check_kinds, check_numbers, check_tree, p
 CONTROLLER_ONLY = ("safety_controller", "calibration")
 # URDF's default joint axis.
 DEFAULT_AXIS = (1.0, 0.0, 0.0)
+BOUNDED_KINDS = ("revolute", "prismatic")  # joints whose <limit> needs lower and upper
 
 
 def parse_urdf(
@@ -247,9 +248,7 @@ def _joint(joint: ET.Element) -> Joint:
         child=_link_of(joint, "child"),
         origin=_origin(joint),
         axis=_floats(joint.find("axis"), "xyz", DEFAULT_AXIS),
-        limit=None
-        if limit is None
-        else Limit(*(_optional_number(limit, k) for k in ("lower", "upper", "effort", "velocity"))),
+        limit=_limit(limit, joint.get("type", "")),
         dynamics=None
         if dynamics is None
         else Dynamics(_number(dynamics, "damping", 0.0), _number(dynamics, "friction", 0.0)),
@@ -261,6 +260,26 @@ def _joint(joint: ET.Element) -> Joint:
             _number(mimic, "offset", 0.0),
         ),
         ignored=tuple(name for name in CONTROLLER_ONLY if joint.find(name) is not None),
+    )
+
+
+def _limit(limit: ET.Element | None, kind: str) -> Limit | None:
+    """A joint's `<limit>`. ROS's URDF parser, which Gazebo reads URDF through, takes a missing
+    `lower` or `upper` as 0, so a revolute or prismatic joint without them is held at 0."""
+    if limit is None:
+        return None
+    lower, upper, effort, velocity = (
+        _optional_number(limit, k) for k in ("lower", "upper", "effort", "velocity")
+    )
+    if kind not in BOUNDED_KINDS:
+        return Limit(lower, upper, effort, velocity)
+    defaulted = tuple(k for k, v in (("lower", lower), ("upper", upper)) if v is None)
+    return Limit(
+        0.0 if lower is None else lower,
+        0.0 if upper is None else upper,
+        effort,
+        velocity,
+        defaulted,
     )
 
 

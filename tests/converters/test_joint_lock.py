@@ -113,3 +113,64 @@ def test_sdf_axis_without_limits_takes_sdf_defaults(tmp_path: Path, limit: str) 
     driven = [i for i in range(model.nu) if model.actuator_trnid[i, 0] == joint.id]
     assert all(not model.actuator_forcelimited[i] for i in driven), "no effort bound"
     assert _largest_drift(model, 0.0) > 0.1, "the hinge swings freely"
+    details = [e.detail for e in convert_full(path).report.entries if "'lock'" in e.subject]
+    assert not any("limit" in d for d in details), f"SDF's defaults are not a problem: {details}"
+
+
+def _urdf_limit(tmp_path: Path, limit: str) -> Path:
+    path = _urdf(tmp_path, "revolute", 0.0)
+    path.write_text(
+        path.read_text().replace('<limit lower="0.0" upper="0.0" effort="10" velocity="1"/>', limit)
+    )
+    return path
+
+
+def test_a_urdf_limit_without_lower_and_upper_holds_the_joint_at_0(tmp_path: Path) -> None:
+    """ROS's URDF parser, which Gazebo reads URDF through, takes a missing bound as 0: the
+    joint is held at 0 under the 4.9 N m load, and the report says why and what to write."""
+    conversion = convert_full(_urdf_limit(tmp_path, '<limit effort="10" velocity="1"/>'))
+    drift = _largest_drift(conversion.spec.compile(), 0.0)
+    assert drift < HOLD_TOL, f"drifted {drift:.3g} rad"
+    details = " ".join(e.detail for e in conversion.report.entries if "'lock'" in e.subject)
+    for part in ("no lower and upper", "[0, 0] rad", 'type="continuous"', "lower = upper"):
+        assert part in details, f"{part!r} not in {details!r}"
+
+
+@pytest.mark.parametrize(
+    ("bounds", "expected"), [('lower="-1"', (-1.0, 0.0)), ('upper="0.5"', (0.0, 0.5))]
+)
+def test_a_urdf_limit_with_one_bound_takes_0_for_the_other(
+    tmp_path: Path, bounds: str, expected: tuple[float, float]
+) -> None:
+    """The hinge swings under gravity within the range URDF's default makes, never past it."""
+    path = _urdf_limit(tmp_path, f'<limit {bounds} effort="10" velocity="1"/>')
+    conversion = convert_full(path)
+    model = conversion.spec.compile()
+    joint = model.joint("lock")
+    assert model.jnt_limited[joint.id] and tuple(model.jnt_range[joint.id]) == expected
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    seen = []
+    while data.time < DURATION_S:
+        mujoco.mj_step(model, data)
+        seen.append(float(data.qpos[model.jnt_qposadr[joint.id]]))
+    low, high = expected
+    assert low - 0.02 < min(seen) and max(seen) < high + 0.02, (min(seen), max(seen))
+    details = " ".join(e.detail for e in conversion.report.entries if "'lock'" in e.subject)
+    missing = "upper" if "lower" in bounds else "lower"
+    assert f"has no {missing}: URDF reads a missing bound as 0" in details, details
+
+
+def test_a_urdf_revolute_joint_without_limit_is_unlimited_and_named(tmp_path: Path) -> None:
+    """ROS's parser refuses such a file; twin loads it unlimited and says what to add."""
+    conversion = convert_full(_urdf_limit(tmp_path, ""))
+    model = conversion.spec.compile()
+    assert not model.jnt_limited[model.joint("lock").id]
+    assert _largest_drift(model, 0.0) > 0.1, "the hinge swings freely"
+    warnings = [
+        e.detail
+        for e in conversion.report.entries
+        if "'lock'" in e.subject and e.outcome.value == "warning"
+    ]
+    assert any("without <limit>: URDF requires one" in w for w in warnings), warnings
+    assert not any("None" in w for w in warnings), warnings
