@@ -73,8 +73,10 @@ def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
     if isinstance(record, AckermannDrive):
         wheels = record.left_joints + record.right_joints
         steering = record.left_steering_joints + record.right_steering_joints
+        # gz-sim steers by joint speed commands (`steering_gain`), gazebo_ros to an angle
+        steer = "position" if record.steering_gain is None else "velocity"
         return [(j, "velocity", record.max_wheel_torque, None) for j in wheels] + [
-            (j, "position", math.inf, None) for j in steering
+            (j, steer, math.inf, None) for j in steering
         ]
     if isinstance(record, TricycleDrive):
         return [

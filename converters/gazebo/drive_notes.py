@@ -93,7 +93,10 @@ USED: dict[str, set[str]] = {
         "wheel_radius",
         "steering_limit",
         "max_velocity",
+        "min_velocity",
         "max_acceleration",
+        "min_acceleration",
+        "steer_p_gain",
         "frame_id",
         "child_frame_id",
     },
@@ -153,9 +156,9 @@ USED: dict[str, set[str]] = {
 
 APPROXIMATED: dict[str, tuple[str, ...]] = {
     "gazebo_ros_skid_steer_drive": (
-        "four wheels driven as the two sides of a diff drive, as the plugin does; they slide "
-        "sideways in a turn, so twin trims the two sides' speeds from the base's heading until it "
-        "turns as commanded (a track multiplier it learns, within 0.5-5)",
+        "four wheels driven as the two sides of a diff drive, as the plugin does; in a turn "
+        "they slide sideways and the base turns as their friction lets it, slower than the "
+        "command (no heading correction, as in Gazebo)",
     ),
     "gz-sim-diff-drive-system": (
         "speed and acceleration limits on the commanded twist, as its SpeedLimiters apply them; "
@@ -168,8 +171,9 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
         "track and radius measured on the model, as the plugin does",
     ),
     "gz-sim-ackermann-steering-system": (
-        "steering joints as position servos at their Ackermann angles instead of its P "
-        "controller on their velocity; wheels as velocity servos without a force bound",
+        "steering joints commanded its P controller's speed at every step, wheels their "
+        "speeds, through velocity servos without a force bound (gz-sim sets joint velocities); "
+        "jerk limits not run",
     ),
     "gazebo_ros_tricycle_drive": (
         "steering joint as a position servo (the plugin sets the angle directly); the wheel base "

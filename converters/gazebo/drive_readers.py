@@ -204,6 +204,13 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         steering_limit=p.number(0.5, "steering_limit"),
         max_velocity=p.number(math.inf, "max_velocity"),
         max_acceleration=p.number(0.0, "max_acceleration"),
+        twist_bounds=(  # one pair of SpeedLimiters, the same bounds on v and on ω
+            p.number(-math.inf, "min_velocity", signed=True),
+            p.number(math.inf, "max_velocity", signed=True),
+            p.number(-math.inf, "min_acceleration", signed=True),
+            p.number(math.inf, "max_acceleration", signed=True),
+        ),
+        steering_gain=p.number(1.0, "steer_p_gain", signed=True),
         update_rate=EVERY_STEP,
         odometry_source="encoder",
         odometry_frame=p.text(f"{ctx.model}/odom", "frame_id"),

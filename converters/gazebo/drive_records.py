@@ -119,7 +119,12 @@ class AckermannDrive(_Record):
         max_wheel_torque [N m] (inf = unbounded), update_rate [Hz], odometry_source,
         odometry_frame, robot_base_frame, family, notes: as `DiffDrive`. angular_is_steering:
         the plugin reads cmd_vel's angular.z as the steering angle (gazebo_ros) rather than a
-        yaw rate (gz-sim).
+        yaw rate (gz-sim). twist_bounds: gz-sim's speed limiters, the same for the forward
+        speed and the yaw rate: (min, max) of the command [m/s or rad/s] and (min, max) of its
+        change [m/s² or rad/s²], signed, ±inf where no tag sets one (None: `max_velocity` and
+        `max_acceleration` bound the speed alone, as gazebo_ros). steering_gain: gz-sim's
+        `steer_p_gain` [1/s]: each update the steering joints are commanded the speed
+        gain·(angle − joint angle) (None: position targets, as gazebo_ros' PID holds them).
     """
 
     name: str
@@ -142,6 +147,8 @@ class AckermannDrive(_Record):
     robot_base_frame: str = "base_footprint"
     family: str = "gazebo_ros_ackermann_drive"
     angular_is_steering: bool = True
+    twist_bounds: tuple[float, float, float, float] | None = None
+    steering_gain: float | None = None
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     gz: GzNames | None = None  # a gz-sim system's names (None: not a gz-sim system)
     notes: tuple[str, ...] = ()
@@ -189,6 +196,8 @@ class TricycleDrive(_Record):
     robot_base_frame: str = "base_link"
     family: str = "gazebo_ros_tricycle_drive"
     angular_is_steering: bool = True
+    twist_bounds: tuple[float, float, float, float] | None = None
+    steering_gain: float | None = None
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 

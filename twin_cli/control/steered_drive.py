@@ -7,8 +7,9 @@ targets through the world's joint command API:
 
 - Ackermann: each driven wheel a velocity target at its no-slip speed v·(1 ∓ b·tan φ/(2L))/r
   (gz-sim's partial differential; gazebo_ros' one PID force on both rear wheels is an open
-  differential, which settles at the same speeds), each steered wheel a position target at its
-  own Ackermann angle for the kingpin width;
+  differential, which settles at the same speeds), each steered wheel its own Ackermann angle
+  for the kingpin width: a position target (gazebo_ros), or, as gz-sim's update does, the speed
+  `steering_gain`·(angle − joint angle) at every update after its speed limiters bound v and ω;
 - tricycle: the steered wheel a velocity target v/(cos φ·r) and its steering joint a position
   target φ (the plugin sets the angle directly, twin through a position servo).
 
@@ -22,7 +23,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control.drive_base import DriveController
-from twin_cli.control.kinematics import body_twist, ramp
+from twin_cli.control.kinematics import body_twist, limit_change, ramp
 from twin_cli.control.steering import (
     ackermann_angles,
     axle_speeds,
@@ -53,6 +54,7 @@ class SteeredDriveController(DriveController):
     def __init__(self, world: World, entity: str, plugin: AckermannDrive | TricycleDrive) -> None:
         self.tricycle = type(plugin).__name__ == "TricycleDrive"
         self.speed, self.phi = 0.0, 0.0  # written at the last update: v [m/s], φ [rad]
+        self.limited = (0.0, 0.0)  # gz-sim's last limited (v [m/s], ω [rad/s])
         super().__init__(world, entity, plugin)
 
     # ------------------------------------------------------------------ geometry
@@ -74,20 +76,36 @@ class SteeredDriveController(DriveController):
 
     def goals(self) -> tuple[float, float]:
         """The command's base speed v [m/s] and bicycle angle φ [rad], within the limits."""
+        return self._bicycle(*self._bounded_twist())
+
+    def _bounded_twist(self) -> tuple[float, float]:
+        """The command's (v, ω) within the plugin's speed bounds (gz-sim bounds ω too)."""
         t = self.twist
-        top = math.inf if self.tricycle else self.plugin.max_velocity
-        v = clip(t.linear, top)
+        bounds = None if self.tricycle else self.plugin.twist_bounds
+        if bounds is None:
+            top = math.inf if self.tricycle else self.plugin.max_velocity
+            return clip(t.linear, top), t.angular
+        low, high = bounds[:2]
+        return min(max(t.linear, low), high), min(max(t.angular, low), high)
+
+    def _bicycle(self, v: float, angular: float) -> tuple[float, float]:
+        """(v, the bicycle angle φ [rad]) of a speed and the command's way of steering."""
+        t = self.twist
         if t.steering is not None:
             return v, clip(t.steering, self.limit)
         if t.curvature is not None:
             return v, steering_for_curvature(t.curvature, self.wheel_base, self.limit)
-        return v, steering_for_yaw_rate(v, t.angular, self.wheel_base, self.limit)
+        return v, steering_for_yaw_rate(v, angular, self.wheel_base, self.limit)
 
     # ------------------------------------------------------------------ the update
     def _reset_targets(self) -> None:
         self.speed, self.phi = 0.0, 0.0
+        self.limited = (0.0, 0.0)
 
     def _apply(self, dt: float, force: bool) -> None:
+        if not self.tricycle and self.plugin.twist_bounds is not None:
+            self._apply_limited(dt, force)
+            return
         v_goal, phi_goal = self.goals()
         speed = ramp(self.speed, v_goal, self._acceleration(v_goal), dt)
         turn_rate = 0.0 if not self.tricycle else self.plugin.max_steering_speed
@@ -97,6 +115,25 @@ class SteeredDriveController(DriveController):
             wheels, steering = self._targets(speed, phi)
             self._write(wheels, "velocity")
             self._write(steering, "position")
+
+    def _apply_limited(self, dt: float, force: bool) -> None:
+        """gz-sim's update: v and ω through its speed limiters (each change bounded on its
+        own), the wheels' speeds from them, and each steering joint commanded a speed
+        proportional to how far it is from its angle (`steering_gain`), at every update."""
+        low, high = self.plugin.twist_bounds[2:]
+        goal, last = self._bounded_twist(), self.limited
+        self.limited = (
+            limit_change(last[0], goal[0], low, high, dt),
+            limit_change(last[1], goal[1], low, high, dt),
+        )
+        speed, phi = self._bicycle(*self.limited)
+        wheels, steering = self._targets(speed, phi)
+        if (speed, phi) != (self.speed, self.phi) or force:
+            self.speed, self.phi = speed, phi
+            self._write(wheels, "velocity")
+        gain = self.plugin.steering_gain
+        rates = {j: gain * (angle - self.joint_position(j)) for j, angle in steering.items()}
+        self._write(rates, "velocity")
 
     def _acceleration(self, goal: float) -> float:
         """The speed ramp's limit [m/s²] (0 = none)."""

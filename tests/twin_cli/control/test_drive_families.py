@@ -88,7 +88,7 @@ GZ_ACKERMANN = (
     "</left_steering_joint><right_steering_joint>right_steering_joint</right_steering_joint>"
     "<kingpin_width>0.3</kingpin_width><steering_limit>0.6</steering_limit><wheel_base>0.4"
     "</wheel_base><wheel_separation>0.3</wheel_separation><wheel_radius>0.05</wheel_radius>"
-    "</plugin>"
+    "<steer_p_gain>10</steer_p_gain></plugin>"  # steers within 0.5 s (the default 1/s: 5 s)
 )
 TRICYCLE = (
     '<plugin name="tri" filename="libgazebo_ros_tricycle_drive.so"><steering_joint>'
@@ -430,11 +430,14 @@ def test_ackermann_encoder_odometry_on_a_straight_line_stays_on_the_world_pose(
     tmp_path: Path, speed: float, accel: float
 ) -> None:
     """gz-sim AckermannSteering's odometry integrates its rear wheels' turns. Driven 5 m
-    straight at `speed` with its `max_acceleration` (a rate the rear wheels' friction can give
-    the car: about half its weight at μ = 1, so below ~4 m/s² no wheel slips), the odometry
-    stays within 5 mm and 0.005 rad of the world pose, before and after the stop."""
+    straight at `speed` with its `max_acceleration` and `min_acceleration` (rates the rear
+    wheels' friction can give the car: about half its weight at μ = 1, so below ~4 m/s² no wheel
+    slips; without `min_acceleration` the plugin stops the wheels at once and the car slides),
+    the odometry stays within 5 mm and 0.005 rad of the world pose, before and after the stop."""
     plugin = GZ_ACKERMANN.replace(
-        "</plugin>", f"<max_acceleration>{accel}</max_acceleration></plugin>"
+        "</plugin>",
+        f"<max_acceleration>{accel}</max_acceleration><min_acceleration>{-accel}"
+        "</min_acceleration></plugin>",
     )
     world = _spawned(tmp_path, "gz_ackermann_steering_sdf", dm.sdf_ackermann(plugin))
     world.step(300)
