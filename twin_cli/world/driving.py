@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import mujoco
 
+from converters.mjcf.export_servos import INTEGRAL_MARGIN
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
 from twin_cli.world import gravity_comp, joint_control, native_servos, servos, sleeping
@@ -106,9 +107,11 @@ def command_joints(
         positions = {
             int(state.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
         }
-        dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
-        rolling = dofs if mode == "velocity" else dofs[:0]
-        loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
+        loads = None  # tuning loads, looked up only for a command that tunes a servo
+        if not all(_native(state, c) or _continues_speed(state, c) for c in checked):
+            dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
+            rolling = dofs if mode == "velocity" else dofs[:0]
+            loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
         commands = [_set_command(state, c, loads) for c in checked]
         gravity_comp.switch(state.model, state.commands)
         servos.keep_awake(state.model, state.commands)
@@ -140,9 +143,22 @@ def _checked(
     return key, a, j, mode, float(value), effort, limits
 
 
-def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.JointCommand:
-    """Writes one checked command."""
+def _native(state: WorldState, checked: tuple) -> bool:
+    """Whether a checked command is in the mode of the model's own servo law."""
+    law = state.native.get(checked[0])
+    return law is not None and law.mode == checked[3]
+
+
+def _set_command(state: WorldState, checked: tuple, loads: tuple | None) -> control.JointCommand:
+    """Writes one checked command (`loads`: `joint_control.posture_loads`, None when no command
+    tunes a servo)."""
     key, a, j, mode, value, effort, limits = checked
+    previous = state.commands.get(key)
+    law = state.native.get(key)
+    if law is not None and law.mode == mode:
+        return _set_native(state, (key, a, j, value, effort, limits), law, previous)
+    if loads is None:
+        return _set_speed(state, checked)
     inertia, _, carried = loads
     dof = int(state.model.jnt_dofadr[j])
     here = float(state.data.qpos[state.model.jnt_qposadr[j]])
@@ -159,10 +175,6 @@ def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.Joi
         reference=reference,
         carried=float(carried[dof]),
     )
-    previous = state.commands.get(key)
-    law = state.native.get(key)
-    if law is not None and law.mode == mode:
-        return _set_native(state, (key, a, j, value, effort, limits), law, previous)
     was = servos.kind(previous) if previous else ""
     cmd = control.JointCommand(key, mode, value, kp, kv, effort, limits.velocity, 0.0, rule)
     if reference and previous and was == servos.kind(cmd) == "velocity":
@@ -176,6 +188,40 @@ def _set_command(state: WorldState, checked: tuple, loads: tuple) -> control.Joi
             lead = float(carried[dof]) * (value - before) / cmd.kv
         servos.start(state.model, state.data, a, cmd, was, lead)
     control.apply_command(state.model, state.data, a, cmd, law)
+    state.commands[key] = cmd
+    return cmd
+
+
+def _continues_speed(state: WorldState, checked: tuple) -> bool:
+    """Whether a checked command only changes the speed of a servo already running a non-zero
+    speed: it keeps its gains, so the loads they were tuned on need no new look (a drive that
+    steers by speed writes one at every step)."""
+    key, a, _, mode, value, _, _ = checked
+    previous = state.commands.get(key)
+    return (
+        mode == "velocity"
+        and value != 0.0
+        and previous is not None
+        and previous.mode == "velocity"
+        and previous.target != 0.0
+        and previous.kp > 0.0
+        and previous.kv > 0.0
+        and key not in state.native
+        and servos.has_reference(state.model, a)
+    )
+
+
+def _set_speed(state: WorldState, checked: tuple) -> control.JointCommand:
+    """Writes a new speed into a running velocity servo (`_continues_speed`): its gains stay,
+    and its reference steps back by the lag the change builds, on the inertia its integral gain
+    was tuned for (`servos.gains` inverted)."""
+    key, a, _, _, value, _, _ = checked
+    previous = state.commands[key]
+    carried = previous.kv**2 / (4.0 * INTEGRAL_MARGIN * previous.kp)
+    cmd = replace(previous, target=value)
+    lead = carried * (value - previous.target) / cmd.kv
+    servos.start(state.model, state.data, a, cmd, "velocity", lead)
+    control.apply_command(state.model, state.data, a, cmd, None)
     state.commands[key] = cmd
     return cmd
 
