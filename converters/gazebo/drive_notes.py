@@ -68,6 +68,9 @@ USED: dict[str, set[str]] = {
         "max_linear_velocity",
         "max_velocity",
         "max_angular_velocity",
+        "min_linear_velocity",
+        "min_velocity",
+        "min_angular_velocity",
     },
     "gazebo_ros_ackermann_drive": {
         "front_left_joint",

@@ -392,3 +392,28 @@ def test_a_tracked_vehicle_is_reported_not_run_with_each_of_its_tags(tmp_path: P
     for tag in ("left_track=<...>", "right_track=<...>", "tracks_separation=0.4"):
         assert tag in line.detail, f"{tag} missing from {line.detail}"
     assert "steering_efficiency=0.5" in line.detail and not done.plugins, "no drive runs"
+
+
+@pytest.mark.parametrize(
+    ("plugin", "tags"),
+    [
+        (
+            GZ_DIFF.format(file="gz-sim-diff-drive-system"),
+            ("min_velocity", "min_linear_velocity", "min_angular_velocity", "min_acceleration"),
+        ),
+        (GZ_ACKERMANN, ("min_velocity", "min_acceleration", "steer_p_gain")),
+    ],
+    ids=["diff_drive", "ackermann"],
+)
+def test_gz_limiter_tags_twin_runs_are_not_reported_unused(
+    tmp_path: Path, plugin: str, tags: tuple[str, ...]
+) -> None:
+    """Each tag here changes what the drive does (a lower speed or acceleration bound, the
+    steering gain), so the report must not call it unused; a jerk bound is not run and says so."""
+    given = "".join(f"<{t}>-0.5</{t}>" if t != "steer_p_gain" else f"<{t}>2</{t}>" for t in tags)
+    text = plugin.replace("</plugin>", f"{given}<max_jerk>3</max_jerk></plugin>")
+    robot = dm.sdf_diff_drive(text) if "diff" in plugin else dm.sdf_ackermann(text)
+    notes = [e.detail for e in _convert(tmp_path, robot, "sdf").report.entries]
+    unused = [n for n in notes if "not used by twin" in n]
+    assert any("<max_jerk>" in n for n in unused), notes
+    assert not [n for n in unused for t in tags if f"<{t}>" in n], unused

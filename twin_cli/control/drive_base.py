@@ -26,9 +26,10 @@ if TYPE_CHECKING:
     from twin_cli.world.entities import Entity
 
 
-STOP_SLACK = 1e-9
-"""[s] sim time a command's end may pass unseen: data.time sums the step, so an update on the
-end's instant reads it a few ulps either side."""
+STOP_SLACK = 0.5
+"""Fraction of a step a command's end may pass unseen: data.time sums the step, so an update on
+the end's instant reads it off by a rounding error that grows with the sum (1e-13 s at 5 s, 1e-9
+s after an hour, 2e-8 s after a day at 1 ms); half a step holds at any sim time."""
 
 
 def update_rate(declared: float, timestep: float) -> float:
@@ -156,7 +157,8 @@ class DriveController:
         dt, self.last_time = now - self.last_time, now
         if self.plugin.odometry_source == "encoder" and dt > 0:
             self.encoder = integrate_twist(self.encoder, *self._encoder_motion(dt), 1.0)
-        if now > self.until + STOP_SLACK:  # the stop reaches the plugin as a cmd_vel would
+        step = float(self.world.model.opt.timestep)
+        if now > self.until + STOP_SLACK * step:  # the stop reaches the plugin as a cmd_vel would
             self.twist, self.until = STOP, math.inf
         force = self.updates == 0 or self.world.commands() != self._written
         self._apply(dt, force)

@@ -14,6 +14,7 @@ import drive_models as dm
 import pytest
 
 from twin_cli.control import controller_of, drive
+from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 
 PATH_TOLERANCE = 0.02  # fraction of the distance driven
@@ -116,4 +117,21 @@ def test_a_slow_drive_holds_a_timed_command_for_its_whole_duration(
     the duration: the wheels turn for 2 s. Stopped at the update the duration ends on, they
     turned one update less (0.57 m at 10 Hz, 5 % short)."""
     driven = _distance_driven(_world(tmp_path, plugin, controller_rate), duration=2.0)
+    assert driven == pytest.approx(0.6, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 0.6"
+
+
+def test_a_timed_command_a_day_into_a_world_still_runs_its_whole_duration(
+    tmp_path: Path,
+) -> None:
+    """data.time sums the step, so a day in, an update on a command's end reads it up to about
+    1e-8 s late: the end must still be seen at the update after it (0.6 m at 10 Hz), not one
+    update early (0.57 m)."""
+    robot = tmp_path / "base.urdf"
+    plugin = _ros_diff("<update_rate>10</update_rate>").replace("0.2</max", "0</max")
+    robot.write_text(dm.two_wheel_base(plugin))
+    world = World()
+    world.data.time = 86400.0  # an empty world a day in: nothing to disturb
+    world.spawn(SpawnRequest(str(robot), on_ground=True), name="base")
+    world.step(300)
+    driven = _distance_driven(world, duration=2.0)
     assert driven == pytest.approx(0.6, rel=PATH_TOLERANCE), f"drove {driven:.4f} m of 0.6"
