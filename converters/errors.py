@@ -141,7 +141,7 @@ class XacroError(ConversionError):
     def __init__(self, path: str, message: str, fix: str | None = None) -> None:
         fix = fix or "fix the xacro file or pass the missing argument with --arg NAME:=VALUE"
         super().__init__(f"{path}: xacro failed: {message}; {fix}")
-        self.path = path
+        self.path, self.detail, self.fix = path, message, fix
 
 
 class XacroBudgetError(ConversionError):

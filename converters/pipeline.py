@@ -16,6 +16,7 @@ from converters.errors import (
     InputFileError,
     MissingVisualMeshError,
     URDFStructureError,
+    XacroError,
 )
 from converters.formats import format_of
 from converters.isolated.budget import XacroBudget
@@ -25,7 +26,7 @@ from converters.provenance import Provenance
 from converters.report import Report
 from converters.resources.packages import PackageResolver
 from converters.urdf.reader import parse_urdf
-from converters.urdf.xacro_expand import expand_xacro, needs_xacro
+from converters.urdf.xacro_expand import XacroResult, expand_xacro, needs_xacro, xacro_marker
 
 if TYPE_CHECKING:
     import mujoco
@@ -72,12 +73,14 @@ def read_description(
         except (OSError, UnicodeDecodeError) as exc:
             raise InputFileError(str(path), f"cannot be read ({exc})", "check the file") from exc
     stage(f"expanding xacro {path}")
-    if budget is None:
-        result = expand_xacro(path, args, resolver)
-    else:
-        from converters.urdf.xacro_worker import expand_bounded
-
-        result = expand_bounded(path, dict(args), resolver, budget)
+    try:
+        result = _expand(path, args, resolver, budget)
+    except XacroError as exc:
+        marker = xacro_marker(path)
+        if marker is None or marker.startswith("."):
+            raise
+        why = f"read as xacro because its text has {marker!r}"
+        raise XacroError(exc.path, f"{exc.detail} ({why})", exc.fix) from None
     for call in result.unexpanded:
         report.warn(
             f"xacro macro call {call}",
@@ -87,6 +90,17 @@ def read_description(
     for line in result.warnings:
         report.warn("xacro", line)
     return result.text
+
+
+def _expand(
+    path: Path, args: Mapping[str, str], resolver: PackageResolver, budget: XacroBudget | None
+) -> XacroResult:
+    """xacro on `path`, here or (with a budget) in a bounded child."""
+    if budget is None:
+        return expand_xacro(path, args, resolver)
+    from converters.urdf.xacro_worker import expand_bounded
+
+    return expand_bounded(path, dict(args), resolver, budget)
 
 
 def read_robot(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import io
+import re
 import threading
 import xml.dom.minidom
 from collections.abc import Iterator, Mapping
@@ -23,6 +24,7 @@ XACRO_MARKERS = ("<xacro:",) + tuple(  # in a file with another suffix: written 
     f"$({name}" for name in ("find ", "arg ", "env ", "optenv ", "eval ", "dirname)")
 )
 """Tags and substitution args (xacro's `$(...)`: what only xacro evaluates in a file's text)."""
+_COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
 FOUND: contextvars.ContextVar[dict[str, str]] = contextvars.ContextVar("xacro_found")
 """Packages `$(find)` resolved in the current expansion: name → directory (for messages)."""
 
@@ -53,13 +55,24 @@ def needs_xacro(path: Path) -> bool:
     some carry text placeholders (turtlebot3's `${namespace}`, which its launch file replaces)
     that xacro would refuse.
     """
-    if any(suffix.lower() in XACRO_SUFFIXES for suffix in path.suffixes):
-        return True
+    return xacro_marker(path) is not None
+
+
+def xacro_marker(path: Path) -> str | None:
+    """What makes `path` xacro (`needs_xacro`): its `.xacro` suffix, the first xacro tag or
+    substitution arg in its text, or None. Substitution args count outside XML comments only
+    (xacro leaves comments as they are, and URDFs note the command that made them there)."""
+    suffix = next((s for s in path.suffixes if s.lower() in XACRO_SUFFIXES), None)
+    if suffix is not None:
+        return suffix
     try:
         text = path.read_text(errors="replace")
     except OSError:
-        return False
-    return any(marker in text for marker in XACRO_MARKERS)
+        return None
+    if XACRO_MARKERS[0] in text:
+        return XACRO_MARKERS[0]
+    code = _COMMENT.sub("", text)
+    return next((m for m in XACRO_MARKERS[1:] if m in code), None)
 
 
 @contextlib.contextmanager

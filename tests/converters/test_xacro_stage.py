@@ -83,3 +83,33 @@ def test_an_include_missing_from_a_found_package_names_the_package(robot: Path) 
     assert f"gone.xacro does not exist in package 'helper', found at {helper}" in message
     assert "--package helper=PATH" in message and "--arg" not in message
     assert message.count("gone.xacro") == 1, message
+
+
+PLAIN = (
+    '<?xml version="1.0"?>\n<!-- made by: xacro $(find my_pkg)/urdf/r.urdf.xacro -->\n'
+    '<robot name="plain"><link name="base"><inertial><mass value="1"/><inertia ixx="1" '
+    'iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    "<gazebo><plugin name='p' filename='libx.so'><namespace>${namespace}</namespace></plugin>"
+    "</gazebo></robot>"
+)
+
+
+def test_substitution_args_in_a_comment_leave_a_urdf_plain(tmp_path: Path) -> None:
+    """URDFs note the xacro command that made them in a comment, and keep text placeholders a
+    launch file fills (`${namespace}`): read as plain URDF, the placeholder stays as written."""
+    path = tmp_path / "plain.urdf"
+    path.write_text(PLAIN)
+    result = convert_full(path)
+    assert [link.name for link in result.description.links] == ["base"]
+    assert not any("xacro" in e.subject for e in result.report.entries), result.report.entries
+
+
+def test_a_urdf_read_as_xacro_for_its_text_says_why_when_xacro_fails(tmp_path: Path) -> None:
+    """Outside a comment, `$(arg …)` makes a `.urdf` xacro (as a ROS launch file would run it);
+    when xacro then fails on the file, the error says what made it xacro."""
+    path = tmp_path / "plain.urdf"
+    path.write_text(PLAIN.replace("<link name=", '<link name="$(arg side)x"/><link name=', 1))
+    with pytest.raises(XacroError) as caught:
+        convert_full(path)
+    message = str(caught.value)
+    assert str(path) in message and "read as xacro because its text has '$(arg '" in message
