@@ -8,10 +8,13 @@ them from `cmd_vel`. twin runs that controller as a differential drive (`DiffDri
 
 - `left_wheel_names`, `right_wheel_names`, `wheel_separation`, `wheel_radius` (required), times
   `wheel_separation_multiplier` and the wheel radius multipliers;
-- `linear.x.max_velocity`, `angular.z.max_velocity` clip the twist; `linear.x.max_acceleration`
-  ramps the wheels' rim speeds. A limit counts where its value is a number and its
-  `has_velocity_limits` / `has_acceleration_limits` flag is true (Humble's rule, which Gazebo
-  Classic's gazebo_ros2_control runs) or not false (Jazzy's, for gz_ros2_control);
+- `linear.x.*` and `angular.z.*` speed limiters bound the twist: `max_velocity`/`min_velocity`,
+  and the change of each by `max_acceleration` and a braking bound (Humble: `min_acceleration`;
+  Jazzy: `max_deceleration`, and backward `max_acceleration_reverse`/
+  `max_deceleration_reverse`, by the sign of the last command). A limit counts where its value
+  is a number and its `has_velocity_limits` / `has_acceleration_limits` flag is true (Humble's
+  rule, which Gazebo Classic's gazebo_ros2_control runs) or not false (Jazzy's, for
+  gz_ros2_control);
 - `cmd_vel_timeout` (default 0.5 s): a cmd_vel taken over ROS holds that long;
 - odometry from the wheels' joint positions, in `odom_frame_id` → `base_frame_id`, on the
   controller's `~/odom` (`<ns>/<controller>/odom`);
@@ -54,8 +57,6 @@ NOT_RUN = {
     "enable_odom_tf": "`twin serve --ros` always publishes the odom frame in /tf",
     "tf_frame_prefix_enable": "frames are prefixed with the entity's name",
     "tf_frame_prefix": "frames are prefixed with the entity's name",
-    "linear.x.max_acceleration_reverse": "reversing is bounded as driving forward",
-    "linear.x.max_deceleration_reverse": "reversing is bounded as driving forward",
     "preserve_turning_radius": "v and ω are bounded each on its own, as Humble's controller",
     "linear.x.max_jerk": "no jerk limit",
     "angular.z.max_jerk": "no jerk limit",
@@ -135,6 +136,12 @@ def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -
             "use their mean"
         )
     notes += [f"{key}: {why}" for key, why in NOT_RUN.items() if parameter(params, key) is not None]
+    if not flags:  # Jazzy's controller declares it but passes it to no limiter
+        notes += [
+            f"{axis}.min_acceleration: not used by Jazzy's controller (use max_deceleration)"
+            for axis in ("linear.x", "angular.z")
+            if parameter(params, f"{axis}.min_acceleration") is not None
+        ]
     return DiffDrive(
         name=name,
         where=f"{where} {name}",
@@ -145,6 +152,7 @@ def _diff_drive(name: str, params: dict, where: str, rate: float, flags: bool) -
         max_wheel_torque=math.inf,  # the speed is set; the joint's own motor bounds it
         max_wheel_acceleration=0.0,  # the twist is bounded instead
         twist_acceleration=_twist_acceleration(params, where, name, flags),
+        reverse_acceleration=None if flags else _reverse_acceleration(params, where, name),
         odometry_source="encoder",
         update_rate=rate,
         family=FAMILY,
@@ -240,25 +248,49 @@ def _min_velocities(
 def _twist_acceleration(
     params: dict, path: str, controller: str, flags: bool
 ) -> tuple[float, float, float, float]:
-    """(min, max) change of linear.x [m/s²], then of angular.z [rad/s²], as the controller's
-    speed limiters bound its command: where `max_acceleration` limits (`_limit`), from
-    `min_acceleration` (signed), else `-max_deceleration` (Jazzy's name), else -max; no limit:
-    ±inf."""
+    """(min, max) change of linear.x [m/s²], then of angular.z [rad/s²], while the command is
+    forward, as the controller's speed limiters bound it; no limit: ±inf. Where
+    `max_acceleration` limits (`_limit`): Humble (`flags`) brakes at `min_acceleration`
+    (signed), else -max; Jazzy's rate limiter ignores `min_acceleration` and brakes at
+    `max_deceleration`, else `max_acceleration_reverse`, else -max."""
     bounds: list[float] = []
+    names = ("min_acceleration",) if flags else ("max_deceleration", "max_acceleration_reverse")
     for axis in ("linear.x", "angular.z"):
         top = _limit(params, axis, "acceleration", path, controller, flags, math.inf)
         low = -math.inf
         if math.isfinite(top):
-            given = _number(params, f"{axis}.min_acceleration", path, controller)
-            slowing = _number(params, f"{axis}.max_deceleration", path, controller)
-            if given is not None and math.isfinite(given):
-                low = given
-            elif slowing is not None and math.isfinite(slowing):
-                low = -abs(slowing)
-            else:
-                low = -top
+            found = (_given(params, axis, name, path, controller) for name in names)
+            given = next((v for v in found if v is not None), None)
+            low = -top if given is None else given if flags else -abs(given)
         bounds += [low, top]
     return bounds[0], bounds[1], bounds[2], bounds[3]
+
+
+def _reverse_acceleration(
+    params: dict, path: str, controller: str
+) -> tuple[float, float, float, float]:
+    """Jazzy's bounds on the change of linear.x, then angular.z, while the command is backward:
+    (`max_acceleration_reverse`, else -max; `max_deceleration_reverse`, else +max), ±inf where
+    `max_acceleration` does not limit."""
+    bounds: list[float] = []
+    for axis in ("linear.x", "angular.z"):
+        top = _limit(params, axis, "acceleration", path, controller, False, math.inf)
+        if not math.isfinite(top):
+            bounds += [-math.inf, math.inf]
+            continue
+        speeding = _given(params, axis, "max_acceleration_reverse", path, controller)
+        slowing = _given(params, axis, "max_deceleration_reverse", path, controller)
+        bounds += [
+            -top if speeding is None else -abs(speeding),
+            top if slowing is None else abs(slowing),
+        ]
+    return bounds[0], bounds[1], bounds[2], bounds[3]
+
+
+def _given(params: dict, axis: str, name: str, path: str, controller: str) -> float | None:
+    """`<axis>.<name>` when it is a finite number, else None (unset, or NaN: Jazzy's unset)."""
+    value = _number(params, f"{axis}.{name}", path, controller)
+    return value if value is not None and math.isfinite(value) else None
 
 
 def _limit(

@@ -72,7 +72,11 @@ class DiffDrive(_Record):
         twist_acceleration: the bounds (min, max) on the commanded forward speed's change
         [m/s²] and then on the yaw rate's [rad/s²], ±inf where none, for a plugin that limits
         the body twist before it turns it into wheel speeds (gz-sim's SpeedLimiter); None: the
-        wheels' rims ramp at max_wheel_acceleration instead (gazebo_ros' diff drive);
+        wheels' rims ramp at max_wheel_acceleration instead (gazebo_ros' diff drive); these
+        bounds hold while the last command is forward (> 0);
+        reverse_acceleration: the same bounds while the last command is backward (< 0), from 0
+        its min with twist_acceleration's max (ros2_controllers' rate limiter since Jazzy);
+        None: twist_acceleration whatever the direction;
         command_timeout [s]: how long a ROS cmd_vel holds (diff_drive_controller's
         cmd_vel_timeout; 0: until the next); odom_topic: the odometry's ROS topic as the plugin
         names it (relative: under the entity's name); notes: what was approximated or ignored,
@@ -96,6 +100,7 @@ class DiffDrive(_Record):
     max_angular_velocity: float = math.inf
     min_velocities: tuple[float, float] | None = None
     twist_acceleration: tuple[float, float, float, float] | None = None
+    reverse_acceleration: tuple[float, float, float, float] | None = None
     command_timeout: float = 0.0
     odom_topic: str = "odom"
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)

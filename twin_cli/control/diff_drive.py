@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from twin_cli.control.drive_base import DriveController
-from twin_cli.control.kinematics import body_twist, limit_change, ramp, rim_speeds
+from twin_cli.control.kinematics import body_twist, limit_change, ramp, rim_speeds, signed_bounds
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import DiffDrive
@@ -75,11 +75,12 @@ class DiffDriveController(DriveController):
                 ramp(self.rims[0], goals[0], accel, dt),
                 ramp(self.rims[1], goals[1], accel, dt),
             )
-        else:  # the twist's speed limiter (gz-sim): v and ω each bounded on their own
+        else:  # the twist's speed limiters: v and ω each bounded on their own
             goal, last = self.goal_twist(), self.limited
+            back = self.plugin.reverse_acceleration
             self.limited = (
-                limit_change(last[0], goal[0], bounds[0], bounds[1], dt),
-                limit_change(last[1], goal[1], bounds[2], bounds[3], dt),
+                limit_change(last[0], goal[0], *signed_bounds(last[0], bounds[:2], back, 0), dt),
+                limit_change(last[1], goal[1], *signed_bounds(last[1], bounds[2:], back, 2), dt),
             )
             rims = rim_speeds(*self.limited, self.plugin.wheel_separation)
         if rims != self.rims or force:  # a held command costs nothing

@@ -47,6 +47,23 @@ def limit_change(current: float, target: float, lowest: float, highest: float, d
     return current + min(max(change, lowest * dt), highest * dt)
 
 
+def signed_bounds(
+    last: float,
+    forward: tuple[float, float],
+    reverse: tuple[float, float, float, float] | None,
+    at: int,
+) -> tuple[float, float]:
+    """The (min, max) rate [per s] bounding a command's change after `last`: `forward` while it
+    is forward (> 0); `reverse[at:at + 2]` while backward (< 0), and from 0 that min with the
+    forward max, as ros2_controllers' rate limiter picks them; `forward` always when `reverse`
+    is None."""
+    if reverse is None or last > 0.0:
+        return forward[0], forward[1]
+    if last < 0.0:
+        return reverse[at], reverse[at + 1]
+    return reverse[at], forward[1]
+
+
 def body_twist(left: float, right: float, radius: float, separation: float) -> tuple[float, float]:
     """Forward speed [m/s] and yaw rate [rad/s] from wheel joint speeds [rad/s]."""
     v_left, v_right = left * radius, right * radius

@@ -302,23 +302,41 @@ ANGULAR_LIMITS = (
 )
 
 
+JAZZY, HUMBLE = "gz_ros2_control-system", "libgazebo_ros2_control.so"
+
+
 @pytest.mark.parametrize(
-    ("extra", "linear", "angular", "at_end", "after_stop"),
+    ("plugin", "extra", "linear", "angular", "at_end", "after_stop"),
     [
         # ω rises at 0.5 rad/s² for 2 s: 3 rad at the end of 4 s at 1 rad/s, and falls at -max
-        (ANGULAR_LIMITS, 0.0, 1.0, 3.0, 4.0),
-        # v rises at 1.5 m/s² and falls at the given 0.5 m/s²: 1.17 m, then 0.09 m more
-        ("    linear.x.min_acceleration: -0.5\n", 0.3, 0.0, 0.3 * (4.0 - 0.1), 0.3 * 3.9 + 0.09),
+        (JAZZY, ANGULAR_LIMITS, 0.0, 1.0, 3.0, 4.0),
+        # v rises at 1.5 m/s² and brakes at the given 0.5 m/s²: 1.17 m, then 0.09 m more
+        (JAZZY, "    linear.x.max_deceleration: -0.5\n", 0.3, 0.0, 1.17, 1.17 + 0.09),
+        (HUMBLE, "    linear.x.min_acceleration: -0.5\n", 0.3, 0.0, 1.17, 1.17 + 0.09),
+        # Jazzy passes min_acceleration to no limiter: it brakes at -max, 0.03 m more
+        (JAZZY, "    linear.x.min_acceleration: -0.5\n", 0.3, 0.0, 1.17, 1.17 + 0.03),
+        # backward, v speeds up at the given 0.25 m/s² (1.2 s) and brakes at +max
+        (JAZZY, "    linear.x.max_acceleration_reverse: -0.25\n", -0.3, 0.0, -1.02, -1.05),
         # reversing is clamped at the given linear.x.min_velocity, not at -max_velocity
-        ("    linear.x.min_velocity: -0.1\n", -0.3, 0.0, -0.1 * (4.0 - 0.1 / 3.0), -0.4),
+        (JAZZY, "    linear.x.min_velocity: -0.1\n", -0.3, 0.0, -0.1 * (4.0 - 0.1 / 3.0), -0.4),
     ],
+    ids=["angular", "jazzy_brake", "humble_brake", "jazzy_min_accel", "jazzy_reverse", "min_vel"],
 )
 def test_the_controllers_speed_limiters_bound_v_and_w_each(
-    tmp_path: Path, extra: str, linear: float, angular: float, at_end: float, after_stop: float
+    tmp_path: Path,
+    plugin: str,
+    extra: str,
+    linear: float,
+    angular: float,
+    at_end: float,
+    after_stop: float,
 ) -> None:
-    """diff_drive_controller's speed limiters bound the change of linear.x and of angular.z,
-    each between min_acceleration (signed; unset: -max_acceleration) and max_acceleration, and
-    the speeds between min_velocity (unset: -max_velocity) and max_velocity.
+    """diff_drive_controller's speed limiters bound the change of linear.x and of angular.z and
+    the speeds between min_velocity (unset: -max_velocity) and max_velocity. The change is
+    bounded by max_acceleration and a braking bound: Humble's min_acceleration (signed; unset:
+    -max); Jazzy's rate limiter picks its pair by the last command's sign: forward
+    (max_deceleration, else max_acceleration_reverse, else -max; max_acceleration), backward
+    (max_acceleration_reverse, else -max; max_deceleration_reverse, else +max).
     Oracle: those ramps in closed form, the heading [rad] (in place) or the distance [m] at the
     end of a 4 s command and 2.5 s later; bound: 2 % as the drive families' path bound."""
     from twin_cli.control import drive
@@ -326,7 +344,7 @@ def test_the_controllers_speed_limiters_bound_v_and_w_each(
     yaml = YAML.replace("max_velocity: 0.4", "max_velocity: 1.0").replace(
         "    angular.z.max_velocity: 2.0\n", f"    angular.z.max_velocity: 2.0\n{extra}"
     )
-    robot = dm.settled_base(tmp_path, _base(tmp_path, yaml).read_text())
+    robot = dm.settled_base(tmp_path, _base(tmp_path, yaml, plugin).read_text())
     start = robot.get_pose("base")
 
     def progress() -> float:
