@@ -201,8 +201,6 @@ class TricycleDrive(_Record):
     robot_base_frame: str = "base_link"
     family: str = "gazebo_ros_tricycle_drive"
     angular_is_steering: bool = True
-    twist_bounds: tuple[float, float, float, float] | None = None
-    steering_gain: float | None = None
     cmd_vel_topic: str = ""  # the ROS topic its plugin takes cmd_vel on ("": none named)
     notes: tuple[str, ...] = ()
 
