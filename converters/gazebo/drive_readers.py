@@ -202,8 +202,6 @@ def read_gz_ackermann(p: Params, blob: Blob, ctx: ReadContext) -> AckermannDrive
         kingpin_width=p.number(0.8, "kingpin_width"),
         wheel_radius=p.number(0.2, "wheel_radius"),
         steering_limit=p.number(0.5, "steering_limit"),
-        max_velocity=p.number(math.inf, "max_velocity"),
-        max_acceleration=p.number(0.0, "max_acceleration"),
         twist_bounds=(  # one pair of SpeedLimiters, the same bounds on v and on ω
             p.number(-math.inf, "min_velocity", signed=True),
             p.number(math.inf, "max_velocity", signed=True),

@@ -127,9 +127,10 @@ class AckermannDrive(_Record):
         yaw rate (gz-sim). twist_bounds: gz-sim's speed limiters, the same for the forward
         speed and the yaw rate: (min, max) of the command [m/s or rad/s] and (min, max) of its
         change [m/s² or rad/s²], signed, ±inf where no tag sets one (None: `max_velocity` and
-        `max_acceleration` bound the speed alone, as gazebo_ros). steering_gain: gz-sim's
-        `steer_p_gain` [1/s]: each update the steering joints are commanded the speed
-        gain·(angle − joint angle) (None: position targets, as gazebo_ros' PID holds them).
+        `max_acceleration` bound the speed alone, as gazebo_ros; with twist_bounds those two
+        fields are unused). steering_gain: gz-sim's `steer_p_gain` [1/s]: each update the
+        steering joints are commanded the speed gain·(angle − joint angle) (None: position
+        targets, as gazebo_ros' PID holds them).
     """
 
     name: str
