@@ -23,7 +23,9 @@ import pytest
 from corpus_registry import REPO_ROOT
 from mesh_models import MESH_LINKS, geom_extents, write_mesh_package
 
-# One worker builds and installs once for the whole module.
+# One worker runs the module and builds and installs once per run: the fixture is session-scoped
+# because a module-scoped one is torn down whenever the worker runs another module's test in
+# between (it was built twice a run, 145 s each on two busy cores).
 pytestmark = pytest.mark.xdist_group("installed_product")
 
 PACKAGES = ("twin_cli", "converters", "scenarios")
@@ -120,7 +122,7 @@ def _build_wheel(destination: Path) -> Path:
     return wheel
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def product(tmp_path_factory: pytest.TempPathFactory) -> Product:
     base = tmp_path_factory.mktemp("installed")
     wheel = _build_wheel(base)
