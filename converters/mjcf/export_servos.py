@@ -39,6 +39,7 @@ import numpy as np
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
 from converters.mjcf.servo_gains import largest_inertia, position_gains, reflected_inertia
+from converters.mjcf.velocity_motors import Motor, add_velocity_motors
 from converters.mjcf.world_options import TIMESTEP_S
 
 INTEGRAL_MARGIN = 8.0
@@ -52,16 +53,21 @@ if TYPE_CHECKING:
     import mujoco
 
 EXPORTED = "exported_motor"  # record key: the torque motor a servo replaced in the file
+VELOCITY_MOTOR = "velocity_motor"  # record key: the joint's velocity motor (`velocity_motors`)
+MOTOR_JOINTS = ("hinge", "slide")  # joint kinds a velocity motor's rotor can copy
 UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag commands
 SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
 
 
 def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str, str]:
-    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc).
+    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc), and
+    gives each joint whose tags offer velocity commands Gazebo's velocity motor
+    (`converters.mjcf.velocity_motors`): a joint whose first mode is velocity keeps its torque
+    motor for effort commands and runs its velocity commands on the motor.
 
     Returns:
-        Each joint given a servo, with its mode ("position" or "velocity").
+        Each joint given a servo or a velocity motor, with its first mode.
     """
     text = spec.text(CONTROL_TEXT)
     if text is None:
@@ -70,19 +76,21 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     chosen = [
         (i, a, records[a.target]) for i, a in enumerate(spec.actuators) if _servoed(a, records)
     ]
-    if not chosen:
+    driven = [a for a in spec.actuators if _offers_velocity(spec, a, records)]
+    if not chosen and not driven:
         return {}
     servoed: dict[str, str] = {}
     held: dict[str, float] = {}  # each position servo's effort limit
-    inertia, home = _home_inertia(spec)
+    inertia, home, model = _home_inertia(spec)
     key = _home_key(spec)
     ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
     if key is not None and len(ctrl) != len(spec.actuators):
         ctrl = np.zeros(len(spec.actuators))
+    motors = _motors(driven, records, inertia)
     for i, actuator, record in chosen:
         joint = actuator.target
-        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0:
-            continue  # nothing to tune a servo on: the torque motor stays
+        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or joint in motors:
+            continue  # nothing to tune a servo on, or a velocity motor: the torque motor stays
         record[EXPORTED] = {
             "ctrlrange": [float(v) for v in actuator.ctrlrange],
             "ctrllimited": int(actuator.ctrllimited),
@@ -101,8 +109,50 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         key.ctrl = ctrl
     for joint, changed in compensate(spec, held).items():
         records[joint][EXPORTED][GRAVCOMP] = changed
+    for joint, motor in motors.items():
+        records[joint][VELOCITY_MOTOR] = {"effort": motor.effort, "engaged": motor.engaged}
+        servoed.setdefault(joint, records[joint]["modes"][0])
+    add_velocity_motors(spec, list(motors.values()), model, timestep)
     text.data = json.dumps(records)
     return servoed
+
+
+def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
+    """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
+    offer velocity commands, with a finite effort limit (the motor's bound)."""
+    import mujoco
+
+    record = records.get(actuator.target)
+    joint = spec.joint(actuator.target) if record is not None else None
+    return (
+        joint is not None
+        and joint.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+        and actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT
+        and float(actuator.gear[0]) == 1.0
+        and actuator.dyntype == mujoco.mjtDyn.mjDYN_NONE
+        and actuator.biastype == mujoco.mjtBias.mjBIAS_NONE
+        and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
+        and record.get("source") not in UNTAGGED_SOURCES
+        and "velocity" in record.get("modes", ())
+        and VELOCITY_MOTOR not in record
+    )
+
+
+def _motors(
+    driven: list[mujoco.MjsActuator], records: dict, inertia: dict[str, tuple[float, float]]
+) -> dict[str, Motor]:
+    """The velocity motor of each of `driven`'s joints that has an inertia to scale its rotor."""
+    motors = {}
+    for actuator in driven:
+        joint, record = actuator.target, records[actuator.target]
+        own = inertia.get(joint, (0.0, 0.0))[0]
+        effort = float(np.max(np.abs(actuator.ctrlrange)))
+        if own > 0.0 and np.isfinite(effort) and effort > 0.0:
+            speed = record.get("velocity_limit")
+            speed = float(speed) if speed is not None and speed > 0 else float("inf")
+            engaged = record["modes"][0] == "velocity"
+            motors[joint] = Motor(joint, effort, own, speed, engaged)
+    return motors
 
 
 def _servoed(actuator: mujoco.MjsActuator, records: dict) -> bool:
@@ -212,10 +262,10 @@ def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[f
 
 def _home_inertia(
     spec: mujoco.MjSpec,
-) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
+) -> tuple[dict[str, tuple[float, float]], dict[str, float], mujoco.MjModel]:
     """Each joint's reflected inertia (`servo_gains.reflected_inertia`: the other joints held,
     a floating base free) at the home posture and the largest over its range
-    (`servo_gains.largest_inertia`) [kg m² or kg], and its home position."""
+    (`servo_gains.largest_inertia`) [kg m² or kg], its home position, and the compiled model."""
     import mujoco
 
     model = spec.copy().compile()
@@ -234,7 +284,7 @@ def _home_inertia(
         at_home = float(reflected[dof])
         inertia[model.joint(j).name] = (at_home, max(at_home, float(largest[dof])))
         home[model.joint(j).name] = float(data.qpos[adr])
-    return inertia, home
+    return inertia, home, model
 
 
 def _home_key(spec: mujoco.MjSpec) -> mujoco.MjsKey | None:

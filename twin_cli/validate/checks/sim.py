@@ -16,6 +16,7 @@ from twin_cli.spawn_request import SpawnRequest
 from twin_cli.validate.checks.base import CannotApply, RobotUnderTest
 from twin_cli.validate.checks.model_joints import HINGE, SLIDE, joint_effort
 from twin_cli.validate.scenario import Action, Obstacle, Scenario
+from twin_cli.world.rotors import is_rotor
 
 PLANE = 0  # mjtGeom mjGEOM_PLANE
 NO_BODY = "the robot has no body that can move (an MJCF with only world geoms): nothing to simulate"
@@ -120,7 +121,9 @@ class ScenarioRun:
                 self._velocity_limits.get(model.joint(j).name.removeprefix(prefix)),
             )
             for j in range(model.njnt)
-            if int(model.jnt_bodyid[j]) in self.bodies and int(model.jnt_type[j]) in (HINGE, SLIDE)
+            if int(model.jnt_bodyid[j]) in self.bodies
+            and int(model.jnt_type[j]) in (HINGE, SLIDE)
+            and not is_rotor(model.joint(j).name)
         ]
         self.mass = float(sum(model.body_mass[b] for b in self.bodies))
         self.floating = any(
