@@ -89,7 +89,9 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     motors = _motors(driven, records, inertia)
     for i, actuator, record in chosen:
         joint = actuator.target
-        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or joint in motors:
+        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or (
+            joint in motors and motors[joint].engaged
+        ):
             continue  # nothing to tune a servo on, or a velocity motor: the torque motor stays
         record[EXPORTED] = {
             "ctrlrange": [float(v) for v in actuator.ctrlrange],

@@ -18,13 +18,13 @@ import mujoco
 import numpy as np
 
 from converters.mjcf.export_servos import VELOCITY_MOTOR
-from converters.mjcf.velocity_motors import SUFFIX, is_rotor, rotor_name
+from converters.mjcf.velocity_motors import is_rotor, rotor_name
 
 RULE = "Gazebo's joint motor: a velocity constraint within ±effort"  # what `twin joints` shows
 _ACTUATOR = mujoco.mjtObj.mjOBJ_ACTUATOR
 _TENDON = mujoco.mjtObj.mjOBJ_TENDON
 
-__all__ = ["RULE", "SUFFIX", "Rotor", "is_rotor", "rotor_name"]
+__all__ = ["RULE", "Rotor", "is_rotor", "rotor_name"]  # is_rotor: for the record and validate
 
 
 @dataclass(frozen=True)
