@@ -97,6 +97,7 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     body.explicitinertial = True
     body.mass = ROTOR_MASS
     body.inertia = [ROTOR_MASS] * 3
+    body.ipos = [0.0, 0.0, 0.0]  # an inertial with a position is written to the file
     armature = ARMATURE_RATIO * motor.inertia
     body.add_joint(name=name, type=joint.type, axis=axis, armature=armature)
     actuator = spec.add_actuator(name=name, target=name)
