@@ -80,6 +80,21 @@ def test_an_overloaded_wheel_saturates_at_its_effort_and_comes_back_without_payi
     assert behind == pytest.approx(slip, rel=0.01), f"{behind:.4f} rad behind, slip {slip:.4f}"
 
 
+@pytest.mark.parametrize("fraction", [0.5, 1.5])
+def test_a_driven_wheels_effort_is_what_its_motor_puts_on_it(wheel: World, fraction) -> None:
+    """The joint's effort is its velocity motor's force on it (the tendon's constraint force,
+    as ODE reports its motor's): against a load within the effort, the load itself (the wheel
+    keeps its speed); past it, exactly the effort limit (Newton on the disc and the bound)."""
+    _load(wheel, -fraction * EFFORT)
+    wheel.step(300)
+    efforts = []
+    for _ in range(20):
+        wheel.step(10)
+        efforts.append(wheel.joint_states("w")[0].effort)
+    expected = min(fraction, 1.0) * EFFORT
+    assert efforts == pytest.approx([expected] * 20, rel=1e-6), f"efforts {efforts[:3]} N m"
+
+
 def test_an_overloaded_wheel_recovers_without_a_burst(wheel: World) -> None:
     """Gazebo's joint motor, a velocity constraint bounded by FMax, comes back from a stall at
     its command: the speed after the release never passes it by more than 5 %."""
