@@ -105,9 +105,8 @@ HEADING_SAME = 0.01  # fraction: the rate at two headings with fdir1 along the a
             0.5,
             marks=pytest.mark.xfail(
                 strict=True,
-                reason="on velocity motors the isotropic base turns at 0.4171 rad/s, as fast as "
-                "fdir1 with μ 0.5 across (0.4169): its wheels hold their speeds while the tyres "
-                "slip at twin's μ cap (contact.CONTACT_MU_MAX)",
+                reason="on velocity motors the isotropic base turns at 0.4171 rad/s and fdir1 "
+                "with μ 0.5 across at 0.4169, not 5 % faster (integral servos: faster)",
             ),
         ),
         0.3,
