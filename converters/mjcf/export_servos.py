@@ -12,21 +12,23 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
     force stays within ±effort (`forcerange`), as Menagerie's models do;
   - a position servo is stiff and damped so that a move at the effort limit stops on target
     (`servo_gains`);
-  - a velocity servo is MuJoCo's `intvelocity`: its activation integrates the commanded speed
-    into a position the servo tracks, so a loaded joint keeps its speed and `ctrl` 0 holds it
-    where it is, as Gazebo's joint motor (a velocity constraint bounded by the effort) does. A
-    damper alone let a parked turtlebot3 roll 227 mm down 5° in 10 s; this holds it within
-    0.03 mm. kv = I/h on the joint's reflected inertia I at the home posture, the integral
-    kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it gives them). The
-    price of the integral without a World's feed-forward: a speed step overshoots (19 % on
-    turtlebot3's wheels, whose robot they carry) before it settles on the command;
+  - a velocity servo (a joint whose first mode is velocity and that has no effort limit) is
+    MuJoCo's `intvelocity`: its activation integrates the commanded speed
+    into a position the servo tracks. kv = I/h on the joint's reflected inertia I at the home
+    posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it
+    gives them);
+  - every joint whose tags offer velocity with a finite effort gets Gazebo's velocity motor
+    instead (`velocity_motors`: a rotor and a friction tendon bounded by the effort, which
+    stores nothing, where the integral paid a stall back as a burst); its torque motor stays
+    for effort commands, and a position-first joint keeps its position servo beside it;
   - on a fixed base, the position servos carry the weight of the bodies they hold through
     MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
   - the `home` keyframe's ctrl holds the home posture.
 Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
 torque motor. The control record keeps the motor each servo replaced (`EXPORTED`) and the
-compensation it added. A World gives a description the same servos when it spawns it and runs
-them by ctrl (`twin_cli.world.native_servos`), so the file and the world are one model.
+compensation it added, and a joint's velocity motor its effort (`VELOCITY_MOTOR`). A World gives
+a description the same servos when it spawns it and runs them by ctrl
+(`twin_cli.world.native_servos`), so the file and the world are one model.
 """
 
 from __future__ import annotations
