@@ -16,7 +16,6 @@ from twin_cli.spawn_request import SpawnRequest
 from twin_cli.validate.checks.base import CannotApply, RobotUnderTest
 from twin_cli.validate.checks.model_joints import HINGE, SLIDE, joint_effort
 from twin_cli.validate.scenario import Action, Obstacle, Scenario
-from twin_cli.world.rotors import is_rotor
 
 PLANE = 0  # mjtGeom mjGEOM_PLANE
 NO_BODY = "the robot has no body that can move (an MJCF with only world geoms): nothing to simulate"
@@ -105,6 +104,8 @@ class ScenarioRun:
             video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
+        from twin_cli.world.rotors import is_rotor  # mujoco: scenario parsing stays light
+
         model = self.world.model
         prefix = f"{self.entity}/"
         self.bodies = [b for b in range(model.nbody) if model.body(b).name.startswith(prefix)]
