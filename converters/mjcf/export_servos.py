@@ -12,21 +12,23 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
     force stays within ±effort (`forcerange`), as Menagerie's models do;
   - a position servo is stiff and damped so that a move at the effort limit stops on target
     (`servo_gains`);
-  - a velocity servo is MuJoCo's `intvelocity`: its activation integrates the commanded speed
-    into a position the servo tracks, so a loaded joint keeps its speed and `ctrl` 0 holds it
-    where it is, as Gazebo's joint motor (a velocity constraint bounded by the effort) does. A
-    damper alone let a parked turtlebot3 roll 227 mm down 5° in 10 s; this holds it within
-    0.03 mm. kv = I/h on the joint's reflected inertia I at the home posture, the integral
-    kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it gives them). The
-    price of the integral without a World's feed-forward: a speed step overshoots (19 % on
-    turtlebot3's wheels, whose robot they carry) before it settles on the command;
+  - a velocity servo (a joint whose first mode is velocity and that has no effort limit) is
+    MuJoCo's `intvelocity`: its activation integrates the commanded speed
+    into a position the servo tracks. kv = I/h on the joint's reflected inertia I at the home
+    posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it
+    gives them);
+  - every joint whose tags offer velocity with a finite effort gets Gazebo's velocity motor
+    instead (`velocity_motors`: a rotor and a friction tendon bounded by the effort, which
+    stores nothing, where the integral paid a stall back as a burst); its torque motor stays
+    for effort commands, and a position-first joint keeps its position servo beside it;
   - on a fixed base, the position servos carry the weight of the bodies they hold through
     MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
   - the `home` keyframe's ctrl holds the home posture.
 Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
 torque motor. The control record keeps the motor each servo replaced (`EXPORTED`) and the
-compensation it added. A World gives a description the same servos when it spawns it and runs
-them by ctrl (`twin_cli.world.native_servos`), so the file and the world are one model.
+compensation it added, and a joint's velocity motor its effort (`VELOCITY_MOTOR`). A World gives
+a description the same servos when it spawns it and runs them by ctrl
+(`twin_cli.world.native_servos`), so the file and the world are one model.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ import numpy as np
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
 from converters.mjcf.servo_gains import largest_inertia, position_gains, reflected_inertia
+from converters.mjcf.velocity_motors import Motor, add_velocity_motors
 from converters.mjcf.world_options import TIMESTEP_S
 
 INTEGRAL_MARGIN = 8.0
@@ -52,16 +55,21 @@ if TYPE_CHECKING:
     import mujoco
 
 EXPORTED = "exported_motor"  # record key: the torque motor a servo replaced in the file
+VELOCITY_MOTOR = "velocity_motor"  # record key: the joint's velocity motor (`velocity_motors`)
+MOTOR_JOINTS = ("hinge", "slide")  # joint kinds a velocity motor's rotor can copy
 UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag commands
 SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
 
 
 def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str, str]:
-    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc).
+    """Rewrites `spec`'s tagged position and velocity joint motors as servos (module doc), and
+    gives each joint whose tags offer velocity commands Gazebo's velocity motor
+    (`converters.mjcf.velocity_motors`): a joint whose first mode is velocity keeps its torque
+    motor for effort commands and runs its velocity commands on the motor.
 
     Returns:
-        Each joint given a servo, with its mode ("position" or "velocity").
+        Each joint given a servo or a velocity motor, with its first mode.
     """
     text = spec.text(CONTROL_TEXT)
     if text is None:
@@ -70,19 +78,23 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     chosen = [
         (i, a, records[a.target]) for i, a in enumerate(spec.actuators) if _servoed(a, records)
     ]
-    if not chosen:
+    driven = [a for a in spec.actuators if _offers_velocity(spec, a, records)]
+    if not chosen and not driven:
         return {}
     servoed: dict[str, str] = {}
     held: dict[str, float] = {}  # each position servo's effort limit
-    inertia, home = _home_inertia(spec)
+    inertia, home, model = _home_inertia(spec)
     key = _home_key(spec)
     ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
     if key is not None and len(ctrl) != len(spec.actuators):
         ctrl = np.zeros(len(spec.actuators))
+    motors = _motors(driven, records, inertia)
     for i, actuator, record in chosen:
         joint = actuator.target
-        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0:
-            continue  # nothing to tune a servo on: the torque motor stays
+        if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or (
+            joint in motors and motors[joint].engaged
+        ):
+            continue  # nothing to tune a servo on, or a velocity motor: the torque motor stays
         record[EXPORTED] = {
             "ctrlrange": [float(v) for v in actuator.ctrlrange],
             "ctrllimited": int(actuator.ctrllimited),
@@ -101,8 +113,50 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         key.ctrl = ctrl
     for joint, changed in compensate(spec, held).items():
         records[joint][EXPORTED][GRAVCOMP] = changed
+    for joint, motor in motors.items():
+        records[joint][VELOCITY_MOTOR] = {"effort": motor.effort, "engaged": motor.engaged}
+        servoed.setdefault(joint, records[joint]["modes"][0])
+    add_velocity_motors(spec, list(motors.values()), model, timestep)
     text.data = json.dumps(records)
     return servoed
+
+
+def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
+    """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
+    offer velocity commands, with a finite effort limit (the motor's bound)."""
+    import mujoco
+
+    record = records.get(actuator.target)
+    joint = spec.joint(actuator.target) if record is not None else None
+    return (
+        joint is not None
+        and joint.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+        and actuator.trntype == mujoco.mjtTrn.mjTRN_JOINT
+        and float(actuator.gear[0]) == 1.0
+        and actuator.dyntype == mujoco.mjtDyn.mjDYN_NONE
+        and actuator.biastype == mujoco.mjtBias.mjBIAS_NONE
+        and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
+        and record.get("source") not in UNTAGGED_SOURCES
+        and "velocity" in record.get("modes", ())
+        and VELOCITY_MOTOR not in record
+    )
+
+
+def _motors(
+    driven: list[mujoco.MjsActuator], records: dict, inertia: dict[str, tuple[float, float]]
+) -> dict[str, Motor]:
+    """The velocity motor of each of `driven`'s joints that has an inertia to scale its rotor."""
+    motors = {}
+    for actuator in driven:
+        joint, record = actuator.target, records[actuator.target]
+        own = inertia.get(joint, (0.0, 0.0))[0]
+        effort = float(np.max(np.abs(actuator.ctrlrange)))
+        if own > 0.0 and np.isfinite(effort) and effort > 0.0:
+            speed = record.get("velocity_limit")
+            speed = float(speed) if speed is not None and speed > 0 else float("inf")
+            engaged = record["modes"][0] == "velocity"
+            motors[joint] = Motor(joint, effort, own, speed, engaged)
+    return motors
 
 
 def _servoed(actuator: mujoco.MjsActuator, records: dict) -> bool:
@@ -212,10 +266,10 @@ def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[f
 
 def _home_inertia(
     spec: mujoco.MjSpec,
-) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
+) -> tuple[dict[str, tuple[float, float]], dict[str, float], mujoco.MjModel]:
     """Each joint's reflected inertia (`servo_gains.reflected_inertia`: the other joints held,
     a floating base free) at the home posture and the largest over its range
-    (`servo_gains.largest_inertia`) [kg m² or kg], and its home position."""
+    (`servo_gains.largest_inertia`) [kg m² or kg], its home position, and the compiled model."""
     import mujoco
 
     model = spec.copy().compile()
@@ -234,7 +288,7 @@ def _home_inertia(
         at_home = float(reflected[dof])
         inertia[model.joint(j).name] = (at_home, max(at_home, float(largest[dof])))
         home[model.joint(j).name] = float(data.qpos[adr])
-    return inertia, home
+    return inertia, home, model
 
 
 def _home_key(spec: mujoco.MjSpec) -> mujoco.MjsKey | None:

@@ -13,6 +13,7 @@ import pytest
 from corpus_registry import corpus_ids, corpus_ids_expecting
 
 from converters.mjcf.servo_gains import BRAKE_RAD, DAMPING_RATIO, OMEGA_STEP
+from converters.mjcf.velocity_motors import rotor_name
 from converters.mjcf.writer import write_model
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
@@ -69,12 +70,27 @@ def test_tagged_joints_are_servos_bounded_by_their_effort(
     done = converted_corpus(robot_id)
     source = done.spec.compile()
     model = mujoco.MjModel.from_xml_path(str(_scene(tmp_path, converted_corpus, robot_id)))
-    for a in range(model.nu):
-        name = model.actuator(a).name
+    for a in range(source.nu):
+        name = source.actuator(a).name
         effort = source.actuator(name).ctrlrange
+        if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TENDON, rotor_name(name)) >= 0:
+            _assert_velocity_motor(model, name, effort)
+            continue
+        a = model.actuator(name).id
         assert model.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE, f"{name}: a servo"
         assert model.actuator_biasprm[a, 2] < 0, f"{name}: damped"
         assert list(model.actuator_forcerange[a]) == list(effort), f"{name}: ±effort"
+
+
+def _assert_velocity_motor(model: mujoco.MjModel, name: str, effort: np.ndarray) -> None:
+    """A joint whose tags offer velocity: its torque motor within ±effort, a damped velocity
+    actuator on its rotor, and the tendon's friction bound = the effort."""
+    a, rotor = model.actuator(name).id, model.actuator(rotor_name(name)).id
+    assert model.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_NONE, f"{name}: a torque motor"
+    assert list(model.actuator_ctrlrange[a]) == list(effort), f"{name}: ±effort"
+    assert model.actuator_biasprm[rotor, 2] < 0, f"{name}: the rotor's actuator damped"
+    bound = model.tendon_frictionloss[model.tendon(rotor_name(name)).id]
+    assert bound == max(abs(effort)), f"{name}: the tendon's bound {bound} is the effort"
 
 
 def test_exported_arm_holds_its_home_posture_from_the_keyframe(
@@ -243,8 +259,9 @@ def test_an_exported_velocity_servo_driven_into_its_limit_leaves_it_at_once(
 ) -> None:
     """A velocity-commanded hinge (±3 rad, 2 N m) driven at 1 rad/s into its limit for 3 s, then
     back at -1 rad/s: it leaves the limit within 0.2 s, as Gazebo's joint motor (which stores
-    nothing) does, because its `intvelocity` reference stops at the joint's range instead of
-    winding on past it (3 s past would hold it at the limit for about 3 s more)."""
+    nothing) does. Its velocity motor's rotor winds on past the range, but the tendon only
+    couples speeds (an integral reference wound on past the range would hold it there for about
+    3 s more)."""
     from converters.pipeline import convert
 
     source = tmp_path / "hinge.urdf"
@@ -258,7 +275,7 @@ def test_an_exported_velocity_servo_driven_into_its_limit_leaves_it_at_once(
     model = mujoco.MjModel.from_xml_path(str(write_model(spec, report, tmp_path / "out")))
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    a, q = model.actuator("d0").id, model.joint("d0").qposadr[0]
+    a, q = model.actuator(rotor_name("d0")).id, model.joint("d0").qposadr[0]
     data.ctrl[a] = 1.0
     mujoco.mj_step(model, data, 6000)  # 3 s to the limit at 3 rad, 3 s against it
     assert data.qpos[q] == pytest.approx(3.0, abs=0.01), "at its limit"

@@ -19,6 +19,7 @@ from corpus_registry import corpus_ids, corpus_ids_expecting
 
 import scenarios
 from converters.gazebo.drive_records import held_from_load
+from converters.mjcf.velocity_motors import is_rotor
 from converters.mjcf.writer import write_model
 from converters.pipeline import convert
 from twin_cli.spawn_request import SpawnRequest
@@ -98,21 +99,40 @@ def _source_home(spec: mujoco.MjSpec) -> np.ndarray:
     return model.key("home").qpos.copy()
 
 
+def _own_qpos(model: mujoco.MjModel) -> np.ndarray:
+    """qpos addresses of the robot's own joints: the file adds a rotor per velocity motor
+    (`converters.mjcf.velocity_motors`), after the robot's joints it sits beside."""
+    widths = (7, 4, 1, 1)
+    return np.array(
+        [
+            int(model.jnt_qposadr[j]) + k
+            for j in range(model.njnt)
+            if not is_rotor(model.joint(j).name)
+            for k in range(widths[int(model.jnt_type[j])])
+        ],
+        dtype=int,
+    )
+
+
 def _assert_placed(scene: Path, spec: mujoco.MjSpec, label: str) -> None:
     """Floating: on the floor, upright, joints and orientation as converted; fixed: the key
     unchanged."""
     model, data = _at_home(scene)
     source = _source_home(spec)
+    own = _own_qpos(model)
     free = _free_adr(model)
     if not free:
-        assert np.array_equal(model.key("home").qpos, source), f"{label}: fixed base moved"
+        key = model.key("home").qpos[own]
+        assert np.array_equal(key, source), f"{label}: fixed base moved"
         return
     gap = _floor_gap(model, data)
     assert abs(gap) <= FLOOR_M, f"{label}: lowest collision point {gap:.4f} m from the floor"
     assert np.array_equal(data.qpos[free[0] + 3 : free[0] + 7], IDENTITY), f"{label}: upright"
     moved = np.zeros(model.nq, dtype=bool)
     moved[[a + 2 for a in free]] = True
-    assert np.array_equal(data.qpos[~moved], source[~moved]), f"{label}: only root z changes"
+    moved = moved[own]
+    qpos = data.qpos[own]
+    assert np.array_equal(qpos[~moved], source[~moved]), f"{label}: only root z changes"
 
 
 def _gate(scene: Path) -> str | None:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from corpus_registry import corpus_ids
 
+from converters.mjcf.velocity_motors import ROTOR_MASS, is_rotor
 from converters.mjcf.writer import stl_bytes, write_model
 
 
@@ -91,15 +92,23 @@ def test_a_users_scene_can_include_the_robot_and_add_a_geom_only_body(tmp_path: 
 
 @pytest.mark.parametrize("robot_id", corpus_ids())
 def test_written_mjcf_reads_back_bit_for_bit(tmp_path: Path, converted_corpus, robot_id) -> None:
-    """Masses, inertias, frames, joint ranges and primitive sizes survive the file exactly."""
+    """Masses, inertias, frames, joint ranges and primitive sizes survive the file exactly. The
+    file adds a velocity motor's rotor body and joint (ROTOR_MASS each) per joint whose tags
+    offer velocity (`converters.mjcf.velocity_motors`); the robot's own are compared by name."""
     done = converted_corpus(robot_id)
     reference = done.spec.compile()
     loaded = mujoco.MjModel.from_xml_path(str(write_model(done.spec, done.report, tmp_path)))
-    fields = ("body_mass", "body_inertia", "body_ipos", "body_pos", "body_quat", "jnt_range")
+    bodies = [loaded.body(reference.body(b).name).id for b in range(reference.nbody)]
+    joints = [loaded.joint(reference.joint(j).name).id for j in range(reference.njnt)]
+    fields = ("body_mass", "body_inertia", "body_ipos", "body_pos", "body_quat")
     for field in fields:
-        expected, actual = getattr(reference, field), getattr(loaded, field)
+        expected, actual = getattr(reference, field), getattr(loaded, field)[bodies]
         assert np.array_equal(actual, expected), f"{robot_id}: {field} differs in the file"
+    assert np.array_equal(loaded.jnt_range[joints], reference.jnt_range), "joint ranges"
     primitive = reference.geom_type != mujoco.mjtGeom.mjGEOM_MESH
     assert np.array_equal(loaded.geom_size[primitive], reference.geom_size[primitive]), "sizes"
-    total = float(loaded.body_mass.sum())
+    total = float(loaded.body_mass[bodies].sum())
     assert total == float(reference.body_mass.sum()), f"{robot_id}: total mass {total} kg"
+    rotors = sorted(set(range(loaded.nbody)) - set(bodies))
+    assert all(is_rotor(loaded.body(b).name) for b in rotors), "only rotors are added"
+    assert np.all(loaded.body_mass[rotors] == ROTOR_MASS), "rotor masses [kg]"

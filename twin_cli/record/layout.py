@@ -20,6 +20,7 @@ from twin_cli.names import namespace
 from twin_cli.record.frames import Pose, Sources, unique_odom_topics
 from twin_cli.record.tf_tree import Edge, EntityTree, entity_tree, model_names, static_pose
 from twin_cli.world.entities import EntityIndex, element_names
+from twin_cli.world.rotors import is_rotor
 
 _FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
 _IDENTITY_QUAT = np.array([1.0, 0.0, 0.0, 0.0])
@@ -146,8 +147,11 @@ def entity_layout(
     tf_topic: str = "",
 ) -> EntityLayout:
     """One entity's layout (see EntityLayout)."""
-    joints = np.array([j for j in ix.joints if model.jnt_type[j] != _FREE], dtype=np.int64)
-    names = element_names(model, model.name_jntadr[joints])
+    moving = [j for j in ix.joints if model.jnt_type[j] != _FREE]
+    names = element_names(model, model.name_jntadr[moving])
+    kept = [k for k, n in enumerate(names) if not is_rotor(n)]  # velocity motors' rotors
+    joints = np.array([moving[k] for k in kept], dtype=np.int64)
+    names = [names[k] for k in kept]
     free = [j for j in ix.joints if model.jnt_type[j] == _FREE]
     return EntityLayout(
         name=name,

@@ -8,11 +8,13 @@ state vectors into this ring (no Python object per sample) and an encoder proces
 process inherits (no named segment to leak).
 
 A record is MuJoCo's state `[time, qpos, qvel, mocap_pos, mocap_quat]` (`mj_getState`, one C
-call) followed by `qfrc_actuator`: two copies, because after `mj_step` every Python operation
-meets caches that the step has emptied (~2-4 µs each). Records carry no header: all records of
-one compiled model have its `record_length`, and the writer tells the reader (over the pipe,
-before the first such record) the position from which they start (`start_layout`). A record that
-does not fit before the end of the ring starts at 0; both sides know the length, so both skip.
+call) followed by the joint efforts (`qfrc_actuator`, plus the tendon's force on a joint a
+velocity motor drives, `twin_cli.world.rotors`): two copies, because after `mj_step` every
+Python operation meets caches that the step has emptied (~2-4 µs each). Records carry no header:
+all records of one compiled model have its `record_length`, and the writer tells the reader
+(over the pipe, before the first such record) the position from which they start
+(`start_layout`). A record that does not fit before the end of the ring starts at 0; both sides
+know the length, so both skip.
 Positions are absolute counts of doubles (never wrapped), so `write - read` is what is in use.
 The writer never overwrites unread data: when the ring is full it waits, and the recording
 reports that time (`RecordingStatus.blocked_s`). x86-64 keeps stores in order, so the reader
@@ -30,6 +32,8 @@ from collections.abc import Callable
 
 import mujoco
 import numpy as np
+
+from twin_cli.world.rotors import effort_dofs
 
 HEADER = 8  # int64 slots: write, read, samples, done, ...
 WRITE, READ, SAMPLES, DONE = 0, 1, 2, 3
@@ -88,6 +92,8 @@ class RingWriter:
         self._model: mujoco.MjModel | None = None
         self._d: mujoco.MjData | None = None  # the MjData whose qfrc_actuator view is cached
         self._forces: np.ndarray | None = None
+        self._motors: tuple[np.ndarray, np.ndarray] = (np.zeros(0, int), np.zeros(0, int))
+        self._constraint: np.ndarray | None = None  # the cached qfrc_constraint view
         self._state = self._length = 0
         self.blocked_s = 0.0  # [s] waited for room (the reader fell behind)
         self.waits = 0
@@ -95,6 +101,7 @@ class RingWriter:
     def start_layout(self, model: mujoco.MjModel) -> int:
         """Records from now on are of `model`; the position they start at, for the reader."""
         self._model, self._d = model, None
+        self._motors = effort_dofs(model)
         self._state = int(mujoco.mj_stateSize(model, STATE))
         self._length = record_length(model)
         return self._write
@@ -104,6 +111,7 @@ class RingWriter:
         False if the reader is gone."""
         if d is not self._d:
             self._d, self._forces = d, d.qfrc_actuator  # each attribute access costs ~0.5 µs
+            self._constraint = d.qfrc_constraint
         length, write = self._length, self._write
         pos = write % self._capacity
         if pos + length > self._capacity or write + length > self._limit:
@@ -113,6 +121,9 @@ class RingWriter:
         middle = pos + self._state
         mujoco.mj_getState(self._model, d, self._data[pos:middle], STATE)
         np.copyto(self._data[middle : pos + length], self._forces)
+        joints, rotors = self._motors
+        if len(joints):
+            self._data[middle + joints] -= self._constraint[rotors]
         self._write = write = self._write + length
         self._header[WRITE] = write
         return True

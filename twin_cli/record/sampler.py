@@ -19,6 +19,7 @@ from twin_cli.errors import EntityNotFoundError
 from twin_cli.record.frames import Sources, prefix_template, sources_of
 from twin_cli.record.layout import Layout, make_layout
 from twin_cli.world.observers import WorldView, world_view
+from twin_cli.world.rotors import joint_efforts
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World
@@ -86,7 +87,7 @@ class Sampler:
             self._layout,
             d.qpos.copy(),
             d.qvel.copy(),
-            d.qfrc_actuator.copy(),
+            joint_efforts(world.model, d),  # a velocity motor's joint: its tendon's force
             d.mocap_pos.copy(),
             d.mocap_quat.copy(),
         )

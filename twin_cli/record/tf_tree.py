@@ -19,6 +19,7 @@ from twin_cli.record.frames import (
 )
 from twin_cli.world.entities import MODEL_SITE, EntityIndex, element_names
 from twin_cli.world.pose import quat_multiply, rotate
+from twin_cli.world.rotors import is_rotor
 
 
 @dataclass(frozen=True)
@@ -173,7 +174,11 @@ def _model_links(
 ) -> tuple[dict[str, Anchor], list[UrdfJoint], list[str]]:
     """An entity without a URDF: its bodies, and its sites (SDF frames) fixed to them."""
     prefix, anchors, joints, roots = f"{name}/", {}, [], []
-    link_of = {int(b): n.removeprefix(prefix) for n, b in names.bodies.items() if b in ix.bodies}
+    link_of = {
+        int(b): n.removeprefix(prefix)
+        for n, b in names.bodies.items()
+        if b in ix.bodies and not is_rotor(n)
+    }
     for body, link in link_of.items():
         anchors[link] = Anchor(body)
         parent = int(model.body_parentid[body])

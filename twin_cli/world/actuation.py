@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
 
-from twin_cli.world import native_servos, servos, sleeping
+from twin_cli.world import native_servos, rotors, servos, sleeping
 
 MODES = ("position", "velocity", "effort")
 ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
@@ -119,6 +119,7 @@ def apply_command(
       any gain.
     """
     sleeping.wake_actuated(model, data, (a,))  # a sleeping robot must feel its new command
+    cmd = _run_rotor(model, data, a, cmd)
     if law is not None and cmd.native:
         native_servos.restore(model, a, law)
         data.ctrl[a] = cmd.target
@@ -159,6 +160,22 @@ def apply_command(
     model.actuator_biasprm[a, 2] = -cmd.kv / gear
     data.ctrl[a] = cmd.target
     _apply_rotor(model, data, a, cmd)
+
+
+def _run_rotor(
+    model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand
+) -> JointCommand:
+    """A joint with a velocity motor (`twin_cli.world.rotors`): a velocity command engages it
+    and leaves the joint's own motor at zero effort (the command returned); any other command
+    disengages it and is returned unchanged."""
+    rotor = rotors.rotor_of(model, a)
+    if rotor is None:
+        return cmd
+    if cmd.mode != "velocity" or not math.isfinite(cmd.effort):
+        rotors.disengage(model, data, rotor)
+        return cmd
+    rotors.engage(model, data, rotor, cmd.target, cmd.effort)
+    return replace(cmd, mode="effort", target=0.0, velocity_limit=math.inf, native=False)
 
 
 def _apply_rotor(model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand) -> None:

@@ -15,7 +15,7 @@ import mujoco
 from converters.mjcf.export_servos import INTEGRAL_MARGIN
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import gravity_comp, joint_control, native_servos, servos, sleeping
+from twin_cli.world import gravity_comp, joint_control, native_servos, rotors, servos, sleeping
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -108,7 +108,9 @@ def command_joints(
             int(state.model.jnt_qposadr[c[2]]): c[4] for c in checked if c[3] == "position"
         }
         loads = None  # tuning loads, looked up only for a command that tunes a servo
-        if not all(_native(state, c) or _continues_speed(state, c) for c in checked):
+        if not all(
+            _native(state, c) or _continues_speed(state, c) or _rotor(state, c) for c in checked
+        ):
             dofs = state.model.jnt_dofadr[[c[2] for c in checked]]
             rolling = dofs if mode == "velocity" else dofs[:0]
             loads = joint_control.posture_loads(state.model, state.data, positions, dofs, rolling)
@@ -149,12 +151,34 @@ def _native(state: WorldState, checked: tuple) -> bool:
     return law is not None and law.mode == checked[3]
 
 
+def _rotor(state: WorldState, checked: tuple) -> bool:
+    """Whether a checked command is a velocity that the joint's velocity motor runs."""
+    _, a, _, mode, _, effort, _ = checked
+    return (
+        mode == "velocity" and math.isfinite(effort) and rotors.rotor_of(state.model, a) is not None
+    )
+
+
+def _set_rotor(state: WorldState, checked: tuple) -> control.JointCommand:
+    """Writes a velocity command into the joint's velocity motor (`twin_cli.world.rotors`):
+    the rotor's speed and the tendon's bound; no gains to tune."""
+    key, a, _, _, value, effort, limits = checked
+    cmd = control.JointCommand(
+        key, "velocity", value, 0.0, 0.0, effort, limits.velocity, 0.0, rotors.RULE
+    )
+    control.apply_command(state.model, state.data, a, cmd, state.native.get(key))
+    state.commands[key] = cmd
+    return cmd
+
+
 def _set_command(state: WorldState, checked: tuple, loads: tuple | None) -> control.JointCommand:
     """Writes one checked command (`loads`: `joint_control.posture_loads`, None when no command
     tunes a servo)."""
     key, a, j, mode, value, effort, limits = checked
     previous = state.commands.get(key)
     law = state.native.get(key)
+    if _rotor(state, checked):
+        return _set_rotor(state, checked)
     if law is not None and law.mode == mode:
         return _set_native(state, (key, a, j, value, effort, limits), law, previous)
     if loads is None:
@@ -265,10 +289,13 @@ def start_commands(state: WorldState, names: Iterable[str]) -> None:
         for a in state.require(name).actuators:
             key = model.actuator(int(a)).name
             law = state.native.get(key)
-            if law is None:
+            if law is None and model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
                 continue
             j = int(model.actuator_trnid[a, 0])
             joint = model.joint(j).name.removeprefix(f"{name}/")
+            if law is None:
+                _start_rotor(state, name, (key, int(a), j, joint))
+                continue
             limits = joint_control.limits_of(model, name, joint)
             value = native_servos.start_value(model, data.qpos, int(a), law)
             effort = control.effort_limit(model, int(a))
@@ -277,12 +304,26 @@ def start_commands(state: WorldState, names: Iterable[str]) -> None:
     servos.keep_awake(model, state.commands)
 
 
+def _start_rotor(state: WorldState, name: str, motor: tuple) -> None:
+    """Holds a joint whose velocity motor is on from load (`rotors.engaged_at_load`) at speed 0,
+    as the exported file does: a velocity command of 0."""
+    key, a, j, joint = motor
+    if key in state.commands or rotors.rotor_of(state.model, a) is None:
+        return
+    effort = rotors.engaged_at_load(joint_control.record_of(state.model, name, joint))
+    if effort is not None:
+        limits = joint_control.limits_of(state.model, name, joint)
+        _set_rotor(state, (key, a, j, "velocity", 0.0, effort, limits))
+
+
 def _actuated(m: mujoco.MjModel, ix: EntityIndex) -> dict[int, int]:
-    """Joint id → id of the joint motor that drives it, for one entity."""
+    """Joint id → id of the joint motor that drives it, for one entity (velocity motors'
+    rotors are no joints of the entity's)."""
+    names = element_names(m, m.name_actuatoradr[ix.actuators])
     return {
         int(m.actuator_trnid[a][0]): int(a)
-        for a in ix.actuators
-        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT
+        for a, n in zip(ix.actuators, names, strict=True)
+        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and not rotors.is_rotor(n)
     }
 
 
@@ -323,6 +364,13 @@ def release_commands(
             limp = control.JointCommand(old.actuator, "effort", 0.0, 0.0, 0.0, old.effort)
             control.apply_command(model, data, a, limp)
             sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
+        rotor = rotors.rotor_of(model, a) if a >= 0 else None
+        entity, _, joint = old.actuator.partition("/")
+        held = rotors.engaged_at_load(joint_control.record_of(model, entity, joint))
+        if rotor is not None and held is not None:
+            rotors.engage(model, data, rotor, 0.0, held)  # as compiled: holding at speed 0
+        elif rotor is not None:
+            rotors.disengage(model, data, rotor)
 
 
 def reapply_commands(
@@ -388,6 +436,8 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
         if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
             continue  # a site actuator (a rotor's thrust or drag) drives no joint of its own
         key = element_names(model, model.name_actuatoradr[[a]])[0]
+        if rotors.is_rotor(key):
+            continue  # a velocity motor's rotor: its joint's command shows it
         j = int(model.actuator_trnid[a][0])
         joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
         limits = joint_control.limits_of(model, name, joint)

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from twin_cli.world import rotors
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate, vec3
 
@@ -71,19 +72,21 @@ def root_twist(model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex) -
 def joint_states(
     model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
 ) -> list[JointState]:
-    """States of the entity's joints other than its free joint, in model order."""
+    """States of the entity's joints other than its free joint and velocity motors' rotors, in
+    model order; a joint's effort is its motor's (`rotors.joint_efforts`)."""
     names = element_names(model, model.name_jntadr[index.joints])
     states = []
+    efforts = rotors.joint_efforts(model, data)
     for j, name in zip(index.joints, names, strict=True):
         kind, qa, da = model.jnt_type[j], model.jnt_qposadr[j], model.jnt_dofadr[j]
-        if kind == _FREE:
+        if kind == _FREE or rotors.is_rotor(name):
             continue
         if kind == _BALL:
             angle = 2.0 * math.acos(min(1.0, abs(float(data.qpos[qa]))))
             speed = float(np.linalg.norm(data.qvel[da : da + 3]))
             states.append(JointState(name.removeprefix(prefix), angle, speed, 0.0))
             continue
-        effort = float(data.qfrc_actuator[da])
+        effort = float(efforts[da])
         states.append(
             JointState(
                 name.removeprefix(prefix), float(data.qpos[qa]), float(data.qvel[da]), effort
@@ -95,7 +98,8 @@ def joint_states(
 def link_poses(
     model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
 ) -> dict[str, Pose]:
-    """World poses of the entity's bodies, computed on scratch data (the live data is untouched)."""
+    """World poses of the entity's bodies (velocity motors' rotors excluded), computed on
+    scratch data (the live data is untouched)."""
     scratch = mujoco.MjData(model)
     scratch.qpos[:] = data.qpos
     scratch.mocap_pos[:] = data.mocap_pos
@@ -105,16 +109,17 @@ def link_poses(
     return {
         name.removeprefix(prefix): Pose.at(scratch.xpos[b], scratch.xquat[b])
         for b, name in zip(index.bodies, names, strict=True)
+        if not rotors.is_rotor(name)
     }
 
 
 def joint_names(model: mujoco.MjModel, index: EntityIndex, prefix: str) -> list[str]:
-    """The entity's joint names without prefix (free joint excluded)."""
+    """The entity's joint names without prefix (free joint and rotors excluded)."""
     names = element_names(model, model.name_jntadr[index.joints])
     return [
         n.removeprefix(prefix)
         for j, n in zip(index.joints, names, strict=True)
-        if model.jnt_type[j] != _FREE
+        if model.jnt_type[j] != _FREE and not rotors.is_rotor(n)
     ]
 
 

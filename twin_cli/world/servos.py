@@ -49,7 +49,12 @@ import numpy as np
 
 from converters.control_text import CONTROL_TEXT
 from converters.mjcf.export_gravcomp import GRAVCOMP, restore_gravcomp
-from converters.mjcf.export_servos import EXPORTED, INTEGRAL_MARGIN, export_servos
+from converters.mjcf.export_servos import (
+    EXPORTED,
+    INTEGRAL_MARGIN,
+    VELOCITY_MOTOR,
+    export_servos,
+)
 from twin_cli.world import gravity_comp, sleeping, speed_holds
 
 if TYPE_CHECKING:
@@ -101,7 +106,8 @@ def carry_exported_servos(spec: mujoco.MjSpec) -> None:
     if text is None:
         return
     records = json.loads(text.data)
-    if not any(isinstance(r, dict) and EXPORTED in r for r in records.values()):
+    done = (EXPORTED, VELOCITY_MOTOR)
+    if not any(isinstance(r, dict) and any(k in r for k in done) for r in records.values()):
         export_servos(spec)
         records = json.loads(text.data)
     handed = False

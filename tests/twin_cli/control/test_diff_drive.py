@@ -104,11 +104,6 @@ def test_turtlebot3_ends_within_2_percent_of_the_unicycle(driven: dict) -> None:
     assert heading <= 0.02 * (th - start.yaw), f"heading {heading:.4f} rad off"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the wheels' own intvelocity servos pay their integral's lag back: the left wheel "
-    "peaks at 5.13 rad/s on a 4.85 rad/s command (Gazebo's velocity constraint does not)",
-)
 def test_wheels_never_exceed_their_commanded_speed(driven: dict) -> None:
     plugin = driven["plugin"]
     radius = plugin.wheel_diameter / 2

@@ -381,25 +381,35 @@ def test_a_base_no_one_has_driven_holds_on_a_slope(tmp_path: Path, name: str) ->
     assert rolled > 0.05, f"{name} without its plugins rolled only {rolled:.3f} m: no control"
 
 
-def test_a_plugin_hold_is_the_wheels_own_servo_at_zero_until_the_first_drive(
+def test_a_plugin_hold_is_the_wheels_own_motor_at_zero_until_the_first_drive(
     tmp_path: Path,
 ) -> None:
-    """A spawned base's held wheels are their own servos (the exported file's `intvelocity`) at
-    ctrl 0; the drive's commands then write ctrl and nothing else on the model."""
+    """A spawned base's held wheels are their velocity motors (the exported file's rotor and
+    friction tendon, bounded by the effort) at speed 0; the drive's commands then write the
+    rotors' ctrl and nothing else on the model."""
     import numpy as np
+
+    from twin_cli.world import rotors
 
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     m, wheels = world.model, ("wheel_left_joint", "wheel_right_joint")
     ids = [m.actuator(f"base/{j}").id for j in wheels]
+    motors = [rotors.rotor_of(m, a) for a in ids]
+    spin = [r.actuator for r in motors]
+    tendons = [r.tendon for r in motors]
     shown = {world.joint_commands("base")[j]["rule"] for j in wheels}
-    assert shown == {"the model's own intvelocity servo: ctrl = target"}, shown
-    assert list(world.data.ctrl[ids]) == [0.0, 0.0], "held: speed 0"
+    assert shown == {rotors.RULE}, shown
+    assert list(world.data.ctrl[spin]) == [0.0, 0.0], "held: speed 0"
+    bound = m.tendon_frictionloss[tendons].copy()
+    efforts = [world.joint_commands("base")[j]["effort_limit"] for j in wheels]
+    assert list(bound) == pytest.approx(efforts, rel=1e-12), "the bound is the effort limit"
     law = m.actuator_gainprm[ids].copy(), m.actuator_biasprm[ids].copy()
     drive(world, "base", V)
     world.step(100)
-    assert all(world.data.ctrl[ids] > 0), "driven: the wheels' speeds are their ctrl"
+    assert all(world.data.ctrl[spin] > 0), "driven: the wheels' speeds are their rotors' ctrl"
     assert np.array_equal(m.actuator_gainprm[ids], law[0]), "gains unchanged"
     assert np.array_equal(m.actuator_biasprm[ids], law[1]), "gains unchanged"
+    assert np.array_equal(m.tendon_frictionloss[tendons], bound), "bound unchanged"
 
 
 def test_the_first_drive_keeps_the_force_the_hold_carried(tmp_path: Path) -> None:

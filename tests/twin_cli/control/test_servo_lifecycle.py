@@ -96,11 +96,6 @@ def test_a_loaded_world_overloads_and_recovers_as_the_saved_one(tmp_path):
     assert peaks[1] == pytest.approx(peaks[0], rel=1e-3), f"saved, loaded: {peaks} rad/s"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the stall's stored integral comes back as a burst: 82 rad/s peak on a 2 rad/s "
-    "command (MuJoCo has no bounded integral an actuator can hold)",
-)
 def test_an_overloaded_wheel_recovers_without_a_burst_in_a_loaded_world(tmp_path):
     """Gazebo's constraint motor stores nothing during a stall, so no world, saved or loaded,
     shows a catch-up burst: the peak after the overload stays within 15 % of the command."""

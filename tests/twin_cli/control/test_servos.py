@@ -59,14 +59,12 @@ def test_a_wheel_holds_its_speed_under_half_its_effort_limit(wheel: World) -> No
     assert speeds.min() > 0.9 * SPEED, f"dipped to {speeds.min():.3f} rad/s when loaded"
 
 
-def test_an_overloaded_wheel_saturates_at_its_effort_and_then_catches_up_its_reference(wheel):
+def test_an_overloaded_wheel_saturates_at_its_effort_and_comes_back_without_paying_back(wheel):
     """Overloaded, the wheel decelerates as Newton's law with the effort at its limit says.
-    Released, it runs back onto its reference path r = r0 + v*·t, which MuJoCo integrates in
-    the servo's activation: the integral keeps what the stall stored and pays it back. Gazebo's
-    motor, a velocity constraint bounded by FMax, stores nothing (with a windup observer in
-    Python the wheel came back at 3.07 rad/s peak, 3.11 rad behind its path); MuJoCo has no
-    bounded integral an actuator can hold, so here the wheel peaks at 43 rad/s and is back at
-    speed, on its path, 3.3 s after the release (measured)."""
+    Released, it speeds up at effort/I back to its command and runs on from where it is, as
+    Gazebo's motor (a velocity constraint bounded by FMax) does: nothing stored, so it ends
+    behind its path by the slip alone, Δv²/(2·a_stall) + Δv²/(2·a_back), Δv the speed lost
+    (an integral servo paid it back: 43 rad/s peak, back on its path 3.3 s after the release)."""
     q0, t0 = wheel.joint_states("w")[0].position, float(wheel.data.time)
     load = -1.5 * EFFORT
     _load(wheel, load)
@@ -76,15 +74,27 @@ def test_an_overloaded_wheel_saturates_at_its_effort_and_then_catches_up_its_ref
     _load(wheel, -load)  # the load removed (the pushes add up to 0)
     after = _speeds(wheel, 400)
     assert after[-20:] == pytest.approx(SPEED, rel=0.01), "back at its speed within 4 s"
+    lost = SPEED - speeds[-1]
+    slip = lost**2 / (2 * -(load + EFFORT) / MOMENT) + lost**2 / (2 * EFFORT / MOMENT)
     behind = q0 + SPEED * (float(wheel.data.time) - t0) - wheel.joint_states("w")[0].position
-    assert abs(behind) < 1e-3, f"{behind:.4f} rad off its reference path after the stall"
+    assert behind == pytest.approx(slip, rel=0.01), f"{behind:.4f} rad behind, slip {slip:.4f}"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the stall's stored integral comes back as a burst: 43 rad/s peak (Gazebo's FMax "
-    "constraint stores nothing; MuJoCo has no bounded integral an actuator can hold)",
-)
+@pytest.mark.parametrize("fraction", [0.5, 1.5])
+def test_a_driven_wheels_effort_is_what_its_motor_puts_on_it(wheel: World, fraction) -> None:
+    """The joint's effort is its velocity motor's force on it (the tendon's constraint force,
+    as ODE reports its motor's): against a load within the effort, the load itself (the wheel
+    keeps its speed); past it, exactly the effort limit (Newton on the disc and the bound)."""
+    _load(wheel, -fraction * EFFORT)
+    wheel.step(300)
+    efforts = []
+    for _ in range(20):
+        wheel.step(10)
+        efforts.append(wheel.joint_states("w")[0].effort)
+    expected = min(fraction, 1.0) * EFFORT
+    assert efforts == pytest.approx([expected] * 20, rel=1e-6), f"efforts {efforts[:3]} N m"
+
+
 def test_an_overloaded_wheel_recovers_without_a_burst(wheel: World) -> None:
     """Gazebo's joint motor, a velocity constraint bounded by FMax, comes back from a stall at
     its command: the speed after the release never passes it by more than 5 %."""
@@ -95,11 +105,16 @@ def test_an_overloaded_wheel_recovers_without_a_burst(wheel: World) -> None:
     assert after.max() < 1.05 * SPEED, f"a catch-up burst to {after.max():.2f} rad/s"
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="the velocity motor's friction row is soft: the held wheel creeps at 2.5e-6, 5.1e-6 "
+    "and 9.1e-6 rad/s under 0.25, 0.5 and 0.9 of its effort (R·f·h, R = (1 − d)/d / I at "
+    "MuJoCo's largest impedance d = 0.9999); ODE's CFM about 1e-9 holds it",
+)
 @pytest.mark.parametrize("fraction", [0.25, 0.5, 0.9])
 def test_a_zero_velocity_command_holds_the_wheel_still_under_load(wheel: World, fraction) -> None:
     """Gazebo's FMax constraint at speed 0 (ODE, CFM about 1e-9) holds a load within its limit
-    still. The wheel's own servo, MuJoCo's `intvelocity` at ctrl 0, holds its integral's
-    position: within 1e-6 rad and 1e-6 rad/s over 2 s, up to 0.9 of the effort."""
+    still: within 1e-6 rad and 1e-6 rad/s over 2 s, up to 0.9 of the effort."""
     wheel.command("w", "spin", mode="velocity", value=0.0)
     wheel.step(200)
     _load(wheel, -fraction * EFFORT)
@@ -110,11 +125,6 @@ def test_a_zero_velocity_command_holds_the_wheel_still_under_load(wheel: World, 
     assert abs(state.position - start) < 1e-6 and abs(state.velocity) < 1e-6, state
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="an intvelocity at ctrl 0 stores the slip in its integral and pulls the wheel back "
-    "once the load is gone (Gazebo's FMax constraint stores nothing)",
-)
 def test_a_held_wheel_slips_at_its_effort_and_stays_where_it_slipped(wheel: World) -> None:
     """Past its effort the hold slips with the effort exactly opposing the load, and once the
     load is gone the wheel stops where it is: a bounded constraint stores nothing to pay back

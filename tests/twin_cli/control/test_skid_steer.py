@@ -90,12 +90,12 @@ def test_a_skid_steer_turns_as_coulomb_friction_lets_it(
     )
 
 
-# Longer wheel bases (a/c 0.67 and 1.0) turn further below Coulomb's rate than COULOMB_SHORT
+# The longest wheel base (a/c 1.0) turns further below Coulomb's rate than COULOMB_SHORT
 # (measured, ROS 1's skid steer at 0.3 m/s and 0.5 rad/s, mean over half a turn of heading). The
 # wheels' armature is not the cause: at a/c 1.0 none from 0.5 to 10 times the converter's raised
-# the turn above 0.62 of Coulomb's rate.
+# the turn above 0.62 of Coulomb's rate. a/c 0.67 turned at 0.762 of it while the wheels ran on
+# integral servos; on Gazebo's velocity motor (no stored lag) it is within the bound.
 LONG_BASES = {
-    0.2: "a/c 0.67: 0.762 of Coulomb's rate",
     0.3: "a/c 1.0: 0.546 of Coulomb's rate",
 }
 

@@ -98,7 +98,20 @@ def test_mu2_along_the_wheels_turns_slower_as_in_gazebo(tmp_path: Path):
 HEADING_SAME = 0.01  # fraction: the rate at two headings with fdir1 along the axle
 
 
-@pytest.mark.parametrize("mu_across", [0.5, 0.3])
+@pytest.mark.parametrize(
+    "mu_across",
+    [
+        pytest.param(
+            0.5,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="on velocity motors the isotropic base turns at 0.4171 rad/s and fdir1 "
+                "with μ 0.5 across at 0.4169, not 5 % faster (integral servos: faster)",
+            ),
+        ),
+        0.3,
+    ],
+)
 def test_fdir1_along_the_axle_turns_with_the_wheels_and_faster(tmp_path: Path, mu_across: float):
     """fdir1 '0 0 1' (the axle) puts μ1 across each wheel at every heading: the same rate at
     headings 0 and 0.7 rad, above the isotropic base's mean over half a turn, and within the

@@ -650,3 +650,39 @@ def test_a_recording_is_private_and_a_fifo_without_reader_is_refused_at_once(tmp
     with pytest.raises(RequestError, match="cannot be written"):
         open_output(fifo, overwrite=True)  # would block the server for ever without a reader
     assert stat.S_ISFIFO(fifo.stat().st_mode), "the FIFO is untouched"
+
+
+def test_a_velocity_motors_joint_records_its_motors_force_as_effort(tmp_path):
+    """A wheel on Gazebo's velocity motor (converters.mjcf.velocity_motors) holding its speed
+    against 0.05 N m: the sampler and the ring both record that load as its effort (the
+    tendon's force on the joint; its actuator pushes nothing), as `joint_states` reads it."""
+    from models import _control_inertial, write_urdf
+
+    from twin_cli.record import ring
+    from twin_cli.record.sampler import Sampler
+
+    urdf = f"""<robot name="w"><link name="world"/>
+<link name="base">{_control_inertial(1, 1)}</link>
+<link name="disc">{_control_inertial(0.2, 1e-3)}</link>
+<joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="spin" type="continuous"><parent link="base"/><child link="disc"/>
+  <axis xyz="0 0 1"/><limit effort="0.1" velocity="10"/></joint>
+<ros2_control name="r" type="system"><joint name="spin">
+  <command_interface name="velocity"/></joint></ros2_control></robot>"""
+    world = World()
+    world.spawn(write_urdf(tmp_path, urdf), name="w", pose=Pose(z=1.0))
+    world.command("w", "spin", mode="velocity", value=3.0)
+    world.push("w", torque=(0.0, 0.0, -0.05), link="disc", duration=10.0)
+    world.step(500)
+    dof = int(world.model.joint("w/spin").dofadr[0])
+    with world.lock:
+        sample = Sampler(world).capture()
+        data, header, _ = ring.views(ring.allocate(4 * ring.record_length(world.model))[1])
+        writer, reader = ring.RingWriter(data, header, lambda: True), ring.RingReader(data, header)
+        reader.add_layout(writer.start_layout(world.model), 0, world.model)
+        assert writer.put(world.data)
+    (_, run), *_ = reader.read(int(header[ring.WRITE]), 10)
+    recorded = run[0][-world.model.nv + dof]
+    assert world.joint_states("w")[0].effort == pytest.approx(0.05, rel=1e-6), "joint_states"
+    assert sample.qfrc_actuator[dof] == pytest.approx(0.05, rel=1e-6), "sampled effort [N m]"
+    assert recorded == pytest.approx(0.05, rel=1e-6), "ring's effort [N m]"

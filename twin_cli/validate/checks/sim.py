@@ -104,6 +104,8 @@ class ScenarioRun:
             video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
+        from twin_cli.world.rotors import is_rotor  # mujoco: scenario parsing stays light
+
         model = self.world.model
         prefix = f"{self.entity}/"
         self.bodies = [b for b in range(model.nbody) if model.body(b).name.startswith(prefix)]
@@ -120,7 +122,9 @@ class ScenarioRun:
                 self._velocity_limits.get(model.joint(j).name.removeprefix(prefix)),
             )
             for j in range(model.njnt)
-            if int(model.jnt_bodyid[j]) in self.bodies and int(model.jnt_type[j]) in (HINGE, SLIDE)
+            if int(model.jnt_bodyid[j]) in self.bodies
+            and int(model.jnt_type[j]) in (HINGE, SLIDE)
+            and not is_rotor(model.joint(j).name)
         ]
         self.mass = float(sum(model.body_mass[b] for b in self.bodies))
         self.floating = any(
