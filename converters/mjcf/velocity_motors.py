@@ -21,7 +21,8 @@ Measured against the integral servo: a free 1 N m wheel reaches 95 % of 2 rad/s 
 effort allows 4 ms) without overshoot; after a 1 s stall at 2 rad/s it peaks at 2.00 rad/s
 (servo 35.3); a held wheel pushed past its effort and released stays where it slipped.
 The constraint is on (frictionloss E) when velocity is the joint's first mode; a World switches
-it with the command's mode (`twin_cli.world.rotors`) and leaves J's own motor for the others.
+it with the command's mode (`twin_cli.world.velocity_motors`) and leaves J's own motor for
+the others.
 """
 
 from __future__ import annotations

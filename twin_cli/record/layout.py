@@ -20,7 +20,7 @@ from twin_cli.names import namespace
 from twin_cli.record.frames import Pose, Sources, unique_odom_topics
 from twin_cli.record.tf_tree import Edge, EntityTree, entity_tree, model_names, static_pose
 from twin_cli.world.entities import EntityIndex, element_names
-from twin_cli.world.rotors import is_rotor
+from twin_cli.world.velocity_motors import is_rotor
 
 _FREE, _BALL = mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL
 _IDENTITY_QUAT = np.array([1.0, 0.0, 0.0, 0.0])

@@ -9,7 +9,7 @@ process inherits (no named segment to leak).
 
 A record is MuJoCo's state `[time, qpos, qvel, mocap_pos, mocap_quat]` (`mj_getState`, one C
 call) followed by the joint efforts (`qfrc_actuator`, plus the tendon's force on a joint a
-velocity motor drives, `twin_cli.world.rotors`): two copies, because after `mj_step` every
+velocity motor drives, `twin_cli.world.velocity_motors`): two copies, because after `mj_step` every
 Python operation meets caches that the step has emptied (~2-4 µs each). Records carry no header:
 all records of one compiled model have its `record_length`, and the writer tells the reader
 (over the pipe, before the first such record) the position from which they start
@@ -33,7 +33,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from twin_cli.world.rotors import effort_dofs
+from twin_cli.world.velocity_motors import effort_dofs
 
 HEADER = 8  # int64 slots: write, read, samples, done, ...
 WRITE, READ, SAMPLES, DONE = 0, 1, 2, 3

@@ -19,7 +19,7 @@ from twin_cli.errors import EntityNotFoundError
 from twin_cli.record.frames import Sources, prefix_template, sources_of
 from twin_cli.record.layout import Layout, make_layout
 from twin_cli.world.observers import WorldView, world_view
-from twin_cli.world.rotors import joint_efforts
+from twin_cli.world.velocity_motors import joint_efforts
 
 if TYPE_CHECKING:
     from twin_cli.world.engine import World

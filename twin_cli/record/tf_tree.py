@@ -19,7 +19,7 @@ from twin_cli.record.frames import (
 )
 from twin_cli.world.entities import MODEL_SITE, EntityIndex, element_names
 from twin_cli.world.pose import quat_multiply, rotate
-from twin_cli.world.rotors import is_rotor
+from twin_cli.world.velocity_motors import is_rotor
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from twin_cli.world import native_servos, rotors, servos, sleeping
+from twin_cli.world import native_servos, servos, sleeping, velocity_motors
 
 MODES = ("position", "velocity", "effort")
 ROTOR_PARTS = (":drag_x", ":drag_y")  # besides ":thrust"
@@ -119,7 +119,7 @@ def apply_command(
       any gain.
     """
     sleeping.wake_actuated(model, data, (a,))  # a sleeping robot must feel its new command
-    cmd = _run_rotor(model, data, a, cmd)
+    cmd = _run_velocity_motor(model, data, a, cmd)
     if law is not None and cmd.native:
         native_servos.restore(model, a, law)
         data.ctrl[a] = cmd.target
@@ -162,19 +162,19 @@ def apply_command(
     _apply_rotor(model, data, a, cmd)
 
 
-def _run_rotor(
+def _run_velocity_motor(
     model: mujoco.MjModel, data: mujoco.MjData, a: int, cmd: JointCommand
 ) -> JointCommand:
-    """A joint with a velocity motor (`twin_cli.world.rotors`): a velocity command engages it
-    and leaves the joint's own motor at zero effort (the command returned); any other command
-    disengages it and is returned unchanged."""
-    rotor = rotors.rotor_of(model, a)
+    """A joint with a velocity motor (`twin_cli.world.velocity_motors`): a velocity command
+    engages it and leaves the joint's own motor at zero effort (the command returned); any other
+    command disengages it and is returned unchanged."""
+    rotor = velocity_motors.rotor_of(model, a)
     if rotor is None:
         return cmd
     if cmd.mode != "velocity" or not math.isfinite(cmd.effort):
-        rotors.disengage(model, data, rotor)
+        velocity_motors.disengage(model, data, rotor)
         return cmd
-    rotors.engage(model, data, rotor, cmd.target, cmd.effort)
+    velocity_motors.engage(model, data, rotor, cmd.target, cmd.effort)
     return replace(cmd, mode="effort", target=0.0, velocity_limit=math.inf, native=False)
 
 

@@ -15,7 +15,14 @@ import mujoco
 from converters.mjcf.export_servos import INTEGRAL_MARGIN
 from twin_cli.errors import InvalidRequestError, ModeNotOfferedError, PartNotFoundError
 from twin_cli.world import actuation as control
-from twin_cli.world import gravity_comp, joint_control, native_servos, rotors, servos, sleeping
+from twin_cli.world import (
+    gravity_comp,
+    joint_control,
+    native_servos,
+    servos,
+    sleeping,
+    velocity_motors,
+)
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.state import WorldState
 from twin_cli.world.values import finite_vector
@@ -155,16 +162,18 @@ def _rotor(state: WorldState, checked: tuple) -> bool:
     """Whether a checked command is a velocity that the joint's velocity motor runs."""
     _, a, _, mode, _, effort, _ = checked
     return (
-        mode == "velocity" and math.isfinite(effort) and rotors.rotor_of(state.model, a) is not None
+        mode == "velocity"
+        and math.isfinite(effort)
+        and velocity_motors.rotor_of(state.model, a) is not None
     )
 
 
 def _set_rotor(state: WorldState, checked: tuple) -> control.JointCommand:
-    """Writes a velocity command into the joint's velocity motor (`twin_cli.world.rotors`):
+    """Writes a velocity command into the joint's velocity motor (`twin_cli.world.velocity_motors`):
     the rotor's speed and the tendon's bound; no gains to tune."""
     key, a, _, _, value, effort, limits = checked
     cmd = control.JointCommand(
-        key, "velocity", value, 0.0, 0.0, effort, limits.velocity, 0.0, rotors.RULE
+        key, "velocity", value, 0.0, 0.0, effort, limits.velocity, 0.0, velocity_motors.RULE
     )
     control.apply_command(state.model, state.data, a, cmd, state.native.get(key))
     state.commands[key] = cmd
@@ -305,12 +314,12 @@ def start_commands(state: WorldState, names: Iterable[str]) -> None:
 
 
 def _start_rotor(state: WorldState, name: str, motor: tuple) -> None:
-    """Holds a joint whose velocity motor is on from load (`rotors.engaged_at_load`) at speed 0,
-    as the exported file does: a velocity command of 0."""
+    """Holds a joint whose velocity motor is on from load (`velocity_motors.engaged_at_load`) at
+    speed 0, as the exported file does: a velocity command of 0."""
     key, a, j, joint = motor
-    if key in state.commands or rotors.rotor_of(state.model, a) is None:
+    if key in state.commands or velocity_motors.rotor_of(state.model, a) is None:
         return
-    effort = rotors.engaged_at_load(joint_control.record_of(state.model, name, joint))
+    effort = velocity_motors.engaged_at_load(joint_control.record_of(state.model, name, joint))
     if effort is not None:
         limits = joint_control.limits_of(state.model, name, joint)
         _set_rotor(state, (key, a, j, "velocity", 0.0, effort, limits))
@@ -323,7 +332,7 @@ def _actuated(m: mujoco.MjModel, ix: EntityIndex) -> dict[int, int]:
     return {
         int(m.actuator_trnid[a][0]): int(a)
         for a, n in zip(ix.actuators, names, strict=True)
-        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and not rotors.is_rotor(n)
+        if m.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and not velocity_motors.is_rotor(n)
     }
 
 
@@ -364,13 +373,13 @@ def release_commands(
             limp = control.JointCommand(old.actuator, "effort", 0.0, 0.0, 0.0, old.effort)
             control.apply_command(model, data, a, limp)
             sleeping.hold_awake(model, sleeping.actuator_trees(model, (a,)), False)
-        rotor = rotors.rotor_of(model, a) if a >= 0 else None
+        rotor = velocity_motors.rotor_of(model, a) if a >= 0 else None
         entity, _, joint = old.actuator.partition("/")
-        held = rotors.engaged_at_load(joint_control.record_of(model, entity, joint))
+        held = velocity_motors.engaged_at_load(joint_control.record_of(model, entity, joint))
         if rotor is not None and held is not None:
-            rotors.engage(model, data, rotor, 0.0, held)  # as compiled: holding at speed 0
+            velocity_motors.engage(model, data, rotor, 0.0, held)  # as compiled: holding at speed 0
         elif rotor is not None:
-            rotors.disengage(model, data, rotor)
+            velocity_motors.disengage(model, data, rotor)
 
 
 def reapply_commands(
@@ -436,7 +445,7 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
         if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
             continue  # a site actuator (a rotor's thrust or drag) drives no joint of its own
         key = element_names(model, model.name_actuatoradr[[a]])[0]
-        if rotors.is_rotor(key):
+        if velocity_motors.is_rotor(key):
             continue  # a velocity motor's rotor: its joint's command shows it
         j = int(model.actuator_trnid[a][0])
         joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")

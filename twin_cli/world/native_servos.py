@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin_cli.world import rotors, speed_holds
+from twin_cli.world import speed_holds, velocity_motors
 from twin_cli.world.servos import has_reference
 
 FIELDS = (
@@ -103,7 +103,7 @@ def capture(model: mujoco.MjModel) -> dict[str, Law]:
     for a in range(model.nu):
         mode = mode_of(model, a)
         name = model.actuator(a).name
-        if mode is None or name + ROTOR_THRUST in names or rotors.is_rotor(name):
+        if mode is None or name + ROTOR_THRUST in names or velocity_motors.is_rotor(name):
             continue
         integrates = int(model.actuator_dyntype[a]) == _INTEGRATOR
         gain = float(model.actuator_gainprm[a, 0])

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from twin_cli.world import rotors
+from twin_cli.world import velocity_motors
 from twin_cli.world.entities import EntityIndex, element_names
 from twin_cli.world.pose import Pose, quat4, quat_multiply, rotate, vec3
 
@@ -73,13 +73,13 @@ def joint_states(
     model: mujoco.MjModel, data: mujoco.MjData, index: EntityIndex, prefix: str
 ) -> list[JointState]:
     """States of the entity's joints other than its free joint and velocity motors' rotors, in
-    model order; a joint's effort is its motor's (`rotors.joint_efforts`)."""
+    model order; a joint's effort is its motor's (`velocity_motors.joint_efforts`)."""
     names = element_names(model, model.name_jntadr[index.joints])
     states = []
-    efforts = rotors.joint_efforts(model, data)
+    efforts = velocity_motors.joint_efforts(model, data)
     for j, name in zip(index.joints, names, strict=True):
         kind, qa, da = model.jnt_type[j], model.jnt_qposadr[j], model.jnt_dofadr[j]
-        if kind == _FREE or rotors.is_rotor(name):
+        if kind == _FREE or velocity_motors.is_rotor(name):
             continue
         if kind == _BALL:
             angle = 2.0 * math.acos(min(1.0, abs(float(data.qpos[qa]))))
@@ -109,7 +109,7 @@ def link_poses(
     return {
         name.removeprefix(prefix): Pose.at(scratch.xpos[b], scratch.xquat[b])
         for b, name in zip(index.bodies, names, strict=True)
-        if not rotors.is_rotor(name)
+        if not velocity_motors.is_rotor(name)
     }
 
 
@@ -119,7 +119,7 @@ def joint_names(model: mujoco.MjModel, index: EntityIndex, prefix: str) -> list[
     return [
         n.removeprefix(prefix)
         for j, n in zip(index.joints, names, strict=True)
-        if model.jnt_type[j] != _FREE and not rotors.is_rotor(n)
+        if model.jnt_type[j] != _FREE and not velocity_motors.is_rotor(n)
     ]
 
 

@@ -389,16 +389,16 @@ def test_a_plugin_hold_is_the_wheels_own_motor_at_zero_until_the_first_drive(
     rotors' ctrl and nothing else on the model."""
     import numpy as np
 
-    from twin_cli.world import rotors
+    from twin_cli.world import velocity_motors
 
     world = _spawned(tmp_path, "gazebo_ros_diff_drive", FAMILIES["gazebo_ros_diff_drive"].robot())
     m, wheels = world.model, ("wheel_left_joint", "wheel_right_joint")
     ids = [m.actuator(f"base/{j}").id for j in wheels]
-    motors = [rotors.rotor_of(m, a) for a in ids]
+    motors = [velocity_motors.rotor_of(m, a) for a in ids]
     spin = [r.actuator for r in motors]
     tendons = [r.tendon for r in motors]
     shown = {world.joint_commands("base")[j]["rule"] for j in wheels}
-    assert shown == {rotors.RULE}, shown
+    assert shown == {velocity_motors.RULE}, shown
     assert list(world.data.ctrl[spin]) == [0.0, 0.0], "held: speed 0"
     bound = m.tendon_frictionloss[tendons].copy()
     efforts = [world.joint_commands("base")[j]["effort_limit"] for j in wheels]

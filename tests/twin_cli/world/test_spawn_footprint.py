@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[3]
 # entity to the world's spec left world/spawn.py (499 lines) for world/attach.py. A new module on
 # the path must be needed (raise this, saying why) or run only when the description declares it.
 # 69 with Gazebo's velocity motor: its builder (converters/mjcf/velocity_motors.py, imported by
-# the export every spawn runs) and world/rotors.py (joint states and commands ask it).
+# the export every spawn runs) and world/velocity_motors.py (joint states and commands ask it).
 HUMANOID_BOUND = 69
 PLUGIN_FAMILY = {
     f"converters/gazebo/{name}.py"

@@ -104,7 +104,7 @@ class ScenarioRun:
             video.film(self.world, self.entity)  # `twin validate --video`: a no-op otherwise
 
     def _index_robot(self) -> None:
-        from twin_cli.world.rotors import is_rotor  # mujoco: scenario parsing stays light
+        from twin_cli.world.velocity_motors import is_rotor  # mujoco: scenario parsing stays light
 
         model = self.world.model
         prefix = f"{self.entity}/"
