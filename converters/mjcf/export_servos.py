@@ -123,7 +123,9 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
 
 def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
     """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
-    offer velocity commands, with a finite effort limit (the motor's bound)."""
+    offer velocity commands, with a finite effort limit (the motor's bound), and give no velocity
+    PID: ros2_control's `velocity_pid` and gz-sim's JointController with force commands close a
+    PID on the speed error, a force law, not the joint motor's constraint."""
     import mujoco
 
     record = records.get(actuator.target)
@@ -138,6 +140,7 @@ def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records:
         and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
         and record.get("source") not in UNTAGGED_SOURCES
         and "velocity" in record.get("modes", ())
+        and not record.get("pid", {}).get("velocity")  # a tag PID is a force loop, kept as such
         and VELOCITY_MOTOR not in record
     )
 

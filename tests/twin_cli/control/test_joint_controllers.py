@@ -7,10 +7,12 @@ d_gain 2). Oracle: the commanded speed and angle; the joints offer only the plug
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
 
+from converters.mjcf.velocity_motors import rotor_name
 from twin_cli.errors import InvalidRequestError
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
@@ -74,3 +76,48 @@ def test_a_joint_controllers_joint_offers_only_its_mode(
     with pytest.raises(InvalidRequestError, match=f"offers only {offered}") as caught:
         rig.command_joints("rig", {joint: 1.0}, mode=mode)
     assert f"--mode {offered}" in str(caught.value), "the message names the fix"
+
+
+FORCE_RIG = RIG.replace(
+    "<joint_name>fan_joint</joint_name></plugin>",
+    "<joint_name>fan_joint</joint_name><use_force_commands>true</use_force_commands>"
+    "<p_gain>0.5</p_gain><cmd_max>2</cmd_max></plugin>",
+)
+
+
+def _force_rig(tmp_path: Path) -> World:
+    path = tmp_path / "rig.urdf"
+    path.write_text(FORCE_RIG)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="rig")
+    return world
+
+
+def test_a_force_commanded_joint_controller_gets_no_joint_motor(tmp_path: Path) -> None:
+    """A velocity PID in the tags is a force law: the joint keeps it, not Gazebo's joint motor
+    (which put the disc at 2 rad/s 10 ms after a 3 rad/s command, p_gain 0.5 or not)."""
+    world = _force_rig(tmp_path)
+    tendons = [world.model.tendon(t).name for t in range(world.model.ntendon)]
+    assert rotor_name("rig/fan_joint") not in tendons, tendons
+
+
+PID_LAW = (
+    "twin's tag-PID velocity servo spins the disc up far slower than gz-sim's p·(ω* − ω): "
+    "0.0089, 0.032, 0.10 rad/s at 10, 20, 40 ms where the law gives 1.18, 1.90, 2.59"
+)
+
+
+@pytest.mark.xfail(strict=True, reason=PID_LAW)
+@pytest.mark.parametrize("t", [0.01, 0.02, 0.04])
+def test_a_force_commanded_joint_controller_closes_its_pid_not_a_rigid_motor(
+    tmp_path: Path, t: float
+) -> None:
+    """With `use_force_commands` gz-sim's JointController pushes p·(ω* − ω) (within cmd_max):
+    the 0.01 kg m² disc spins up as ω*(1 − e^(−p·t/I)), not at once as the joint motor of a
+    plain velocity command would (2 N m on 0.01 kg m²: 3 rad/s in 15 ms)."""
+    world = _force_rig(tmp_path)
+    world.command_joints("rig", {"fan_joint": 3.0}, mode="velocity")
+    world.step(round(t / world.model.opt.timestep))
+    expected = 3.0 * (1.0 - math.exp(-0.5 * t / 0.01))
+    speed = _state(world, "fan_joint").velocity
+    assert speed == pytest.approx(expected, rel=0.05), f"{speed:.4f} rad/s at {t} s"
