@@ -35,7 +35,9 @@ import numpy as np
 if TYPE_CHECKING:
     import mujoco
 
-SUFFIX = ":motor"  # the rotor body, joint, actuator and tendon of joint J are named J + SUFFIX
+SUFFIX = "|velocity_motor"
+"""The rotor body, joint, actuator and tendon of joint J are named J + SUFFIX: a mark no robot
+file writes (SDF's nested names join with "::", so ":motor" named a nested model's `motor`)."""
 ARMATURE_RATIO = 1e6  # rotor armature / J's inertia: the reference keeps its speed under J's pull
 SOLIMP = 0.9999  # MuJoCo's largest impedance: the friction row as rigid as the solver allows
 ROTOR_MASS = 1e-9  # [kg] the rotor body's mass: MuJoCo needs one on a body with a joint
