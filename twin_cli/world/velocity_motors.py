@@ -13,16 +13,17 @@ reference, and a position servo on top of it would need an outer loop in Python 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import mujoco
 import numpy as np
 
 from converters.mjcf.export_servos import VELOCITY_MOTOR
-from converters.mjcf.velocity_motors import is_rotor, rotor_name
+from converters.mjcf.velocity_motors import SUFFIX, is_rotor, rotor_name
 
 RULE = "Gazebo's joint motor: a velocity constraint within ±effort"  # what `twin joints` shows
 _ACTUATOR = mujoco.mjtObj.mjOBJ_ACTUATOR
-_TENDON = mujoco.mjtObj.mjOBJ_TENDON
+MODELS_KEPT = 2  # compiled models whose motor lookups are kept: the world's and the one before
 
 __all__ = ["RULE", "Rotor", "is_rotor", "rotor_name"]  # is_rotor: for the record and validate
 
@@ -37,10 +38,23 @@ class Rotor:
 
 def rotor_of(model: mujoco.MjModel, a: int) -> Rotor | None:
     """The velocity motor of joint motor `a`, or None if its joint has none."""
-    name = rotor_name(model.actuator(a).name)
-    r = mujoco.mj_name2id(model, _ACTUATOR, name)
-    t = mujoco.mj_name2id(model, _TENDON, name)
-    return Rotor(r, t) if r >= 0 and t >= 0 else None
+    return _motors(model).get(a)
+
+
+@lru_cache(maxsize=MODELS_KEPT)
+def _motors(model: mujoco.MjModel) -> dict[int, Rotor]:
+    """Joint motor id → its velocity motor, for one compiled model: looked up once, not by name
+    at every command (gz-sim's Ackermann commands its steering joints at every step)."""
+    out = {}
+    for t in range(model.ntendon):
+        name = model.tendon(t).name
+        if not is_rotor(name):
+            continue
+        a = mujoco.mj_name2id(model, _ACTUATOR, name.removesuffix(SUFFIX))
+        r = mujoco.mj_name2id(model, _ACTUATOR, name)
+        if a >= 0 and r >= 0:
+            out[a] = Rotor(r, t)
+    return out
 
 
 def engage(
@@ -64,6 +78,7 @@ def engaged_at_load(record: dict | None) -> float | None:
     return float(motor["effort"]) if motor and motor.get("engaged") else None
 
 
+@lru_cache(maxsize=MODELS_KEPT)
 def effort_dofs(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray]:
     """(joint dofs, rotor dofs) of every velocity motor of `model`: the tendon's force on the
     joint is the opposite of its force on the rotor, the only constraint the rotor has."""
