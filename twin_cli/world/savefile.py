@@ -23,6 +23,7 @@ from twin_cli.errors import EntityNotFoundError, InvalidRequestError, TwinError,
 from twin_cli.files import input_files
 from twin_cli.files.output_files import OutputFileError, write_atomically
 from twin_cli.spawn_request import SpawnRequest
+from twin_cli.world import save_upgrades
 from twin_cli.world.actuation import JointCommand, Push
 from twin_cli.world.decomposing import PENDING
 from twin_cli.world.engine import World
@@ -142,7 +143,10 @@ def load(path: str | os.PathLike) -> World:
     doc = _read(Path(path))
     world = _new_world(path, doc)
     entities = [_respawn(path, world, item.model_dump()) for item in doc.entities]
-    layout, state = _servo_references(world, dict(doc.layout), np.array(doc.state, dtype=float))
+    layout, state = save_upgrades.add_rotors(
+        world.model, dict(doc.layout), np.array(doc.state, dtype=float)
+    )
+    layout, state = _servo_references(world, layout, state)
     laws = _laws(world)
     layout, state = _own_servos(world, laws, layout, state)
     saved = [JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands]
@@ -343,6 +347,8 @@ def _respawn(path: str | os.PathLike, world: World, item: dict[str, Any]) -> Ent
         raise WorldFileError(path, problem, "restore its source file, or spawn afresh") from exc
     spawn_state = EntityState(**{k: np.array(v) for k, v in item["spawn_state"].items()})
     entity = world.entity(item["name"])
+    index = world.index_of(item["name"])
+    spawn_state = save_upgrades.add_entity_rotors(world.model, index, spawn_state)
     if spawn_state.act.size != entity.spawn_state.act.size:
         # saved before its motors carried servo references, or before its tagged position
         # joints ran their own servos (no activation): the spawn's activations as spawned now

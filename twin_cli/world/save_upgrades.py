@@ -1,0 +1,135 @@
+"""World files saved before joints had velocity motors, loaded into a world that gives them one.
+
+A joint whose tags offer velocity commands now has a velocity motor: a rotor body with a joint,
+an actuator and a tendon (`converters.mjcf.velocity_motors`). A file saved before holds the same
+model without them, so its state is shorter by one qpos, one dof, one actuator and one body per
+motor, and nothing else moved: the rotors were added after every element of their kind, in the
+order each array keeps. Such a state gets the rotors' entries put back in: angle 0, speed that
+of the joint each one drives (the motor holds the joint at the rotor's speed), the rest 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields, replace
+
+import mujoco
+import numpy as np
+
+from twin_cli.world.entities import EntityIndex, EntityState
+from twin_cli.world.snapshot import layout_of
+from twin_cli.world.state import STATE
+from twin_cli.world.velocity_motors import effort_dofs, is_rotor
+
+_S = mujoco.mjtState
+# The state elements whose entries follow the model's qpos, dofs, actuators or bodies (the
+# others keep their size: time, activations, equality flags, mocaps, user data, plugins).
+_PER = {
+    int(_S.mjSTATE_QPOS): "qpos",
+    int(_S.mjSTATE_QVEL): "dof",
+    int(_S.mjSTATE_WARMSTART): "dof",
+    int(_S.mjSTATE_CTRL): "actuator",
+    int(_S.mjSTATE_QFRC_APPLIED): "dof",
+    int(_S.mjSTATE_XFRC_APPLIED): "body",
+}
+_ENTITY_PARTS = {
+    "qpos": ("qpos", "qpos"),
+    "qvel": ("dofs", "dof"),
+    "qacc_warmstart": ("dofs", "dof"),
+    "qfrc_applied": ("dofs", "dof"),
+    "ctrl": ("actuators", "actuator"),
+    "xfrc_applied": ("bodies", "body"),
+}
+
+
+def rotor_masks(model: mujoco.MjModel) -> dict[str, np.ndarray]:
+    """Per qpos entry, dof, actuator and body of `model`: whether it is a velocity motor's."""
+    masks = {
+        "qpos": np.zeros(model.nq, bool),
+        "dof": np.zeros(model.nv, bool),
+        "actuator": np.array([is_rotor(model.actuator(a).name) for a in range(model.nu)], bool),
+        "body": np.array([is_rotor(model.body(b).name) for b in range(model.nbody)], bool),
+    }
+    for j in range(model.njnt):
+        if is_rotor(model.joint(j).name):
+            masks["qpos"][model.jnt_qposadr[j]] = True
+            masks["dof"][model.jnt_dofadr[j]] = True
+    return masks
+
+
+def older_layout(model: mujoco.MjModel, masks: dict[str, np.ndarray]) -> dict[str, int]:
+    """The layout `model` had before it had velocity motors."""
+    sizes = layout_of(model)
+    sizes["nq"] -= int(masks["qpos"].sum())
+    sizes["nv"] -= int(masks["dof"].sum())
+    sizes["nu"] -= int(masks["actuator"].sum())
+    sizes["nbody"] -= int(masks["body"].sum())
+    return sizes
+
+
+def add_rotors(
+    model: mujoco.MjModel, layout: dict[str, int], state: np.ndarray
+) -> tuple[dict[str, int], np.ndarray]:
+    """A world state saved before its joints had velocity motors, with their entries added;
+    any other state unchanged."""
+    masks = rotor_masks(model)
+    if not masks["body"].any() or layout != older_layout(model, masks):
+        return layout, state
+    if np.size(state) != mujoco.mj_stateSize(model, STATE) - _added(model, masks):
+        return layout, state
+    pieces, at = [], 0
+    for bit in (1 << k for k in range(int(_S.mjNSTATE))):
+        if not int(STATE) & bit:
+            continue
+        size = mujoco.mj_stateSize(model, bit)
+        kind = _PER.get(bit)
+        if kind is None:
+            pieces.append(state[at : at + size])
+            at += size
+            continue
+        width = size // len(masks[kind])
+        old = state[at : at + size - width * int(masks[kind].sum())]
+        at += len(old)
+        pieces.append(_widened(old, masks[kind], width))
+    new = np.concatenate(pieces)
+    _rotor_speeds(model, new[1 + model.nq : 1 + model.nq + model.nv])
+    return layout_of(model), new
+
+
+def add_entity_rotors(model: mujoco.MjModel, index: EntityIndex, saved: EntityState) -> EntityState:
+    """An entity's saved spawn state with its velocity motors' entries added, if it lacks them."""
+    if len(saved.qpos) == len(index.qpos):
+        return saved
+    masks = rotor_masks(model)
+    changes = {}
+    for f in fields(EntityState):
+        if f.name not in _ENTITY_PARTS:
+            continue
+        part, kind = _ENTITY_PARTS[f.name]
+        width = 6 if f.name == "xfrc_applied" else 1
+        values = np.asarray(getattr(saved, f.name), float).ravel()
+        wide = _widened(values, masks[kind][getattr(index, part)], width)
+        changes[f.name] = wide.reshape(-1, 6) if width == 6 else wide
+    return replace(saved, **changes)
+
+
+def _added(model: mujoco.MjModel, masks: dict[str, np.ndarray]) -> int:
+    """How many state values the velocity motors add."""
+    total = 0
+    for bit, kind in _PER.items():
+        size = mujoco.mj_stateSize(model, bit)
+        total += size // len(masks[kind]) * int(masks[kind].sum()) if len(masks[kind]) else 0
+    return total
+
+
+def _widened(old: np.ndarray, mask: np.ndarray, width: int) -> np.ndarray:
+    """`old` (one `width`-wide entry per False of `mask`) with zeros where `mask` is True."""
+    out = np.zeros(len(mask) * width)
+    keep = np.repeat(~mask, width)
+    out[keep] = old
+    return out
+
+
+def _rotor_speeds(model: mujoco.MjModel, qvel: np.ndarray) -> None:
+    """Each rotor at the speed of the joint its motor drives (in place)."""
+    joints, rotors = effort_dofs(model)
+    qvel[rotors] = qvel[joints]
