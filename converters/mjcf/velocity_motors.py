@@ -102,9 +102,14 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     body.inertia = [ROTOR_MASS] * 3
     body.ipos = [0.0, 0.0, 0.0]  # an inertial with a position is written to the file
     armature = ARMATURE_RATIO * motor.inertia
-    body.add_joint(name=name, type=joint.type, axis=axis, armature=armature)
+    rotor = body.add_joint(name=name, type=joint.type, axis=axis, armature=armature)
+    # nothing from a default class: the rotor's only force is its actuator and the tendon's
+    rotor.damping, rotor.stiffness = np.zeros(len(rotor.damping)), np.zeros(len(rotor.stiffness))
+    rotor.frictionloss, rotor.springref = 0.0, 0.0
+    rotor.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     actuator = spec.add_actuator(name=name, target=name)
     actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
+    actuator.gear = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     actuator.set_to_velocity(kv=armature / timestep)
     if np.isfinite(motor.speed):
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
@@ -113,6 +118,11 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     tendon.wrap_joint(motor.joint, 1.0)
     tendon.wrap_joint(name, -1.0)
     tendon.frictionloss = motor.effort if motor.engaged else 0.0
+    tendon.damping, tendon.stiffness = (
+        np.zeros(len(tendon.damping)),
+        np.zeros(len(tendon.stiffness)),
+    )
+    tendon.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     tendon.solref_friction = [2.0 * timestep, 1.0]
     tendon.solimp_friction = [SOLIMP, SOLIMP, 0.001, 0.5, 2.0]
 
