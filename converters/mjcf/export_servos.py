@@ -129,7 +129,9 @@ def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records:
     import mujoco
 
     record = records.get(actuator.target)
-    joint = spec.joint(actuator.target) if record is not None else None
+    if record is None:
+        return False
+    joint = spec.joint(actuator.target)
     return (
         joint is not None
         and joint.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)

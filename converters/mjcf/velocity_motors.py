@@ -99,8 +99,8 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     body = parent.add_body(name=name, pos=anchor)
     body.explicitinertial = True
     body.mass = ROTOR_MASS
-    body.inertia = [ROTOR_MASS] * 3
-    body.ipos = [0.0, 0.0, 0.0]  # an inertial with a position is written to the file
+    body.inertia = np.full(3, ROTOR_MASS)
+    body.ipos = np.zeros(3)  # an inertial with a position is written to the file
     armature = ARMATURE_RATIO * motor.inertia
     rotor = body.add_joint(name=name, type=joint.type, axis=axis, armature=armature)
     # nothing from a default class: the rotor's only force is its actuator and the tendon's
@@ -109,7 +109,7 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     rotor.limited = mujoco.mjtLimited.mjLIMITED_FALSE
     actuator = spec.add_actuator(name=name, target=name)
     actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
-    actuator.gear = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    actuator.gear = np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     actuator.set_to_velocity(kv=armature / timestep)
     if np.isfinite(motor.speed):
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
@@ -123,8 +123,8 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
         np.zeros(len(tendon.stiffness)),
     )
     tendon.limited = mujoco.mjtLimited.mjLIMITED_FALSE
-    tendon.solref_friction = [2.0 * timestep, 1.0]
-    tendon.solimp_friction = [SOLIMP, SOLIMP, 0.001, 0.5, 2.0]
+    tendon.solref_friction = np.array([2.0 * timestep, 1.0])
+    tendon.solimp_friction = np.array([SOLIMP, SOLIMP, 0.001, 0.5, 2.0])
 
 
 def _rekey(spec: mujoco.MjSpec, before: mujoco.MjModel) -> None:
