@@ -116,7 +116,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     for joint, motor in motors.items():
         records[joint][VELOCITY_MOTOR] = {"effort": motor.effort, "engaged": motor.engaged}
         servoed.setdefault(joint, records[joint]["modes"][0])
-    add_velocity_motors(spec, list(motors.values()), model, timestep)
+    if motors:  # a robot without velocity joints runs none of it
+        add_velocity_motors(spec, list(motors.values()), model, timestep)
     text.data = json.dumps(records)
     return servoed
 

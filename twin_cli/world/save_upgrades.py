@@ -96,18 +96,20 @@ def add_rotors(
 
 
 def add_entity_rotors(model: mujoco.MjModel, index: EntityIndex, saved: EntityState) -> EntityState:
-    """An entity's saved spawn state with its velocity motors' entries added, if it lacks them."""
-    if len(saved.qpos) == len(index.qpos):
-        return saved
+    """An entity's saved spawn state with its velocity motors' entries added, if it is exactly
+    the state of the entity without them; any other state unchanged (the restore checks it)."""
     masks = rotor_masks(model)
     changes = {}
     for f in fields(EntityState):
         if f.name not in _ENTITY_PARTS:
             continue
         part, kind = _ENTITY_PARTS[f.name]
+        mask = masks[kind][getattr(index, part)]
         width = 6 if f.name == "xfrc_applied" else 1
         values = np.asarray(getattr(saved, f.name), float).ravel()
-        wide = _widened(values, masks[kind][getattr(index, part)], width)
+        if not mask.any() or values.size != width * int((~mask).sum()):
+            return saved
+        wide = _widened(values, mask, width)
         changes[f.name] = wide.reshape(-1, 6) if width == 6 else wide
     return replace(saved, **changes)
 
@@ -123,8 +125,10 @@ def _added(model: mujoco.MjModel, masks: dict[str, np.ndarray]) -> int:
 
 def _widened(old: np.ndarray, mask: np.ndarray, width: int) -> np.ndarray:
     """`old` (one `width`-wide entry per False of `mask`) with zeros where `mask` is True."""
-    out = np.zeros(len(mask) * width)
     keep = np.repeat(~mask, width)
+    if old.size != int(keep.sum()):
+        raise ValueError(f"{old.size} values for {int(keep.sum())} places")
+    out = np.zeros(len(mask) * width)
     out[keep] = old
     return out
 

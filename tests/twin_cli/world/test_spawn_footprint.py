@@ -27,9 +27,9 @@ ROOT = Path(__file__).resolve().parents[3]
 # were looked up from the description, 71 after, 66 with `WHEN_DECLARED`, 67 when attaching an
 # entity to the world's spec left world/spawn.py (499 lines) for world/attach.py. A new module on
 # the path must be needed (raise this, saying why) or run only when the description declares it.
-# 69 with Gazebo's velocity motor: its builder (converters/mjcf/velocity_motors.py, imported by
-# the export every spawn runs) and world/velocity_motors.py (joint states and commands ask it).
-HUMANOID_BOUND = 69
+# 68 with Gazebo's velocity motor: world/velocity_motors.py (joint states and commands ask it;
+# its builder, converters/mjcf/velocity_motors.py, runs only for a robot with velocity joints).
+HUMANOID_BOUND = 68
 PLUGIN_FAMILY = {
     f"converters/gazebo/{name}.py"
     for name in (
