@@ -37,13 +37,17 @@ RIG = f"""<robot name="rig"><link name="world"/><link name="base">{INERTIAL}</li
   </gazebo></robot>"""
 
 
-@pytest.fixture
-def rig(tmp_path: Path) -> World:
+def _spawned(tmp_path: Path, text: str) -> World:
     path = tmp_path / "rig.urdf"
-    path.write_text(RIG)
+    path.write_text(text)
     world = World()
     world.spawn(SpawnRequest(str(path)), name="rig")
     return world
+
+
+@pytest.fixture
+def rig(tmp_path: Path) -> World:
+    return _spawned(tmp_path, RIG)
 
 
 def _state(world: World, joint: str):  # noqa: ANN202
@@ -86,11 +90,7 @@ FORCE_RIG = RIG.replace(
 
 
 def _force_rig(tmp_path: Path) -> World:
-    path = tmp_path / "rig.urdf"
-    path.write_text(FORCE_RIG)
-    world = World()
-    world.spawn(SpawnRequest(str(path)), name="rig")
-    return world
+    return _spawned(tmp_path, FORCE_RIG)
 
 
 def test_a_force_commanded_joint_controller_gets_no_joint_motor(tmp_path: Path) -> None:
