@@ -15,8 +15,8 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
   - a velocity servo (a joint whose first mode is velocity and that has no effort limit) is
     MuJoCo's `intvelocity`: its activation integrates the commanded speed
     into a position the servo tracks. kv = I/h on the joint's reflected inertia I at the home
-    posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I) (the tag's vel_kp and vel_ki where it
-    gives them);
+    posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I); a tag's velocity PID (ros2_control's
+    `velocity_pid`, gz-sim JointController's force commands) is that controller's own law;
   - every joint whose tags offer velocity with a finite effort gets Gazebo's velocity motor
     instead (`velocity_motors`: a rotor and a friction tendon bounded by the effort, which
     stores nothing, where the integral paid a stall back as a burst); its torque motor stays
@@ -232,18 +232,33 @@ def _to_intvelocity(
     """A velocity servo with an integral: MuJoCo's `intvelocity`, whose activation is the
     position the velocity command integrates to and which a position servo tracks, so `ctrl`
     0 holds a loaded joint where it is (a parked base on a slope) and a loaded joint keeps its
-    speed. kv = I/h (or the tag's vel_kp); the integral gain kp = kv²/(4·INTEGRAL_MARGIN·I) (or
-    the tag's vel_ki), as a World's velocity servo on the joint's own inertia. A limited joint's
-    reference stays in its range."""
+    speed. kv = I/h, the integral kp = kv²/(4·INTEGRAL_MARGIN·I), as a World's velocity servo on
+    the joint's own inertia. A limited joint's reference stays in its range.
+
+    A tag's velocity PID is the controller's own law instead (`_to_velocity_pid`)."""
     import mujoco
 
-    damping = float(pid[0]) if pid else kv
-    integral = float(pid[1]) if pid and pid[1] > 0 else damping**2 / (4 * INTEGRAL_MARGIN * inertia)
-    actuator.set_to_intvelocity(kp=integral, kv=damping)
+    if pid:
+        _to_velocity_pid(actuator, pid)
+        return
+    actuator.set_to_intvelocity(kp=kv**2 / (4 * INTEGRAL_MARGIN * inertia), kv=kv)
     joint = spec.joint(actuator.target)
     if joint is not None and joint.limited == mujoco.mjtLimited.mjLIMITED_TRUE:
         actuator.actlimited = mujoco.mjtLimited.mjLIMITED_TRUE
         actuator.actrange = np.asarray(joint.range, dtype=float)
+
+
+def _to_velocity_pid(actuator: mujoco.MjsActuator, pid: tuple) -> None:
+    """ros2_control's `velocity_pid` and gz-sim's JointController with force commands push
+    p·(ω* − ω) + i·∫(ω* − ω) within the effort limit. Without an integral that is MuJoCo's
+    `velocity` actuator (kv = p) exactly. With one it is an `intvelocity` (kp = i, kv = p),
+    whose damping acts on ω alone: the same integral and steady speed, but a command's step
+    reaches the force through the integral, not at once as p·Δω* (the plugin's notes say so)."""
+    p, i = float(pid[0]), float(pid[1])
+    if i > 0.0:
+        actuator.set_to_intvelocity(kp=i, kv=p)
+    else:
+        actuator.set_to_velocity(kv=p)
 
 
 def _force_bound(actuator: mujoco.MjsActuator) -> float:
