@@ -73,6 +73,7 @@ def _link_name(state: WorldState, name: str, ix: EntityIndex, link: str | None) 
     links = [
         n.removeprefix(f"{name}/")
         for n in element_names(state.model, state.model.name_bodyadr[ix.bodies])
+        if not velocity_motors.is_rotor(n)  # a motor's reference, not a link to push
     ]
     if link is None and links:
         return f"{name}/{links[0]}"

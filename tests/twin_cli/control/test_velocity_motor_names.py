@@ -36,3 +36,39 @@ def test_a_nested_joint_named_motor_is_listed_and_commanded(tmp_path: Path, spee
     world.step(500)
     state = {s.name: s for s in world.joint_states("bot")}["arm::motor"]
     assert state.velocity == pytest.approx(speed, rel=1e-3), f"{state.velocity} rad/s"
+
+
+SPINNER = """<robot name="bot"><link name="world"/>
+<link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0"
+  ixz="0" iyz="0"/></inertial></link>
+<link name="disc"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0"
+  ixz="0" iyz="0"/></inertial></link>
+<joint name="anchor" type="fixed"><parent link="world"/><child link="base"/></joint>
+<joint name="spin" type="continuous"><parent link="base"/><child link="disc"/>
+  <axis xyz="0 0 1"/><limit effort="5" velocity="10"/></joint>
+<ros2_control name="s" type="system"><hardware><plugin>gz_ros2_control/GazeboSimSystem</plugin>
+  </hardware><joint name="spin"><command_interface name="velocity"/>
+  <command_interface name="effort"/><state_interface name="velocity"/></joint>
+</ros2_control></robot>"""
+
+
+def test_a_rotor_is_no_link_to_push(tmp_path: Path) -> None:
+    """Only the robot's own links take a push: the rotor body is the motor's speed reference."""
+    from converters.mjcf.velocity_motors import rotor_name
+    from twin_cli.errors import PartNotFoundError
+
+    path = tmp_path / "bot.urdf"
+    path.write_text(SPINNER)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bot")
+    rotor = rotor_name("spin")
+    bodies = [world.model.body(b).name for b in range(world.model.nbody)]
+    assert f"bot/{rotor}" in bodies, f"the joint has its velocity motor: {bodies}"
+    with pytest.raises(PartNotFoundError) as caught:
+        world.push("bot", torque=(0.0, 0.0, 1.0), link=rotor)
+    assert "velocity_motor" not in str(caught.value).split("its links:", 1)[1], caught.value
+    world.command_joints("bot", {"spin": 0.0}, mode="effort")  # the disc free to turn
+    world.push("bot", torque=(0.0, 0.0, 0.01), link="disc", duration=0.1)
+    world.step(100)
+    speed = {s.name: s for s in world.joint_states("bot")}["spin"].velocity
+    assert speed == pytest.approx(0.1, rel=0.02), "the disc takes the push: τ·t/I"
