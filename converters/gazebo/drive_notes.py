@@ -143,7 +143,6 @@ USED: dict[str, set[str]] = {
         "joint_name",
         "use_force_commands",
         "p_gain",
-        "i_gain",
         "cmd_max",
         "initial_velocity",  # held from load (twin_cli.world.plugin_holds)
     },
@@ -159,11 +158,6 @@ USED: dict[str, set[str]] = {
 }
 
 APPROXIMATED: dict[str, tuple[str, ...]] = {
-    "gz-sim-joint-controller-system": (
-        "with use_force_commands its PID is the joint's servo: p alone is MuJoCo's velocity "
-        "actuator, exactly its law; with an i_gain an intvelocity, whose step in the command "
-        "reaches the force through the integral rather than at once as p times the step",
-    ),
     "gazebo_ros_skid_steer_drive": (
         "four wheels driven as the two sides of a diff drive, as the plugin does; in a turn "
         "they slide sideways and the base turns as their friction lets it, slower than the "

@@ -87,14 +87,21 @@ def _rule_text(record: dict, control: JointControl | None) -> str:
     if record["source"] == "default":
         why = "no control tag" if control is None else "its tags declare none twin drives"
         return f"{modes} ({why}); servo gains from the reflected inertia"
-    gains = ", ".join(
-        f"{mode} PID kp={g[0]:g} kd={g[2]:g}" + (f" (ki={g[1]:g} not run)" if g[1] else "")
-        for mode, g in record["pid"].items()
-    )
+    gains = ", ".join(_pid_text(mode, g) for mode, g in record["pid"].items())
     rule = gains or "servo gains from the reflected inertia"
     plugin = record["plugin"] or "no gazebo_ros(2)_control plugin: Gazebo would not drive it"
     tags = " and ".join(f"<{kind}>" for kind in record["source"].split("+"))
     return f"{modes} from {tags}; {rule}; {plugin}"
+
+
+def _pid_text(mode: str, gains: tuple) -> str:
+    """A tag PID as twin runs it: a position PID's kp and kd; a velocity PID's p on the speed
+    error (`export_servos._to_velocity_pid`); the gains it does not run named."""
+    p, i, d = gains
+    if mode == "velocity":
+        unused = ", ".join(f"{k}={v:g}" for k, v in (("ki", i), ("kd", d)) if v)
+        return f"velocity PID kp={p:g}" + (f" ({unused} not run)" if unused else "")
+    return f"{mode} PID kp={p:g} kd={d:g}" + (f" (ki={i:g} not run)" if i else "")
 
 
 def _mode_text(mode: str, bounds: dict) -> str:

@@ -58,6 +58,7 @@ EXPORTED = "exported_motor"  # record key: the torque motor a servo replaced in 
 VELOCITY_MOTOR = "velocity_motor"  # record key: the joint's velocity motor (`velocity_motors`)
 MOTOR_JOINTS = ("hinge", "slide")  # joint kinds a velocity motor's rotor can copy
 UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag commands
+FOLLOW_TAU = 1e-12  # [s] time constant of an activation that follows ctrl within one step
 SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
 
@@ -122,6 +123,16 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     return servoed
 
 
+def tag_pid(record: dict, mode: str) -> tuple | None:
+    """The (p, i, d) gains a joint's tags give `mode`'s PID, or None. A velocity PID without a
+    p gain is none: gazebo_ros2_control then sets the joint's velocity, as for a plain velocity
+    interface, rather than run a loop that pushes nothing."""
+    pid = record.get("pid", {}).get(mode)
+    if not pid or (mode == "velocity" and float(pid[0]) <= 0.0):
+        return None
+    return tuple(pid)
+
+
 def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
     """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
     offer velocity commands, with a finite effort limit (the motor's bound), and give no velocity
@@ -143,7 +154,7 @@ def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records:
         and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
         and record.get("source") not in UNTAGGED_SOURCES
         and "velocity" in record.get("modes", ())
-        and not record.get("pid", {}).get("velocity")  # a tag PID is a force loop, kept as such
+        and tag_pid(record, "velocity") is None  # a tag PID is a force loop, kept as such
         and VELOCITY_MOTOR not in record
     )
 
@@ -208,7 +219,7 @@ def _to_servo(
         mujoco.mjtLimited.mjLIMITED_TRUE if np.isfinite(high) else mujoco.mjtLimited.mjLIMITED_FALSE
     )
     actuator.ctrlrange = np.array([low, high]) if np.isfinite(high) else np.zeros(2)
-    pid = record.get("pid", {}).get(mode)
+    pid = tag_pid(record, mode)
     if mode == "position":
         if pid:  # the world's rule: kv = max(kd, 2√(kp·I)), at most I/h with an effort limit
             kp = float(pid[0])
@@ -235,7 +246,7 @@ def _to_intvelocity(
     speed. kv = I/h, the integral kp = kv²/(4·INTEGRAL_MARGIN·I), as a World's velocity servo on
     the joint's own inertia. A limited joint's reference stays in its range.
 
-    A tag's velocity PID is the controller's own law instead (`_to_velocity_pid`)."""
+    A tag's velocity PID is its controller's own law instead (`_to_velocity_pid`)."""
     import mujoco
 
     if pid:
@@ -250,15 +261,20 @@ def _to_intvelocity(
 
 def _to_velocity_pid(actuator: mujoco.MjsActuator, pid: tuple) -> None:
     """ros2_control's `velocity_pid` and gz-sim's JointController with force commands push
-    p·(ω* − ω) + i·∫(ω* − ω) within the effort limit. Without an integral that is MuJoCo's
-    `velocity` actuator (kv = p) exactly. With one it is an `intvelocity` (kp = i, kv = p),
-    whose damping acts on ω alone: the same integral and steady speed, but a command's step
-    reaches the force through the integral, not at once as p·Δω* (the plugin's notes say so)."""
-    p, i = float(pid[0]), float(pid[1])
-    if i > 0.0:
-        actuator.set_to_intvelocity(kp=i, kv=p)
-    else:
-        actuator.set_to_velocity(kv=p)
+    p·(ω* − ω) (+ i·∫(ω* − ω)) within the effort limit. The p term is MuJoCo's velocity law,
+    force = p·(ctrl − q̇), written as a general actuator whose one activation follows ctrl within
+    the step (`filterexact`, τ FOLLOW_TAU, `actearly`): the force of a `velocity` actuator to the
+    last bit, and the activation slot such a joint had as an `intvelocity` before, so that world
+    files saved then load unchanged. The integral and derivative gains are reported, not run:
+    one actuator cannot add ∫ctrl to p·ctrl, and the `intvelocity` (kp = i, kv = p) that tried
+    took p/i seconds to answer a step (5 s at p 0.5, i 0.1), where the PID answers at once."""
+    import mujoco
+
+    p = float(pid[0])
+    actuator.set_to_velocity(kv=p)
+    actuator.dyntype = mujoco.mjtDyn.mjDYN_FILTEREXACT
+    actuator.dynprm = np.array([FOLLOW_TAU] + [0.0] * (len(actuator.dynprm) - 1))
+    actuator.actearly = True
 
 
 def _force_bound(actuator: mujoco.MjsActuator) -> float:

@@ -33,6 +33,7 @@ _NONE = mujoco.mjtBias.mjBIAS_NONE
 _FIXED = mujoco.mjtGain.mjGAIN_FIXED
 _INTEGRATOR = mujoco.mjtDyn.mjDYN_INTEGRATOR
 _NO_DYN = mujoco.mjtDyn.mjDYN_NONE
+_FOLLOW = mujoco.mjtDyn.mjDYN_FILTEREXACT  # a tag velocity PID's activation (native_servos)
 
 
 @dataclass(frozen=True)
@@ -130,8 +131,9 @@ def apply_command(
         return
     if law is not None:
         native_servos.lift(model, a, law)
-    if model.actuator_dyntype[a] == _INTEGRATOR and not servos.has_reference(model, a):
-        model.actuator_dyntype[a] = _NO_DYN  # a model's intvelocity in another mode: no integral
+    own_dynamics = model.actuator_dyntype[a] in (_INTEGRATOR, _FOLLOW)
+    if own_dynamics and not servos.has_reference(model, a):
+        model.actuator_dyntype[a] = _NO_DYN  # a model's own servo in another mode: ctrl alone
         model.actuator_actlimited[a] = 0
     gear = abs(model.actuator_gear[a][0]) or 1.0
     limit = cmd.effort / gear

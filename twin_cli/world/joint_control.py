@@ -236,6 +236,7 @@ def servo_rule(
         carried: the inertia the joint carries through its contacts (`carried_inertia`).
     """
     pid = limits.pid.get(mode)
+    pid = None if pid and mode == "velocity" and pid[0] <= 0 else pid  # as `tag_pid`
     if reference:
         speed = servos.SPEED_MARGIN * limits.velocity if step > 0 else math.inf  # inf: a hold
         motion = (speed, step)
@@ -275,9 +276,8 @@ def _reference_rule(
     rule = "carried inertia"
     if pid and mode == "position":
         kp, kv, rule = pid[0], max(pid[2], 2.0 * math.sqrt(pid[0] * own)), "tag PID (pos_*)"
-    elif pid:
-        kp = pid[1] if pid[1] > 0 else kp
-        kv, rule = pid[0], "tag PID (vel_kp" + (", vel_ki)" if pid[1] > 0 else ")")
+    elif pid:  # the controller's p·(ω* − ω); its integral is not run, as in the export
+        kp, kv, rule = 0.0, pid[0], "tag PID (vel_kp" + ("; vel_ki not run)" if pid[1] else ")")
     if pid and math.isfinite(effort) and kv > own / timestep:
         kv, rule = own / timestep, f"{rule}, damping capped at I/h"
     return kp, kv, rule

@@ -42,6 +42,7 @@ FIELDS = (
     "forcerange",
     "actlimited",
     "actrange",
+    "actearly",
 )
 RULE = "the model's own {} servo: ctrl = target"  # what `twin joints` shows
 ROTOR_THRUST = ":thrust"  # a rotor's joint motor (converters.gazebo.multicopter) is not a servo
@@ -49,6 +50,7 @@ _FIXED = int(mujoco.mjtGain.mjGAIN_FIXED)
 _AFFINE = int(mujoco.mjtBias.mjBIAS_AFFINE)
 _NONE = int(mujoco.mjtDyn.mjDYN_NONE)
 _INTEGRATOR = int(mujoco.mjtDyn.mjDYN_INTEGRATOR)
+_FOLLOW = int(mujoco.mjtDyn.mjDYN_FILTEREXACT)  # an activation that follows ctrl (actearly)
 _JOINT = int(mujoco.mjtTrn.mjTRN_JOINT)
 
 
@@ -91,7 +93,8 @@ def mode_of(model: mujoco.MjModel, a: int) -> str | None:
         return None
     if bias[1] == -gain and dyn in (_NONE, _INTEGRATOR):
         return "position" if dyn == _NONE else "velocity"
-    if bias[1] == 0.0 and bias[2] == -gain and dyn == _NONE:
+    follows = dyn == _FOLLOW and bool(model.actuator_actearly[a])  # a tag's velocity PID
+    if bias[1] == 0.0 and bias[2] == -gain and (dyn == _NONE or follows):
         return "velocity"
     return None
 

@@ -7,10 +7,10 @@ d_gain 2). Oracle: the commanded speed and angle; the joints offer only the plug
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import pytest
+from pid_law import pid_law
 
 from converters.mjcf.velocity_motors import rotor_name
 from twin_cli.errors import InvalidRequestError
@@ -82,27 +82,17 @@ def test_a_joint_controllers_joint_offers_only_its_mode(
     assert f"--mode {offered}" in str(caught.value), "the message names the fix"
 
 
-def _force_rig(tmp_path: Path, p_gain: float = 0.5) -> World:
-    """The rig with the fan's JointController on force commands: p_gain, cmd_max 2 N m."""
+def _force_rig(tmp_path: Path, p_gain: float = 0.5, i_gain: float = 0.0) -> World:
+    """The rig with the fan's JointController on force commands: p_gain, i_gain, cmd_max 2 N m."""
     text = RIG.replace(
         "<joint_name>fan_joint</joint_name></plugin>",
         "<joint_name>fan_joint</joint_name><use_force_commands>true</use_force_commands>"
-        f"<p_gain>{p_gain}</p_gain><cmd_max>{CMD_MAX}</cmd_max></plugin>",
+        f"<p_gain>{p_gain}</p_gain><i_gain>{i_gain}</i_gain><cmd_max>{CMD_MAX}</cmd_max></plugin>",
     )
     return _spawned(tmp_path, text)
 
 
-CMD_MAX, DISC = 2.0, 0.01  # the force rig's cmd_max [N m] and the disc's inertia [kg m²]
-
-
-def _pid_law(target: float, p: float, t: float) -> float:
-    """The disc's speed t s after a step to `target` under p·(ω* − ω) clamped to ±CMD_MAX:
-    a constant acceleration CMD_MAX/I while the clamp binds, then an exponential approach."""
-    clamped = max(0.0, (target - CMD_MAX / p) * DISC / CMD_MAX)  # how long the clamp binds
-    if t <= clamped:
-        return CMD_MAX * t / DISC
-    start = CMD_MAX * clamped / DISC
-    return target - (target - start) * math.exp(-p * (t - clamped) / DISC)
+CMD_MAX = 2.0  # [N m] the force rig's cmd_max
 
 
 def test_a_force_commanded_joint_controller_gets_no_joint_motor(tmp_path: Path) -> None:
@@ -113,19 +103,21 @@ def test_a_force_commanded_joint_controller_gets_no_joint_motor(tmp_path: Path) 
     assert rotor_name("rig/fan_joint") not in tendons, tendons
 
 
-@pytest.mark.parametrize("p_gain", [0.2, 0.5, 5.0])
+@pytest.mark.parametrize(("p_gain", "i_gain"), [(0.2, 0.0), (0.5, 0.0), (5.0, 0.0), (0.5, 0.1)])
 def test_a_force_commanded_joint_controller_closes_its_pid_not_a_rigid_motor(
-    tmp_path: Path, p_gain: float
+    tmp_path: Path, p_gain: float, i_gain: float
 ) -> None:
-    """With `use_force_commands` gz-sim's JointController pushes p·(ω* − ω) within cmd_max:
-    the 0.01 kg m² disc spins up as that law says (at p 5 the clamp binds for 13 ms), not at
-    once as the joint motor of a plain velocity command would (2 N m: 3 rad/s in 15 ms)."""
-    world = _force_rig(tmp_path, p_gain)
+    """With `use_force_commands` gz-sim's JointController pushes p·(ω* − ω) + i·∫(ω* − ω)
+    within cmd_max: the 0.01 kg m² disc spins up as that law says (at p 5 the clamp binds for
+    13 ms), not at once as the joint motor of a plain velocity command would (2 N m: 3 rad/s in
+    15 ms), nor through its integral alone (an intvelocity with kp = i, kv = p: 0.001 rad/s at
+    10 ms and 0.54 at 1 s for p 0.5, i 0.1). twin runs p; an i_gain of 0.1 adds under 2 % here."""
+    world = _force_rig(tmp_path, p_gain, i_gain)
     world.command_joints("rig", {"fan_joint": 3.0}, mode="velocity")
     h, elapsed = world.model.opt.timestep, 0.0
     for t in (0.005, 0.01, 0.02, 0.04, 0.1):
         world.step(round((t - elapsed) / h))
         elapsed = t
-        expected = _pid_law(3.0, p_gain, t)
+        expected = pid_law(3.0, p_gain, i_gain, t, cmd_max=CMD_MAX)
         speed = _state(world, "fan_joint").velocity
         assert speed == pytest.approx(expected, rel=0.05), f"{speed:.4f} rad/s at {t} s"
