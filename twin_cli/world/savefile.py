@@ -245,7 +245,7 @@ def _natives(world: World, laws: dict, commands: list[JointCommand], state: np.n
     out = {}
     for cmd in commands:
         law = laws.get(cmd.actuator)
-        if law is not None and law.mode == cmd.mode and not cmd.native:
+        if law is not None and law.mode == cmd.mode:  # a saved native row: today's law
             rule = native_servos.rule(law)
             cmd = renew(cmd, kp=law.kp, kv=law.kv, feedforward=0.0, rule=rule, native=True)
         out[cmd.actuator] = cmd
