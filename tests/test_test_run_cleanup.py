@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 from corpus_registry import REPO_ROOT
 from reaper import processes_with
+from signal_state import signal_state
 
 READY_TIMEOUT_S = 90.0  # [s] the inner run starts pytest, then a world (imports mujoco)
 GONE_TIMEOUT_S = 20.0  # [s] the reaper's SIGTERM grace is 5 s
@@ -79,7 +80,13 @@ def test_an_interrupted_run_leaves_no_twin_process(tmp_path: Path, how: str) -> 
         os.killpg(inner.pid, signal.SIGINT)  # what a terminal sends its foreground job
     else:
         inner.send_signal(signal.SIGTERM)  # what make sends the command it runs
-    inner.wait(timeout=60)
+    try:
+        inner.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        state = signal_state(inner.pid)  # what it was doing, before the kill below ends it
+        os.killpg(inner.pid, signal.SIGKILL)
+        inner.wait()
+        pytest.fail(f"{how}: the inner run still running 60 s after the signal: {state}")
     deadline = time.monotonic() + GONE_TIMEOUT_S
     while processes_with(*marker) and time.monotonic() < deadline:
         time.sleep(0.1)

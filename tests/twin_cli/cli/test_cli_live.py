@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from models import CONTROL_RIG, two_wheel_bot
 from sensor_models import imu_box, lidar_post
+from signal_state import signal_state
 
 import scenarios
 
@@ -266,7 +267,13 @@ def test_echo_prints_text_and_ends_cleanly_on_ctrl_c_and_a_closed_pipe(world):
     )  # fmt: skip
     assert proc.stdout is not None and proc.stdout.readline(), "a first message"
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=30)
+    try:
+        _, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        state = signal_state(proc.pid)  # what it was doing, before the kill below ends it
+        proc.kill()
+        proc.communicate()
+        pytest.fail(f"`twin topics echo` still running 30 s after Ctrl-C: {state}")
     assert proc.returncode == 0 and "Traceback" not in err, f"Ctrl-C: {proc.returncode} {err}"
 
 
