@@ -97,7 +97,12 @@ class BagRecording(Follows):
         """Starts the encoder, takes the first sample now and follows the world's stepping."""
         fds = (self._ring_fd, self._child.fileno())
         command = self._encoder_command(fds)
-        self._process = subprocess.Popen(command, pass_fds=fds, stdin=subprocess.DEVNULL)
+        # A session of its own: a Ctrl-C to the terminal's group could reach the encoder before
+        # its first line ignores it (its start-up takes seconds on a busy host), and end it with
+        # the file the server opened still empty. The server tells it when to stop.
+        self._process = subprocess.Popen(
+            command, pass_fds=fds, stdin=subprocess.DEVNULL, start_new_session=True
+        )
         os.close(self._ring_fd)
         self._child.close()
         self._pump.start()

@@ -118,13 +118,29 @@ def _last_stamps(path: Path) -> dict[str, float]:
 ENDINGS = ["twin stop", "SIGTERM", "SIGINT to the group", "SIGTERM to the group"]
 
 
+def test_a_ctrl_c_while_the_encoder_starts_leaves_a_finished_file(tmp_path, serve_world):
+    """Ctrl-C to the world's group the moment its encoder process exists, before the encoder's
+    imports: the world ends and the file it opened still gets its header and summary."""
+    out, rt = tmp_path / "run.mcap", tmp_path / "rt"
+    with serve_world(rt, "early", "--record", str(out), new_session=True) as (_, proc):
+        encoder = _encoder_of(proc.pid)
+        os.killpg(proc.pid, signal.SIGINT)
+        proc.wait(timeout=STOP_PATIENCE_S)
+        deadline = time.monotonic() + 60.0
+        while _alive(encoder) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not _alive(encoder), "the encoder outlived its world"
+    assert "/clock" in _summary(out), "the file has its summary"
+
+
 @pytest.mark.parametrize("ending", ENDINGS)
 def test_a_recording_world_that_is_stopped_leaves_a_finished_file_and_no_process(
     tmp_path: Path, ending: str, serve_world
 ) -> None:
     """Recording from the start (`--record`), a humanoid spawned: however the world is asked to
     end, it ends well within `twin stop`'s patience, the file has its summary and rosbag2
-    metadata, and no encoder is left behind. A signal to the group reaches the encoder too."""
+    metadata, and no encoder is left behind. A signal to the group ends the world, which
+    stops its encoder."""
     out, rt = tmp_path / "run.mcap", tmp_path / "rt"
     with serve_world(rt, "ends", "--record", str(out), new_session=True) as (client, proc):
         client.spawn(HUMANOID, name="h", pose={"z": 1.0})
