@@ -52,6 +52,8 @@ A velocity step makes it store the lag of the damping term and give it back as o
 overestimated; the integral then settles a load in about 4·INTEGRAL_MARGIN·I_c/kv."""
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+
     import mujoco
 
 EXPORTED = "exported_motor"  # record key: the torque motor a servo replaced in the file
@@ -123,11 +125,11 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     return servoed
 
 
-def tag_pid(record: dict, mode: str) -> tuple | None:
-    """The (p, i, d) gains a joint's tags give `mode`'s PID, or None. A velocity PID without a
-    p gain is none: gazebo_ros2_control then sets the joint's velocity, as for a plain velocity
-    interface, rather than run a loop that pushes nothing."""
-    pid = record.get("pid", {}).get(mode)
+def tag_pid(pids: Mapping[str, Sequence[float]], mode: str) -> tuple | None:
+    """The (p, i, d) gains a joint's tags give `mode`'s PID (`pids`: a control record's "pid"),
+    or None. A velocity PID without a p gain is none: gazebo_ros2_control then sets the joint's
+    velocity, as for a plain velocity interface, rather than run a loop that pushes nothing."""
+    pid = pids.get(mode)
     if not pid or (mode == "velocity" and float(pid[0]) <= 0.0):
         return None
     return tuple(pid)
@@ -154,7 +156,7 @@ def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records:
         and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
         and record.get("source") not in UNTAGGED_SOURCES
         and "velocity" in record.get("modes", ())
-        and tag_pid(record, "velocity") is None  # a tag PID is a force loop, kept as such
+        and tag_pid(record.get("pid", {}), "velocity") is None  # a tag PID: a force loop
         and VELOCITY_MOTOR not in record
     )
 
@@ -219,7 +221,7 @@ def _to_servo(
         mujoco.mjtLimited.mjLIMITED_TRUE if np.isfinite(high) else mujoco.mjtLimited.mjLIMITED_FALSE
     )
     actuator.ctrlrange = np.array([low, high]) if np.isfinite(high) else np.zeros(2)
-    pid = tag_pid(record, mode)
+    pid = tag_pid(record.get("pid", {}), mode)
     if mode == "position":
         if pid:  # the world's rule: kv = max(kd, 2√(kp·I)), at most I/h with an effort limit
             kp = float(pid[0])
@@ -229,29 +231,22 @@ def _to_servo(
             speed = record.get("velocity_limit")
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
         actuator.set_to_position(kp=kp, kv=kv)
+    elif pid:
+        _to_velocity_pid(actuator, pid)
     else:
-        _to_intvelocity(spec, actuator, pid, inertia, kv)
+        _to_intvelocity(spec, actuator, inertia, kv)
 
 
 def _to_intvelocity(
-    spec: mujoco.MjSpec,
-    actuator: mujoco.MjsActuator,
-    pid: tuple | None,
-    inertia: float,
-    kv: float,
+    spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, inertia: float, kv: float
 ) -> None:
     """A velocity servo with an integral: MuJoCo's `intvelocity`, whose activation is the
     position the velocity command integrates to and which a position servo tracks, so `ctrl`
     0 holds a loaded joint where it is (a parked base on a slope) and a loaded joint keeps its
     speed. kv = I/h, the integral kp = kv²/(4·INTEGRAL_MARGIN·I), as a World's velocity servo on
-    the joint's own inertia. A limited joint's reference stays in its range.
-
-    A tag's velocity PID is its controller's own law instead (`_to_velocity_pid`)."""
+    the joint's own inertia. A limited joint's reference stays in its range."""
     import mujoco
 
-    if pid:
-        _to_velocity_pid(actuator, pid)
-        return
     actuator.set_to_intvelocity(kp=kv**2 / (4 * INTEGRAL_MARGIN * inertia), kv=kv)
     joint = spec.joint(actuator.target)
     if joint is not None and joint.limited == mujoco.mjtLimited.mjLIMITED_TRUE:

@@ -27,6 +27,7 @@ import mujoco
 import numpy as np
 
 from converters.description import MODES
+from converters.mjcf.export_servos import tag_pid
 from twin_cli.world import servos
 
 # ω·dt of the position servo's spring (MuJoCo's implicit integrators leave springs explicit: < 2)
@@ -235,8 +236,7 @@ def servo_rule(
             otherwise the older rules below (actuators with their own bias or dynamics).
         carried: the inertia the joint carries through its contacts (`carried_inertia`).
     """
-    pid = limits.pid.get(mode)
-    pid = None if pid and mode == "velocity" and pid[0] <= 0 else pid  # as `tag_pid`
+    pid = tag_pid(limits.pid, mode)
     if reference:
         speed = servos.SPEED_MARGIN * limits.velocity if step > 0 else math.inf  # inf: a hold
         motion = (speed, step)

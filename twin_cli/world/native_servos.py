@@ -2,7 +2,8 @@
 
 A robot's file gives some joints a MuJoCo servo bounded by its `forcerange`: a `position`
 actuator (force = kp·(ctrl − q) − kv·q̇), an `intvelocity` (its activation integrates ctrl into a
-position that a position servo tracks) or a `velocity` actuator (force = kv·(ctrl − q̇)). twin's
+position that a position servo tracks) or a `velocity` actuator (force = kv·(ctrl − q̇); a tag's
+velocity PID is that law on an activation that follows ctrl within the step). twin's
 export writes them for the joints a robot's tags command by position or velocity
 (`converters.mjcf.export_servos`), and a World spawning a description writes the same ones, so a
 Menagerie model, a `twin convert` file and the description it came from all carry their servos
