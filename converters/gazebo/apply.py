@@ -115,7 +115,7 @@ def _apply_surface(
         geom.condim = max(int(geom.condim), 4)
     geom.friction = np.array(friction)
     geom.priority = friction_priority(mu)
-    if mu <= 0.0:  # Gazebo's μ 0 is frictionless; a zero-width friction pyramid is singular
+    if mu <= 0.0:  # Gazebo's μ 0 is frictionless; a zero-width friction cone is singular
         geom.condim = 1
     if surface.declares_bitmask:  # `collide_bits` runs only for a surface that has one
         bits = collide_bits.collide_bits(surface.category_bitmask, surface.collide_bitmask)
@@ -123,13 +123,11 @@ def _apply_surface(
         geom.contype, geom.conaffinity = bits.contype, bits.conaffinity
     # Untagged surfaces get SDF's defaults (kp 1e12, kd 1): rigid, i.e. the stiffest S the
     # step resolves. MuJoCo's own default (solref 0.02 s) let ABB's wrist sink 23 mm.
-    softness = contact_softness(
-        surface.kp, surface.kd, masses.of(origin.body), mu=mu, condim=int(geom.condim)
-    )
+    softness = contact_softness(surface.kp, surface.kd, masses.of(origin.body))
     geom.solref = np.array(softness.solref)
     geom.solimp = np.array(softness.solimp)
     if surface.kp is not None or surface.kd is not None:
-        _report_softness(origin, surface, softness, masses.of(origin.body), mu, report)
+        _report_softness(origin, surface, softness, masses.of(origin.body), report)
 
 
 def _report_softness(
@@ -137,7 +135,6 @@ def _report_softness(
     surface: Surface,
     softness: ContactSoftness,
     mass: float,
-    geom_mu: float,
     report: Report,
 ) -> None:
     subject = f"link '{origin.link}' geom '{origin.geom}'"
@@ -146,20 +143,7 @@ def _report_softness(
         f"solref={softness.solref[0]:.6g} {softness.solref[1]:.6g}; rest sinkage "
         f"{softness.sinkage * 1e3:.4g} mm (Gazebo {softness.sinkage_gazebo * 1e3:.4g} mm)"
     )
-    if abs(softness.pyramid_softening - 1.0) > 0.01:
-        report.approximated(
-            subject,
-            figures + f"; at μ {geom_mu:g} MuJoCo's pyramidal friction cone makes the rest "
-            f"sinkage {softness.pyramid_softening:.3g} times the single contact's "
-            "(docs/contacts.md)"
-            + (
-                "; stiffer than MuJoCo's rigid contact reproduces: clamped"
-                if softness.clamped
-                else ""
-            ),
-            tag="kp",
-        )
-    elif softness.clamped:
+    if softness.clamped:
         report.approximated(
             subject,
             figures + "; stiffer than MuJoCo's rigid contact reproduces: clamped (sinks microns)",
@@ -202,9 +186,9 @@ def _report_surface(subject: str, surface: Surface, report: Report) -> None:
     if surface.mu1 is not None and contact_mu(surface.mu1) < surface.mu1:
         report.approximated(
             subject,
-            f"μ1={surface.mu1:g} → {CONTACT_MU_MAX:g}: in MuJoCo's pyramidal friction cone a "
-            f"larger μ lets the contact sink (wheels to their axles at μ 50); μ "
-            f"{CONTACT_MU_MAX:g} already holds on a 63° slope",
+            f"μ1={surface.mu1:g} → {CONTACT_MU_MAX:g}: in MuJoCo a larger μ lets the contact "
+            f"sink (wheels to their axles at μ 100); μ {CONTACT_MU_MAX:g} already holds on a "
+            "63° slope",
             tag="mu1",
         )
     elif surface.mu1 is not None:

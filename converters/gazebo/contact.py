@@ -28,14 +28,9 @@ m·g/kp exactly (S = (1 - d)·kp/m, m the mass of the geom's body) and its behav
 A contact through the centre of mass (a ball) reproduces kp exactly; a cube resting on a face
 has m/4 at each corner (kp/4 each), as before.
 
-Friction coefficient. The rule above is that of a single normal row (MuJoCo's elliptic cone, or
-a frictionless contact). twin's worlds use MuJoCo's pyramidal cone, whose contact is 2·(condim−1)
-edge rows n ± μ·t sharing one regulariser, 2·μ²·(1 + μ²)·R_n at impratio 1 (chosen by MuJoCo so
-that the edges' friction matches the elliptic cone's). Along the normal the edges act as one row
-of regulariser ρ·R_n, ρ = μ²·(1 + μ²)/(condim − 1) (`pyramid_softening`): 1 at μ 1 and condim 3,
-0.005 at μ 0.1, 3.66 at μ 1.5, and a ball rests at ρ·m·g/kp. The impedance that would undo ρ is
-shared by the friction rows, and lowering it below μ 1 made parked robots creep (docs/contacts.md
-gives the figures), so the settings stay those of the row and the report states the sinkage.
+Friction coefficient. The rule above is that of a single normal row, which is what a contact is
+along its normal in twin's worlds at every μ: they use MuJoCo's elliptic friction cone
+(`converters.mjcf.world_options.CONE`), whose friction rows have regularisers of their own.
 """
 
 from __future__ import annotations
@@ -61,14 +56,11 @@ GAZEBO_STEP = 0.001
 """SDF default `max_step_size` [s]; the step the kp/kd mapping is checked for."""
 
 CONTACT_MU_MAX = 2.0
-"""Largest μ a robot's or model's geom gets. MuJoCo's pyramidal friction cone (twin's worlds use
-it, as ODE uses a friction pyramid) builds a contact from the edges n ± μ·t, so with a large μ
-every edge is nearly tangential and the contact gives way along the normal (`pyramid_softening`).
-Measured on a cart of four wheels: rest sinkage 0.007 mm at μ 2, 0.24 mm at 5, 5.4 mm at 10
-(40 kg chassis; 0.05, 0.23, 0.68, 1.6 mm at μ 2-5 for 400 kg), and at μ 50-100 the wheels sink
-to their axles and the chassis rests on the ground. Gazebo robots write μ 100 or 1e5 to mean "no
-slip"; μ 2 already holds on a 63° slope. Gazebo's ground plane keeps its μ 100: the min-μ rule
-lets the capped robot geom decide the pair."""
+"""Largest μ a robot's or model's geom gets. With a large μ MuJoCo's friction rows carry the
+contact and it gives way along the normal: a 40 kg cart on four wheels rests 0.35 mm low at μ 10
+and sinks to its axles at μ 100 (elliptic cone; on the pyramidal cone 0.24 mm at μ 5). Gazebo
+robots write μ 100 or 1e5 to mean "no slip"; μ 2 already holds on a 63° slope. Gazebo's ground
+plane keeps its μ 100: the min-μ rule lets the capped robot geom decide the pair."""
 MU_MIN = 1e-6
 MU_MAX = 1e9
 PRIORITY_PER_DECADE = 1000
@@ -110,8 +102,7 @@ class ContactSoftness:
 
     `solref` is direct (-S [1/s²], -B [1/s]); `clamped` is True when the surface is stiffer
     than HARD_IMPEDANCE reproduces; `damping_ratio_gazebo` is kd/(2·sqrt(kp·m)) and
-    `damping_ratio` the one used, B/(2·√S); `sinkage` is MuJoCo's at rest under 9.8 m/s², which
-    is `pyramid_softening` times the single row's (1 at μ 1).
+    `damping_ratio` the one used, B/(2·√S); `sinkage` is MuJoCo's at rest under 9.8 m/s².
     """
 
     solref: tuple[float, float]
@@ -121,7 +112,6 @@ class ContactSoftness:
     damping_ratio: float
     sinkage_gazebo: float
     sinkage: float
-    pyramid_softening: float = 1.0
 
 
 def contact_mu(mu: float) -> float:
@@ -147,23 +137,11 @@ def max_contact_stiffness(timestep: float = GAZEBO_STEP) -> float:
     return MAX_CORRECTION_ERP / timestep**2
 
 
-def pyramid_softening(mu: float, condim: int = 3) -> float:
-    """ρ: the normal regulariser of MuJoCo's pyramidal contact over a single normal row's.
-
-    Args:
-        mu: the contact's sliding μ (> 0); condim: 3 (sliding) or more (torsion, rolling).
-    """
-    return mu * mu * (1.0 + mu * mu) / (condim - 1)
-
-
 def contact_softness(
     kp: float | None,
     kd: float | None,
     mass: float,
     timestep: float = GAZEBO_STEP,
-    *,
-    mu: float = DEFAULT_MU,
-    condim: int = 3,
 ) -> ContactSoftness:
     """Map Gazebo's kp/kd (ODE's ERP/CFM) onto MuJoCo's direct solref and solimp.
 
@@ -172,9 +150,6 @@ def contact_softness(
         kd: contact damping [N s/m] (SDF default 1 when None).
         mass: mass carried by the contact [kg] (twin uses the mass of the geom's body).
         timestep: simulation step [s] the result must be stable at.
-        mu, condim: the geom's sliding μ and condim; with μ > 0 and condim ≥ 3 MuJoCo's
-            pyramidal contact rests at `pyramid_softening`(μ, condim) times the row's sinkage,
-            and the returned sinkage says so.
 
     Returns:
         The settings, with the rest sinkage under 9.8 m/s² in Gazebo and in MuJoCo [m].
@@ -198,7 +173,6 @@ def contact_softness(
     ratio = DAMPING_RATIO if hard else 1.0
     damping = min(max(2.0 * ratio * math.sqrt(stiffness), kd / mass), 1.0 / timestep)
     zeta_gazebo = kd / (2.0 * math.sqrt(kp * mass)) if kp > 0 else math.inf
-    rho = pyramid_softening(mu, condim) if mu > 0.0 and condim >= 3 else 1.0
     return ContactSoftness(
         solref=(-stiffness, -damping),
         solimp=(d, d, SOLIMP_WIDTH, 0.5, 2.0),
@@ -206,8 +180,7 @@ def contact_softness(
         damping_ratio_gazebo=zeta_gazebo,
         damping_ratio=damping / (2.0 * math.sqrt(stiffness)),
         sinkage_gazebo=mass * 9.8 / kp if kp > 0 else math.inf,
-        sinkage=rho * (1.0 - d) * 9.8 / stiffness,
-        pyramid_softening=rho,
+        sinkage=(1.0 - d) * 9.8 / stiffness,
     )
 
 

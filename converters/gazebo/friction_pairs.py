@@ -139,7 +139,7 @@ def _why_isotropic(kind: str, fdir1: tuple[float, ...] | None, low_mu: float) ->
     if kind not in FRAME_FROM_NORMAL:
         return f"a {kind}'s contact frame follows its axis, not Gazebo's world directions"
     if low_mu <= 0.0:
-        return "one direction frictionless: MuJoCo's friction pyramid needs both μ > 0"
+        return "one direction frictionless: MuJoCo's friction cone needs both μ > 0"
     return ""
 
 

@@ -37,9 +37,9 @@ GRAVITY = (0.0, 0.0, -9.81)
 # and costs 1.2-1.8 times the step (mean 1.34-1.39 over the corpus and the humanoid, measured by
 # benchmarks/bench_integrator.py). Neither integrator lets a corpus robot diverge in the
 # random-ctrl gates. At rest only limp robots whose heavy links swing a light one do worse: an
-# IRB 2400 lying limp on its free base moves 1.04 mm and turns 4.2 mrad in 60 s (implicit: 0.05
-# mm, 0.008 mrad); held by its motors both give the same. The server's PUT /physics takes
-# {"integrator": "implicit"} for a world that needs the other.
+# IRB 2400 lying limp on its free base moved 1.04 mm and turned 4.2 mrad in 60 s on the pyramidal
+# cone (implicit: 0.05 mm, 0.008 mrad); held by its motors both give the same. The server's
+# PUT /physics takes {"integrator": "implicit"} for a world that needs the other.
 INTEGRATOR = "implicitfast"
 SOLVER = "newton"
 # Solver convergence threshold, fixed in every world. MuJoCo 4 solves each constraint island on its
@@ -48,6 +48,14 @@ SOLVER = "newton"
 # move 1.4e-7 m (and scaling the tolerance by meaninertia·nv, as once done here, 6 mm); 1e-12
 # keeps it within 1.3e-13 m for 0.3 % more solver iterations (1145 against 1142 in 700 steps).
 SOLVER_TOLERANCE = 1e-12
+# MuJoCo's elliptic friction cone: a contact is one normal row and its friction rows, each with its
+# own regulariser, so a contact's stiffness along the normal is the one its kp asks for at every
+# μ (a ball rests at m·g/kp for μ 0-1.5 and kp 1e3-1e7), and its friction is the circle μ·f_n
+# (or the ellipse of a pair's two μ) at every heading. The pyramidal cone shares one regulariser
+# among its 2·(condim − 1) edges, μ²·(1 + μ²)/2 times the normal's at condim 3: a ball rested at
+# 0.005 of m·g/kp at μ 0.1 and 3.7 times it at μ 1.5, and a skid steer's turn swung 30 % with
+# its heading (docs/contacts.md).
+CONE = mujoco.mjtCone.mjCONE_ELLIPTIC
 
 
 @dataclass(frozen=True)
@@ -67,10 +75,12 @@ class WorldOptions:
 
 
 def apply_world_options(spec: mujoco.MjSpec, options: WorldOptions = WorldOptions()) -> None:
-    """Writes timestep, gravity, iterations, solver, integrator and tolerance into `spec.option`."""
+    """Writes timestep, gravity, iterations, solver, integrator, tolerance and the friction cone
+    into `spec.option`."""
     spec.option.timestep = options.timestep
     spec.option.gravity = np.array(options.gravity)
     spec.option.iterations = options.iterations
     spec.option.solver = SOLVERS[options.solver]
     spec.option.integrator = INTEGRATORS[options.integrator]
     spec.option.tolerance = SOLVER_TOLERANCE
+    spec.option.cone = CONE

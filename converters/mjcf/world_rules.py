@@ -69,7 +69,7 @@ def min_friction_priorities(spec: mujoco.MjSpec) -> None:
 
     MuJoCo combines friction by maximum unless priorities differ; Gazebo by minimum. Converted
     robots already carry `friction_priority(μ)` on collision geoms; a plain MJCF geom (priority
-    0) would otherwise take the ground's μ=100, which MuJoCo's pyramidal cone cannot resolve:
+    0) would otherwise take the ground's μ=100, which MuJoCo's friction cone cannot resolve:
     measured, a 1 kg ball falls through such a ground.
     """
     for geom in spec.geoms:

@@ -22,6 +22,7 @@ from converters.gazebo.contact import (
     limit_solref,
     max_contact_stiffness,
 )
+from converters.mjcf.world_options import CONE
 
 G = 9.8
 STEP = 0.001
@@ -42,6 +43,7 @@ def _world(gravity: tuple[float, float, float] = (0.0, 0.0, -G)) -> mujoco.MjSpe
     spec = mujoco.MjSpec()
     spec.option.timestep = STEP
     spec.option.gravity = list(gravity)
+    spec.option.cone = CONE  # twin's worlds' friction cone
     add_gazebo_ground(spec)
     return spec
 
@@ -101,7 +103,7 @@ def test_gazebo_ground_is_named_plane_with_mu_100():
 
 
 def _settle_ball(kp: float, kd: float, mass: float, seconds: float = 1.0, mu: float = 1.0):
-    soft = contact_softness(kp, kd, mass, mu=mu)
+    soft = contact_softness(kp, kd, mass)
     spec = _world()
     _free_geom(spec, mujoco.mjtGeom.mjGEOM_SPHERE, [0.1, 0, 0], 0.1, mass, mu, soft)
     model = spec.compile()
@@ -119,13 +121,11 @@ def test_resting_ball_sinks_mg_over_kp(kp, mass):
 
 @pytest.mark.parametrize("mu", [0.05, 0.2, 0.7, 1.3, 2.0])
 @pytest.mark.parametrize("kp", [3e3, 1e6])
-def test_resting_ball_sinks_as_mujocos_pyramid_softens_it_and_the_report_says_so(kp, mu):
-    """MuJoCo's pyramidal edges act along the normal as one row of regulariser
-    μ²(1 + μ²)/2 times the single row's: the ball rests there, and the settings report it."""
-    assert _world().option.cone == mujoco.mjtCone.mjCONE_PYRAMIDAL, "the cone twin's worlds use"
+def test_resting_ball_sinks_mg_over_kp_at_every_mu_and_the_report_says_so(kp, mu):
+    """On the elliptic cone the normal row keeps its own regulariser whatever μ is: the ball
+    rests at m·g/kp, and the settings report that sinkage."""
     sinkage, soft, _, _ = _settle_ball(kp, 1.0, 1.5, seconds=3.0, mu=mu)
-    softening = mu**2 * (1 + mu**2) / 2
-    assert sinkage == pytest.approx(softening * 1.5 * G / kp, rel=0.02), f"μ {mu}: {sinkage} m"
+    assert sinkage == pytest.approx(1.5 * G / kp, rel=0.02), f"μ {mu}: {sinkage} m"
     assert soft.sinkage == pytest.approx(sinkage, rel=0.02), "reported sinkage"
 
 

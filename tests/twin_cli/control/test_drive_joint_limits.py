@@ -112,11 +112,11 @@ TURNS_SLIP = (
         0.0,
         pytest.param(
             0.5,
-            marks=pytest.mark.xfail(strict=True, reason=TURNS_SLIP.format("0.123 m off 1.5 m")),
+            marks=pytest.mark.xfail(strict=True, reason=TURNS_SLIP.format("0.129 m off 1.5 m")),
         ),
         pytest.param(
             -0.8,
-            marks=pytest.mark.xfail(strict=True, reason=TURNS_SLIP.format("0.157 m off 1.5 m")),
+            marks=pytest.mark.xfail(strict=True, reason=TURNS_SLIP.format("0.159 m off 1.5 m")),
         ),
     ],
 )
