@@ -12,15 +12,15 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
     force stays within ±effort (`forcerange`), as Menagerie's models do;
   - a position servo is stiff and damped so that a move at the effort limit stops on target
     (`servo_gains`);
-  - a velocity servo (a joint whose first mode is velocity and that has no effort limit) is
-    MuJoCo's `intvelocity`: its activation integrates the commanded speed
-    into a position the servo tracks. kv = I/h on the joint's reflected inertia I at the home
-    posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I); a tag's velocity PID (ros2_control's
-    `velocity_pid`, gz-sim JointController's force commands) is that controller's own law;
-  - every joint whose tags offer velocity with a finite effort gets Gazebo's velocity motor
-    instead (`velocity_motors`: a rotor and a friction tendon bounded by the effort, which
-    stores nothing, where the integral paid a stall back as a burst); its torque motor stays
-    for effort commands, and a position-first joint keeps its position servo beside it;
+  - every joint whose tags offer velocity gets Gazebo's velocity motor (`velocity_motors`: a
+    rotor and a friction tendon bounded by the effort, or by UNBOUNDED_EFFORT where the joint
+    has no effort limit, as Gazebo's velocity command then has none); it stores nothing, where
+    an integral servo paid a stall back as a burst. Its torque motor stays for effort commands,
+    and a position-first joint keeps its position servo beside it. A tag's velocity PID
+    (ros2_control's `velocity_pid`, gz-sim JointController's force commands) is that
+    controller's own law instead; a velocity-first joint the motor cannot serve (no inertia
+    along its axis to scale a rotor on) is MuJoCo's `intvelocity`, kv = I/h on the joint's
+    reflected inertia I at the home posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I);
   - on a fixed base, the position servos carry the weight of the bodies they hold through
     MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
   - the `home` keyframe's ctrl holds the home posture.
@@ -63,6 +63,7 @@ UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag co
 FOLLOW_TAU = 1e-12  # [s] time constant of an activation that follows ctrl within one step
 SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
+UNBOUNDED_EFFORT = 1e9  # [N m or N] the motor's bound for a joint without an effort limit
 
 
 def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str, str]:
@@ -137,9 +138,9 @@ def tag_pid(pids: Mapping[str, Sequence[float]], mode: str) -> tuple | None:
 
 def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
     """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
-    offer velocity commands, with a finite effort limit (the motor's bound), and give no velocity
-    PID: ros2_control's `velocity_pid` and gz-sim's JointController with force commands close a
-    PID on the speed error, a force law, not the joint motor's constraint."""
+    offer velocity commands and give no velocity PID: ros2_control's `velocity_pid` and gz-sim's
+    JointController with force commands close a PID on the speed error, a force law, not the
+    joint motor's constraint."""
     import mujoco
 
     record = records.get(actuator.target)
@@ -153,7 +154,6 @@ def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records:
         and float(actuator.gear[0]) == 1.0
         and actuator.dyntype == mujoco.mjtDyn.mjDYN_NONE
         and actuator.biastype == mujoco.mjtBias.mjBIAS_NONE
-        and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
         and record.get("source") not in UNTAGGED_SOURCES
         and "velocity" in record.get("modes", ())
         and tag_pid(record.get("pid", {}), "velocity") is None  # a tag PID: a force loop
@@ -165,11 +165,17 @@ def _motors(
     driven: list[mujoco.MjsActuator], records: dict, inertia: dict[str, tuple[float, float]]
 ) -> dict[str, Motor]:
     """The velocity motor of each of `driven`'s joints that has an inertia to scale its rotor."""
+    import mujoco
+
     motors = {}
     for actuator in driven:
         joint, record = actuator.target, records[actuator.target]
         own = inertia.get(joint, (0.0, 0.0))[0]
-        effort = float(np.max(np.abs(actuator.ctrlrange)))
+        effort = (
+            float(np.max(np.abs(actuator.ctrlrange)))
+            if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
+            else UNBOUNDED_EFFORT
+        )
         if own > 0.0 and np.isfinite(effort) and effort > 0.0:
             speed = record.get("velocity_limit")
             speed = float(speed) if speed is not None and speed > 0 else float("inf")

@@ -8,6 +8,7 @@ without paying the slip back; a servo with an integral (MuJoCo's `intvelocity`) 
 
 MuJoCo has that constraint as a tendon's dry friction, which bounds a velocity-level constraint
 by `frictionloss` and keeps nothing between steps. Each joint J (hinge or slide) of effort E
+(a large finite bound where J has no effort limit: gz-sim's velocity command is then unbounded)
 whose tags offer velocity commands gets:
   - a rotor: a hinge or slide on J's axis at J's anchor, in a massless body that is a child of
     J's parent body (it turns relative to the same parent), with armature ARMATURE_RATIO × J's

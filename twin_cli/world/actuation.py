@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
+from converters.mjcf.export_servos import UNBOUNDED_EFFORT
 from twin_cli.world import native_servos, servos, sleeping, velocity_motors
 
 MODES = ("position", "velocity", "effort")
@@ -173,10 +174,11 @@ def _run_velocity_motor(
     rotor = velocity_motors.rotor_of(model, a)
     if rotor is None:
         return cmd
-    if cmd.mode != "velocity" or not math.isfinite(cmd.effort):
+    if cmd.mode != "velocity":
         velocity_motors.disengage(model, data, rotor)
         return cmd
-    velocity_motors.engage(model, data, rotor, cmd.target, cmd.effort)
+    effort = cmd.effort if math.isfinite(cmd.effort) else UNBOUNDED_EFFORT
+    velocity_motors.engage(model, data, rotor, cmd.target, effort)
     return replace(cmd, mode="effort", target=0.0, velocity_limit=math.inf, native=False)
 
 

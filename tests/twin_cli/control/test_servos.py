@@ -165,3 +165,21 @@ def test_a_position_move_runs_at_the_velocity_limit_and_settles_without_overshoo
     assert q.max() - 1.0 < 0.01, f"overshoot {q.max() - 1.0:.4f} rad"
     assert max(v) <= 1.0, f"peak speed {max(v):.3f} rad/s over the 1 rad/s limit"
     assert q[-1] == pytest.approx(1.0, abs=1e-4), "holds its target under gravity"
+
+
+@pytest.mark.parametrize("load", [1.0, 10.0, 100.0])
+def test_a_wheel_without_an_effort_limit_holds_its_speed_under_any_load(tmp_path, load) -> None:
+    """gz-sim's and gazebo_ros2_control's velocity command on a joint that states no effort
+    limit is unbounded: the joint keeps its speed whatever loads it (here 1e3 to 1e5 times the
+    disc's I·rad/s²), and comes back from nothing it stored when the load goes."""
+    text = _wheel().replace(f'<limit effort="{EFFORT}" velocity="10"/>', "")
+    world = World()
+    world.spawn(write_urdf(tmp_path, text), name="w", pose=Pose(z=1.0))
+    world.command("w", "spin", mode="velocity", value=SPEED)
+    world.step(200)
+    _load(world, -load)
+    loaded = _speeds(world, 50)
+    assert loaded == pytest.approx(SPEED, rel=1e-2), f"under {load} N m: {loaded.min():.4f}"
+    world.push("w", torque=(0.0, 0.0, load), link="disc", duration=1e3)  # the load taken off
+    released = _speeds(world, 50, every=1)
+    assert released.max() <= SPEED * 1.001, f"peak {released.max():.4f} rad/s after the release"

@@ -3,7 +3,8 @@ written by twin at commit 911a000 (an arm whose ros2_control `vel_joint` has no 
 an `intvelocity` of its own, commanded 1 rad/s, and a fan whose gz-sim JointController runs
 force commands, p 0.5, commanded 3 rad/s; saved 0.5 s later). The fan's PID is now its law
 p·(ω* − ω) on an activation that follows ctrl, in the slot its integral had, so every other
-joint keeps its own saved activation. Oracle: the file's own state and commands, and the law."""
+joint keeps its own saved activation; the arm's `vel_joint` now runs Gazebo's velocity motor,
+unbounded as its joint is. Oracle: the file's own state and commands, and the law."""
 
 from __future__ import annotations
 
@@ -42,7 +43,7 @@ def test_each_joint_goes_on_from_its_saved_state_under_its_command(save: Path) -
     world.step(200)
     arm = {s.name: s for s in world.joint_states("arm")}
     assert arm["vel_joint"].position == pytest.approx(saved["vel_joint"] + 0.2, abs=1e-3)
-    assert arm["vel_joint"].velocity == pytest.approx(1.0, rel=1e-3), "its integral is its own"
+    assert arm["vel_joint"].velocity == pytest.approx(1.0, rel=1e-3), "on its velocity motor"
     fan = {s.name: s for s in world.joint_states("rig")}["fan_joint"]
     assert fan.velocity == pytest.approx(3.0, rel=1e-3), "p·(ω* − ω) on 0.01 kg m², 0.2 s"
     row = world.joint_commands("rig")["fan_joint"]
