@@ -23,11 +23,15 @@ SKID_A = 0.06  # half the wheel base of skid_steer_bot's default layout [m] (a/c
 COULOMB_FACTOR = 1.0 / (1.0 + (SKID_A / (TRACK / 2)) ** 2)
 """A skid steer's turn rate over its command under Coulomb friction, its wheels at the unicycle's
 speeds and equal loads: 1/(1 + (a/c)²) = 0.862 for skid_steer_bot's default layout."""
-COULOMB_SHORT = 0.20
+COULOMB_SHORT = 0.05
 """Most a skid steer of skid_steer_bot's default layout turns below Coulomb's rate, as a fraction
 of it. Measured for commands of 0.3-1 rad/s with 0-0.3 m/s and each skid-steer plugin the tests
-use, as the mean over half a turn of heading: 13.3 % to 15.5 % below; never above it (a heading
-loop that steered on the world's heading turned 16 % above)."""
+use, as the mean over half a turn of heading: 0.01 % to 4.2 % below (ROS 2's diff drive, whose
+wheels ramp at 1 rad/s², the most)."""
+COULOMB_OVER = 0.01
+"""Most a skid steer turns above Coulomb's rate, as a fraction of it: the rate is that of rigid
+contacts, and MuJoCo's soft friction rows give a little at the wheels (measured up to 0.7 %; a
+heading loop that steered on the world's heading turned 16 % above)."""
 
 
 def _inertial(mass: float, i: float, xyz: str = "0 0 0") -> str:

@@ -45,7 +45,6 @@ from converters.gazebo.drive_records import (
     TricycleDrive,
 )
 from converters.gazebo.multicopter import Rotor, add_rotors
-from converters.gazebo.skid_wheels import weigh_skid_wheels
 from converters.gazebo.trajectory_controller import start_at_initial_positions
 from converters.gazebo.wheel_contact import centre_wheel_contacts
 from converters.report import Report
@@ -96,8 +95,7 @@ def add_drive_motors(
 ) -> None:
     """Motors for every drive's joints (unless they have one), planar servos for holonomic
     bases, each multicopter rotor its actuators (`converters.gazebo.multicopter.add_rotors`),
-    wheels that touch the ground on their mid-plane (`converters.gazebo.wheel_contact`),
-    skid-steer wheels as heavy along their rolling direction as across it (`skid_wheels`), and a
+    wheels that touch the ground on their mid-plane (`converters.gazebo.wheel_contact`), and a
     report line for each approximation a drive makes.
 
     Raises:
@@ -108,7 +106,6 @@ def add_drive_motors(
     add_rotors(spec, tuple(p for p in plugins if isinstance(p, Rotor)), report)
     drives = tuple(p for p in plugins if not isinstance(p, Rotor))
     centre_wheel_contacts(spec, drives, report)
-    weigh_skid_wheels(spec, drives, report)
     driven = {a.target for a in spec.actuators}
     for record in plugins:
         if isinstance(record, Rotor):

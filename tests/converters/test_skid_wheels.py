@@ -1,7 +1,7 @@
-"""Skid-steer wheels as converted: each wheel of a drive with several wheels a side carries the
-robot's mass shared over the drive's wheels at its rim as armature (m·r², r the wheel's own
-radius), reported once per wheel; a two-wheeled diff drive's wheels keep none. Oracle: the
-robot's masses and wheel radius written here."""
+"""Skid-steer wheels as converted: a drive adds nothing to its wheels' inertia (no armature, no
+report line about their weight), with one wheel a side or several, whichever plugins name them.
+Their turn comes from the contacts alone (tests/twin_cli/control/test_skid_steer.py). Oracle: the
+robot's file, which states no armature."""
 
 from __future__ import annotations
 
@@ -24,7 +24,6 @@ DIFF = (
     "</wheel_separation><wheel_diameter>0.1</wheel_diameter></plugin>"
 )
 WHEELS = ("left_front_joint", "left_rear_joint", "right_front_joint", "right_rear_joint")
-ROBOT_MASS = 6.0 + 4 * 0.3  # drive_models: the chassis and four wheels [kg]
 
 
 def _converted(tmp_path: Path, text: str) -> tuple:
@@ -35,25 +34,18 @@ def _converted(tmp_path: Path, text: str) -> tuple:
 
 
 @pytest.mark.parametrize(
-    "plugins",
+    ("robot", "plugins", "wheels"),
     [
-        dm.SKID_STEER_ROS1,
-        # the plugin's default diameter (0.15 m) is not the wheel's
-        dm.SKID_STEER_ROS1.replace("<wheelDiameter>0.1</wheelDiameter>", ""),
-        dm.SKID_STEER_ROS1 + GZ_PAIRS,
+        (dm.skid_steer_bot, dm.SKID_STEER_ROS1, WHEELS),
+        (dm.skid_steer_bot, dm.SKID_STEER_ROS1 + GZ_PAIRS, WHEELS),
+        (dm.two_wheel_base, DIFF, ("wheel_left_joint", "wheel_right_joint")),
     ],
+    ids=["ros1_skid_steer", "two_drives_on_the_same_wheels", "two_wheeled_diff_drive"],
 )
-def test_each_skid_steer_wheel_carries_its_load_at_its_rim(tmp_path: Path, plugins: str) -> None:
-    model, report = _converted(tmp_path, dm.skid_steer_bot(plugins))
-    for name in WHEELS:
-        armature = model.dof_armature[model.joint(name).dofadr[0]]
-        assert armature == pytest.approx(ROBOT_MASS / 4 * dm.R**2, rel=1e-9)
-    reported = [e.subject for e in report.entries if "skid-steer wheel" in e.detail]
-    assert sorted(reported) == sorted(f"joint '{j}'" for j in WHEELS), "once per wheel"
-
-
-def test_a_two_wheeled_diff_drive_keeps_its_wheels_as_they_are(tmp_path: Path) -> None:
-    model, report = _converted(tmp_path, dm.two_wheel_base(DIFF))
-    for name in ("wheel_left_joint", "wheel_right_joint"):
-        assert model.dof_armature[model.joint(name).dofadr[0]] == 0.0
-    assert not [e for e in report.entries if "skid-steer wheel" in e.detail]
+def test_a_drive_leaves_its_wheels_inertia_as_the_file_gives_it(
+    tmp_path: Path, robot, plugins: str, wheels: tuple[str, ...]
+) -> None:
+    model, report = _converted(tmp_path, robot(plugins))
+    for name in wheels:
+        assert model.dof_armature[model.joint(name).dofadr[0]] == 0.0, name
+    assert not [e for e in report.entries if "armature" in e.detail]

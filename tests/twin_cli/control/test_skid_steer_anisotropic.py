@@ -17,10 +17,8 @@ Rates are measured over the first 0.3 rad of heading, where the directions stay 
 `fdir1` along the axle (μ1 across the wheel, μ2 along it) the directions turn with the wheels, in
 Gazebo and in twin alike, and the rate no longer depends on the heading.
 
-MuJoCo's pyramidal cone bounds |f_l|/μ_l + |f_t|/μ_t ≤ N (a diamond, on the wheel's axes when the
-frame follows them); its force of maximum dissipation lies on the diamond's edge when
-μ_l·(ω − Ω)·c = μ_t·Ω·a, so Ω = ω / (1 + μ_t·a/(μ_l·c)): 0.833·ω at μ_t/μ_l 0.5, 0.893·ω at 0.3.
-The measured rates are 0.96 and 0.98 of that (docs/contacts.md).
+twin's worlds use MuJoCo's elliptic friction cone, which bounds the friction force by that
+ellipse (a contact pair per wheel carries its two μ, docs/contacts.md).
 """
 
 from __future__ import annotations
@@ -40,6 +38,9 @@ A, C = dm.SKID_A, dm.TRACK / 2  # half the wheel base and half the track [m]
 COMMAND = 0.5  # [rad/s] in place
 SPAN = 0.3  # [rad] of heading the rate is measured over
 FASTER = 1.05  # the anisotropic base turns at least this many times the isotropic one
+# Fraction of the hand calculation the rate may differ by: measured 1.4 % and 3.9 % above it with
+# mu2 0.3 and 0.5 across (Gazebo's default directions), 0.03 % with fdir1 and μ 0.3 across.
+HAND_CALCULATION = 0.05
 
 
 def _turn_rate(
@@ -77,12 +78,12 @@ def coulomb_factor(mu_along: float, mu_across: float) -> float:
 @pytest.mark.parametrize("mu2", [0.5, 0.3])
 def test_mu2_across_the_wheels_turns_faster_by_the_hand_calculation(tmp_path: Path, mu2: float):
     """Heading along world y: mu1 = 1 along the wheels, mu2 across. Faster than isotropic, and
-    within the skid-steer tests' bound of the hand calculation (never above it)."""
+    within HAND_CALCULATION of the hand calculation."""
     isotropic = _turn_rate(tmp_path, 1.0, 1.0, math.pi / 2)
     rate = _turn_rate(tmp_path, 1.0, mu2, math.pi / 2)
     assert rate > FASTER * isotropic, f"{rate:.4f} rad/s, isotropic {isotropic:.4f}"
     ratio = rate / (COMMAND * coulomb_factor(1.0, mu2))
-    assert 1.0 - dm.COULOMB_SHORT <= ratio <= 1.0, (
+    assert ratio == pytest.approx(1.0, abs=HAND_CALCULATION), (
         f"μ2 {mu2}: {rate:.4f} rad/s, {ratio:.3f} of the hand calculation "
         f"{COMMAND * coulomb_factor(1.0, mu2):.4f}"
     )
@@ -98,27 +99,14 @@ def test_mu2_along_the_wheels_turns_slower_as_in_gazebo(tmp_path: Path):
 HEADING_SAME = 0.01  # fraction: the rate at two headings with fdir1 along the axle
 
 
-@pytest.mark.parametrize(
-    "mu_across",
-    [
-        pytest.param(
-            0.5,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="on velocity motors the isotropic base turns at 0.4171 rad/s and fdir1 "
-                "with μ 0.5 across at 0.4169, not 5 % faster (integral servos: faster)",
-            ),
-        ),
-        0.3,
-    ],
-)
+@pytest.mark.parametrize("mu_across", [0.5, 0.3])
 def test_fdir1_along_the_axle_turns_with_the_wheels_and_faster(tmp_path: Path, mu_across: float):
     """fdir1 '0 0 1' (the axle) puts μ1 across each wheel at every heading: the same rate at
-    headings 0 and 0.7 rad, above the isotropic base's mean over half a turn, and within the
-    skid-steer tests' bound of the hand calculation."""
+    headings 0 and 0.7 rad, above the isotropic base's mean over half a turn, and within
+    HAND_CALCULATION of the hand calculation."""
     rates = [_turn_rate(tmp_path, mu_across, 1.0, yaw, "0 0 1") for yaw in (0.0, 0.7)]
     assert rates[1] == pytest.approx(rates[0], rel=HEADING_SAME), f"rates {rates}"
     isotropic = _turn_rate(tmp_path, 1.0, 1.0, 0.0, span=math.pi)
     assert rates[0] > FASTER * isotropic, f"{rates[0]:.4f} rad/s, isotropic {isotropic:.4f}"
     ratio = rates[0] / (COMMAND * coulomb_factor(1.0, mu_across))
-    assert 1.0 - dm.COULOMB_SHORT <= ratio <= 1.0, f"{ratio:.3f} of the hand calculation"
+    assert ratio == pytest.approx(1.0, abs=HAND_CALCULATION), f"{ratio:.3f} of the hand calculation"

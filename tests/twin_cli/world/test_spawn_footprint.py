@@ -44,7 +44,6 @@ PLUGIN_FAMILY = {
         "controller_drives",
         "trajectory_controller",
         "multicopter",
-        "skid_wheels",
         "wheel_contact",
         "wheel_geometry",
     )
@@ -138,7 +137,7 @@ WHEELS = ("wheel_left_joint", "wheel_right_joint")
         (
             _text(skid_steer_bot(SKID_STEER_ROS1)),
             PLUGIN_FAMILY,
-            "converters/gazebo/skid_wheels.py",
+            "converters/gazebo/drive_motors.py",
         ),
         (_text(imu_box()), SENSOR_FAMILY, "converters/gazebo/sensor_sites.py"),
         (_terrain, WHEN_DECLARED, "converters/mjcf/heightfields.py"),
