@@ -72,7 +72,7 @@ def add_motors(
             report.approximated(
                 f"joint '{joint.name}'",
                 "no <limit effort>: a motor without a force bound, as Gazebo drives a joint "
-                "its control tag names; servos use gains from the reflected inertia",
+                "its control tag names; its velocity commands run Gazebo's joint motor, unbounded",
             )
             continue
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE

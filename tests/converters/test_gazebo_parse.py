@@ -99,6 +99,6 @@ def test_robotiq_fingertips_get_what_gazebo_simulates_unless_as_written() -> Non
     for side in ("left", "right"):
         name = f"robotiq_85_{side}_finger_tip_link_collision_0"
         assert gazebo.geom(name).friction[0] == pytest.approx(1.0), f"{side}: Gazebo's μ"
-        # As written: μ 1e5, which twin caps (MuJoCo's pyramidal cone sinks under larger μ).
+        # As written: μ 1e5, which twin caps (MuJoCo's contact sinks under a larger μ).
         mu = written_model.geom(name).friction[0]
         assert mu == pytest.approx(CONTACT_MU_MAX), f"{side}: as written, capped"

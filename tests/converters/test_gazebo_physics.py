@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from converters.gazebo.contact import add_gazebo_ground
+from converters.mjcf.world_options import CONE
 from converters.pipeline import convert
 
 
@@ -43,6 +44,7 @@ def _world(tmp_path: Path, parts, gravity=(0.0, 0.0, -G)):
     world = mujoco.MjSpec()
     world.option.timestep = STEP
     world.option.gravity = list(gravity)
+    world.option.cone = CONE  # twin's worlds' friction cone
     add_gazebo_ground(world)
     for i, (text, position) in enumerate(parts):
         spec, _ = convert(models.write_urdf(tmp_path, text, f"part{i}.urdf"))
@@ -98,8 +100,8 @@ def test_incline_threshold_is_sharp_within_three_percent(tmp_path, factor):
 
 @pytest.mark.parametrize("mu", [1.0, 100.0, 1e5])
 def test_no_slip_wheels_carry_the_cart_on_gazebos_ground(tmp_path, mu):
-    # Gazebo robots write μ 100 or 1e5 for "no slip"; in MuJoCo's pyramidal cone such a μ let
-    # the wheels sink to their axles (the chassis then rested on the ground).
+    # Gazebo robots write μ 100 or 1e5 for "no slip"; in MuJoCo such a μ lets the wheels sink
+    # to their axles (the chassis then rests on the ground), hence twin's cap.
     model, data = _world(tmp_path, [(models.wheeled_cart(mu), (0.0, 0.0, 0.21))])
     mujoco.mj_step(model, data, nstep=1500)
     clearance = data.xpos[model.body("e0/chassis").id, 2] - 0.1

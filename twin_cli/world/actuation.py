@@ -23,7 +23,6 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from converters.mjcf.export_servos import UNBOUNDED_EFFORT
 from twin_cli.world import native_servos, servos, sleeping, velocity_motors
 
 MODES = ("position", "velocity", "effort")
@@ -177,8 +176,7 @@ def _run_velocity_motor(
     if cmd.mode != "velocity":
         velocity_motors.disengage(model, data, rotor)
         return cmd
-    effort = cmd.effort if math.isfinite(cmd.effort) else UNBOUNDED_EFFORT
-    velocity_motors.engage(model, data, rotor, cmd.target, effort)
+    velocity_motors.engage(model, data, rotor, cmd.target, cmd.effort)
     return replace(cmd, mode="effort", target=0.0, velocity_limit=math.inf, native=False)
 
 

@@ -161,12 +161,8 @@ def _native(state: WorldState, checked: tuple) -> bool:
 
 def _rotor(state: WorldState, checked: tuple) -> bool:
     """Whether a checked command is a velocity that the joint's velocity motor runs."""
-    _, a, _, mode, _, effort, _ = checked
-    return (
-        mode == "velocity"
-        and math.isfinite(effort)
-        and velocity_motors.rotor_of(state.model, a) is not None
-    )
+    _, a, _, mode, _, _, _ = checked
+    return mode == "velocity" and velocity_motors.rotor_of(state.model, a) is not None
 
 
 def _set_rotor(state: WorldState, checked: tuple) -> control.JointCommand:

@@ -238,7 +238,7 @@ def _natives(world: World, laws: dict, commands: list[JointCommand], state: np.n
     saved when such joints were limp motors would otherwise have them pulled to ctrl 0)."""
     from dataclasses import replace as renew
 
-    from twin_cli.world import native_servos
+    from twin_cli.world import native_servos, velocity_motors
     from twin_cli.world.actuation import effort_limit
 
     model = world.model
@@ -248,6 +248,12 @@ def _natives(world: World, laws: dict, commands: list[JointCommand], state: np.n
         if law is not None and law.mode == cmd.mode:  # a saved native row: today's law
             rule = native_servos.rule(law)
             cmd = renew(cmd, kp=law.kp, kv=law.kv, feedforward=0.0, rule=rule, native=True)
+        elif cmd.mode == "velocity" and velocity_motors.rotor_of(
+            model, model.actuator(cmd.actuator).id
+        ):  # a row saved when the joint ran a servo of its own: today's velocity motor
+            cmd = renew(
+                cmd, kp=0.0, kv=0.0, feedforward=0.0, rule=velocity_motors.RULE, native=False
+            )
         out[cmd.actuator] = cmd
     for name, law in laws.items():
         if name in out:

@@ -4,21 +4,23 @@ others, and the effort it puts on its joint.
 The converter gives each joint whose tags offer velocity commands a rotor and a tendon whose dry
 friction, bounded by the joint's effort, couples the joint to the rotor's speed
 (`converters.mjcf.velocity_motors`). A velocity command writes the rotor's ctrl and the tendon's
-`frictionloss` (= the effort limit); the joint's own motor pushes nothing. A position or effort
-command switches the friction off (frictionloss 0: no constraint row at all) and runs the
-joint's motor as before (`twin_cli.world.servos`, `native_servos`): the rotor is a speed
-reference, and a position servo on top of it would need an outer loop in Python at every step.
+`frictionloss` (= the effort limit, or UNBOUNDED_EFFORT for a joint without one); the joint's
+own motor pushes nothing. A position or effort command switches the friction off
+(frictionloss 0: no constraint row at all) and runs the joint's motor as before
+(`twin_cli.world.servos`, `native_servos`): the rotor is a speed reference, and a position servo
+on top of it would need an outer loop in Python at every step.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
 import mujoco
 import numpy as np
 
-from converters.mjcf.export_servos import VELOCITY_MOTOR
+from converters.mjcf.export_servos import UNBOUNDED_EFFORT, VELOCITY_MOTOR
 from converters.mjcf.velocity_motors import SUFFIX, is_rotor, rotor_name
 
 RULE = "Gazebo's joint motor: a velocity constraint within ±effort"  # what `twin joints` shows
@@ -60,8 +62,9 @@ def _motors(model: mujoco.MjModel) -> dict[int, Rotor]:
 def engage(
     model: mujoco.MjModel, data: mujoco.MjData, rotor: Rotor, speed: float, effort: float
 ) -> None:
-    """Runs the joint at `speed` [rad/s or m/s] within ±`effort` [N m or N]."""
-    model.tendon_frictionloss[rotor.tendon] = effort
+    """Runs the joint at `speed` [rad/s or m/s] within ±`effort` [N m or N]; an infinite effort
+    (a joint without an effort limit) is the export's UNBOUNDED_EFFORT on the tendon."""
+    model.tendon_frictionloss[rotor.tendon] = min(effort, UNBOUNDED_EFFORT)
     data.ctrl[rotor.actuator] = speed
 
 
@@ -73,9 +76,12 @@ def disengage(model: mujoco.MjModel, data: mujoco.MjData, rotor: Rotor) -> None:
 
 def engaged_at_load(record: dict | None) -> float | None:
     """The effort [N m or N] a joint's velocity motor holds it with from load (velocity is its
-    first mode, as the exported file has it), or None."""
+    first mode, as the exported file has it; inf for a joint without an effort limit), or None."""
     motor = record.get(VELOCITY_MOTOR) if record else None
-    return float(motor["effort"]) if motor and motor.get("engaged") else None
+    if not motor or not motor.get("engaged"):
+        return None
+    effort = float(motor["effort"])
+    return math.inf if effort >= UNBOUNDED_EFFORT else effort
 
 
 @lru_cache(maxsize=MODELS_KEPT)

@@ -11,7 +11,7 @@ from models import CONTROL_RIG as WHEEL_URDF
 from models import ball_on_plane, wheeled_cart, write_urdf
 
 from twin_cli.errors import InvalidRequestError, PartNotFoundError
-from twin_cli.world import Pose, World, WorldSettings
+from twin_cli.world import Pose, World, WorldSettings, velocity_motors
 
 
 @pytest.fixture
@@ -340,8 +340,39 @@ def test_wheels_a_control_tag_names_without_an_effort_limit_get_a_motor(tmp_path
     world.command_joints("cart", wheels, mode="velocity")
     world.step(1000)
     speeds = [j.velocity for j in world.joint_states("cart")]
-    # an intvelocity's integral pays back its lag: 1.7 % fast still after 1 s (measured)
-    assert speeds == pytest.approx([1.0] * 4, rel=0.02), speeds
+    # Gazebo's joint motor, unbounded as the joints state no effort limit: no lag to pay back
+    assert speeds == pytest.approx([1.0] * 4, rel=1e-3), speeds
+    rules = {row["rule"] for row in world.joint_commands("cart").values()}
+    assert rules == {velocity_motors.RULE}, rules
     pose = world.get_pose("cart")
     assert pose.z == pytest.approx(0.2, abs=1e-4) and abs(pose.yaw) < 1e-4, pose
     assert 0.08 < pose.x < 0.1, f"rolled {pose.x:.4f} m in 1 s at ω·r = 0.1 m/s"
+
+
+def test_a_position_first_joint_without_an_effort_limit_runs_velocity_on_its_motor(tmp_path):
+    """A joint whose tags offer position first and velocity after it, with no `<limit>`: a
+    velocity command runs Gazebo's joint motor (unbounded) and the row says so, with no gains of
+    a servo and no effort limit; a position command afterwards runs the joint's own servo."""
+    tags = "".join(
+        f'<joint name="{w}_axle"><command_interface name="position"/>'
+        '<command_interface name="velocity"/><state_interface name="velocity"/></joint>'
+        for w in ("lf", "rf", "lb", "rb")
+    )
+    text = wheeled_cart().replace(
+        "</robot>", f'<ros2_control name="cart" type="system">{tags}</ros2_control></robot>'
+    )
+    world = World()
+    world.spawn(write_urdf(tmp_path, text), name="cart", pose=Pose(z=0.21))
+    world.step(200)
+    world.command_joints("cart", {"lf_axle": 2.0}, mode="velocity")
+    world.step(300)
+    row = world.joint_commands("cart")["lf_axle"]
+    assert (row["rule"], row["kp"], row["kv"], row["effort_limit"]) == (
+        velocity_motors.RULE,
+        0.0,
+        0.0,
+        None,
+    ), row
+    assert world.joint_states("cart")[0].velocity == pytest.approx(2.0, rel=1e-3)
+    world.command_joints("cart", {"lf_axle": 0.0}, mode="position")
+    assert world.joint_commands("cart")["lf_axle"]["rule"] != velocity_motors.RULE

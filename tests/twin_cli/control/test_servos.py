@@ -180,6 +180,7 @@ def test_a_wheel_without_an_effort_limit_holds_its_speed_under_any_load(tmp_path
     _load(world, -load)
     loaded = _speeds(world, 50)
     assert loaded == pytest.approx(SPEED, rel=1e-2), f"under {load} N m: {loaded.min():.4f}"
+    assert world.joint_commands("w")["spin"]["effort_limit"] is None, "unbounded, as the file"
     world.push("w", torque=(0.0, 0.0, load), link="disc", duration=1e3)  # the load taken off
     released = _speeds(world, 50, every=1)
     assert released.max() <= SPEED * 1.001, f"peak {released.max():.4f} rad/s after the release"

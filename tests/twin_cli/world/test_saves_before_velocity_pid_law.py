@@ -16,6 +16,7 @@ import pytest
 from pid_law import pid_law
 
 from twin_cli.world.savefile import load
+from twin_cli.world.velocity_motors import RULE
 
 SAVES = Path(__file__).parent / "saves"
 NAME = "pid_saved_as_intvelocity"
@@ -48,6 +49,9 @@ def test_each_joint_goes_on_from_its_saved_state_under_its_command(save: Path) -
     assert fan.velocity == pytest.approx(3.0, rel=1e-3), "p·(ω* − ω) on 0.01 kg m², 0.2 s"
     row = world.joint_commands("rig")["fan_joint"]
     assert (row["kp"], row["kv"]) == (0.0, 0.5), f"the command row is the law's: {row}"
+    arm_row = world.joint_commands("arm")["vel_joint"]
+    assert (arm_row["kp"], arm_row["kv"], arm_row["rule"]) == (0.0, 0.0, RULE), arm_row
+    assert arm_row["effort_limit"] is None, "no effort limit, as its URDF states none"
 
 
 def test_a_reset_starts_the_fan_by_its_law_from_its_spawn_state(save: Path) -> None:
