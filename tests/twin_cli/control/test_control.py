@@ -322,12 +322,12 @@ def test_velocity_command_rolls_a_wheeled_cart_without_chatter(tmp_path):
     assert 0.08 < pose.x < 0.1, f"rolled {pose.x:.4f} m in 1 s at ω·r = 0.1 m/s"
 
 
-def test_wheels_a_control_tag_names_without_an_effort_limit_get_a_motor(tmp_path):
-    # gz_ros2_control's diff-drive demo and husky: velocity interfaces on continuous joints
-    # without <limit>. Gazebo drives them; twin gave them no motor ("actuated joints: none").
+def _tagged_cart(tmp_path, interfaces: tuple[str, ...]) -> World:
+    """The wheeled cart, its axles without `<limit>` and each offering `interfaces` through
+    `<ros2_control>`, spawned in a new world as `cart`."""
+    commands = "".join(f'<command_interface name="{i}"/>' for i in interfaces)
     tags = "".join(
-        f'<joint name="{w}_axle"><command_interface name="velocity"/>'
-        '<state_interface name="velocity"/></joint>'
+        f'<joint name="{w}_axle">{commands}<state_interface name="velocity"/></joint>'
         for w in ("lf", "rf", "lb", "rb")
     )
     text = wheeled_cart().replace(
@@ -335,6 +335,13 @@ def test_wheels_a_control_tag_names_without_an_effort_limit_get_a_motor(tmp_path
     )
     world = World()
     world.spawn(write_urdf(tmp_path, text), name="cart", pose=Pose(z=0.21))
+    return world
+
+
+def test_wheels_a_control_tag_names_without_an_effort_limit_get_a_motor(tmp_path):
+    # gz_ros2_control's diff-drive demo and husky: velocity interfaces on continuous joints
+    # without <limit>. Gazebo drives them; twin gave them no motor ("actuated joints: none").
+    world = _tagged_cart(tmp_path, ("velocity",))
     world.step(500)
     wheels = {f"{w}_axle": 1.0 for w in ("lf", "rf", "lb", "rb")}
     world.command_joints("cart", wheels, mode="velocity")
@@ -353,16 +360,7 @@ def test_a_position_first_joint_without_an_effort_limit_runs_velocity_on_its_mot
     """A joint whose tags offer position first and velocity after it, with no `<limit>`: a
     velocity command runs Gazebo's joint motor (unbounded) and the row says so, with no gains of
     a servo and no effort limit; a position command afterwards runs the joint's own servo."""
-    tags = "".join(
-        f'<joint name="{w}_axle"><command_interface name="position"/>'
-        '<command_interface name="velocity"/><state_interface name="velocity"/></joint>'
-        for w in ("lf", "rf", "lb", "rb")
-    )
-    text = wheeled_cart().replace(
-        "</robot>", f'<ros2_control name="cart" type="system">{tags}</ros2_control></robot>'
-    )
-    world = World()
-    world.spawn(write_urdf(tmp_path, text), name="cart", pose=Pose(z=0.21))
+    world = _tagged_cart(tmp_path, ("position", "velocity"))
     world.step(200)
     world.command_joints("cart", {"lf_axle": 2.0}, mode="velocity")
     world.step(300)
