@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from benchmarks.bench_rest import corpus_request, corpus_robots
+from benchmarks.bench_rest import spawn_requests
 
 # [s] sim time. A limp robot folds first: the bundled humanoid, symmetric, stands about 4 s on
 # its feet and has fallen by 6 s.
@@ -46,16 +46,6 @@ REST_SAMPLE_STEPS = 10  # |qvel| is sampled every 10 steps at rest
 UNLIMITED_CTRL = 10.0  # half-range for an actuator without ctrlrange (10 % of it: ±1 rad/s)
 COMPARED = ("implicit", "implicitfast")  # MuJoCo's integrators that treat damping implicitly
 MEAN_RATIO_TARGET = 1.15  # the project's goal for the world's step cost over implicitfast's
-
-
-def _spawn_requests() -> dict:
-    """Robot id → SpawnRequest: the corpus robots, then the bundled humanoid."""
-    from scenarios import HUMANOID
-    from twin_cli.spawn_request import SpawnRequest
-
-    requests = {rid: corpus_request(robot) for rid, robot in corpus_robots().items()}
-    requests["humanoid"] = SpawnRequest(str(HUMANOID), on_ground=True)
-    return requests
 
 
 def _models(request) -> tuple[str, dict, object]:  # noqa: ANN001
@@ -186,7 +176,7 @@ def _table(rows: dict) -> str:
 def run() -> dict:
     start = time.perf_counter()
     rows: dict[str, dict] = {}
-    for rid, request in _spawn_requests().items():
+    for rid, request in spawn_requests().items():
         try:
             rows[rid] = _robot(request)
         except Exception as exc:  # a robot that needs options the bench does not give

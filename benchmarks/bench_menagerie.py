@@ -103,7 +103,7 @@ def _twin(request, timestep: float) -> tuple:  # noqa: ANN001
     return _no_sleep(copy.deepcopy(world.model)), copy.copy(world.data)
 
 
-def _states(model, data) -> tuple[bytes, list]:  # noqa: ANN001
+def random_ctrl_states(model, data) -> tuple[bytes, list]:  # noqa: ANN001
     """(the settled rest state, the states along the random ctrl sequence), as mjSTATE_INTEGRATION
     vectors (qpos, qvel, act, ctrl, ...)."""
     import mujoco
@@ -177,8 +177,8 @@ def _variants(twin: tuple, menagerie: tuple, twin_states: list, m_states: list) 
 def _robot(folder: Path, request) -> dict:  # noqa: ANN001
     menagerie = _menagerie(folder)
     twin = _twin(request, menagerie[0].opt.timestep)
-    t_rest, t_states = _states(*twin)
-    m_rest, m_states = _states(*menagerie)
+    t_rest, t_states = random_ctrl_states(*twin)
+    m_rest, m_states = random_ctrl_states(*menagerie)
     t_air, m_air = _in_the_air(*twin), _in_the_air(*menagerie)
     air = step_ratio(twin, menagerie, [t_air], [m_air]) if t_air is not None else None
     t_stages, m_stages = stage_timers([(*twin, t_states), (*menagerie, m_states)])

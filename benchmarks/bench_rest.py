@@ -52,6 +52,17 @@ def corpus_request(robot: dict):  # noqa: ANN201 (SpawnRequest, imported lazily)
     )
 
 
+def spawn_requests() -> dict:
+    """Robot id → SpawnRequest: the corpus robots, then the bundled humanoid (the only robot
+    without ../shared)."""
+    from scenarios import HUMANOID
+    from twin_cli.spawn_request import SpawnRequest
+
+    requests = {rid: corpus_request(robot) for rid, robot in corpus_robots().items()}
+    requests["humanoid"] = SpawnRequest(str(HUMANOID), on_ground=True)
+    return requests
+
+
 def _spawn(world, robot: dict, name: str) -> None:
     world.spawn(corpus_request(robot), name=name)
 
