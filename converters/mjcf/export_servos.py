@@ -13,8 +13,8 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
   - a position servo is stiff and damped so that a move at the effort limit stops on target
     (`servo_gains`);
   - every joint whose tags offer velocity gets Gazebo's velocity motor (`velocity_motors`: a
-    rotor and a friction tendon bounded by the effort, or by UNBOUNDED_EFFORT where the joint
-    has no effort limit, as Gazebo's velocity command then has none); it stores nothing, where
+    rotor and a friction tendon bounded by the effort, or by its UNBOUNDED_EFFORT where the
+    joint has no effort limit, as Gazebo's velocity command then has none); it stores nothing, where
     an integral servo paid a stall back as a burst. Its torque motor stays for effort commands,
     and a position-first joint keeps its position servo beside it. A tag's velocity PID
     (ros2_control's `velocity_pid`, gz-sim JointController's force commands) is that
@@ -63,7 +63,6 @@ UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag co
 FOLLOW_TAU = 1e-12  # [s] time constant of an activation that follows ctrl within one step
 SERVO_MODES = ("position", "velocity")
 HOME_KEY = "home"
-UNBOUNDED_EFFORT = 1e9  # [N m or N] the motor's bound for a joint without an effort limit
 
 
 def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str, str]:
@@ -118,7 +117,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     for joint, changed in compensate(spec, held).items():
         records[joint][EXPORTED][GRAVCOMP] = changed
     for joint, motor in motors.items():
-        records[joint][VELOCITY_MOTOR] = {"effort": motor.effort, "engaged": motor.engaged}
+        effort = motor.effort if np.isfinite(motor.effort) else None  # None: no effort limit
+        records[joint][VELOCITY_MOTOR] = {"effort": effort, "engaged": motor.engaged}
         servoed.setdefault(joint, records[joint]["modes"][0])
     if motors:  # a robot without velocity joints runs none of it
         add_velocity_motors(spec, list(motors.values()), model, timestep)
@@ -174,9 +174,9 @@ def _motors(
         effort = (
             float(np.max(np.abs(actuator.ctrlrange)))
             if actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
-            else UNBOUNDED_EFFORT
+            else float("inf")
         )
-        if own > 0.0 and np.isfinite(effort) and effort > 0.0:
+        if own > 0.0 and effort > 0.0:
             speed = record.get("velocity_limit")
             speed = float(speed) if speed is not None and speed > 0 else float("inf")
             engaged = record["modes"][0] == "velocity"

@@ -42,6 +42,7 @@ file writes (SDF's nested names join with "::", so ":motor" named a nested model
 ARMATURE_RATIO = 1e6  # rotor armature / J's inertia: the reference keeps its speed under J's pull
 SOLIMP = 0.9999  # MuJoCo's largest impedance: the friction row as rigid as the solver allows
 ROTOR_MASS = 1e-9  # [kg] the rotor body's mass: MuJoCo needs one on a body with a joint
+UNBOUNDED_EFFORT = 1e9  # [N m or N] the tendon's bound for a joint without an effort limit
 
 
 @dataclass(frozen=True)
@@ -49,9 +50,9 @@ class Motor:
     """One velocity motor to build.
 
     Attributes:
-        joint: J's name. effort: its effort limit E [N m or N]. inertia: its inertia about the
-        axis [kg m² or kg]. speed: its velocity limit [rad/s or m/s] (inf: none), the rotor's
-        ctrlrange. engaged: whether the constraint starts on (velocity is J's first mode).
+        joint: J's name. effort: its effort limit E [N m or N] (inf: none). inertia: its inertia
+        about the axis [kg m² or kg]. speed: its velocity limit [rad/s or m/s] (inf: none), the
+        rotor's ctrlrange. engaged: whether the constraint starts on (velocity is J's first mode).
     """
 
     joint: str
@@ -118,7 +119,7 @@ def _add_one(spec: mujoco.MjSpec, motor: Motor, model: mujoco.MjModel, timestep:
     tendon = spec.add_tendon(name=name)
     tendon.wrap_joint(motor.joint, 1.0)
     tendon.wrap_joint(name, -1.0)
-    tendon.frictionloss = motor.effort if motor.engaged else 0.0
+    tendon.frictionloss = min(motor.effort, UNBOUNDED_EFFORT) if motor.engaged else 0.0
     tendon.damping, tendon.stiffness = (
         np.zeros(len(tendon.damping)),
         np.zeros(len(tendon.stiffness)),

@@ -20,8 +20,8 @@ from functools import lru_cache
 import mujoco
 import numpy as np
 
-from converters.mjcf.export_servos import UNBOUNDED_EFFORT, VELOCITY_MOTOR
-from converters.mjcf.velocity_motors import SUFFIX, is_rotor, rotor_name
+from converters.mjcf.export_servos import VELOCITY_MOTOR
+from converters.mjcf.velocity_motors import SUFFIX, UNBOUNDED_EFFORT, is_rotor, rotor_name
 
 RULE = "Gazebo's joint motor: a velocity constraint within ±effort"  # what `twin joints` shows
 _ACTUATOR = mujoco.mjtObj.mjOBJ_ACTUATOR
@@ -80,8 +80,7 @@ def engaged_at_load(record: dict | None) -> float | None:
     motor = record.get(VELOCITY_MOTOR) if record else None
     if not motor or not motor.get("engaged"):
         return None
-    effort = float(motor["effort"])
-    return math.inf if effort >= UNBOUNDED_EFFORT else effort
+    return math.inf if motor["effort"] is None else float(motor["effort"])
 
 
 @lru_cache(maxsize=MODELS_KEPT)
