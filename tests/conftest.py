@@ -31,6 +31,19 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(skip)
 
 
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Under `--dist loadgroup`, an `xdist_group` test must carry its group in its node id: that
+    is how pytest-xdist sends a group to one worker. A pytest that drops it splits every group over
+    the workers (a session fixture built once per worker, a shared server raced) without a word."""
+    grouped = item.get_closest_marker("xdist_group") is not None
+    if grouped and item.config.getoption("loadgroup", default=False) and "@" not in item.nodeid:
+        pytest.fail(
+            "--dist loadgroup did not group this test: this pytest and pytest-xdist disagree on "
+            "node ids; install the versions the test extra names",
+            pytrace=False,
+        )
+
+
 def pytest_terminal_summary(terminalreporter) -> None:
     """One line that says how many tests the missing corpus skipped, and why."""
     skipped = terminalreporter.stats.get("skipped", [])
