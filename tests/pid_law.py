@@ -4,14 +4,24 @@ from __future__ import annotations
 
 
 def pid_law(
-    target: float, p: float, i: float, t: float, *, inertia: float = 0.01, cmd_max: float = 2.0
+    target: float,
+    p: float,
+    i: float,
+    t: float,
+    *,
+    inertia: float = 0.01,
+    cmd_max: float = 2.0,
+    cmd_min: float | None = None,
+    start: float = 0.0,
 ) -> float:
-    """The disc's speed t s after a step to `target` under gz-math's PID on the speed error,
-    p·e + i·∫e with gz-sim JointController's integral limit ±1 N m, the sum clamped to
-    ±cmd_max [N m], integrated in 10 µs steps."""
-    speed, integral, dt = 0.0, 0.0, 1e-5
+    """The disc's speed t s after a step from `start` to `target` [rad/s] under gz-math's PID on
+    the speed error, p·e + i·∫e with gz-sim JointController's integral limit ±1 N m, the sum
+    clamped to [cmd_min, cmd_max] [N m] (cmd_min -cmd_max unless given), integrated in 10 µs
+    steps."""
+    low = -cmd_max if cmd_min is None else cmd_min
+    speed, integral, dt = start, 0.0, 1e-5
     for _ in range(round(t / dt)):
         error = target - speed
         integral = min(max(integral + i * error * dt, -1.0), 1.0)
-        speed += min(max(p * error + integral, -cmd_max), cmd_max) / inertia * dt
+        speed += min(max(p * error + integral, low), cmd_max) / inertia * dt
     return speed

@@ -62,31 +62,36 @@ def planar_actuator(plugin: str, axis: str) -> str:
     return f"planar:{plugin}:{axis}"
 
 
-JointMode = tuple[str, str, float, "tuple[float, float, float] | None"]
+JointMode = tuple[str, str, "tuple[float, float]", "tuple[float, float, float] | None"]
+
+
+def _within(effort: float) -> tuple[float, float]:
+    return (-effort, effort)
 
 
 def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
-    """(joint, mode, effort bound [N m or N], pid) for each joint the drive commands."""
+    """(joint, mode, force range [N m or N], pid) for each joint the drive commands."""
     if isinstance(record, DiffDrive):
-        return [(j, "velocity", record.max_wheel_torque, None) for j in record.wheel_joints()]
+        wheels = record.wheel_joints()
+        return [(j, "velocity", _within(record.max_wheel_torque), None) for j in wheels]
     if isinstance(record, AckermannDrive):
         wheels = record.left_joints + record.right_joints
         steering = record.left_steering_joints + record.right_steering_joints
         # gz-sim steers by joint speed commands (`steering_gain`), gazebo_ros to an angle
         steer = "position" if record.steering_gain is None else "velocity"
-        return [(j, "velocity", record.max_wheel_torque, None) for j in wheels] + [
-            (j, steer, math.inf, None) for j in steering
+        return [(j, "velocity", _within(record.max_wheel_torque), None) for j in wheels] + [
+            (j, steer, _within(math.inf), None) for j in steering
         ]
     if isinstance(record, TricycleDrive):
         return [
-            (record.actuated_wheel_joint, "velocity", record.max_wheel_torque, None),
-            (record.steering_joint, "position", math.inf, None),
+            (record.actuated_wheel_joint, "velocity", _within(record.max_wheel_torque), None),
+            (record.steering_joint, "position", _within(math.inf), None),
         ]
     if isinstance(record, JointDrive):
-        return [(j, record.mode, record.max_force, record.pid) for j in record.joints]
+        return [(j, record.mode, record.force_range, record.pid) for j in record.joints]
     if isinstance(record, TrajectoryDrive):
         rows = zip(record.joints, record.max_forces, record.pids, strict=True)
-        return [(j, "position", bound, pid) for j, bound, pid in rows]
+        return [(j, "position", _within(bound), pid) for j, bound, pid in rows]
     return []
 
 
@@ -110,18 +115,18 @@ def add_drive_motors(
     for record in plugins:
         if isinstance(record, Rotor):
             continue
-        for joint, mode, effort, pid in joint_modes(record):
+        for joint, mode, force, pid in joint_modes(record):
             if spec.joint(joint) is None:
                 free = mujoco.mjtJoint.mjJNT_FREE
                 joints = [j.name for j in spec.joints if j.type != free]
                 raise PluginJointError(report.source, record.name, "", joint, joints)
             if joint not in driven:
-                _motor(spec, joint, effort)
+                _motor(spec, joint, force)
                 set_control_record(spec, joint, _record(record, mode, pid))
                 driven.add(joint)
             elif _untagged(spec, joint):
                 if not isinstance(record, JointDrive | TrajectoryDrive):
-                    _bound(spec, joint, effort)
+                    _bound(spec, joint, force)
                 set_control_record(spec, joint, _record(record, mode, pid))
         if isinstance(record, HolonomicDrive):
             _planar_servos(spec, record)
@@ -140,29 +145,30 @@ def _untagged(spec: mujoco.MjSpec, joint: str) -> bool:
     return records.get(joint, {}).get("source") == "default"
 
 
-def _bound(spec: mujoco.MjSpec, joint: str, effort: float) -> None:
+def _bound(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
     """A wheel drive's own torque bound (gazebo_ros' `fmax`, which replaces the joint motor's
     bound in ODE) replaces the joint's effort limit on the motor it already has; a drive that
     sets velocities (unbounded here: gz-sim's) leaves the joint's limit, which Gazebo's velocity
     command obeys. Joint controllers' forces stay within the joint's limit as well."""
     import mujoco
 
-    if not math.isfinite(effort):
+    if not all(math.isfinite(f) for f in force):
         return
     for motor in spec.actuators:
         if motor.target == joint and motor.trntype == mujoco.mjtTrn.mjTRN_JOINT:
             motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            motor.ctrlrange = np.array([-effort, effort])
+            motor.ctrlrange = np.array(force, dtype=float)
 
 
-def _motor(spec: mujoco.MjSpec, joint: str, effort: float) -> None:
+def _motor(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
+    """The joint's motor, its torque within `force` (both ends finite) or free."""
     import mujoco
 
     motor = spec.add_actuator(name=joint, target=joint)
     motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
-    if math.isfinite(effort):
+    if all(math.isfinite(f) for f in force):
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        motor.ctrlrange = np.array([-effort, effort])
+        motor.ctrlrange = np.array(force, dtype=float)
 
 
 def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:

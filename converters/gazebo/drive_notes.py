@@ -144,15 +144,16 @@ USED: dict[str, set[str]] = {
         "use_force_commands",
         "p_gain",
         "cmd_max",
+        "cmd_min",
         "initial_velocity",  # held from load (twin_cli.world.plugin_holds)
     },
     "gz-sim-joint-position-controller-system": {
         "joint_name",
         "use_velocity_commands",
         "p_gain",
-        "i_gain",
         "d_gain",
         "cmd_max",
+        "cmd_min",
     },
     "gz-sim-joint-trajectory-controller-system": trajectory_controller.USED,
 }

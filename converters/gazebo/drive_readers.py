@@ -22,6 +22,7 @@ from converters.gazebo.drive_records import (
     DEFAULT_SEPARATION,
     DEFAULT_TORQUE,
     EVERY_STEP,
+    UNBOUNDED,
     AckermannDrive,
     DiffDrive,
     DriveRecord,
@@ -295,6 +296,18 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
     )
 
 
+POSITION_PID_NOTE = (
+    "its PID as a position servo: kp = p_gain, kv = d_gain on the joint's speed, the force "
+    "within [cmd_min, cmd_max]; the PID's integral (i_gain, 0.1 unless given, within "
+    "i_min/i_max) and its derivative's kick when the target jumps are not run"
+)
+
+SET_SPEED_NOTE = (
+    "with use_velocity_commands, a stiff position servo (gz-sim sets the speed that reaches the "
+    "target in one step, at most cmd_max when given; that speed bound is not run)"
+)
+
+
 def read_joint_controller(p: Params, blob: Blob, ctx: ReadContext) -> JointDrive:
     """gz-sim JointController: a velocity on its joints (set directly, or through its PID on
     the joint force with `use_force_commands`)."""
@@ -306,7 +319,7 @@ def read_joint_controller(p: Params, blob: Blob, ctx: ReadContext) -> JointDrive
         joints=_required(p, ("joint_name",)),
         mode="velocity",
         pid=gains if force else None,
-        max_force=p.number(1000.0, "cmd_max") if force else math.inf,
+        force_range=_pid_output(p) if force else UNBOUNDED,
         initial=p.number(0.0, "initial_velocity", signed=True),
     )
 
@@ -322,10 +335,19 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
         joints=_required(p, ("joint_name",)),
         mode="position",
         pid=None if velocity else gains,
-        max_force=math.inf if velocity else p.number(1000.0, "cmd_max"),
+        force_range=UNBOUNDED if velocity else _pid_output(p),
         initial=p.number(0.0, "initial_position", signed=True),
         family="gz_joint_position_controller",
+        notes=(SET_SPEED_NOTE,) if velocity else (POSITION_PID_NOTE,),
     )
+
+
+def _pid_output(p: Params) -> tuple[float, float]:
+    """The force range [N m or N] gz-math's PID clamps its output to: [`cmd_min`, `cmd_max`],
+    each defaulting to ∓1000 on its own (so a lone `cmd_max` 2 leaves pushes down to -1000), and
+    no clamp at all when `cmd_max` < `cmd_min`."""
+    low, high = p.number(-1000.0, "cmd_min", signed=True), p.number(1000.0, "cmd_max", signed=True)
+    return (low, high) if high >= low else UNBOUNDED
 
 
 def _distance(a: object, b: object) -> float:

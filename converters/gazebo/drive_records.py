@@ -28,6 +28,7 @@ DEFAULT_TORQUE = 5.0  # [N m]
 DEFAULT_ACCELERATION = 0.0  # [m/s²] at the wheel rim; 0 = unlimited
 DEFAULT_RATE = 100.0  # [Hz]
 EVERY_STEP = 0.0
+UNBOUNDED = (-math.inf, math.inf)  # a force range without a bound
 """[Hz] the update rate of a plugin that acts at every physics step: gz-sim's DiffDrive,
 AckermannSteering and MecanumDrive set their joints' velocities in every `PreUpdate` (their
 `odom_publish_frequency` only throttles the odometry messages), ROS 1's planar move sets the
@@ -250,7 +251,8 @@ class JointDrive(_Record):
     Attributes:
         joints: the joints it commands; mode: "velocity" or "position"; pid: (p, i, d) when the
         system runs its own PID on the joint's force, else None (it sets the joint's velocity);
-        max_force [N m or N] (inf: none), initial: the system's initial command, notes.
+        force_range: (low, high) [N m or N] its force stays in, initial: the system's initial
+        command, notes.
     """
 
     name: str
@@ -258,7 +260,7 @@ class JointDrive(_Record):
     joints: tuple[str, ...]
     mode: str
     pid: tuple[float, float, float] | None = None
-    max_force: float = math.inf
+    force_range: tuple[float, float] = UNBOUNDED
     initial: float = 0.0
     family: str = "gz_joint_controller"
     notes: tuple[str, ...] = ()

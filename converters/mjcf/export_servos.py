@@ -136,6 +136,17 @@ def tag_pid(pids: Mapping[str, Sequence[float]], mode: str) -> tuple | None:
     return tuple(pid)
 
 
+def tag_servo_gains(
+    pid: Sequence[float], inertia: float, timestep: float, effort: float
+) -> tuple[float, float]:
+    """(kp, kv) of a position servo a tag's PID sets: its p and its d, as Gazebo's PID applies
+    them (no damping added: an underdamped tag rings in twin as in Gazebo). The one change: with
+    an effort limit kv stays at most I/h, since MuJoCo integrates the damping of a clamped
+    force explicitly and more than I/h per step then overshoots the speed it brakes."""
+    kp, kd = float(pid[0]), max(float(pid[2]), 0.0)
+    return kp, min(kd, inertia / timestep) if np.isfinite(effort) else kd
+
+
 def _offers_velocity(spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, records: dict) -> bool:
     """Whether a joint motor (gear 1, no dynamics or bias) drives a hinge or slide whose tags
     offer velocity commands and give no velocity PID: ros2_control's `velocity_pid` and gz-sim's
@@ -229,10 +240,8 @@ def _to_servo(
     actuator.ctrlrange = np.array([low, high]) if np.isfinite(high) else np.zeros(2)
     pid = tag_pid(record.get("pid", {}), mode)
     if mode == "position":
-        if pid:  # the world's rule: kv = max(kd, 2√(kp·I)), at most I/h with an effort limit
-            kp = float(pid[0])
-            damping = max(float(pid[2]), 2.0 * np.sqrt(max(kp, 0.0) * inertia))
-            kv = min(damping, kv) if np.isfinite(effort) else damping
+        if pid:  # the controller's own p and d, as the world runs them (`tag_servo_gains`)
+            kp, kv = tag_servo_gains(pid, inertia, timestep, effort)
         else:
             speed = record.get("velocity_limit")
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)

@@ -180,9 +180,9 @@ def test_servo_gains_follow_the_effort_bound_and_the_tags_pid(tmp_path: Path) ->
     assert not model.actuator_forcelimited[d0.id]
     assert d0.gainprm[0] == pytest.approx(inertia * omega**2)
     assert d0.biasprm[2] == pytest.approx(-d0.gainprm[0] * tau)
-    # The tags' PID: kp = pos_kp, kv = max(pos_kd, 2√(kp·I)) within I/h (an effort limit).
+    # The tags' PID: kp = pos_kp, kv = pos_kd as written, within I/h (an effort limit).
     assert d1.gainprm[0] == pytest.approx(120.0)
-    assert -d1.biasprm[2] == pytest.approx(min(max(4.0, 2 * np.sqrt(120 * inertia)), inertia / h))
+    assert -d1.biasprm[2] == pytest.approx(min(4.0, inertia / h))
     assert list(d1.forcerange) == [-5.0, 5.0]
 
 

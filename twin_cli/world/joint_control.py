@@ -245,7 +245,7 @@ def servo_rule(
     if mode == "position":
         kp, kv = _position_gains(inertia, timestep, step, SPEED_MARGIN * vmax)
         if pid:
-            kp, kv = pid[0], max(pid[2], kp * step / (SPEED_MARGIN * vmax))
+            kp, kv = pid[0], max(pid[2], 0.0)
         return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
     if mode == "velocity":
         kv, rule = _velocity_gain(pid, effort, vmax, inertia, timestep)
@@ -267,7 +267,7 @@ def _reference_rule(
 
     `motion` is (ramp speed, step) of a position command. A tag's damping above I/h is capped
     there when the joint has an effort limit (a clamped step is explicit, see `_velocity_gain`);
-    its stiffness is used as written.
+    otherwise its gains are used as written, with no damping added.
     """
     if mode == "effort":
         return 0.0, 0.0, "effort"
@@ -275,7 +275,7 @@ def _reference_rule(
     kp, kv = servos.gains(mode, inertia, timestep, effort, *motion)
     rule = "carried inertia"
     if pid and mode == "position":
-        kp, kv, rule = pid[0], max(pid[2], 2.0 * math.sqrt(pid[0] * own)), "tag PID (pos_*)"
+        kp, kv, rule = pid[0], max(pid[2], 0.0), "tag PID (pos_*)"  # Gazebo's p and d
     elif pid:  # the controller's p·(ω* − ω); its integral is not run, as in the export
         kp, kv, rule = 0.0, pid[0], "tag PID (vel_kp" + ("; vel_ki not run)" if pid[1] else ")")
     if pid and math.isfinite(effort) and kv > own / timestep:

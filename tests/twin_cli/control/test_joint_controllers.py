@@ -121,3 +121,67 @@ def test_a_force_commanded_joint_controller_closes_its_pid_not_a_rigid_motor(
         expected = pid_law(3.0, p_gain, i_gain, t, cmd_max=CMD_MAX)
         speed = _state(world, "fan_joint").velocity
         assert speed == pytest.approx(expected, rel=0.05), f"{speed:.4f} rad/s at {t} s"
+
+
+def _force_rig_within(tmp_path: Path, p_gain: float, bounds: str) -> World:
+    """The force rig (i_gain 0) whose JointController's output limits are the tags `bounds`."""
+    text = RIG.replace(
+        "<joint_name>fan_joint</joint_name></plugin>",
+        "<joint_name>fan_joint</joint_name><use_force_commands>true</use_force_commands>"
+        f"<p_gain>{p_gain}</p_gain>{bounds}</plugin>",
+    )
+    return _spawned(tmp_path, text)
+
+
+@pytest.mark.parametrize(
+    ("bounds", "cmd_max", "cmd_min"),
+    [
+        ("<cmd_max>2</cmd_max>", 2.0, -1000.0),  # a lone cmd_max: cmd_min keeps gz-math's -1000
+        ("<cmd_max>2</cmd_max><cmd_min>-0.5</cmd_min>", 2.0, -0.5),
+        ("<cmd_max>0.8</cmd_max><cmd_min>-2</cmd_min>", 0.8, -2.0),
+    ],
+)
+def test_a_force_commanded_joint_controller_pushes_within_cmd_min_and_cmd_max(
+    tmp_path: Path, bounds: str, cmd_max: float, cmd_min: float
+) -> None:
+    """gz-math's PID clamps its output to [cmd_min, cmd_max], each defaulting on its own: the
+    disc (p 1, time constant I/p = 10 steps) spins up to 3 rad/s within cmd_max and back to 0
+    within cmd_min, as the clamped law says; with a lone cmd_max of 2 N m it brakes at p·e
+    (3 N m), not at -2 N m (1.82 rad/s after 5 ms where ±cmd_max would leave 2.0)."""
+    world = _force_rig_within(tmp_path, 1.0, bounds)
+    world.command_joints("rig", {"fan_joint": 3.0}, mode="velocity")
+    h = world.model.opt.timestep
+    world.step(round(0.5 / h))
+    spun = _state(world, "fan_joint").velocity
+    assert spun == pytest.approx(3.0, rel=0.01), f"{spun:.4f} rad/s after 0.5 s at 3 rad/s"
+    world.command_joints("rig", {"fan_joint": 0.0}, mode="velocity")
+    elapsed = 0.0
+    for t in (0.005, 0.01, 0.02, 0.05):
+        world.step(round((t - elapsed) / h))
+        elapsed = t
+        law = pid_law(0.0, 1.0, 0.0, t, cmd_max=cmd_max, cmd_min=cmd_min, start=spun)
+        speed = _state(world, "fan_joint").velocity
+        assert speed == pytest.approx(law, abs=0.03 * spun), f"{speed:.4f} rad/s at {t} s"
+
+
+@pytest.mark.parametrize("d_gain", [0.05, 0.2, 0.5])
+def test_a_joint_position_controller_rings_as_its_gains_say(tmp_path: Path, d_gain: float) -> None:
+    """p_gain 30 on the 0.01 kg m² dial with a d_gain below critical damping (2√(p·I) = 1.1):
+    gz-sim's PID adds no damping, so the dial overshoots a 1 rad step by exp(−ζπ/√(1−ζ²)) of it,
+    ζ = d/(2√(p·I)), and peaks half a damped period after the step (ω_d = √(p/I)·√(1−ζ²))."""
+    import math
+
+    world = _spawned(tmp_path, RIG.replace("<d_gain>2</d_gain>", f"<d_gain>{d_gain}</d_gain>"))
+    world.command_joints("rig", {"dial_joint": 1.0}, mode="position")
+    h = world.model.opt.timestep
+    angles = []
+    for _ in range(round(0.2 / h)):
+        world.step(1)
+        angles.append(_state(world, "dial_joint").position)
+    peak = max(angles)
+    zeta = d_gain / (2.0 * math.sqrt(30.0 * 0.01))
+    damped = math.sqrt(30.0 / 0.01) * math.sqrt(1.0 - zeta**2)
+    assert peak - 1.0 == pytest.approx(math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2)), rel=0.05)
+    assert (angles.index(peak) + 1) * h == pytest.approx(math.pi / damped, rel=0.05)
+    row = world.joint_commands("rig")["dial_joint"]
+    assert (row["kp"], row["kv"]) == (30.0, d_gain), "p_gain and d_gain as the servo's gains"
