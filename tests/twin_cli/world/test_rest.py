@@ -40,8 +40,8 @@ STILL_FALLING = {
     "booster_t1": "topples from standing: 58.6 mm, 0.80 rad; a hand 236 mm",
     "abb_irb2400_12_155": "limp wrist swung by explicit Coriolis forces: 0.025 mm, 0.004 mrad; "
     "its limp lever link_lever_b swings 6.1 mm",
-    "ur5e": "its own servos hold it at home from load on its free base, which rocks: "
-    "1.03 mm, 0.80 mrad",
+    "ur5e": "held at home, its outstretched arm lies on its wrist: base edge and wrist carry "
+    "2.1 N and 0.5 N sideways, under which the soft friction creeps 15 µm/s: 1.03 mm, 0.80 mrad",
 }
 
 
