@@ -125,7 +125,9 @@ def add_drive_motors(
                 set_control_record(spec, joint, _record(record, mode, pid))
                 driven.add(joint)
             elif _untagged(spec, joint):
-                if not isinstance(record, JointDrive | TrajectoryDrive):
+                if isinstance(record, JointDrive | TrajectoryDrive):
+                    _narrow(spec, joint, force)
+                else:
                     _bound(spec, joint, force)
                 set_control_record(spec, joint, _record(record, mode, pid))
         if isinstance(record, HolonomicDrive):
@@ -149,7 +151,7 @@ def _bound(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
     """A wheel drive's own torque bound (gazebo_ros' `fmax`, which replaces the joint motor's
     bound in ODE) replaces the joint's effort limit on the motor it already has; a drive that
     sets velocities (unbounded here: gz-sim's) leaves the joint's limit, which Gazebo's velocity
-    command obeys. Joint controllers' forces stay within the joint's limit as well."""
+    command obeys. Joint controllers' forces stay within the joint's limit as well (`_narrow`)."""
     import mujoco
 
     if not all(math.isfinite(f) for f in force):
@@ -158,6 +160,22 @@ def _bound(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
         if motor.target == joint and motor.trntype == mujoco.mjtTrn.mjTRN_JOINT:
             motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
             motor.ctrlrange = np.array(force, dtype=float)
+
+
+def _narrow(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
+    """A joint controller's PID output range on a joint with its own effort limit: the force
+    stays within both, as gz-sim clamps the PID's output and the physics engine then the
+    joint's effort."""
+    import mujoco
+
+    for motor in spec.actuators:
+        if motor.target == joint and motor.trntype == mujoco.mjtTrn.mjTRN_JOINT:
+            limited = motor.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE
+            low, high = motor.ctrlrange if limited else (-math.inf, math.inf)
+            low, high = max(float(low), force[0]), min(float(high), force[1])
+            if math.isfinite(low) and math.isfinite(high) and low < high:  # else the joint's
+                motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+                motor.ctrlrange = np.array([low, high])
 
 
 def _motor(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:

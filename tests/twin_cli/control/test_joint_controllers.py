@@ -185,3 +185,43 @@ def test_a_joint_position_controller_rings_as_its_gains_say(tmp_path: Path, d_ga
     assert (angles.index(peak) + 1) * h == pytest.approx(math.pi / damped, rel=0.05)
     row = world.joint_commands("rig")["dial_joint"]
     assert (row["kp"], row["kv"]) == (30.0, d_gain), "p_gain and d_gain as the servo's gains"
+
+
+def test_a_joint_controllers_force_stays_within_the_joints_effort_limit_too(
+    tmp_path: Path,
+) -> None:
+    """The fan's joint with its own effort limit of 1.5 N m under a PID whose output range is
+    [-0.5, 2]: gz-sim clamps the PID to its range and the physics engine the joint to its
+    limit, so the disc (p 1) spins up at 1.5 N m and brakes at 0.5 N m."""
+    limited = RIG.replace(
+        '<joint name="fan_joint" type="continuous"><parent link="base"/><child link="fan"/>\n'
+        '    <axis xyz="0 0 1"/></joint>',
+        '<joint name="fan_joint" type="revolute"><parent link="base"/><child link="fan"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1000" upper="1000" effort="1.5" velocity="100"/>'
+        "</joint>",
+    )
+    assert limited != RIG
+    world = _spawned(
+        tmp_path,
+        limited.replace(
+            "<joint_name>fan_joint</joint_name></plugin>",
+            "<joint_name>fan_joint</joint_name><use_force_commands>true</use_force_commands>"
+            "<p_gain>1</p_gain><cmd_max>2</cmd_max><cmd_min>-0.5</cmd_min></plugin>",
+        ),
+    )
+    h = world.model.opt.timestep
+    world.command_joints("rig", {"fan_joint": 3.0}, mode="velocity")
+    elapsed = 0.0
+    for t in (0.005, 0.01, 0.02):
+        world.step(round((t - elapsed) / h))
+        elapsed = t
+        law = pid_law(3.0, 1.0, 0.0, t, cmd_max=1.5, cmd_min=-0.5)
+        speed = _state(world, "fan_joint").velocity
+        assert speed == pytest.approx(law, rel=0.03), f"spin-up: {speed:.4f} rad/s at {t} s"
+    world.step(round(0.5 / h))
+    spun = _state(world, "fan_joint").velocity
+    world.command_joints("rig", {"fan_joint": 0.0}, mode="velocity")
+    world.step(round(0.02 / h))
+    law = pid_law(0.0, 1.0, 0.0, 0.02, cmd_max=1.5, cmd_min=-0.5, start=spun)
+    speed = _state(world, "fan_joint").velocity
+    assert speed == pytest.approx(law, abs=0.03 * spun), f"braking: {speed:.4f} rad/s after 20 ms"
