@@ -53,6 +53,7 @@ def _gazebo_example(expected: str) -> str:
         "three numbers": "1 0 0",
         "a finite number": "0.5",
         "a finite number >= 0": "0.5",
+        "a number below cmd_max": "-1000",
         "0 (encoder) or 1 (world)": "1",
         "a wheel joint name": "wheel_left_joint",
     }

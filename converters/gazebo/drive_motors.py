@@ -90,8 +90,8 @@ def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
     if isinstance(record, JointDrive):
         return [(j, record.mode, record.force_range, record.pid) for j in record.joints]
     if isinstance(record, TrajectoryDrive):
-        rows = zip(record.joints, record.max_forces, record.pids, strict=True)
-        return [(j, "position", _within(bound), pid) for j, bound, pid in rows]
+        rows = zip(record.joints, record.force_ranges, record.pids, strict=True)
+        return [(j, "position", force, pid) for j, force, pid in rows]
     return []
 
 
@@ -165,7 +165,8 @@ def _bound(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
 def _narrow(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
     """A joint controller's PID output range on a joint with its own effort limit: the force
     stays within both, as gz-sim clamps the PID's output and the physics engine then the
-    joint's effort."""
+    joint's effort. Ranges that do not overlap (a PID that only pushes beyond the joint's
+    limit) keep the joint's limit alone, both ways."""
     import mujoco
 
     for motor in spec.actuators:

@@ -345,9 +345,15 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
 def _pid_output(p: Params) -> tuple[float, float]:
     """The force range [N m or N] gz-math's PID clamps its output to: [`cmd_min`, `cmd_max`],
     each defaulting to ∓1000 on its own (so a lone `cmd_max` 2 leaves pushes down to -1000), and
-    no clamp at all when `cmd_max` < `cmd_min`."""
+    no clamp at all when `cmd_max` < `cmd_min`.
+
+    Raises:
+        GazeboTagError: `cmd_min` equals `cmd_max` (a constant force, not a controller).
+    """
     low, high = p.number(-1000.0, "cmd_min", signed=True), p.number(1000.0, "cmd_max", signed=True)
-    return (low, high) if high >= low else UNBOUNDED
+    if low == high:  # gz-math would push this one force whatever the error: refused
+        raise GazeboTagError(p.source, "", "plugin/cmd_min", f"{low:g}", "a number below cmd_max")
+    return (low, high) if high > low else UNBOUNDED
 
 
 def _distance(a: object, b: object) -> float:

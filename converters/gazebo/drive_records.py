@@ -28,11 +28,11 @@ DEFAULT_TORQUE = 5.0  # [N m]
 DEFAULT_ACCELERATION = 0.0  # [m/s²] at the wheel rim; 0 = unlimited
 DEFAULT_RATE = 100.0  # [Hz]
 EVERY_STEP = 0.0
-UNBOUNDED = (-math.inf, math.inf)  # a force range without a bound
 """[Hz] the update rate of a plugin that acts at every physics step: gz-sim's DiffDrive,
 AckermannSteering and MecanumDrive set their joints' velocities in every `PreUpdate` (their
 `odom_publish_frequency` only throttles the odometry messages), ROS 1's planar move sets the
 model's velocity at every world update."""
+UNBOUNDED = (-math.inf, math.inf)  # a force range without a bound
 
 
 def _plain(value: Any) -> Any:
@@ -280,9 +280,9 @@ class TrajectoryDrive(_Record):
         initial_positions: [rad or m] per joint, what the PIDs hold before any trajectory;
         pids: per joint (p, i, d) for twin's position servo: the position PID's p, no i (not
         used), its d plus the velocity PID's p (both act on the joint's speed), or None when
-        they are 0 (gz-sim applies no force; twin's own gains); max_forces [N m or N] per
-        joint (inf: none); topic, progress_topic: where gz-sim takes trajectories and reports
-        progress.
+        they are 0 (gz-sim applies no force; twin's own gains); force_ranges: (low, high)
+        [N m or N] per joint; topic, progress_topic: where gz-sim takes trajectories and
+        reports progress.
     """
 
     name: str
@@ -290,7 +290,7 @@ class TrajectoryDrive(_Record):
     joints: tuple[str, ...]
     initial_positions: tuple[float, ...]
     pids: tuple[tuple[float, float, float] | None, ...]
-    max_forces: tuple[float, ...]
+    force_ranges: tuple[tuple[float, float], ...]
     topic: str
     progress_topic: str
     family: str = "gz_joint_trajectory_controller"

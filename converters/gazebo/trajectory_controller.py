@@ -17,14 +17,13 @@ all 0 make gz-sim apply no force; twin's servo then uses its own gains, and says
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from converters.description.gazebo import Blob
 from converters.errors import GazeboTagError
-from converters.gazebo.drive_records import TrajectoryDrive
+from converters.gazebo.drive_records import UNBOUNDED, TrajectoryDrive
 from converters.gazebo.plugin_params import Params
 
 if TYPE_CHECKING:
@@ -74,7 +73,7 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
         joints=joints,
         initial_positions=_nth_all(p.numbers("initial_position", signed=True), count, 0.0),
         pids=pids,
-        max_forces=tuple(_bound(p, i) for i in range(count)),
+        force_ranges=tuple(_bound(p, i) for i in range(count)),
         topic=topic,
         progress_topic=f"{topic}_progress",
         notes=(limp_note,) if limp else (),
@@ -106,10 +105,11 @@ def _pid(p: Params, i: int) -> tuple[float, float, float] | None:
     return (kp, 0.0, kv) if kp or kv else None
 
 
-def _bound(p: Params, i: int) -> float:
-    """Joint `i`'s force bound [N m or N]: the sum of the two PIDs' output limits (gz-sim's
-    ignition::math::PID leaves the output free while cmd_max < cmd_min)."""
-    total = 0.0
+def _bound(p: Params, i: int) -> tuple[float, float]:
+    """Joint `i`'s force range [N m or N]: the sums of the two PIDs' output limits, each PID
+    clamped to its own [cmd_min, cmd_max] (gz-sim's ignition::math::PID leaves the output free
+    while cmd_max < cmd_min)."""
+    total_low, total_high = 0.0, 0.0
     for pid in ("position", "velocity"):
         low = _nth(p.numbers(f"{pid}_cmd_min", signed=True), i, 0.0)
         high = _nth(p.numbers(f"{pid}_cmd_max", signed=True), i, -1.0)
@@ -117,9 +117,9 @@ def _bound(p: Params, i: int) -> float:
         if not any(gains):
             continue  # a PID without gains adds no force
         if high < low:
-            return math.inf
-        total += max(abs(low), abs(high))
-    return total if total > 0 else math.inf
+            return UNBOUNDED
+        total_low, total_high = total_low + low, total_high + high
+    return (total_low, total_high) if total_high > total_low else UNBOUNDED
 
 
 def start_at_initial_positions(spec: mujoco.MjSpec, record: TrajectoryDrive) -> None:

@@ -1,10 +1,10 @@
 """Each motor's command modes and limits → one custom text `control` the world reads.
 
-A MuJoCo motor knows its effort limit (ctrlrange = forcerange = ±effort) but not the joint's
-velocity limit, the modes its `<ros2_control>`/`<transmission>` tags allow, their `min`/`max`
-bounds or their PID gains. The world needs them at command time to write the actuator's gain,
-bias and force range (twin_cli.world.actuation), so they travel in the model as one JSON text
-mapping each motor's joint to its record; attaching an entity prefixes the name
+A MuJoCo motor knows its force range (ctrlrange = forcerange = ±effort, or a PID's) but not
+the joint's velocity limit, the modes its `<ros2_control>`/`<transmission>` tags allow, their
+`min`/`max` bounds or their PID gains. The world needs them at command time to write the
+actuator's gain, bias and force range (twin_cli.world.actuation), so they travel in the model as
+one JSON text mapping each motor's joint to its record; attaching an entity prefixes the name
 (`<entity>/control`) like any element. One text per model, not one per motor: deleting an
 element from a world spec costs MuJoCo a pass over the whole world (~23 ms with 50 humanoids),
 so a delete's cost would otherwise grow with the robot's motor count.

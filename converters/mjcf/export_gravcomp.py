@@ -23,18 +23,20 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
+    from collections.abc import Container
+
     import mujoco
 
 GRAVCOMP = "exported_gravcomp"  # key of a replaced motor's record: what `compensate` changed
 FULL = 1.0  # gravcomp of a body whose whole weight the servos hold
 
 
-def compensate(spec: mujoco.MjSpec, held: dict[str, float]) -> dict[str, dict]:
+def compensate(spec: mujoco.MjSpec, held: dict[str, tuple[float, float]]) -> dict[str, dict]:
     """Writes gravcomp into a fixed-base `spec` for the joints in `held` (see module doc).
 
     Args:
         spec: the robot, its servos already written.
-        held: each position-servoed joint and its effort limit [N m or N] (inf: none).
+        held: each position-servoed joint and its force range [N m or N] (infinite: none).
 
     Returns:
         For each joint changed, what it replaced (for `restore_gravcomp`); empty for a floating
@@ -45,7 +47,7 @@ def compensate(spec: mujoco.MjSpec, held: dict[str, float]) -> dict[str, dict]:
     if any(joint.type == mujoco.mjtJoint.mjJNT_FREE for joint in spec.joints):
         return {}
     changed = {}
-    for name, effort in held.items():
+    for name, (low, high) in held.items():
         joint = spec.joint(name)
         changed[name] = {
             "actgravcomp": bool(joint.actgravcomp),
@@ -53,9 +55,9 @@ def compensate(spec: mujoco.MjSpec, held: dict[str, float]) -> dict[str, dict]:
             "actfrcrange": [float(v) for v in joint.actfrcrange],
         }
         joint.actgravcomp = True
-        if np.isfinite(effort):
+        if np.isfinite(low) and np.isfinite(high):  # compensation within the servo's own range
             joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            joint.actfrcrange = np.array([-effort, effort])
+            joint.actfrcrange = np.array([low, high])
     for body in spec.bodies:
         if body is spec.worldbody or body.gravcomp != 0.0 or not _chain_held(spec, body, held):
             continue
@@ -65,7 +67,7 @@ def compensate(spec: mujoco.MjSpec, held: dict[str, float]) -> dict[str, dict]:
     return changed
 
 
-def _chain_held(spec: mujoco.MjSpec, body: mujoco.MjsBody, held: dict[str, float]) -> bool:
+def _chain_held(spec: mujoco.MjSpec, body: mujoco.MjsBody, held: Container[str]) -> bool:
     """Whether `body` moves and every joint from it down to the world is in `held`."""
     moves = False
     while body is not spec.worldbody:

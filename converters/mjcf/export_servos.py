@@ -85,7 +85,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     if not chosen and not driven:
         return {}
     servoed: dict[str, str] = {}
-    held: dict[str, float] = {}  # each position servo's effort limit
+    held: dict[str, tuple[float, float]] = {}  # each position servo's force range
     inertia, home, model = _home_inertia(spec)
     key = _home_key(spec)
     ctrl = np.array(key.ctrl, dtype=float) if key is not None else np.zeros(0)
@@ -109,7 +109,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         _to_servo(spec, actuator, record, inertia[joint], timestep)
         servoed[joint] = record["modes"][0]
         if record["modes"][0] == "position":
-            held[joint] = _force_bound(actuator)
+            held[joint] = _force_range(actuator)
             if key is not None:
                 ctrl[i] = home[joint]
     if key is not None:
@@ -287,13 +287,14 @@ def _to_velocity_pid(actuator: mujoco.MjsActuator, pid: tuple) -> None:
     actuator.actearly = True
 
 
-def _force_bound(actuator: mujoco.MjsActuator) -> float:
-    """A servo's force bound [N m or N]: its `forcerange`, inf without one."""
+def _force_range(actuator: mujoco.MjsActuator) -> tuple[float, float]:
+    """A servo's force range [N m or N]: its `forcerange` (asymmetric where a PID's output
+    range is), unbounded without one."""
     import mujoco
 
     if actuator.forcelimited != mujoco.mjtLimited.mjLIMITED_TRUE:
-        return float("inf")
-    return float(np.max(np.abs(actuator.forcerange)))
+        return (-np.inf, np.inf)
+    return (float(actuator.forcerange[0]), float(actuator.forcerange[1]))
 
 
 def _target_range(spec: mujoco.MjSpec, joint_name: str, record: dict) -> tuple[float, float]:

@@ -52,27 +52,31 @@ def prepare(spec: mujoco.MjSpec) -> None:
         if joint is None:
             continue
         joint.actgravcomp = True
-        effort = _effort(actuator)
-        if math.isfinite(effort):
+        low, high = _force_range(actuator)
+        if math.isfinite(low) and math.isfinite(high):
             joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            joint.actfrcrange = np.array([-effort, effort])
+            joint.actfrcrange = np.array([low, high])
 
 
-def _effort(actuator: mujoco.MjsActuator) -> float:
-    """The actuator's force limit at its joint [N m or N]: its `forcerange`, and for a plain
-    motor its `ctrlrange` too (the converter's effort limit; an MJCF position servo's ctrlrange
-    is a position range)."""
-    gear = abs(float(actuator.gear[0])) or 1.0
-    limits = []
+def _force_range(actuator: mujoco.MjsActuator) -> tuple[float, float]:
+    """The actuator's force range at its joint [N m or N]: its `forcerange`, and for a plain
+    motor its `ctrlrange` too (the converter's effort limit, or a PID's asymmetric output range;
+    an MJCF position servo's ctrlrange is a position range)."""
+    gear = float(actuator.gear[0]) or 1.0
+    low, high = -math.inf, math.inf
     motor = actuator.biastype == mujoco.mjtBias.mjBIAS_NONE and actuator.dyntype in (
         mujoco.mjtDyn.mjDYN_NONE,
         mujoco.mjtDyn.mjDYN_INTEGRATOR,  # `servos.give_reference` ran first: a motor still
     )
+    ranges = []
     if motor and actuator.ctrllimited == mujoco.mjtLimited.mjLIMITED_TRUE:
-        limits.append(max(abs(v) for v in actuator.ctrlrange) * gear)
+        ranges.append(actuator.ctrlrange)
     if actuator.forcelimited == mujoco.mjtLimited.mjLIMITED_TRUE:
-        limits.append(max(abs(v) for v in actuator.forcerange) * gear)
-    return min(limits) if limits else math.inf
+        ranges.append(actuator.forcerange)
+    for bounds in ranges:
+        ends = sorted(float(v) * gear for v in bounds)
+        low, high = max(low, ends[0]), min(high, ends[1])
+    return low, high
 
 
 def switch(model: mujoco.MjModel, commands: Mapping[str, JointCommand]) -> None:

@@ -244,8 +244,10 @@ def servo_rule(
     vmax = limits.velocity
     if mode == "position":
         kp, kv = _position_gains(inertia, timestep, step, SPEED_MARGIN * vmax)
-        if pid:
+        if pid:  # the tag's gains, kv at most I/h with an effort limit (see `_velocity_gain`)
             kp, kv = pid[0], max(pid[2], 0.0)
+            if math.isfinite(effort):
+                kv = min(kv, inertia / timestep)
         return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
     if mode == "velocity":
         kv, rule = _velocity_gain(pid, effort, vmax, inertia, timestep)

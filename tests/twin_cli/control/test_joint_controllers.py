@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from pid_law import pid_law
+from pid_law import gz_position_pid, pid_law
 
 from converters.mjcf.velocity_motors import rotor_name
 from twin_cli.errors import InvalidRequestError
@@ -164,25 +164,56 @@ def test_a_force_commanded_joint_controller_pushes_within_cmd_min_and_cmd_max(
         assert speed == pytest.approx(law, abs=0.03 * spun), f"{speed:.4f} rad/s at {t} s"
 
 
-@pytest.mark.parametrize("d_gain", [0.05, 0.2, 0.5])
-def test_a_joint_position_controller_rings_as_its_gains_say(tmp_path: Path, d_gain: float) -> None:
-    """p_gain 30 on the 0.01 kg m² dial with a d_gain below critical damping (2√(p·I) = 1.1):
-    gz-sim's PID adds no damping, so the dial overshoots a 1 rad step by exp(−ζπ/√(1−ζ²)) of it,
-    ζ = d/(2√(p·I)), and peaks half a damped period after the step (ω_d = √(p/I)·√(1−ζ²))."""
-    import math
+# d gains of the ring test; where gz-sim's derivative kick matters, what twin does instead
+RING = [
+    pytest.param(0.05, id="d0.05"),
+    pytest.param(
+        0.2,
+        id="d0.2",
+        marks=pytest.mark.xfail(
+            strict=True,
+            reason="gz-math's derivative kick (d·Δ/h for the step the target jumps, 200 N m "
+            "for 1 ms) is not run: overshoot 0.560 against gz-sim's 0.602, peak at 58 ms "
+            "against 51 ms",
+        ),
+    ),
+    pytest.param(
+        0.5,
+        id="d0.5",
+        marks=pytest.mark.xfail(
+            strict=True,
+            reason="gz-math's derivative kick (d·Δ/h for the step the target jumps, 500 N m "
+            "for 1 ms) is not run: overshoot 0.205 against gz-sim's 0.329, peak at 65 ms "
+            "against 44 ms",
+        ),
+    ),
+]
 
-    world = _spawned(tmp_path, RIG.replace("<d_gain>2</d_gain>", f"<d_gain>{d_gain}</d_gain>"))
+
+@pytest.mark.parametrize("d_gain", RING)
+def test_a_joint_position_controller_rings_as_gz_sims_pid_does(
+    tmp_path: Path, d_gain: float
+) -> None:
+    """p_gain 30 (i_gain 0) on the 0.01 kg m² dial with a d_gain below critical damping
+    (2√(p·I) = 1.1): gz-sim's PID adds no damping, so a 1 rad step overshoots. Oracle: gz-math's
+    PID run once a step on a disc (`pid_law.gz_position_pid`); the first overshoot and its time
+    within 5 %. Before, twin damped every tag PID critically: no overshoot at all."""
+    text = RIG.replace("<d_gain>2</d_gain>", f"<d_gain>{d_gain}</d_gain><i_gain>0</i_gain>")
+    world = _spawned(tmp_path, text)
     world.command_joints("rig", {"dial_joint": 1.0}, mode="position")
     h = world.model.opt.timestep
     angles = []
     for _ in range(round(0.2 / h)):
         world.step(1)
         angles.append(_state(world, "dial_joint").position)
-    peak = max(angles)
-    zeta = d_gain / (2.0 * math.sqrt(30.0 * 0.01))
-    damped = math.sqrt(30.0 / 0.01) * math.sqrt(1.0 - zeta**2)
-    assert peak - 1.0 == pytest.approx(math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2)), rel=0.05)
-    assert (angles.index(peak) + 1) * h == pytest.approx(math.pi / damped, rel=0.05)
+    gz = gz_position_pid(1.0, (30.0, 0.0, d_gain), 0.2, step=h)
+    peak, gz_peak = max(angles), max(gz)
+    print(
+        f"d {d_gain}: overshoot {peak - 1:.3f} at {angles.index(peak) + 1} steps; "
+        f"gz-sim {gz_peak - 1:.3f} at {gz.index(gz_peak) + 1}"
+    )
+    assert peak - 1.0 == pytest.approx(gz_peak - 1.0, rel=0.05), "first overshoot"
+    assert angles.index(peak) == pytest.approx(gz.index(gz_peak), rel=0.05), "its time"
     row = world.joint_commands("rig")["dial_joint"]
     assert (row["kp"], row["kv"]) == (30.0, d_gain), "p_gain and d_gain as the servo's gains"
 
@@ -225,3 +256,60 @@ def test_a_joint_controllers_force_stays_within_the_joints_effort_limit_too(
     law = pid_law(0.0, 1.0, 0.0, 0.02, cmd_max=1.5, cmd_min=-0.5, start=spun)
     speed = _state(world, "fan_joint").velocity
     assert speed == pytest.approx(law, abs=0.03 * spun), f"braking: {speed:.4f} rad/s after 20 ms"
+
+
+# A 1 kg bar 0.5 m out on a horizontal hinge fixed to the world: its weight turns the hinge by
+# +4.905 N m at q = 0, which a JointPositionController (p 100, d 2) holds at 0 only if its
+# output range reaches -4.905 N m.
+BAR = """<robot name="bar"><link name="world"/><link name="base">{inertial}</link>
+  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
+  <link name="bar"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-4"
+    iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="bar"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1000" velocity="10"/></joint>
+  <gazebo><plugin filename="gz-sim-joint-position-controller-system"
+    name="gz::sim::systems::JointPositionController"><joint_name>hinge</joint_name>
+    <p_gain>100</p_gain><d_gain>2</d_gain><i_gain>0</i_gain>{bounds}</plugin></gazebo></robot>"""
+
+
+@pytest.mark.parametrize(
+    ("bounds", "holds"),
+    [
+        ("<cmd_max>2</cmd_max>", True),  # [-1000, 2]: the weight needs -4.9 N m
+        ("<cmd_min>-2</cmd_min>", False),  # [-2, 1000]
+        ("<cmd_min>-2</cmd_min><cmd_max>2</cmd_max>", False),
+        ("<cmd_min>-10</cmd_min><cmd_max>0</cmd_max>", True),
+    ],
+)
+def test_a_held_arm_gets_only_the_force_its_pids_range_allows(
+    tmp_path: Path, bounds: str, holds: bool
+) -> None:
+    """The weight held through MuJoCo's gravity compensation counts against the PID's own
+    range, each side for itself: the bar stays within 0.01 rad of 0 for 2 s when the range
+    reaches -4.905 N m, and falls (past 0.3 rad) when it does not, as the static torque balance
+    says (it then swings about where 4.905·cos q = 2 N m)."""
+    path = tmp_path / "bar.urdf"
+    path.write_text(BAR.format(inertial=INERTIAL, bounds=bounds))
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bar")
+    world.command_joints("bar", {"hinge": 0.0}, mode="position")
+    angles = []
+    for _ in range(200):
+        world.step(round(0.01 / world.model.opt.timestep))
+        angles.append({s.name: s for s in world.joint_states("bar")}["hinge"].position)
+    if holds:
+        assert max(map(abs, angles)) < 0.01, f"{bounds}: the bar sagged to {max(angles):.4f} rad"
+    else:
+        assert max(angles) > 0.3, f"{bounds}: the bar held within {max(angles):.4f} rad"
+
+
+def test_equal_cmd_min_and_cmd_max_are_refused_naming_the_tag(tmp_path: Path) -> None:
+    """gz-math would push that one force whatever the error: not a controller twin can run."""
+    from converters.errors import GazeboTagError
+    from converters.pipeline import convert
+
+    path = tmp_path / "rig.urdf"
+    path.write_text(RIG.replace("<d_gain>2</d_gain>", "<cmd_min>2</cmd_min><cmd_max>2</cmd_max>"))
+    with pytest.raises(GazeboTagError, match=r"<plugin/cmd_min>: value '2'") as caught:
+        convert(path)
+    assert "below cmd_max" in str(caught.value), "the message names the fix"

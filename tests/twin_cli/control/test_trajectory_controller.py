@@ -59,7 +59,7 @@ def test_its_per_joint_tags_are_read_in_the_joints_order(
     assert record.initial_positions == (0.3, -0.5)
     assert record.pids == ((200.0, 0.0, 12.0), (100.0, 0.0, 4.0)), "kp; kv = d + velocity p"
     # the first joint's output limits are given, the second's default to none (gz-sim's PID)
-    assert record.max_forces == (60.0, float("inf"))
+    assert record.force_ranges == ((-60.0, 60.0), (-float("inf"), float("inf")))
     expected = "/arm/trajectory" if topic else "/model/arm/joint_trajectory"
     assert (record.topic, record.progress_topic) == (expected, expected + "_progress")
     lines = [e.detail for e in report.entries if e.tag == "plugin"]
