@@ -10,6 +10,7 @@ if TYPE_CHECKING:
     import mujoco
 
 CONTROL_TEXT = "control"
+PID_OFFSET = "pid_offset"  # record key: the constant force [N m or N] a Gazebo PID adds
 
 
 def set_control_record(spec: mujoco.MjSpec, joint: str, record: dict) -> None:

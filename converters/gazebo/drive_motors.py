@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT, set_control_record
+from converters.control_text import CONTROL_TEXT, PID_OFFSET, set_control_record
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     AckermannDrive,
@@ -191,8 +191,9 @@ def _motor(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
 
 
 def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
-    """The plugin's joints take only the mode it commands them in."""
-    return {
+    """The plugin's joints take only the mode it commands them in; a joint controller's PID
+    offset (gz-math's `cmd_offset`, a constant force added before the clamp) travels along."""
+    record = {
         "modes": [mode],
         "source": drive.family,
         "where": drive.where,
@@ -201,6 +202,9 @@ def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
         "velocity_limit": None,
         "plugin": None,
     }
+    if pid and isinstance(drive, JointDrive) and drive.force_offset:
+        record[PID_OFFSET] = drive.force_offset
+    return record
 
 
 def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:

@@ -145,6 +145,7 @@ USED: dict[str, set[str]] = {
         "p_gain",
         "cmd_max",
         "cmd_min",
+        "cmd_offset",
         "initial_velocity",  # held from load (twin_cli.world.plugin_holds)
     },
     "gz-sim-joint-position-controller-system": {
@@ -154,6 +155,7 @@ USED: dict[str, set[str]] = {
         "d_gain",
         "cmd_max",
         "cmd_min",
+        "cmd_offset",
     },
     "gz-sim-joint-trajectory-controller-system": trajectory_controller.USED,
 }

@@ -320,6 +320,7 @@ def read_joint_controller(p: Params, blob: Blob, ctx: ReadContext) -> JointDrive
         mode="velocity",
         pid=gains if force else None,
         force_range=_pid_output(p) if force else UNBOUNDED,
+        force_offset=p.number(0.0, "cmd_offset", signed=True) if force else 0.0,
         initial=p.number(0.0, "initial_velocity", signed=True),
     )
 
@@ -336,6 +337,7 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
         mode="position",
         pid=None if velocity else gains,
         force_range=UNBOUNDED if velocity else _pid_output(p),
+        force_offset=0.0 if velocity else p.number(0.0, "cmd_offset", signed=True),
         initial=p.number(0.0, "initial_position", signed=True),
         family="gz_joint_position_controller",
         notes=(SET_SPEED_NOTE,) if velocity else (POSITION_PID_NOTE,),

@@ -251,8 +251,8 @@ class JointDrive(_Record):
     Attributes:
         joints: the joints it commands; mode: "velocity" or "position"; pid: (p, i, d) when the
         system runs its own PID on the joint's force, else None (it sets the joint's velocity);
-        force_range: (low, high) [N m or N] its force stays in, initial: the system's initial
-        command, notes.
+        force_range: (low, high) [N m or N] its force stays in; force_offset [N m or N] its PID
+        adds (`cmd_offset`); initial: the system's initial command, notes.
     """
 
     name: str
@@ -261,6 +261,7 @@ class JointDrive(_Record):
     mode: str
     pid: tuple[float, float, float] | None = None
     force_range: tuple[float, float] = UNBOUNDED
+    force_offset: float = 0.0
     initial: float = 0.0
     family: str = "gz_joint_controller"
     notes: tuple[str, ...] = ()

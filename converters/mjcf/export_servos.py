@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT
+from converters.control_text import CONTROL_TEXT, PID_OFFSET
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
 from converters.mjcf.servo_gains import largest_inertia, position_gains, reflected_inertia
 from converters.mjcf.velocity_motors import Motor, add_velocity_motors
@@ -246,8 +246,11 @@ def _to_servo(
             speed = record.get("velocity_limit")
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
         actuator.set_to_position(kp=kp, kv=kv)
+        if pid:
+            actuator.biasprm[0] = float(record.get(PID_OFFSET, 0.0))
     elif pid:
         _to_velocity_pid(actuator, pid)
+        actuator.biasprm[0] = float(record.get(PID_OFFSET, 0.0))
     else:
         _to_intvelocity(spec, actuator, inertia, kv)
 

@@ -90,7 +90,7 @@ def mode_of(model: mujoco.MjModel, a: int) -> str | None:
     gain = float(model.actuator_gainprm[a, 0])
     bias = model.actuator_biasprm[a, :3]
     dyn = int(model.actuator_dyntype[a])
-    if gain <= 0.0 or bias[0] != 0.0 or has_reference(model, a):
+    if gain <= 0.0 or has_reference(model, a):  # bias[0]: a PID's constant offset (cmd_offset)
         return None
     if bias[1] == -gain and dyn in (_NONE, _INTEGRATOR):
         return "position" if dyn == _NONE else "velocity"

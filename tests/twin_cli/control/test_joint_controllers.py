@@ -313,3 +313,33 @@ def test_equal_cmd_min_and_cmd_max_are_refused_naming_the_tag(tmp_path: Path) ->
     with pytest.raises(GazeboTagError, match=r"<plugin/cmd_min>: value '2'") as caught:
         convert(path)
     assert "below cmd_max" in str(caught.value), "the message names the fix"
+
+
+@pytest.mark.parametrize(("p_gain", "offset"), [(30.0, 3.0), (30.0, -1.5), (60.0, 3.0)])
+def test_a_position_controllers_cmd_offset_shifts_where_it_settles(
+    tmp_path: Path, p_gain: float, offset: float
+) -> None:
+    """gz-math adds `cmd_offset` to the PID's output: on the unloaded dial the force
+    -p·(q − q*) + offset vanishes at q = q* + offset/p, where the dial settles."""
+    text = RIG.replace(
+        "<p_gain>30</p_gain><d_gain>2</d_gain>",
+        f"<p_gain>{p_gain}</p_gain><d_gain>2</d_gain><cmd_offset>{offset}</cmd_offset>",
+    )
+    world = _spawned(tmp_path, text)
+    world.command_joints("rig", {"dial_joint": 1.0}, mode="position")
+    world.step(round(3.0 / world.model.opt.timestep))
+    angle = _state(world, "dial_joint").position
+    assert angle == pytest.approx(1.0 + offset / p_gain, abs=1e-3), f"dial at {angle:.4f} rad"
+
+
+@pytest.mark.parametrize("offset", [0.5, -0.25])
+def test_a_force_commanded_joint_controllers_cmd_offset_shifts_its_speed(
+    tmp_path: Path, offset: float
+) -> None:
+    """With force commands the fan (p 0.5) settles where p·(ω* − ω) + offset = 0: at
+    ω* + offset/p, 1 rad/s above or 0.5 below a 3 rad/s command."""
+    world = _force_rig_within(tmp_path, 0.5, f"<cmd_offset>{offset}</cmd_offset>")
+    world.command_joints("rig", {"fan_joint": 3.0}, mode="velocity")
+    world.step(round(1.0 / world.model.opt.timestep))
+    speed = _state(world, "fan_joint").velocity
+    assert speed == pytest.approx(3.0 + offset / 0.5, rel=1e-3), f"fan at {speed:.4f} rad/s"
