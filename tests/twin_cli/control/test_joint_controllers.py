@@ -164,29 +164,24 @@ def test_a_force_commanded_joint_controller_pushes_within_cmd_min_and_cmd_max(
         assert speed == pytest.approx(law, abs=0.03 * spun), f"{speed:.4f} rad/s at {t} s"
 
 
-# d gains of the ring test; where gz-sim's derivative kick matters, what twin does instead
+def _kicked(d_gain: float, overshoot: tuple[float, float], peak_ms: tuple[int, int]):  # noqa: ANN202
+    """A ring case gz-sim's derivative kick (d·Δ/h for the step the target jumps) decides,
+    with twin's and gz-sim's measured overshoot and peak time."""
+    reason = (
+        f"gz-math's derivative kick ({d_gain * 1e3:g} N m for 1 ms) is not run: overshoot "
+        f"{overshoot[0]:.3f} against gz-sim's {overshoot[1]:.3f}, peak at {peak_ms[0]} ms "
+        f"against {peak_ms[1]} ms"
+    )
+    return pytest.param(
+        d_gain, id=f"d{d_gain}", marks=pytest.mark.xfail(strict=True, reason=reason)
+    )
+
+
+# d gains of the ring test (below critical damping, 1.1)
 RING = [
     pytest.param(0.05, id="d0.05"),
-    pytest.param(
-        0.2,
-        id="d0.2",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="gz-math's derivative kick (d·Δ/h for the step the target jumps, 200 N m "
-            "for 1 ms) is not run: overshoot 0.560 against gz-sim's 0.602, peak at 58 ms "
-            "against 51 ms",
-        ),
-    ),
-    pytest.param(
-        0.5,
-        id="d0.5",
-        marks=pytest.mark.xfail(
-            strict=True,
-            reason="gz-math's derivative kick (d·Δ/h for the step the target jumps, 500 N m "
-            "for 1 ms) is not run: overshoot 0.205 against gz-sim's 0.329, peak at 65 ms "
-            "against 44 ms",
-        ),
-    ),
+    _kicked(0.2, (0.560, 0.602), (58, 51)),
+    _kicked(0.5, (0.205, 0.329), (65, 44)),
 ]
 
 
