@@ -9,7 +9,8 @@ asked for more than its effort gives exactly its effort. A twin World does the s
 for the bodies its position commands hold (`twin_cli.world.gravity_comp`).
 
 In the file a body is compensated when every joint between it and the world is a position
-servo: a body below a passive, effort or velocity joint falls as it does in Gazebo. A body the
+servo: a body below a passive, effort or velocity joint falls as it does in Gazebo, and one
+below a joint whose tags give its servo a PID (which Gazebo runs alone) sags by load/kp. A body the
 robot's own tags already compensate (Gazebo's gravity off) keeps its value. A floating robot
 (a free joint) gets none: compensating its bodies would make the whole robot weightless. The
 control record keeps what each change replaced, so a World spawning the file hands the

@@ -109,7 +109,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         _to_servo(spec, actuator, record, inertia[joint], timestep)
         servoed[joint] = record["modes"][0]
         if record["modes"][0] == "position":
-            held[joint] = _force_range(actuator)
+            if tag_pid(record.get("pid", {}), "position") is None:  # a Gazebo PID: no help
+                held[joint] = _force_range(actuator)
             if key is not None:
                 ctrl[i] = home[joint]
     if key is not None:

@@ -12,18 +12,23 @@ fixed-base robot is compiled with OFF (a negligible share) and a command switche
 model (`switch`): a body is ON while every joint between it and the world is actuated and holds
 a position command (a joint's own servo holds one from load, `native_servos`). An arm with an
 effort command or a passive joint on the way falls as it does in Gazebo; a velocity servo's
-integral carries its load itself. A body the robot's own tags compensate (Gazebo's gravity
-off: 1) keeps its value.
+integral carries its load itself, and a joint whose tags give its position servo a PID (which
+Gazebo runs alone) carries its load through that PID and sags by load/kp, as there. A body the
+robot's own tags compensate (Gazebo's gravity off: 1) keeps its value.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
+
+from converters.control_text import CONTROL_TEXT
+from converters.mjcf.export_servos import tag_pid
 
 if TYPE_CHECKING:
     from twin_cli.world.actuation import JointCommand
@@ -45,17 +50,31 @@ def prepare(spec: mujoco.MjSpec) -> None:
     for body in spec.bodies:
         if body is not spec.worldbody and body.gravcomp == 0.0:
             body.gravcomp = OFF
+    pids = _tag_pid_joints(spec)
     for actuator in spec.actuators:
         if actuator.trntype != _JOINT:
             continue
         joint = spec.joint(actuator.target)
-        if joint is None:
+        if joint is None or joint.name in pids:
             continue
         joint.actgravcomp = True
         low, high = _force_range(actuator)
         if math.isfinite(low) and math.isfinite(high):
             joint.actfrclimited = mujoco.mjtLimited.mjLIMITED_TRUE
             joint.actfrcrange = np.array([low, high])
+
+
+def _tag_pid_joints(spec: mujoco.MjSpec) -> set[str]:
+    """The joints whose tags give their position servo a PID (a gz-sim joint controller,
+    ros2_control's `position_pid`, a trajectory controller): Gazebo runs that PID alone, so the
+    joint carries its load through it and sags by load/kp, as it does there."""
+    text = spec.text(CONTROL_TEXT)
+    records = json.loads(text.data) if text is not None else {}
+    return {
+        joint
+        for joint, record in records.items()
+        if isinstance(record, dict) and tag_pid(record.get("pid", {}), "position") is not None
+    }
 
 
 def _force_range(actuator: mujoco.MjsActuator) -> tuple[float, float]:
@@ -89,7 +108,9 @@ def switch(model: mujoco.MjModel, commands: Mapping[str, JointCommand]) -> None:
     for key, cmd in commands.items():
         a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key)
         if a >= 0 and cmd.mode == "position" and model.actuator_trntype[a] == _JOINT:
-            held.add(int(model.actuator_trnid[a, 0]))
+            j = int(model.actuator_trnid[a, 0])
+            if model.jnt_actgravcomp[j]:  # not a joint a Gazebo PID holds (`prepare`)
+                held.add(j)
     for b in bodies:
         gravcomp[b] = ON if _chain_held(model, int(b), held) else OFF
 
