@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from converters.description import MODES
-from converters.mjcf.export_servos import tag_pid
+from converters.mjcf.export_servos import tag_pid, tag_servo_gains
 from twin_cli.world import servos
 
 # ω·dt of the position servo's spring (MuJoCo's implicit integrators leave springs explicit: < 2)
@@ -244,10 +244,8 @@ def servo_rule(
     vmax = limits.velocity
     if mode == "position":
         kp, kv = _position_gains(inertia, timestep, step, SPEED_MARGIN * vmax)
-        if pid:  # the tag's gains, kv at most I/h with an effort limit (see `_velocity_gain`)
-            kp, kv = pid[0], max(pid[2], 0.0)
-            if math.isfinite(effort):
-                kv = min(kv, inertia / timestep)
+        if pid:  # the tag's gains as the export writes them
+            kp, kv = tag_servo_gains(pid, inertia, timestep, effort)
         return kp, kv, "tag PID (pos_kp, pos_kd)" if pid else "reflected inertia"
     if mode == "velocity":
         kv, rule = _velocity_gain(pid, effort, vmax, inertia, timestep)
