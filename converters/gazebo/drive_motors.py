@@ -122,14 +122,14 @@ def add_drive_motors(
                 raise PluginJointError(report.source, record.name, "", joint, joints)
             if joint not in driven:
                 _motor(spec, joint, force)
-                set_control_record(spec, joint, _record(record, mode, pid))
+                set_control_record(spec, joint, _record(record, joint, mode, pid))
                 driven.add(joint)
             elif _untagged(spec, joint):
                 if isinstance(record, JointDrive | TrajectoryDrive):
                     _narrow(spec, joint, force)
                 else:
                     _bound(spec, joint, force)
-                set_control_record(spec, joint, _record(record, mode, pid))
+                set_control_record(spec, joint, _record(record, joint, mode, pid))
         if isinstance(record, HolonomicDrive):
             _planar_servos(spec, record)
         if isinstance(record, TrajectoryDrive):
@@ -190,9 +190,10 @@ def _motor(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:
         motor.ctrlrange = np.array(force, dtype=float)
 
 
-def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
-    """The plugin's joints take only the mode it commands them in; a joint controller's PID
-    offset (gz-math's `cmd_offset`, a constant force added before the clamp) travels along."""
+def _record(drive: DriveRecord, joint: str, mode: str, pid: tuple | None) -> dict[str, Any]:
+    """The plugin's joints take only the mode it commands them in; a joint or trajectory
+    controller's PID offset (gz-math's `cmd_offset`, a constant force added before the clamp)
+    travels along."""
     record = {
         "modes": [mode],
         "source": drive.family,
@@ -202,9 +203,19 @@ def _record(drive: DriveRecord, mode: str, pid: tuple | None) -> dict[str, Any]:
         "velocity_limit": None,
         "plugin": None,
     }
-    if pid and isinstance(drive, JointDrive) and drive.force_offset:
-        record[PID_OFFSET] = drive.force_offset
+    offset = _pid_offset(drive, joint)
+    if pid and offset:
+        record[PID_OFFSET] = offset
     return record
+
+
+def _pid_offset(drive: DriveRecord, joint: str) -> float:
+    """The constant force [N m or N] the drive's PID adds on `joint` (0 for other drives)."""
+    if isinstance(drive, JointDrive):
+        return drive.force_offset
+    if isinstance(drive, TrajectoryDrive) and drive.force_offsets:
+        return drive.force_offsets[drive.joints.index(joint)]
+    return 0.0
 
 
 def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:

@@ -282,7 +282,8 @@ class TrajectoryDrive(_Record):
         pids: per joint (p, i, d) for twin's position servo: the position PID's p, no i (not
         used), its d plus the velocity PID's p (both act on the joint's speed), or None when
         they are 0 (gz-sim applies no force; twin's own gains); force_ranges: (low, high)
-        [N m or N] per joint; topic, progress_topic: where gz-sim takes trajectories and
+        [N m or N] per joint; force_offsets: [N m or N] per joint, the sum of its two PIDs'
+        `cmd_offset`; topic, progress_topic: where gz-sim takes trajectories and
         reports progress.
     """
 
@@ -294,6 +295,7 @@ class TrajectoryDrive(_Record):
     force_ranges: tuple[tuple[float, float], ...]
     topic: str
     progress_topic: str
+    force_offsets: tuple[float, ...] = ()
     family: str = "gz_joint_trajectory_controller"
     notes: tuple[str, ...] = ()
 

@@ -10,7 +10,8 @@ and progress goes to `<topic>_progress`.
 
 twin runs the joints as position servos with the plugin's gains: kp = position_p_gain and
 kv = position_d_gain + velocity_p_gain (both terms act on the joint's speed), within the sum of
-the two PIDs' output limits; `twin trajectory ENTITY FILE` sends a trajectory. The joints start at
+the two PIDs' output limits, with the sum of their `cmd_offset` forces as the servo's constant
+force; `twin trajectory ENTITY FILE` sends a trajectory. The joints start at
 their initial positions (the spawn posture) rather than being driven there from 0. Gains that are
 all 0 make gz-sim apply no force; twin's servo then uses its own gains, and says so.
 """
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     from converters.gazebo.drive_readers import ReadContext
 
 HOME_KEY = "home"  # the spawn posture (converters.mjcf.builder)
+PIDS = ("position", "velocity")  # the two PIDs per joint, as their tags' prefixes
 
 USED = {
     "joint_name",
@@ -40,9 +42,11 @@ USED = {
     "position_d_gain",
     "position_cmd_min",
     "position_cmd_max",
+    "position_cmd_offset",
     "velocity_p_gain",
     "velocity_cmd_min",
     "velocity_cmd_max",
+    "velocity_cmd_offset",
     "topic",
 }
 APPROXIMATED = (
@@ -74,6 +78,7 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
         initial_positions=_nth_all(p.numbers("initial_position", signed=True), count, 0.0),
         pids=pids,
         force_ranges=tuple(_bound(p, i) for i in range(count)),
+        force_offsets=tuple(_offset(p, i) for i in range(count)),
         topic=topic,
         progress_topic=f"{topic}_progress",
         notes=(limp_note,) if limp else (),
@@ -105,17 +110,23 @@ def _pid(p: Params, i: int) -> tuple[float, float, float] | None:
     return (kp, 0.0, kv) if kp or kv else None
 
 
+def _offset(p: Params, i: int) -> float:
+    """Joint `i`'s constant force [N m or N]: gz-math adds each PID's `cmd_offset` to its output
+    whatever its gains, and the system sums the two outputs."""
+    return sum(_nth(p.numbers(f"{pid}_cmd_offset", signed=True), i, 0.0) for pid in PIDS)
+
+
 def _bound(p: Params, i: int) -> tuple[float, float]:
     """Joint `i`'s force range [N m or N]: the sums of the two PIDs' output limits, each PID
     clamped to its own [cmd_min, cmd_max] (gz-sim's ignition::math::PID leaves the output free
     while cmd_max < cmd_min)."""
     total_low, total_high = 0.0, 0.0
-    for pid in ("position", "velocity"):
+    for pid in PIDS:
         low = _nth(p.numbers(f"{pid}_cmd_min", signed=True), i, 0.0)
         high = _nth(p.numbers(f"{pid}_cmd_max", signed=True), i, -1.0)
         gains = [_nth(p.numbers(f"{pid}_{g}_gain"), i, 0.0) for g in ("p", "i", "d")]
-        if not any(gains):
-            continue  # a PID without gains adds no force
+        if not any(gains) and not _nth(p.numbers(f"{pid}_cmd_offset", signed=True), i, 0.0):
+            continue  # a PID without gains or offset adds no force
         if high < low:
             return UNBOUNDED
         total_low, total_high = total_low + low, total_high + high

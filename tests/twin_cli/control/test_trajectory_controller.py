@@ -88,6 +88,35 @@ def test_the_arm_starts_at_its_initial_positions_and_follows_a_trajectory(
     assert gains == {"shoulder": (200.0, 12.0), "elbow": (100.0, 4.0)}, "the plugin's gains"
 
 
+@pytest.mark.parametrize(
+    ("offsets", "shifts"),
+    [
+        ((4.0, -1.0, 0.0, 0.5), (3.0 / 200.0, 0.5 / 100.0)),
+        ((-2.0, 0.0, 1.0, 1.0), (-2.0 / 200.0, 2.0 / 100.0)),
+    ],
+)
+def test_its_cmd_offsets_shift_where_each_joint_settles(
+    tmp_path: Path, offsets: tuple[float, float, float, float], shifts: tuple[float, float]
+) -> None:
+    """gz-math adds each PID's `cmd_offset` to its output and the system sums both PIDs: on the
+    unloaded arm the force offset − p·(q − q*) vanishes at q = q* + offset/p, per joint, with
+    (shoulder position, shoulder velocity, elbow position, elbow velocity) offsets."""
+    tags = "".join(  # repeatable tags in the joints' order
+        f"<{pid}_cmd_offset>{offsets[2 * joint + k]}</{pid}_cmd_offset>"
+        for k, pid in enumerate(("position", "velocity"))
+        for joint in (0, 1)
+    )
+    path = tmp_path / "arm.urdf"
+    path.write_text(dm.arm_urdf(JTC.format(joints=NAMED, topic=tags)))
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="arm")
+    world.command_joints("arm", {"shoulder": 0.3, "elbow": -0.5}, mode="position")
+    world.step(round(3.0 / world.model.opt.timestep))
+    end = {s.name: s.position for s in world.joint_states("arm")}
+    expected = {"shoulder": 0.3 + shifts[0], "elbow": -0.5 + shifts[1]}
+    assert end == pytest.approx(expected, abs=2e-4), f"angles [rad]: {end}"
+
+
 def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
     tmp_path: Path,
 ) -> None:
