@@ -193,12 +193,31 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
 }
 
 
+PID_TAGS = {"p_gain", "i_gain", "d_gain", "i_max", "i_min", "cmd_max", "cmd_min", "cmd_offset"}
+MODE_READS: dict[str, tuple[str, bool, set[str]]] = {
+    "gz-sim-joint-controller-system": ("use_force_commands", True, PID_TAGS),
+    "gz-sim-joint-position-controller-system": (
+        "use_velocity_commands",
+        False,
+        PID_TAGS - {"cmd_max"},  # with velocity commands, cmd_max bounds the speed
+    ),
+}
+"""Tags a gz-sim system reads only in one of its modes: (the mode's flag, the flag's value in
+which the tags are read, the tags). In the other mode gz-sim ignores them, and so does twin."""
+
+
 def drive_notes(key: str, params: Params, initial: float = 0.0) -> tuple[str, ...]:
     """The report notes of one drive plugin: its approximations, then each given tag twin does
-    not use (ROS publishing tags named as such)."""
+    not use (ROS publishing tags named as such; a tag the system ignores in its mode, as such)."""
     notes = list(APPROXIMATED.get(key, ()))
     used = USED.get(key, set())
+    flag, reads_when, mode_tags = MODE_READS.get(key, ("", True, set()))
+    idle = mode_tags if flag and params.flag(False, flag) != reads_when else set()
     for tag in params.given():
+        if tag in idle:
+            when = "with" if reads_when else "without"
+            notes.append(f"<{tag}>: gz-sim reads it only {when} {flag}; unused here, as there")
+            continue
         if tag in used:
             continue
         if any(word in tag.lower() for word in ROS_TOPICS):

@@ -419,3 +419,33 @@ def test_gz_limiter_tags_twin_runs_are_not_reported_unused(
     unused = [n for n in notes if "not used by twin" in n]
     assert any("<max_jerk>" in n for n in unused), notes
     assert not [n for n in unused for t in tags if f"<{t}>" in n], unused
+
+
+@pytest.mark.parametrize(
+    ("plugin", "idle", "read"),
+    [
+        (JOINT_CONTROLLER.replace("true", "false"), ("p_gain", "cmd_max"), ()),
+        (JOINT_CONTROLLER, (), ("p_gain", "cmd_max")),
+        (
+            POSITION_CONTROLLER.replace(
+                "</plugin>", "<use_velocity_commands>true</use_velocity_commands></plugin>"
+            ),
+            ("p_gain", "d_gain"),
+            ("cmd_max",),
+        ),
+        (POSITION_CONTROLLER, (), ("p_gain", "d_gain", "cmd_max")),
+    ],
+    ids=["velocity set", "force PID", "speed set", "position PID"],
+)
+def test_pid_tags_gz_sim_ignores_in_a_controllers_mode_are_reported_as_such(
+    tmp_path: Path, plugin: str, idle: tuple[str, ...], read: tuple[str, ...]
+) -> None:
+    """gz-sim's JointController reads its PID tags only with `use_force_commands`, and its
+    JointPositionController only without `use_velocity_commands` (there `cmd_max` bounds the
+    speed): a tag the system ignores in the mode given says so, a tag it reads is not listed."""
+    notes = [e.detail for e in _convert(tmp_path, dm.two_wheel_base(plugin), "urdf").report.entries]
+    for tag in idle:
+        said = [n for n in notes if f"<{tag}>" in n]
+        assert said and all("gz-sim reads it only" in n for n in said), (tag, notes)
+    for tag in read:
+        assert not [n for n in notes if f"<{tag}>:" in n], (tag, notes)
