@@ -78,6 +78,19 @@ def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
     return float(min(limits)) if limits else math.inf
 
 
+def effort_range(model: mujoco.MjModel, actuator: int) -> tuple[float, float]:
+    """The force range [N m or N] the motor can apply at its joint, each side for itself (a
+    Gazebo PID's [cmd_min, cmd_max] need not be symmetric); ±inf where a side is unbounded."""
+    gear = model.actuator_gear[actuator][0] or 1.0
+    low, high = -math.inf, math.inf
+    if model.actuator_ctrllimited[actuator] and model.actuator_biastype[actuator] == _NONE:
+        low, high = sorted(float(v) * gear for v in model.actuator_ctrlrange[actuator])
+    if model.actuator_forcelimited[actuator]:
+        f_low, f_high = sorted(float(v) * gear for v in model.actuator_forcerange[actuator])
+        low, high = max(low, f_low), min(high, f_high)
+    return low, high
+
+
 def servo_gains(mode: str, effort: float, inertia: float, timestep: float) -> tuple[float, float]:
     """PD gains (kp, kv) of a joint without control record or velocity limit (see joint_control)."""
     from twin_cli.world.joint_control import JointLimits, servo_rule

@@ -458,12 +458,25 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
             "rule": cmd.rule if cmd else "",
             "velocity_limit": _finite(limits.velocity),
             "effort_limit": _finite(cmd.effort if cmd else control.effort_limit(model, int(a))),
+            "effort_range": _effort_range(model, int(a), cmd),
         }
     return out
 
 
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
+
+
+def _effort_range(
+    model: mujoco.MjModel, actuator: int, cmd: control.JointCommand | None
+) -> list[float | None]:
+    """[low, high] force [N m or N] the joint's motor applies now (None where unbounded): the
+    World's own servo's symmetric bound, else the actuator's range as the model states it."""
+    if cmd is not None and not cmd.native:
+        low, high = -cmd.effort, cmd.effort
+    else:
+        low, high = control.effort_range(model, actuator)
+    return [_finite(low), _finite(high)]
 
 
 def set_controls(state: WorldState, actuators: Sequence[int], values: Sequence[float]) -> None:

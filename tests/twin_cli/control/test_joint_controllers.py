@@ -163,6 +163,8 @@ def test_a_force_commanded_joint_controller_pushes_within_cmd_min_and_cmd_max(
         law = pid_law(0.0, 1.0, 0.0, t, cmd_max=cmd_max, cmd_min=cmd_min, start=spun)
         speed = _state(world, "fan_joint").velocity
         assert speed == pytest.approx(law, abs=0.03 * spun), f"{speed:.4f} rad/s at {t} s"
+    row = world.joint_commands("rig")["fan_joint"]
+    assert row["effort_range"] == [cmd_min, cmd_max], "`twin joints` shows each side"
 
 
 def _kicked(d_gain: float, overshoot: tuple[float, float], peak_ms: tuple[int, int]):  # noqa: ANN202
@@ -252,6 +254,8 @@ def test_a_joint_controllers_force_stays_within_the_joints_effort_limit_too(
     law = pid_law(0.0, 1.0, 0.0, 0.02, cmd_max=1.5, cmd_min=-0.5, start=spun)
     speed = _state(world, "fan_joint").velocity
     assert speed == pytest.approx(law, abs=0.03 * spun), f"braking: {speed:.4f} rad/s after 20 ms"
+    row = world.joint_commands("rig")["fan_joint"]
+    assert row["effort_range"] == [-0.5, 1.5], "the PID's range within the joint's limit"
 
 
 # A 1 kg bar 0.5 m out on a horizontal hinge fixed to the world: its weight turns the hinge by
