@@ -198,7 +198,7 @@ class WebHost:
         self.address = ViewAddress(self._host, int(reply.getsockname()[1]), self._token)
         world = self._current()
         with world.lock:
-            self._handle.set_model(self.look.model_for(world.model), data=world.data)
+            self._handle.set_model(self.look.model_for(world.page_model()), data=world.data)
         self._thread = threading.Thread(target=self._run, name="twin-view-sync", daemon=True)
         self._thread.start()
         log.info("viewer on port %d (bound to %s)", self.address.port, self._host)
@@ -224,10 +224,10 @@ class WebHost:
         out; lock held."""
         world = self._current()
         self._bridge.world = world
-        self.look.prepare(world.model)  # a new model's copy, outside the world's lock
+        self.look.prepare(world.page_model())  # a new model's copy, outside the world's lock
         with world.lock:
             self._bridge.show_pause_state()
-            self._handle.sync(self.look.model_for(world.model), world.data)
+            self._handle.sync(self.look.model_for(world.page_model()), world.data)
         self.syncs += 1
 
     def close(self) -> None:

@@ -33,6 +33,7 @@ from twin_cli.world.actuation import JointCommand
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.entities import Entity, EntityIndex
 from twin_cli.world.loop import LoopFigures, SteppingLoop, WorldLock
+from twin_cli.world.page_model import plugin_free, refresh
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.scene import build_world_spec
@@ -89,6 +90,18 @@ class World:
     @property
     def data(self) -> mujoco.MjData:
         return self._state.data
+
+    def page_model(self) -> mujoco.MjModel:
+        """The model a browser's MuJoCo can load (`twin_cli.world.page_model`): the world's
+        own, or a copy without plugins made once per model, with the world's options now."""
+        state = self._state
+        with state.lock:
+            shown = state.page_model
+            if shown is None or shown[0] is not state.model:
+                shown = state.page_model = (state.model, plugin_free(state.spec, state.model))
+            if shown[1] is not state.model:
+                refresh(shown[1], state.model)
+            return shown[1]
 
     @property
     def divergences(self) -> int:

@@ -59,6 +59,8 @@ class WorldState:
         file_notes: what a world file held that twin does not simulate.
         decompositions: entity name → the background decomposition of its collision meshes
             (`decomposing`), pending or finished; absent when it had none.
+        page_model: the model a browser was last given (`page_model`), and the model it was
+            made for, or None.
     """
 
     name: str
@@ -91,6 +93,7 @@ class WorldState:
     spec_renewals_refused: int = 0
     file_notes: tuple[str, ...] = ()
     decompositions: dict[str, Decomposition] = field(default_factory=dict)
+    page_model: tuple[mujoco.MjModel, mujoco.MjModel] | None = None
 
     def __post_init__(self) -> None:
         self.scratch_state = np.empty(mujoco.mj_stateSize(self.model, STATE))
