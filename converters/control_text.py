@@ -11,6 +11,7 @@ if TYPE_CHECKING:
 
 CONTROL_TEXT = "control"
 PID_OFFSET = "pid_offset"  # record key: the constant force [N m or N] a Gazebo PID adds
+PID_INTEGRAL = "pid_integral"  # record key: a gz-sim PID's integral bound [N m or N], or None
 
 
 def set_control_record(spec: mujoco.MjSpec, joint: str, record: dict) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 
 def pid_law(
     target: float,
@@ -49,4 +51,32 @@ def gz_position_pid(
         speed += min(max(force, -1000.0), 1000.0) / inertia * step
         angle += speed * step
         angles.append(angle)
+    return angles
+
+
+def gz_held_bar(
+    gains: tuple[float, float, float],
+    integral_limit: float | None,
+    t: float,
+    *,
+    inertia: float,
+    load: float,
+    step: float = 1e-3,
+) -> list[float]:
+    """A bar's angle [rad] at each whole second for t s, from rest at 0, under gravity's torque
+    load·cos q and gz-sim's JointPositionController holding 0: gz-math's PID (p, i, d) on the
+    error q, the integral term within ±integral_limit (None: unbounded), integrated
+    semi-implicitly as gz-physics does. The target never jumps, so there is no kick."""
+    p, i, d = gains
+    angle, speed, integral, angles = 0.0, 0.0, 0.0, []
+    per_second = round(1.0 / step)
+    for k in range(round(t / step)):
+        integral += i * step * angle
+        if integral_limit is not None:
+            integral = min(max(integral, -integral_limit), integral_limit)
+        force = -p * angle - integral - d * speed
+        speed += (load * math.cos(angle) + force) / inertia * step
+        angle += speed * step
+        if (k + 1) % per_second == 0:
+            angles.append(angle)
     return angles

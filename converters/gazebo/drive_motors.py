@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT, PID_OFFSET, set_control_record
+from converters.control_text import CONTROL_TEXT, PID_INTEGRAL, PID_OFFSET, set_control_record
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     AckermannDrive,
@@ -206,6 +206,8 @@ def _record(drive: DriveRecord, joint: str, mode: str, pid: tuple | None) -> dic
     offset = _pid_offset(drive, joint)
     if pid and offset:
         record[PID_OFFSET] = offset
+    if pid and pid[1] and isinstance(drive, JointDrive) and mode == "position":
+        record[PID_INTEGRAL] = drive.integral_limit  # gz-math's integral, bounded or not
     return record
 
 

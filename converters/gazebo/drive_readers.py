@@ -297,9 +297,17 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
 
 
 POSITION_PID_NOTE = (
-    "its PID as a position servo: kp = p_gain, kv = d_gain on the joint's speed, the force "
-    "within [cmd_min, cmd_max]; the PID's integral (i_gain, 0.1 unless given, within "
-    "i_min/i_max) and its derivative's kick when the target jumps are not run"
+    "its PID as MuJoCo's pid actuator: kp = p_gain, kd = d_gain on the joint's speed, ki = "
+    "i_gain (0.1 unless given) with the integral term within ±i_max, the force within "
+    "[cmd_min, cmd_max]; the derivative's kick when the target jumps is not run"
+)
+ASYMMETRIC_INTEGRAL_NOTE = (
+    "i_min {low:g} and i_max {high:g}: the integral term within ±{bound:g} (MuJoCo's pid "
+    "actuator bounds it symmetrically)"
+)
+OFFSET_INTEGRAL_NOTE = (
+    "cmd_offset with i_gain: the offset is the servo's bias and the integral is not run (MuJoCo's "
+    "pid actuator has no constant force)"
 )
 
 SET_SPEED_NOTE = (
@@ -330,6 +338,10 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
     `use_velocity_commands`) towards a position."""
     velocity = p.flag(False, "use_velocity_commands")
     gains = (p.number(1.0, "p_gain"), p.number(0.1, "i_gain"), p.number(0.01, "d_gain"))
+    offset = 0.0 if velocity else p.number(0.0, "cmd_offset", signed=True)
+    limit, notes = _integral_limit(p) if gains[1] and not offset else (None, ())
+    if gains[1] and offset:
+        gains, notes = (gains[0], 0.0, gains[2]), (OFFSET_INTEGRAL_NOTE,)
     return JointDrive(
         name=blob.name or "JointPositionController",
         where=blob.where,
@@ -337,11 +349,25 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
         mode="position",
         pid=None if velocity else gains,
         force_range=UNBOUNDED if velocity else _pid_output(p),
-        force_offset=0.0 if velocity else p.number(0.0, "cmd_offset", signed=True),
+        force_offset=offset,
+        integral_limit=limit,
         initial=p.number(0.0, "initial_position", signed=True),
         family="gz_joint_position_controller",
-        notes=(SET_SPEED_NOTE,) if velocity else (POSITION_PID_NOTE,),
+        notes=(SET_SPEED_NOTE,) if velocity else (POSITION_PID_NOTE, *notes),
     )
+
+
+def _integral_limit(p: Params) -> tuple[float | None, tuple[str, ...]]:
+    """The bound [N m or N] on gz-math's integral term: it clamps the term to [i_min, i_max]
+    (defaults ∓1), or not at all when i_max < i_min. MuJoCo's pid actuator bounds it by one
+    magnitude, the larger, and a note says so when the two differ."""
+    low, high = p.number(-1.0, "i_min", signed=True), p.number(1.0, "i_max", signed=True)
+    if high < low:
+        return None, ()
+    bound = max(abs(low), abs(high))
+    if low == -high:
+        return bound, ()
+    return bound, (ASYMMETRIC_INTEGRAL_NOTE.format(low=low, high=high, bound=bound),)
 
 
 def _pid_output(p: Params) -> tuple[float, float]:

@@ -252,7 +252,8 @@ class JointDrive(_Record):
         joints: the joints it commands; mode: "velocity" or "position"; pid: (p, i, d) when the
         system runs its own PID on the joint's force, else None (it sets the joint's velocity);
         force_range: (low, high) [N m or N] its force stays in; force_offset [N m or N] its PID
-        adds (`cmd_offset`); initial: the system's initial command, notes.
+        adds (`cmd_offset`); integral_limit: [N m or N] the bound on its PID's integral term
+        (None: unbounded); initial: the system's initial command, notes.
     """
 
     name: str
@@ -262,6 +263,7 @@ class JointDrive(_Record):
     pid: tuple[float, float, float] | None = None
     force_range: tuple[float, float] = UNBOUNDED
     force_offset: float = 0.0
+    integral_limit: float | None = None
     initial: float = 0.0
     family: str = "gz_joint_controller"
     notes: tuple[str, ...] = ()

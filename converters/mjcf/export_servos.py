@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT, PID_OFFSET
+from converters.control_text import CONTROL_TEXT, PID_INTEGRAL, PID_OFFSET
 from converters.mjcf.export_gravcomp import GRAVCOMP, compensate
 from converters.mjcf.servo_gains import largest_inertia, position_gains, reflected_inertia
 from converters.mjcf.velocity_motors import Motor, add_velocity_motors
@@ -62,6 +62,8 @@ MOTOR_JOINTS = ("hinge", "slide")  # joint kinds a velocity motor's rotor can co
 UNTAGGED_SOURCES = ("default", "passive")  # records of joints no control tag commands
 FOLLOW_TAU = 1e-12  # [s] time constant of an activation that follows ctrl within one step
 SERVO_MODES = ("position", "velocity")
+PID_PLUGIN = "mujoco.pid"  # MuJoCo's PID actuator plugin, for a gz-sim PID with an integral
+PID_INSTANCE = ":pid"  # suffix of the plugin instance's name, after its actuator's
 HOME_KEY = "home"
 
 
@@ -246,6 +248,9 @@ def _to_servo(
         else:
             speed = record.get("velocity_limit")
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
+        if pid and PID_INTEGRAL in record:
+            _to_pid_plugin(spec, actuator, (kp, float(pid[1]), kv), record[PID_INTEGRAL])
+            return
         actuator.set_to_position(kp=kp, kv=kv)
         if pid:
             actuator.biasprm[0] = float(record.get(PID_OFFSET, 0.0))
@@ -254,6 +259,27 @@ def _to_servo(
         actuator.biasprm[0] = float(record.get(PID_OFFSET, 0.0))
     else:
         _to_intvelocity(spec, actuator, inertia, kv)
+
+
+def _to_pid_plugin(
+    spec: mujoco.MjSpec, actuator: mujoco.MjsActuator, gains: tuple, limit: float | None
+) -> None:
+    """A gz-sim position PID with an integral: MuJoCo's own `mujoco.pid` actuator plugin, force
+    = kp·(ctrl − q) − kd·q̇ + ki·∫(ctrl − q)dt, the integral term within ±`limit` (unbounded for
+    None) and the whole within the actuator's `forcerange`, as gz-math clamps its output. The
+    integral is the actuator's one activation, so the file, the world and a saved world carry
+    it; its damping is explicit, as Gazebo's is (`tag_servo_gains` keeps it at most I/h)."""
+    kp, ki, kd = gains
+    spec.activate_plugin(PID_PLUGIN)
+    instance = spec.add_plugin(name=f"{actuator.name}{PID_INSTANCE}", plugin_name=PID_PLUGIN)
+    instance.active = True
+    config = {"kp": f"{kp!r}", "ki": f"{ki!r}", "kd": f"{kd!r}"}
+    if limit is not None:
+        config["imax"] = f"{float(limit)!r}"
+    instance.config = config
+    actuator.set_to_motor()  # the plugin computes the force; gain and bias are not read
+    actuator.plugin = instance
+    actuator.actdim = 1
 
 
 def _to_intvelocity(

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from converters.mjcf.export_servos import PID_INSTANCE
 from twin_cli.world import speed_holds, velocity_motors
 from twin_cli.world.servos import has_reference
 
@@ -66,6 +67,7 @@ class Law:
         arrays: each `FIELDS` entry's row of the compiled model.
         friction: its joint's own dry friction (`frictionloss`, its solref and solimp), which
             a hold in another mode replaces (`hold`).
+        ki: its integral gain [N m/(rad s) or N/(m s)] (a gz-sim PID's; 0 for the others).
     """
 
     mode: str
@@ -73,6 +75,7 @@ class Law:
     kv: float
     arrays: tuple[tuple[str, np.ndarray], ...]
     friction: tuple[float, np.ndarray, np.ndarray]
+    ki: float = 0.0
 
     @property
     def integrates(self) -> bool:
@@ -82,9 +85,12 @@ class Law:
 
 def mode_of(model: mujoco.MjModel, a: int) -> str | None:
     """The mode of actuator `a`'s servo law as the model has it now, or None if it is none of
-    the three (a motor, a World reference servo, a filtered or geared actuator)."""
+    the three (a motor, a World reference servo, a filtered or geared actuator); a gz-sim PID
+    with an integral, MuJoCo's pid actuator plugin, is a position servo."""
     if int(model.actuator_trntype[a]) != _JOINT or float(model.actuator_gear[a, 0]) != 1.0:
         return None
+    if int(model.actuator_plugin[a]) >= 0:
+        return "position" if pid_gains(model, a) is not None else None
     if int(model.actuator_gaintype[a]) != _FIXED or int(model.actuator_biastype[a]) != _AFFINE:
         return None
     gain = float(model.actuator_gainprm[a, 0])
@@ -112,6 +118,11 @@ def capture(model: mujoco.MjModel) -> dict[str, Law]:
         integrates = int(model.actuator_dyntype[a]) == _INTEGRATOR
         gain = float(model.actuator_gainprm[a, 0])
         kp = gain if mode == "position" or integrates else 0.0
+        kv = -float(model.actuator_biasprm[a, 2])
+        pid = pid_gains(model, a)
+        ki = 0.0
+        if pid is not None:
+            kp, ki, kv = pid
         rows = tuple((f, np.array(getattr(model, f"actuator_{f}")[a])) for f in FIELDS)
         dof = _dof(model, a)
         friction = (
@@ -119,8 +130,25 @@ def capture(model: mujoco.MjModel) -> dict[str, Law]:
             model.dof_solref[dof].copy(),
             model.dof_solimp[dof].copy(),
         )
-        laws[name] = Law(mode, kp, -float(model.actuator_biasprm[a, 2]), rows, friction)
+        laws[name] = Law(mode, kp, kv, rows, friction, ki)
     return laws
+
+
+def pid_gains(model: mujoco.MjModel, a: int) -> tuple[float, float, float] | None:
+    """(kp, ki, kd) of actuator `a` if it is a gz-sim PID run by MuJoCo's pid actuator plugin
+    (`converters.mjcf.export_servos`), else None: read from its instance's config, whose values
+    the model stores in the plugin's attribute order."""
+    instance = int(model.actuator_plugin[a])
+    if instance < 0:
+        return None
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_PLUGIN, instance) or ""
+    if not name.endswith(PID_INSTANCE):
+        return None
+    start = int(model.plugin_attradr[instance])
+    end = int(model.plugin_attradr[instance + 1]) if instance + 1 < model.nplugin else None
+    values = bytes(model.plugin_attr[start:end]).split(b"\0")
+    kp, ki, kd = (float(v) if v else 0.0 for v in values[:3])
+    return kp, ki, kd
 
 
 def restore(model: mujoco.MjModel, a: int, law: Law) -> None:
@@ -159,6 +187,8 @@ def start_value(model: mujoco.MjModel, qpos: np.ndarray, a: int, law: Law) -> fl
 def rule(law: Law) -> str:
     """What `twin joints` shows for a command run by `law`."""
     kind = "intvelocity" if law.integrates else law.mode
+    if law.ki:
+        return RULE.format(f"pid (ki {law.ki:g})")
     return RULE.format(kind)
 
 

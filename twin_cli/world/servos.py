@@ -88,6 +88,7 @@ def give_reference(spec: mujoco.MjSpec) -> None:
             and actuator.dyntype == _NONE
             and actuator.gaintype == _FIXED
             and actuator.biastype == mujoco.mjtBias.mjBIAS_NONE
+            and not actuator.plugin.active  # a plugin computes its force (a gz-sim PID)
         )
         if plain:
             actuator.dyntype = _INTEGRATOR

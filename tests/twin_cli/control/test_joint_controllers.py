@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 
 import pytest
-from pid_law import gz_position_pid, pid_law
+from pid_law import gz_held_bar, gz_position_pid, pid_law
 
 from converters.mjcf.velocity_motors import rotor_name
 from twin_cli.errors import InvalidRequestError
@@ -305,6 +305,55 @@ def test_a_held_arm_gets_only_the_force_its_pids_range_allows(
         assert angles[-1] == pytest.approx(balance, abs=1e-4), f"{bounds}: at {angles[-1]:.5f}"
     else:
         assert max(angles) > 0.3, f"{bounds}: the bar held within {max(angles):.4f} rad"
+
+
+# (tags, the integral's bound the oracle applies): gz-math's defaults (i 0.1 within ±1), an
+# integral that saturates below the 4.9 N m load, one that can carry it, and one unbounded
+# (i_max below i_min: gz-math then clamps nothing)
+INTEGRALS = [
+    pytest.param("", 1.0, id="defaults"),
+    pytest.param("<i_gain>20</i_gain><i_max>2</i_max><i_min>-2</i_min>", 2.0, id="saturates"),
+    pytest.param("<i_gain>20</i_gain><i_max>10</i_max><i_min>-10</i_min>", 10.0, id="carries"),
+    pytest.param("<i_gain>5</i_gain><i_max>-1</i_max><i_min>1</i_min>", None, id="unbounded"),
+]
+
+
+@pytest.mark.parametrize(("tags", "bound"), INTEGRALS)
+def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
+    tmp_path: Path, tags: str, bound: float | None
+) -> None:
+    """The bar's weight sags it to where p·q = 4.9·cos q; gz-math's integral then adds up to its
+    bound: the bar rises to where p·q + bound = 4.9·cos q (0.029 rad for 2 N m), or all the way
+    to 0 when the integral can carry the weight. In the world and in the exported scene.xml,
+    second by second, as gz-math's PID integrated by hand (`gz_held_bar`)."""
+    import mujoco
+
+    from converters.mjcf.writer import write_model
+    from converters.pipeline import convert_full
+
+    path = tmp_path / "bar.urdf"
+    path.write_text(BAR.format(inertial=INERTIAL, bounds=tags).replace("<i_gain>0</i_gain>", ""))
+    i_gain = float(tags.split("<i_gain>")[1].split("<")[0]) if tags else 0.1
+    law = gz_held_bar((100.0, i_gain, 2.0), bound, 8.0, inertia=0.2501, load=4.905)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bar")
+    world.command_joints("bar", {"hinge": 0.0}, mode="position")
+    angles = []
+    for _ in law:
+        world.step(round(1.0 / world.model.opt.timestep))
+        angles.append({s.name: s for s in world.joint_states("bar")}["hinge"].position)
+    assert angles == pytest.approx(law, abs=2e-5), f"world: {angles}"
+    assert "pid" in world.joint_commands("bar")["hinge"]["rule"], "`twin joints` names the PID"
+    done = convert_full(path)
+    scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    exported = []
+    for _ in law:
+        mujoco.mj_step(model, data, nstep=round(1.0 / model.opt.timestep))
+        exported.append(float(data.qpos[0]))
+    assert exported == pytest.approx(law, abs=2e-5), f"scene.xml: {exported}"
 
 
 def test_equal_cmd_min_and_cmd_max_are_refused_naming_the_tag(tmp_path: Path) -> None:

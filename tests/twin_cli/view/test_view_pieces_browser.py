@@ -143,10 +143,12 @@ def page(tmp_path_factory, serve_world):
             tab = browser.new_page(viewport={"width": 640, "height": 480})
             bodies: list[tuple[str, int]] = []  # (URL, body bytes) as Chromium got them
             tab.on("requestfinished", lambda r: bodies.append((r.url, _body_bytes(r))))
+            errors: list[str] = []  # the page's uncaught errors (MuJoCo's WASM exits with one)
+            tab.on("pageerror", lambda e: errors.append(str(e)))
             tab.goto(url)
             wait_shown(tab, 0.0, FIRST_LOAD_S)
             wait_fast_look(tab)
-            yield tab, bodies, urdf
+            yield tab, bodies, urdf, errors
             browser.close()
 
 
@@ -186,12 +188,23 @@ def check_shown(tab, spawns: list[tuple[str, dict, float]]) -> list[float]:
     return drawn
 
 
+# A post on a hinge held by gz-sim's JointPositionController with its default integral gain.
+HELD_ARM = """<robot name="held"><link name="world"/><link name="post"><inertial><mass value="1"/>
+  <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial><visual>
+  <geometry><box size="0.1 0.1 0.4"/></geometry></visual></link>
+  <joint name="hinge" type="revolute"><parent link="world"/><child link="post"/>
+  <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="50" velocity="2"/>
+  </joint><gazebo><plugin filename="gz-sim-joint-position-controller-system"
+  name="gz::sim::systems::JointPositionController"><joint_name>hinge</joint_name>
+  <p_gain>50</p_gain></plugin></gazebo></robot>"""
+
+
 def _body_bytes(request) -> int:
     return int(request.sizes()["responseBodySize"])
 
 
 def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(page):
-    tab, bodies, urdf = page
+    tab, bodies, urdf, errors = page
     frame = frame_ms(tab)
     old = shown_crc(tab)
     asked, first_at = spawn_arm(urdf, "arm1", 0.0)
@@ -246,3 +259,12 @@ def test_spawns_show_in_2_s_a_second_robot_sends_no_mesh_bytes_a_delete_none(pag
             f"third: {timeline(tab, third, third_at)}; fourth: {timeline(tab, fourth, fourth_at)}"
         )
         assert max(drawn) < DRAWN_S, f"drawn {drawn} s after the replies; {times}"
+
+    # A robot whose gz-sim PID runs on MuJoCo's `mujoco.pid` plugin, which the page's MuJoCo
+    # lacks: the page is sent a copy without it (`twin_cli.world.page_model`) and draws it.
+    held = urdf.parent.parent / "held.urdf"
+    held.write_text(HELD_ARM)
+    asked, old = time.time(), shown_crc(tab)
+    assert twin("spawn", str(held), "--name", "held", "-x", "2").returncode == 0
+    wait_shown(tab, asked, 30.0, old)
+    assert not errors, f"the page failed: {errors}"
