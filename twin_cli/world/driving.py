@@ -132,7 +132,7 @@ def _checked(
     state: WorldState, name: str, ix: EntityIndex, joint: str, mode: str, value: float, clip: bool
 ) -> tuple:
     a, j = _motor_of(state, name, ix, joint)
-    limits = joint_control.limits_of(state.model, name, joint)
+    limits = _offered(state, a, joint_control.limits_of(state.model, name, joint))
     if mode not in limits.modes:
         raise ModeNotOfferedError(name, joint, mode, limits.modes, limits.source)
     key = element_names(state.model, state.model.name_actuatoradr[[a]])[0]
@@ -446,7 +446,7 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
             continue  # a velocity motor's rotor: its joint's command shows it
         j = int(model.actuator_trnid[a][0])
         joint = element_names(model, model.name_jntadr[[j]])[0].removeprefix(f"{name}/")
-        limits = joint_control.limits_of(model, name, joint)
+        limits = _offered(state, int(a), joint_control.limits_of(model, name, joint))
         cmd = state.commands.get(key)
         out[joint] = {
             "mode": cmd.mode if cmd else "none",
@@ -463,6 +463,17 @@ def joint_commands(state: WorldState, name: str) -> dict[str, dict]:
     return out
 
 
+def _offered(
+    state: WorldState, a: int, limits: joint_control.JointLimits
+) -> joint_control.JointLimits:
+    """`limits` with the modes actuator `a` can run: a plugin actuator reads ctrl its own way,
+    so it takes its own servo's mode only (none when twin does not know the plugin)."""
+    if state.model.actuator_plugin[a] < 0:
+        return limits
+    law = state.native.get(state.model.actuator(a).name)
+    return replace(limits, modes=(law.mode,) if law is not None else ())
+
+
 def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
@@ -476,7 +487,7 @@ def _effort_range(
         low, high = -cmd.effort, cmd.effort
     else:
         low, high = control.effort_range(model, actuator)
-    return [_finite(low), _finite(high)]
+    return [_finite(float(low)), _finite(float(high))]
 
 
 def set_controls(state: WorldState, actuators: Sequence[int], values: Sequence[float]) -> None:
@@ -506,12 +517,21 @@ def follow_references(
 
     ids = np.asarray(actuators)
     with state.lock:
-        servos.follow(state.model, state.data, ids, references, np.asarray(bias))
+        own = np.array([_own_force(state, int(a)) for a in ids])
+        servos.follow(state.model, state.data, ids, references, np.asarray(bias) + own)
         sleeping.wake_actuated(state.model, state.data, ids)
 
 
 def hold_servo(state: WorldState, actuator: int, ctrl: float) -> None:
-    """Stops a position servo where it is: `ctrl` and no speed feed-forward (bias constant)."""
+    """Stops a position servo where it is: `ctrl` and no speed feed-forward (the bias constant
+    back to the servo's own, a Gazebo PID's `cmd_offset`)."""
     with state.lock:
         state.data.ctrl[actuator] = ctrl
-        state.model.actuator_biasprm[actuator, 0] = 0.0
+        state.model.actuator_biasprm[actuator, 0] = _own_force(state, actuator)
+
+
+def _own_force(state: WorldState, actuator: int) -> float:
+    """The constant force [N m or N] actuator's own servo law adds (its `biasprm[0]`: a Gazebo
+    PID's `cmd_offset`), which a trajectory's speed feed-forward goes on top of; 0 for others."""
+    law = state.native.get(state.model.actuator(actuator).name)
+    return float(dict(law.arrays)["biasprm"][0]) if law is not None else 0.0

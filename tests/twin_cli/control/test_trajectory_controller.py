@@ -95,7 +95,7 @@ def test_the_arm_starts_at_its_initial_positions_and_follows_a_trajectory(
         ((-2.0, 0.0, 1.0, 1.0), (-2.0 / 200.0, 2.0 / 100.0)),
     ],
 )
-def test_its_cmd_offsets_shift_where_each_joint_settles(
+def test_its_cmd_offsets_shift_where_each_joint_settles_before_and_after_a_trajectory(
     tmp_path: Path, offsets: tuple[float, float, float, float], shifts: tuple[float, float]
 ) -> None:
     """gz-math adds each PID's `cmd_offset` to its output and the system sums both PIDs: on the
@@ -115,6 +115,12 @@ def test_its_cmd_offsets_shift_where_each_joint_settles(
     end = {s.name: s.position for s in world.joint_states("arm")}
     expected = {"shoulder": 0.3 + shifts[0], "elbow": -0.5 + shifts[1]}
     assert end == pytest.approx(expected, abs=2e-4), f"angles [rad]: {end}"
+    points = (TrajectoryPoint(1.0, (0.8, -1.0)),)  # the offsets act along and after it too
+    follow_trajectory(world, "arm", Trajectory(("shoulder", "elbow"), points))
+    world.step(round(3.0 / world.model.opt.timestep))
+    end = {s.name: s.position for s in world.joint_states("arm")}
+    expected = {"shoulder": 0.8 + shifts[0], "elbow": -1.0 + shifts[1]}
+    assert end == pytest.approx(expected, abs=2e-4), f"after a trajectory [rad]: {end}"
 
 
 def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
