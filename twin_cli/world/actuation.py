@@ -67,10 +67,10 @@ class JointCommand:
 
 def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
     """The most force [N m or N] the motor can apply at its joint (inf when unlimited): its
-    force range, and a motor's control range (a servo's control range holds targets)."""
+    force range, and a motor's control range (a servo's or a plugin's holds targets)."""
     gear = abs(model.actuator_gear[actuator][0]) or 1.0
     limits = []
-    motor = model.actuator_biastype[actuator] == _NONE
+    motor = model.actuator_biastype[actuator] == _NONE and model.actuator_plugin[actuator] < 0
     if model.actuator_ctrllimited[actuator] and motor:
         limits.append(np.max(np.abs(model.actuator_ctrlrange[actuator])) * gear)
     if model.actuator_forcelimited[actuator]:
@@ -83,7 +83,8 @@ def effort_range(model: mujoco.MjModel, actuator: int) -> tuple[float, float]:
     Gazebo PID's [cmd_min, cmd_max] need not be symmetric); ±inf where a side is unbounded."""
     gear = model.actuator_gear[actuator][0] or 1.0
     low, high = -math.inf, math.inf
-    if model.actuator_ctrllimited[actuator] and model.actuator_biastype[actuator] == _NONE:
+    motor = model.actuator_biastype[actuator] == _NONE and model.actuator_plugin[actuator] < 0
+    if model.actuator_ctrllimited[actuator] and motor:  # a plugin's ctrl is its target
         low, high = sorted(float(v) * gear for v in model.actuator_ctrlrange[actuator])
     if model.actuator_forcelimited[actuator]:
         f_low, f_high = sorted(float(v) * gear for v in model.actuator_forcerange[actuator])

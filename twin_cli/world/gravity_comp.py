@@ -13,7 +13,8 @@ model (`switch`): a body is ON while every joint between it and the world is act
 a position command (a joint's own servo holds one from load, `native_servos`). An arm with an
 effort command or a passive joint on the way falls as it does in Gazebo; a velocity servo's
 integral carries its load itself, and a joint whose tags give its position servo a PID (which
-Gazebo runs alone) carries its load through that PID and sags by load/kp, as there. A body the
+Gazebo runs alone) carries its load through that PID, as there: it sags by load/kp until the
+PID's integral, when it has one, takes up to its bound of the load. A body the
 robot's own tags compensate (Gazebo's gravity off: 1) keeps its value.
 """
 
@@ -55,8 +56,8 @@ def prepare(spec: mujoco.MjSpec) -> None:
         if actuator.trntype != _JOINT:
             continue
         joint = spec.joint(actuator.target)
-        if joint is None or joint.name in pids:
-            continue
+        if joint is None or joint.name in pids or actuator.plugin.active:
+            continue  # a PID (a tag's, or a plugin's such as `mujoco.pid`) holds its load alone
         joint.actgravcomp = True
         low, high = _force_range(actuator)
         if math.isfinite(low) and math.isfinite(high):

@@ -22,12 +22,13 @@ commands before a controller claims it, and as the exported `home` keyframe's ct
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from converters.mjcf.export_servos import PID_INSTANCE
+from converters.mjcf.export_servos import PID_PLUGIN
 from twin_cli.world import speed_holds, velocity_motors
 from twin_cli.world.servos import has_reference
 
@@ -135,15 +136,14 @@ def capture(model: mujoco.MjModel) -> dict[str, Law]:
 
 
 def pid_gains(model: mujoco.MjModel, a: int) -> tuple[float, float, float] | None:
-    """(kp, ki, kd) of actuator `a` if it is a gz-sim PID run by MuJoCo's pid actuator plugin
-    (`converters.mjcf.export_servos`), else None: read from its instance's config, whose values
-    the model stores in the plugin's attribute order."""
+    """(kp, ki, kd) of actuator `a` if it is a position PID run by MuJoCo's pid actuator plugin
+    (a gz-sim PID, `converters.mjcf.export_servos`, or a file's own), else None: read from its
+    instance's config, whose values the model stores in the plugin's attribute order."""
     instance = int(model.actuator_plugin[a])
-    if instance < 0:
+    if instance < 0 or int(model.plugin[instance]) != _pid_slot():
         return None
-    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_PLUGIN, instance) or ""
-    if not name.endswith(PID_INSTANCE):
-        return None
+    if int(model.actuator_dyntype[a]) != _NONE:
+        return None  # ctrl filtered or integrated first: not a position target
     start = int(model.plugin_attradr[instance])
     end = int(model.plugin_attradr[instance + 1]) if instance + 1 < model.nplugin else None
     values = bytes(model.plugin_attr[start:end]).split(b"\0")
@@ -198,3 +198,22 @@ def velocity_limit(model: mujoco.MjModel, actuator: str) -> float:
 
     entity, _, joint = actuator.rpartition("/")
     return limits_of(model, entity, joint).velocity
+
+
+@functools.cache
+def _pid_slot() -> int:
+    """The registry slot of MuJoCo's `mujoco.pid` plugin in this process (-1 if absent): each
+    model names its plugins by slot."""
+    spec = mujoco.MjSpec()
+    spec.activate_plugin(PID_PLUGIN)
+    body = spec.worldbody.add_body()
+    body.add_joint(name="j", type=mujoco.mjtJoint.mjJNT_SLIDE)
+    body.add_geom(size=[0.1, 0, 0])
+    instance = spec.add_plugin(name="pid", plugin_name=PID_PLUGIN)
+    instance.active = True
+    actuator = spec.add_actuator(target="j", trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    actuator.plugin = instance
+    try:
+        return int(spec.compile().plugin[0])
+    except ValueError:
+        return -1

@@ -245,9 +245,15 @@ def driven(cmd: JointCommand) -> bool:
 
 def keep_awake(model: mujoco.MjModel, commands: Mapping[str, JointCommand]) -> None:
     """Keeps the trees of `driven` commands from sleeping until their next command, and lets
-    every other commanded tree sleep (`sleeping.hold_awake`), decided when commands change."""
+    every other commanded tree sleep (`sleeping.hold_awake`), decided when commands change. A
+    plugin's PID (a gz-sim integral) keeps its tree awake: its integral changes its force while
+    the joint rests, which a sleeping tree would not feel."""
     ids = {key: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, key) for key in commands}
-    moving = [a for key, a in ids.items() if a >= 0 and driven(commands[key])]
+    moving = [
+        a
+        for key, a in ids.items()
+        if a >= 0 and (driven(commands[key]) or model.actuator_plugin[a] >= 0)
+    ]
     awake = sleeping.actuator_trees(model, moving)
     resting = sleeping.actuator_trees(model, [a for a in ids.values() if a >= 0]) - awake
     sleeping.hold_awake(model, awake, True)
