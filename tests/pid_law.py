@@ -62,14 +62,17 @@ def gz_held_bar(
     inertia: float,
     load: float,
     step: float = 1e-3,
+    start: tuple[float, float] = (0.0, 0.0),
+    every: float = 1.0,
 ) -> list[float]:
-    """A bar's angle [rad] at each whole second for t s, from rest at 0, under gravity's torque
-    load·cos q and gz-sim's JointPositionController holding 0: gz-math's PID (p, i, d) on the
-    error q, the integral term within ±integral_limit (None: unbounded), integrated
-    semi-implicitly as gz-physics does. The target never jumps, so there is no kick."""
+    """A bar's angle [rad] every `every` s for t s, from `start` (angle, speed) with an empty
+    integral (rest at 0 unless given), under gravity's torque load·cos q and gz-sim's
+    JointPositionController holding 0: gz-math's PID (p, i, d) on the error q, the integral term
+    within ±integral_limit (None: unbounded), integrated semi-implicitly as gz-physics does. The
+    target never jumps, so there is no kick."""
     p, i, d = gains
-    angle, speed, integral, angles = 0.0, 0.0, 0.0, []
-    per_second = round(1.0 / step)
+    (angle, speed), integral, angles = start, 0.0, []
+    per_second = round(every / step)
     for k in range(round(t / step)):
         integral += i * step * angle
         if integral_limit is not None:

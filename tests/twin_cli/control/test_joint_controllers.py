@@ -8,13 +8,14 @@ d_gain 2). Oracle: the commanded speed and angle; the joints offer only the plug
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pytest
 from pid_law import gz_held_bar, gz_position_pid, pid_law
 
 from converters.mjcf.velocity_motors import rotor_name
-from twin_cli.errors import InvalidRequestError
+from twin_cli.errors import InvalidRequestError, ModeNotOfferedError
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 
@@ -343,7 +344,9 @@ def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
         world.step(round(1.0 / world.model.opt.timestep))
         angles.append({s.name: s for s in world.joint_states("bar")}["hinge"].position)
     assert angles == pytest.approx(law, abs=2e-5), f"world: {angles}"
-    assert "pid" in world.joint_commands("bar")["hinge"]["rule"], "`twin joints` names the PID"
+    row = world.joint_commands("bar")["hinge"]
+    assert (row["kp"], row["kv"]) == (100.0, 2.0), f"p_gain and d_gain: {row}"
+    assert row["effort_range"] == [-1000.0, 1000.0], "gz-math's output range, not the targets'"
     done = convert_full(path)
     scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
     model = mujoco.MjModel.from_xml_path(str(scene))
@@ -354,6 +357,52 @@ def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
         mujoco.mj_step(model, data, nstep=round(1.0 / model.opt.timestep))
         exported.append(float(data.qpos[0]))
     assert exported == pytest.approx(law, abs=2e-5), f"scene.xml: {exported}"
+
+
+def test_a_files_own_pid_actuator_is_a_position_servo_and_takes_no_other_mode(
+    tmp_path: Path,
+) -> None:
+    """A hand-written MJCF's `mujoco.pid` actuator (here the exported bar's, its instance
+    renamed) is run by ctrl as the file says, whatever its instance is called; an effort or a
+    velocity command, which the plugin would read as a position target, is refused."""
+    from converters.mjcf.writer import write_model
+    from converters.pipeline import convert_full
+
+    path = tmp_path / "bar.urdf"
+    path.write_text(BAR.format(inertial=INERTIAL, bounds="").replace("<i_gain>0</i_gain>", ""))
+    done = convert_full(path)
+    scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
+    robot = scene.with_name("bar.xml")
+    text = re.sub(r'<text name="control">.*?</text>', "", robot.read_text(), flags=re.S)
+    robot.write_text(text.replace("hinge:pid", "hold"))  # no control record: a user's file
+    world = World()
+    world.spawn(SpawnRequest(str(robot)), name="bar")
+    row = world.joint_commands("bar")["hinge"]
+    assert (row["modes"], row["kp"], row["kv"]) == (["position"], 100.0, 2.0), row
+    for mode in ("effort", "velocity"):
+        with pytest.raises(ModeNotOfferedError, match="offers only position"):
+            world.command_joints("bar", {"hinge": 0.0}, mode=mode)
+    world.command_joints("bar", {"hinge": 0.0}, mode="position")
+    world.step(round(4.0 / world.model.opt.timestep))
+    law = gz_held_bar((100.0, 0.1, 2.0), 1.0, 4.0, inertia=0.2501, load=4.905)
+    angle = {s.name: s for s in world.joint_states("bar")}["hinge"].position
+    assert angle == pytest.approx(law[-1], abs=2e-5), f"{angle:.5f} rad, gz-math {law[-1]:.5f}"
+
+
+def test_a_pid_integral_goes_on_while_island_sleeping_is_on(tmp_path: Path) -> None:
+    """`twin physics --sleep` lets resting trees sleep; a bar at rest under gz-math's default
+    integral (0.1, within ±1) still rises as its integral grows, as gz-sim's does: a sleeping
+    tree would stay where it fell asleep while the integral winds on."""
+    path = tmp_path / "bar.urdf"
+    path.write_text(BAR.format(inertial=INERTIAL, bounds="").replace("<i_gain>0</i_gain>", ""))
+    law = gz_held_bar((100.0, 0.1, 2.0), 1.0, 30.0, inertia=0.2501, load=4.905)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bar")
+    world.set_engine(sleep=True)
+    world.command_joints("bar", {"hinge": 0.0}, mode="position")
+    world.step(round(30.0 / world.model.opt.timestep))
+    angle = {s.name: s for s in world.joint_states("bar")}["hinge"].position
+    assert angle == pytest.approx(law[-1], abs=2e-5), f"{angle:.5f} rad, gz-math {law[-1]:.5f}"
 
 
 def test_equal_cmd_min_and_cmd_max_are_refused_naming_the_tag(tmp_path: Path) -> None:
