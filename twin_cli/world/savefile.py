@@ -147,6 +147,7 @@ def load(path: str | os.PathLike) -> World:
         world.model, dict(doc.layout), np.array(doc.state, dtype=float)
     )
     layout, state = _servo_references(world, layout, state)
+    layout, state = _pid_integrals(world.model, layout, state)
     laws = _laws(world)
     layout, state = _own_servos(world, laws, layout, state)
     saved = [JointCommand(**c.model_dump(exclude=OBSOLETE_COMMAND_FIELDS)) for c in doc.commands]
@@ -280,12 +281,41 @@ def _servo_references(
     if layout.get("na") != 0 or model.na == 0 or rest != {k: int(getattr(model, k)) for k in rest}:
         return layout, state
     references = np.zeros(model.na)
+    integrals = _pid_slots(model)
     for a in range(model.nu):
         if model.actuator_actadr[a] >= 0 and model.actuator_trntype[a] == 0:  # joint transmission
             joint = int(model.actuator_trnid[a, 0])
             references[model.actuator_actadr[a]] = state[1 + int(model.jnt_qposadr[joint])]
+    references[integrals] = 0.0  # a gz-sim PID's integral starts empty
     at = 1 + model.nq + model.nv
     return {**layout, "na": int(model.na)}, np.insert(state, at, references)
+
+
+def _pid_slots(model: mujoco.MjModel) -> list[int]:
+    """The activations that hold a gz-sim PID's integral (MuJoCo's pid actuator plugin)."""
+    from twin_cli.world.native_servos import pid_gains
+
+    return [
+        int(model.actuator_actadr[a]) for a in range(model.nu) if pid_gains(model, a) is not None
+    ]
+
+
+def _pid_integrals(
+    model: mujoco.MjModel, layout: dict[str, int], state: np.ndarray
+) -> tuple[dict[str, int], np.ndarray]:
+    """A file saved before a gz-sim PID's integral ran (its joint's actuator had no activation)
+    gets one per such joint, empty, where MuJoCo's state keeps activations: every other
+    activation keeps its saved value. Other files pass unchanged."""
+    integrals = _pid_slots(model)
+    rest = {k: v for k, v in layout.items() if k != "na"}
+    fits = rest == {k: int(getattr(model, k)) for k in rest}
+    if not integrals or not fits or layout.get("na") != model.na - len(integrals):
+        return layout, state
+    at = 1 + model.nq + model.nv
+    saved = iter(state[at : at + int(layout["na"])])
+    act = [0.0 if k in integrals else next(saved) for k in range(model.na)]
+    new = np.concatenate([state[:at], act, state[at + int(layout["na"]) :]])
+    return {**layout, "na": int(model.na)}, new
 
 
 def _new_world(path: str | os.PathLike, doc: SaveDocument) -> World:
