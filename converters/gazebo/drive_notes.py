@@ -197,7 +197,7 @@ APPROXIMATED: dict[str, tuple[str, ...]] = {
 
 
 PID_TAGS = {"p_gain", "i_gain", "d_gain", "i_max", "i_min", "cmd_max", "cmd_min", "cmd_offset"}
-MODE_READS: dict[str, tuple[str, bool, set[str]]] = {
+MODE_USES: dict[str, tuple[str, bool, set[str]]] = {
     "gz-sim-joint-controller-system": ("use_force_commands", True, PID_TAGS),
     "gz-sim-joint-position-controller-system": (
         "use_velocity_commands",
@@ -205,8 +205,8 @@ MODE_READS: dict[str, tuple[str, bool, set[str]]] = {
         PID_TAGS - {"cmd_max"},  # with velocity commands, cmd_max bounds the speed
     ),
 }
-"""Tags a gz-sim system reads only in one of its modes: (the mode's flag, the flag's value in
-which the tags are read, the tags). In the other mode gz-sim ignores them, and so does twin."""
+"""Tags a gz-sim system uses only in one of its modes: (the mode's flag, the flag's value in
+which the tags are used, the tags). In the other mode gz-sim ignores them, and so does twin."""
 
 
 def drive_notes(key: str, params: Params, initial: float = 0.0) -> tuple[str, ...]:
@@ -214,12 +214,12 @@ def drive_notes(key: str, params: Params, initial: float = 0.0) -> tuple[str, ..
     not use (ROS publishing tags named as such; a tag the system ignores in its mode, as such)."""
     notes = list(APPROXIMATED.get(key, ()))
     used = USED.get(key, set())
-    flag, reads_when, mode_tags = MODE_READS.get(key, ("", True, set()))
+    flag, reads_when, mode_tags = MODE_USES.get(key, ("", True, set()))
     idle = mode_tags if flag and params.flag(False, flag) != reads_when else set()
     for tag in params.given():
         if tag in idle:
             when = "with" if reads_when else "without"
-            notes.append(f"<{tag}>: gz-sim reads it only {when} {flag}; unused here, as there")
+            notes.append(f"<{tag}>: gz-sim uses it only {when} {flag}; unused here, as there")
             continue
         if tag in used:
             continue

@@ -440,12 +440,12 @@ def test_gz_limiter_tags_twin_runs_are_not_reported_unused(
 def test_pid_tags_gz_sim_ignores_in_a_controllers_mode_are_reported_as_such(
     tmp_path: Path, plugin: str, idle: tuple[str, ...], read: tuple[str, ...]
 ) -> None:
-    """gz-sim's JointController reads its PID tags only with `use_force_commands`, and its
+    """gz-sim's JointController uses its PID tags only with `use_force_commands`, and its
     JointPositionController only without `use_velocity_commands` (there `cmd_max` bounds the
     speed): a tag the system ignores in the mode given says so, a tag it reads is not listed."""
     notes = [e.detail for e in _convert(tmp_path, dm.two_wheel_base(plugin), "urdf").report.entries]
     for tag in idle:
         said = [n for n in notes if f"<{tag}>" in n]
-        assert said and all("gz-sim reads it only" in n for n in said), (tag, notes)
+        assert said and all("gz-sim uses it only" in n for n in said), (tag, notes)
     for tag in read:
         assert not [n for n in notes if f"<{tag}>:" in n], (tag, notes)

@@ -33,7 +33,7 @@ from twin_cli.world.actuation import JointCommand
 from twin_cli.world.divergence import Divergence
 from twin_cli.world.entities import Entity, EntityIndex
 from twin_cli.world.loop import LoopFigures, SteppingLoop, WorldLock
-from twin_cli.world.page_model import plugin_free, refresh
+from twin_cli.world.page_model import plugin_free
 from twin_cli.world.pose import Pose
 from twin_cli.world.queries import JointState
 from twin_cli.world.scene import build_world_spec
@@ -93,15 +93,25 @@ class World:
 
     def page_model(self) -> mujoco.MjModel:
         """The model a browser's MuJoCo can load (`twin_cli.world.page_model`): the world's
-        own, or a copy without plugins made once per model, with the world's options now."""
+        own, or a copy without plugins, made once per model (compiled outside the lock when
+        the caller does not hold it) and given the world's options at each call."""
         state = self._state
         with state.lock:
-            shown = state.page_model
-            if shown is None or shown[0] is not state.model:
-                shown = state.page_model = (state.model, plugin_free(state.spec, state.model))
-            if shown[1] is not state.model:
-                refresh(shown[1], state.model)
-            return shown[1]
+            model, shown = state.model, state.page_model
+            if shown is None or shown[0] is not model:
+                if model.nplugin == 0:
+                    state.page_model = shown = (model, model)
+                else:
+                    spec = state.spec.copy()
+            if shown is not None and shown[0] is model:
+                shown[1].opt = model.opt  # the options the world changes in place
+                return shown[1]
+        page = plugin_free(spec)
+        with state.lock:
+            page.opt = state.model.opt
+            if state.model is model:
+                state.page_model = (model, page)
+        return page
 
     @property
     def divergences(self) -> int:

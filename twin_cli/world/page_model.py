@@ -14,31 +14,14 @@ from __future__ import annotations
 import mujoco
 
 
-def plugin_free(spec: mujoco.MjSpec, model: mujoco.MjModel) -> mujoco.MjModel:
-    """`model` itself when it uses no plugin, else a copy compiled from `spec` (the spec `model`
-    was compiled from) with its plugin actuators as integrators and no plugin instances."""
-    if model.nplugin == 0:
-        return model
-    shown = spec.copy()
-    for actuator in shown.actuators:
+def plugin_free(spec: mujoco.MjSpec) -> mujoco.MjModel:
+    """Compiles `spec` (a copy of the world's: it is changed) with its plugin actuators as
+    integrators and no plugin instances."""
+    for actuator in spec.actuators:
         if actuator.plugin.active:
             actuator.plugin.active = False
             actuator.plugin.name = actuator.plugin.plugin_name = ""
             actuator.dyntype = mujoco.mjtDyn.mjDYN_INTEGRATOR  # the activation slot it had
-    for instance in list(shown.plugins):
-        shown.delete(instance)
-    page = shown.compile()
-    refresh(page, model)
-    return page
-
-
-IN_PLACE = ("body_pos", "body_quat", "geom_rgba", "light_pos", "light_dir", "light_active")
-"""What the world changes in its model in place that the page draws (a static entity moved,
-lights), copied into the page's model at every sync with the options."""
-
-
-def refresh(page: mujoco.MjModel, model: mujoco.MjModel) -> None:
-    """Copies the world's options and `IN_PLACE` arrays of `model` into `page`."""
-    page.opt = model.opt
-    for name in IN_PLACE:
-        getattr(page, name)[:] = getattr(model, name)
+    for instance in list(spec.plugins):
+        spec.delete(instance)
+    return spec.compile()
