@@ -9,29 +9,21 @@ gz-math's PID integrated by hand from the saved angle and speed with an empty in
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
+from old_saves import placed_save
 from pid_law import gz_held_bar
 
 from twin_cli.world.savefile import load
 
-SAVES = Path(__file__).parent / "saves"
 NAME = "pid_saved_before_integral"
 
 
 @pytest.fixture
 def save(tmp_path: Path) -> Path:
     """The file, naming the robots' URDFs where this test put them."""
-    doc = json.loads((SAVES / f"{NAME}.json").read_text())
-    for entity, part in zip(doc["entities"], ("bar", "rig"), strict=True):
-        entity["source"] = str(
-            shutil.copy(SAVES / f"{NAME}_{part}.urdf", tmp_path / f"{part}.urdf")
-        )
-    path = tmp_path / "world.json"
-    path.write_text(json.dumps(doc))
-    return path
+    return placed_save(NAME, ("bar", "rig"), tmp_path)
 
 
 def test_each_joint_goes_on_from_its_saved_state_with_an_empty_integral(save: Path) -> None:

@@ -9,30 +9,22 @@ unbounded as its joint is. Oracle: the file's own state and commands, and the la
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
+from old_saves import placed_save
 from pid_law import pid_law
 
 from twin_cli.world.savefile import load
 from twin_cli.world.velocity_motors import RULE
 
-SAVES = Path(__file__).parent / "saves"
 NAME = "pid_saved_as_intvelocity"
 
 
 @pytest.fixture
 def save(tmp_path: Path) -> Path:
     """The file, naming the robots' URDFs where this test put them."""
-    doc = json.loads((SAVES / f"{NAME}.json").read_text())
-    for entity, part in zip(doc["entities"], ("arm", "fan"), strict=True):
-        entity["source"] = str(
-            shutil.copy(SAVES / f"{NAME}_{part}.urdf", tmp_path / f"{part}.urdf")
-        )
-    path = tmp_path / "world.json"
-    path.write_text(json.dumps(doc))
-    return path
+    return placed_save(NAME, ("arm", "fan"), tmp_path)
 
 
 def test_each_joint_goes_on_from_its_saved_state_under_its_command(save: Path) -> None:
