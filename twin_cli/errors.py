@@ -137,6 +137,14 @@ class ModeNotOfferedError(InvalidRequestError):
         # a plugin's record (diff_drive, multicopter_motor_model) is no tag a user can extend
         who = " and ".join(f"<{k}>" for k in kinds) + " tags" if tagged else f"{source} plugin"
         fix = f"use --mode {' or '.join(offered)}"
+        if not offered:  # a MuJoCo plugin twin does not know reads ctrl its own way
+            super().__init__(
+                f"{mode} command for joint [{joint}] of [{entity}]",
+                f"its {who} reads ctrl its own way, so twin writes none",
+                "drive the joint through an actuator without a plugin",
+            )
+            self.offered = offered
+            return
         if tagged:
             fix += (
                 f', or declare {mode} for it (<command_interface name="{mode}"/> in its '

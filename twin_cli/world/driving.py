@@ -471,7 +471,8 @@ def _offered(
     if state.model.actuator_plugin[a] < 0:
         return limits
     law = state.native.get(state.model.actuator(a).name)
-    return replace(limits, modes=(law.mode,) if law is not None else ())
+    source = limits.source if limits.source != "model" else "MuJoCo"
+    return replace(limits, modes=(law.mode,) if law is not None else (), source=source)
 
 
 def _finite(value: float) -> float | None:

@@ -389,6 +389,27 @@ def test_a_files_own_pid_actuator_is_a_position_servo_and_takes_no_other_mode(
     assert angle == pytest.approx(law[-1], abs=2e-5), f"{angle:.5f} rad, gz-math {law[-1]:.5f}"
 
 
+FILTERED_PID = """<mujoco><extension><plugin plugin="mujoco.pid"><instance name="p">
+  <config key="kp" value="10"/></instance></plugin></extension><worldbody>
+  <body name="b" pos="0 0 1"><joint name="j" type="slide" axis="0 0 1"/><geom size="0.1"
+  mass="1"/></body></worldbody><actuator><plugin name="j" joint="j" instance="p"
+  dyntype="filter" dynprm="0.1" actdim="1"/></actuator></mujoco>"""
+
+
+def test_a_plugin_actuator_twin_cannot_read_takes_no_command(tmp_path: Path) -> None:
+    """A `mujoco.pid` whose ctrl is filtered first is no position target twin can write: its
+    joint offers no mode, and a command is refused naming why, the world unchanged."""
+    path = tmp_path / "filtered.xml"
+    path.write_text(FILTERED_PID)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="u")
+    assert world.joint_commands("u")["j"]["modes"] == []
+    before = world.data.ctrl.copy()
+    with pytest.raises(ModeNotOfferedError, match="reads ctrl its own way"):
+        world.command_joints("u", {"j": 0.1}, mode="position")
+    assert (world.data.ctrl == before).all(), "a refused command leaves the world as it was"
+
+
 def test_a_pid_integral_goes_on_while_island_sleeping_is_on(tmp_path: Path) -> None:
     """`twin physics --sleep` lets resting trees sleep; a bar at rest under gz-math's default
     integral (0.1, within ±1) still rises as its integral grows, as gz-sim's does: a sleeping
