@@ -136,26 +136,18 @@ class ModeNotOfferedError(InvalidRequestError):
         tagged = all(k in self.TAG_SOURCES for k in kinds)
         # a plugin's record (diff_drive, multicopter_motor_model) is no tag a user can extend
         who = " and ".join(f"<{k}>" for k in kinds) + " tags" if tagged else f"{source} plugin"
+        why = f"its {who} offer{'' if tagged else 's'} only {', '.join(offered)}"
         fix = f"use --mode {' or '.join(offered)}"
         if not offered:  # a MuJoCo plugin twin does not know reads ctrl its own way
-            super().__init__(
-                f"{mode} command for joint [{joint}] of [{entity}]",
-                f"its {who} reads ctrl its own way, so twin writes none",
-                "drive the joint through an actuator without a plugin",
-            )
-            self.offered = offered
-            return
-        if tagged:
+            why = f"its {who} reads ctrl its own way, so twin writes none"
+            fix = "drive the joint through an actuator without a plugin"
+        elif tagged:
             fix += (
                 f', or declare {mode} for it (<command_interface name="{mode}"/> in its '
                 f"<ros2_control> joint, or a <transmission> with hardware_interface/"
                 f"{mode.capitalize()}JointInterface), then delete the entity and spawn it again"
             )
-        super().__init__(
-            f"{mode} command for joint [{joint}] of [{entity}]",
-            f"its {who} offer{'' if tagged else 's'} only {', '.join(offered)}",
-            fix,
-        )
+        super().__init__(f"{mode} command for joint [{joint}] of [{entity}]", why, fix)
         self.offered = offered
 
 

@@ -26,14 +26,18 @@ on 5° creeps 0.26 mm in 30 s, 2.6 mm at 1e-4 s).
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT, PID_INTEGRAL, PID_OFFSET, set_control_record
+from converters.control_text import (
+    PID_INTEGRAL,
+    PID_OFFSET,
+    control_records,
+    set_control_record,
+)
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     AckermannDrive,
@@ -142,9 +146,7 @@ def _untagged(spec: mujoco.MjSpec, joint: str) -> bool:
     """Whether `joint`'s motor is the builder's default (no control tag, e.g. the torque motor
     of a joint with an effort limit): the plugin that commands the joint then decides its mode
     and gains (a gz-sim joint controller's own PID), as it would for a joint without a motor."""
-    text = spec.text(CONTROL_TEXT)
-    records = json.loads(text.data) if text is not None else {}
-    return records.get(joint, {}).get("source") == "default"
+    return control_records(spec).get(joint, {}).get("source") == "default"
 
 
 def _bound(spec: mujoco.MjSpec, joint: str, force: tuple[float, float]) -> None:

@@ -535,4 +535,4 @@ def _own_force(state: WorldState, actuator: int) -> float:
     """The constant force [N m or N] actuator's own servo law adds (its `biasprm[0]`: a Gazebo
     PID's `cmd_offset`), which a trajectory's speed feed-forward goes on top of; 0 for others."""
     law = state.native.get(state.model.actuator(actuator).name)
-    return float(dict(law.arrays)["biasprm"][0]) if law is not None else 0.0
+    return law.offset if law is not None else 0.0

@@ -93,19 +93,17 @@ class World:
 
     def page_model(self) -> mujoco.MjModel:
         """The model a browser's MuJoCo can load (`twin_cli.world.page_model`): the world's
-        own, or a copy without plugins, made once per model (compiled outside the lock when
-        the caller does not hold it) and given the world's options at each call."""
+        own when it uses no plugin, else a copy without them, made once per model (compiled
+        outside the lock when the caller does not hold it) and given the world's options."""
         state = self._state
         with state.lock:
             model, shown = state.model, state.page_model
-            if shown is None or shown[0] is not model:
-                if model.nplugin == 0:
-                    state.page_model = shown = (model, model)
-                else:
-                    spec = state.spec.copy()
+            if model.nplugin == 0:
+                return model
             if shown is not None and shown[0] is model:
                 shown[1].opt = model.opt  # the options the world changes in place
                 return shown[1]
+            spec = state.spec.copy()
         page = plugin_free(spec)
         with state.lock:
             page.opt = state.model.opt

@@ -20,7 +20,6 @@ robot's own tags compensate (Gazebo's gravity off: 1) keeps its value.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING
@@ -28,7 +27,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from converters.control_text import CONTROL_TEXT
+from converters.control_text import control_records
 from converters.mjcf.export_servos import tag_pid
 
 if TYPE_CHECKING:
@@ -69,11 +68,9 @@ def _tag_pid_joints(spec: mujoco.MjSpec) -> set[str]:
     """The joints whose tags give their position servo a PID (a gz-sim joint controller,
     ros2_control's `position_pid`, a trajectory controller): Gazebo runs that PID alone, so the
     joint carries its load through it and sags by load/kp, as it does there."""
-    text = spec.text(CONTROL_TEXT)
-    records = json.loads(text.data) if text is not None else {}
     return {
         joint
-        for joint, record in records.items()
+        for joint, record in control_records(spec).items()
         if isinstance(record, dict) and tag_pid(record.get("pid", {}), "position") is not None
     }
 

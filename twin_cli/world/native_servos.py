@@ -47,6 +47,7 @@ FIELDS = (
     "actrange",
     "actearly",
 )
+BIASPRM = FIELDS.index("biasprm")
 RULE = "the model's own {} servo: ctrl = target"  # what `twin joints` shows
 ROTOR_THRUST = ":thrust"  # a rotor's joint motor (converters.gazebo.multicopter) is not a servo
 _FIXED = int(mujoco.mjtGain.mjGAIN_FIXED)
@@ -77,6 +78,11 @@ class Law:
     arrays: tuple[tuple[str, np.ndarray], ...]
     friction: tuple[float, np.ndarray, np.ndarray]
     ki: float = 0.0
+
+    @property
+    def offset(self) -> float:
+        """Its constant force [N m or N], `biasprm[0]` (a Gazebo PID's `cmd_offset`)."""
+        return float(self.arrays[BIASPRM][1][0])
 
     @property
     def integrates(self) -> bool:

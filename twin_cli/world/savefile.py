@@ -219,9 +219,7 @@ def _own_servos(
     activations are dropped from the state. Other files pass unchanged."""
     model = world.model
     gone = _exported_positions(model, laws)
-    rest = {k: v for k, v in layout.items() if k != "na"}
-    fits = rest == {k: int(getattr(model, k)) for k in rest}
-    if not gone or not fits or layout.get("na") != model.na + len(gone):
+    if not gone or not _fits_but_na(model, layout) or layout.get("na") != model.na + len(gone):
         return layout, state
     slots, k = [], 0
     for a in range(model.nu):
@@ -277,8 +275,7 @@ def _servo_references(
     joint's saved position: its commands go on from where the joints were. Other files pass
     unchanged."""
     model = world.model
-    rest = {k: v for k, v in layout.items() if k != "na"}
-    if layout.get("na") != 0 or model.na == 0 or rest != {k: int(getattr(model, k)) for k in rest}:
+    if layout.get("na") != 0 or model.na == 0 or not _fits_but_na(model, layout):
         return layout, state
     references = np.zeros(model.na)
     integrals = _pid_slots(model)
@@ -307,15 +304,22 @@ def _pid_integrals(
     gets one per such joint, empty, where MuJoCo's state keeps activations: every other
     activation keeps its saved value. Other files pass unchanged."""
     integrals = _pid_slots(model)
-    rest = {k: v for k, v in layout.items() if k != "na"}
-    fits = rest == {k: int(getattr(model, k)) for k in rest}
-    if not integrals or not fits or layout.get("na") != model.na - len(integrals):
+    if (
+        not integrals
+        or not _fits_but_na(model, layout)
+        or layout.get("na") != model.na - len(integrals)
+    ):
         return layout, state
     at = 1 + model.nq + model.nv
     saved = iter(state[at : at + int(layout["na"])])
     act = [0.0 if k in integrals else next(saved) for k in range(model.na)]
     new = np.concatenate([state[:at], act, state[at + int(layout["na"]) :]])
     return {**layout, "na": int(model.na)}, new
+
+
+def _fits_but_na(model: mujoco.MjModel, layout: dict[str, int]) -> bool:
+    """Whether the saved layout is `model`'s in every size but its activations (`na`)."""
+    return all(v == int(getattr(model, k)) for k, v in layout.items() if k != "na")
 
 
 def _new_world(path: str | os.PathLike, doc: SaveDocument) -> World:

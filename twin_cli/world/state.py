@@ -59,8 +59,8 @@ class WorldState:
         file_notes: what a world file held that twin does not simulate.
         decompositions: entity name → the background decomposition of its collision meshes
             (`decomposing`), pending or finished; absent when it had none.
-        page_model: the model a browser was last given (`page_model`), and the model it was
-            made for, or None.
+        page_model: the model it was made for and the plugin-free copy a browser is given
+            (`page_model`), or None.
     """
 
     name: str
