@@ -64,12 +64,15 @@ def gz_held_bar(
     step: float = 1e-3,
     start: tuple[float, float] = (0.0, 0.0),
     every: float = 1.0,
+    offset: float = 0.0,
+    output: tuple[float, float] = (-1000.0, 1000.0),
 ) -> list[float]:
     """A bar's angle [rad] every `every` s for t s, from `start` (angle, speed) with an empty
     integral (rest at 0 unless given), under gravity's torque load·cos q and gz-sim's
     JointPositionController holding 0: gz-math's PID (p, i, d) on the error q, the integral term
-    within ±integral_limit (None: unbounded), integrated semi-implicitly as gz-physics does. The
-    target never jumps, so there is no kick."""
+    within ±integral_limit (None: unbounded), `offset` (`cmd_offset`) added and the sum within
+    `output` ([cmd_min, cmd_max]), integrated semi-implicitly as gz-physics does. The target
+    never jumps, so there is no kick."""
     p, i, d = gains
     (angle, speed), integral, angles = start, 0.0, []
     per_second = round(every / step)
@@ -77,7 +80,7 @@ def gz_held_bar(
         integral += i * step * angle
         if integral_limit is not None:
             integral = min(max(integral, -integral_limit), integral_limit)
-        force = -p * angle - integral - d * speed
+        force = min(max(offset - p * angle - integral - d * speed, output[0]), output[1])
         speed += (load * math.cos(angle) + force) / inertia * step
         angle += speed * step
         if (k + 1) % per_second == 0:

@@ -305,10 +305,6 @@ ASYMMETRIC_INTEGRAL_NOTE = (
     "i_min {low:g} and i_max {high:g}: the integral term within ±{bound:g} (MuJoCo's pid "
     "actuator bounds it symmetrically)"
 )
-OFFSET_INTEGRAL_NOTE = (
-    "cmd_offset with i_gain: the offset is the servo's bias and the integral is not run (MuJoCo's "
-    "pid actuator has no constant force)"
-)
 
 SET_SPEED_NOTE = (
     "with use_velocity_commands, a stiff position servo (gz-sim sets the speed that reaches the "
@@ -339,9 +335,7 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
     velocity = p.flag(False, "use_velocity_commands")
     gains = (p.number(1.0, "p_gain"), p.number(0.1, "i_gain"), p.number(0.01, "d_gain"))
     offset = 0.0 if velocity else p.number(0.0, "cmd_offset", signed=True)
-    limit, notes = _integral_limit(p) if gains[1] and not offset else (None, ())
-    if gains[1] and offset:
-        gains, notes = (gains[0], 0.0, gains[2]), (OFFSET_INTEGRAL_NOTE,)
+    limit, notes = _integral_limit(p) if gains[1] else (None, ())
     return JointDrive(
         name=blob.name or "JointPositionController",
         where=blob.where,

@@ -23,6 +23,8 @@ So each such joint is written as MuJoCo's own position or integrated-velocity ac
     reflected inertia I at the home posture, the integral kp = kv²/(4·INTEGRAL_MARGIN·I);
   - on a fixed base, the position servos carry the weight of the bodies they hold through
     MuJoCo's gravity compensation, within the effort limit (`export_gravcomp`);
+  - a gz-sim position PID with an integral is MuJoCo's `mujoco.pid` actuator plugin, its
+    `cmd_offset` a constant-force actuator beside it (`_add_offsets`);
   - the `home` keyframe's ctrl holds the home posture.
 Joints with no control tags (Gazebo leaves them passive), and effort interfaces, keep their
 torque motor. The control record keeps the motor each servo replaced (`EXPORTED`) and the
@@ -64,6 +66,7 @@ FOLLOW_TAU = 1e-12  # [s] time constant of an activation that follows ctrl withi
 SERVO_MODES = ("position", "velocity")
 PID_PLUGIN = "mujoco.pid"  # MuJoCo's PID actuator plugin, for a gz-sim PID with an integral
 PID_INSTANCE = ":pid"  # suffix of the plugin instance's name, after its actuator's
+PID_OFFSET_SUFFIX = ":offset"  # a PID plugin's cmd_offset: its tendon and actuator, after the joint
 HOME_KEY = "home"
 
 
@@ -94,6 +97,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     if key is not None and len(ctrl) != len(spec.actuators):
         ctrl = np.zeros(len(spec.actuators))
     motors = _motors(driven, records, inertia)
+    offsets: dict[str, float] = {}  # the constant force beside each PID plugin (`_add_offsets`)
     for i, actuator, record in chosen:
         joint = actuator.target
         if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or (
@@ -109,6 +113,8 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
             "actrange": [float(v) for v in actuator.actrange],
         }
         _to_servo(spec, actuator, record, inertia[joint], timestep)
+        if actuator.plugin.active and record.get(PID_OFFSET):
+            offsets[joint] = float(record[PID_OFFSET])
         servoed[joint] = record["modes"][0]
         if record["modes"][0] == "position":
             if tag_pid(record.get("pid", {}), "position") is None:  # a Gazebo PID: no help
@@ -125,6 +131,7 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         servoed.setdefault(joint, records[joint]["modes"][0])
     if motors:  # a robot without velocity joints runs none of it
         add_velocity_motors(spec, list(motors.values()), model, timestep)
+    _add_offsets(spec, offsets)
     text.data = json.dumps(records)
     return servoed
 
@@ -250,6 +257,8 @@ def _to_servo(
             kp, kv = position_gains(inertia, largest, effort, speed, high - low, timestep)
         if pid and PID_INTEGRAL in record:
             _to_pid_plugin(spec, actuator, (kp, float(pid[1]), kv), record[PID_INTEGRAL])
+            if limited:  # offset and PID are clamped together (`_add_offsets`)
+                actuator.forcerange = actuator.forcerange - float(record.get(PID_OFFSET, 0.0))
             return
         actuator.set_to_position(kp=kp, kv=kv)
         if pid:
@@ -280,6 +289,29 @@ def _to_pid_plugin(
     actuator.set_to_motor()  # the plugin computes the force; gain and bias are not read
     actuator.plugin = instance
     actuator.actdim = 1
+
+
+def _add_offsets(spec: mujoco.MjSpec, offsets: Mapping[str, float]) -> None:
+    """Each gz-sim PID plugin's `cmd_offset` (`offsets`, by joint [N m or N]): MuJoCo's pid
+    actuator has no constant force, so a second actuator pushes it, through a one-joint tendon
+    (the joint keeps one joint actuator, its servo). gz-math clamps offset and PID together to
+    [cmd_min, cmd_max]; the plugin's force range is that range less the offset (`_to_servo`), so
+    the sum is clamped alike. Keyframes get ctrl 0 for the new actuators (they read no ctrl)."""
+    import mujoco
+
+    before = len(spec.actuators)
+    for joint, offset in offsets.items():
+        tendon = spec.add_tendon(name=f"{joint}{PID_OFFSET_SUFFIX}")
+        tendon.wrap_joint(joint, 1.0)
+        push = spec.add_actuator(name=tendon.name, target=tendon.name)
+        push.trntype = mujoco.mjtTrn.mjTRN_TENDON
+        push.gainprm[0] = 0.0  # force = biasprm[0], whatever ctrl holds
+        push.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        push.biasprm[0] = offset
+    for key in spec.keys if offsets else ():
+        ctrl = np.array(key.ctrl, dtype=float)
+        if len(ctrl) == before:
+            key.ctrl = np.concatenate([ctrl, np.zeros(len(offsets))])
 
 
 def _to_intvelocity(

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
+from converters.mjcf.export_servos import PID_OFFSET_SUFFIX
 from twin_cli.world import native_servos, servos, sleeping, velocity_motors
 
 MODES = ("position", "velocity", "effort")
@@ -74,7 +75,8 @@ def effort_limit(model: mujoco.MjModel, actuator: int) -> float:
     if model.actuator_ctrllimited[actuator] and motor:
         limits.append(np.max(np.abs(model.actuator_ctrlrange[actuator])) * gear)
     if model.actuator_forcelimited[actuator]:
-        limits.append(np.max(np.abs(model.actuator_forcerange[actuator])) * gear)
+        shifted = model.actuator_forcerange[actuator] + pid_offset(model, actuator)
+        limits.append(np.max(np.abs(shifted)) * gear)
     return float(min(limits)) if limits else math.inf
 
 
@@ -87,9 +89,21 @@ def effort_range(model: mujoco.MjModel, actuator: int) -> tuple[float, float]:
     if model.actuator_ctrllimited[actuator] and motor:  # a plugin's ctrl is its target
         low, high = sorted(float(v) * gear for v in model.actuator_ctrlrange[actuator])
     if model.actuator_forcelimited[actuator]:
-        f_low, f_high = sorted(float(v) * gear for v in model.actuator_forcerange[actuator])
+        shifted = model.actuator_forcerange[actuator] + pid_offset(model, actuator)
+        f_low, f_high = sorted(float(v) * gear for v in shifted)
         low, high = max(low, f_low), min(high, f_high)
     return low, high
+
+
+def pid_offset(model: mujoco.MjModel, actuator: int) -> float:
+    """The constant force [N m or N] pushed beside a PID plugin actuator (a gz-sim PID's
+    `cmd_offset`, `converters.mjcf.export_servos`), whose own force range is the PID's output
+    range less it; 0 for other actuators."""
+    if model.actuator_plugin[actuator] < 0:
+        return 0.0
+    name = model.actuator(actuator).name + PID_OFFSET_SUFFIX
+    push = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+    return float(model.actuator_biasprm[push, 0]) if push >= 0 else 0.0
 
 
 def servo_gains(mode: str, effort: float, inertia: float, timestep: float) -> tuple[float, float]:

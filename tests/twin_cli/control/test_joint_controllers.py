@@ -308,25 +308,43 @@ def test_a_held_arm_gets_only_the_force_its_pids_range_allows(
         assert max(angles) > 0.3, f"{bounds}: the bar held within {max(angles):.4f} rad"
 
 
-# (tags, the integral's bound the oracle applies): gz-math's defaults (i 0.1 within ±1), an
-# integral that saturates below the 4.9 N m load, one that can carry it, and one unbounded
-# (i_max below i_min: gz-math then clamps nothing)
+# (tags, the integral's bound, cmd_offset and output range the oracle applies): gz-math's
+# defaults (i 0.1 within ±1), an integral that saturates below the 4.9 N m load, one that can
+# carry it, one unbounded (i_max below i_min: gz-math then clamps nothing); then each with a
+# cmd_offset: on the defaults, against an integral that carries it, and one whose sum with the
+# PID is clamped by cmd_min (the bar then swings about where 4.905·cos q = 4)
+WIDE = (-1000.0, 1000.0)
+CARRIES = "<i_gain>20</i_gain><i_max>10</i_max><i_min>-10</i_min>"
 INTEGRALS = [
-    pytest.param("", 1.0, id="defaults"),
-    pytest.param("<i_gain>20</i_gain><i_max>2</i_max><i_min>-2</i_min>", 2.0, id="saturates"),
-    pytest.param("<i_gain>20</i_gain><i_max>10</i_max><i_min>-10</i_min>", 10.0, id="carries"),
-    pytest.param("<i_gain>5</i_gain><i_max>-1</i_max><i_min>1</i_min>", None, id="unbounded"),
+    pytest.param("", 1.0, 0.0, WIDE, id="defaults"),
+    pytest.param(
+        "<i_gain>20</i_gain><i_max>2</i_max><i_min>-2</i_min>", 2.0, 0.0, WIDE, id="saturates"
+    ),
+    pytest.param(CARRIES, 10.0, 0.0, WIDE, id="carries"),
+    pytest.param(
+        "<i_gain>5</i_gain><i_max>-1</i_max><i_min>1</i_min>", None, 0.0, WIDE, id="unbounded"
+    ),
+    pytest.param("<cmd_offset>3</cmd_offset>", 1.0, 3.0, WIDE, id="offset"),
+    pytest.param(f"{CARRIES}<cmd_offset>-2</cmd_offset>", 10.0, -2.0, WIDE, id="offset-carried"),
+    pytest.param(
+        "<cmd_offset>3</cmd_offset><cmd_min>-4</cmd_min>",
+        1.0,
+        3.0,
+        (-4.0, 1000.0),
+        id="offset-clamped",
+    ),
 ]
 
 
-@pytest.mark.parametrize(("tags", "bound"), INTEGRALS)
+@pytest.mark.parametrize(("tags", "bound", "offset", "output"), INTEGRALS)
 def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
-    tmp_path: Path, tags: str, bound: float | None
+    tmp_path: Path, tags: str, bound: float | None, offset: float, output: tuple[float, float]
 ) -> None:
     """The bar's weight sags it to where p·q = 4.9·cos q; gz-math's integral then adds up to its
     bound: the bar rises to where p·q + bound = 4.9·cos q (0.029 rad for 2 N m), or all the way
-    to 0 when the integral can carry the weight. In the world and in the exported scene.xml,
-    second by second, as gz-math's PID integrated by hand (`gz_held_bar`)."""
+    to 0 when the integral can carry the weight. A `cmd_offset` adds to the PID before its
+    output is clamped. In the world and in the exported scene.xml, second by second, as
+    gz-math's PID integrated by hand (`gz_held_bar`)."""
     import mujoco
 
     from converters.mjcf.writer import write_model
@@ -334,8 +352,10 @@ def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
 
     path = tmp_path / "bar.urdf"
     path.write_text(BAR.format(inertial=INERTIAL, bounds=tags).replace("<i_gain>0</i_gain>", ""))
-    i_gain = float(tags.split("<i_gain>")[1].split("<")[0]) if tags else 0.1
-    law = gz_held_bar((100.0, i_gain, 2.0), bound, 8.0, inertia=0.2501, load=4.905)
+    i_gain = float(tags.split("<i_gain>")[1].split("<")[0]) if "<i_gain>" in tags else 0.1
+    law = gz_held_bar(
+        (100.0, i_gain, 2.0), bound, 8.0, inertia=0.2501, load=4.905, offset=offset, output=output
+    )
     world = World()
     world.spawn(SpawnRequest(str(path)), name="bar")
     world.command_joints("bar", {"hinge": 0.0}, mode="position")
@@ -346,7 +366,7 @@ def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
     assert angles == pytest.approx(law, abs=2e-5), f"world: {angles}"
     row = world.joint_commands("bar")["hinge"]
     assert (row["kp"], row["kv"]) == (100.0, 2.0), f"p_gain and d_gain: {row}"
-    assert row["effort_range"] == [-1000.0, 1000.0], "gz-math's output range, not the targets'"
+    assert row["effort_range"] == list(output), "gz-math's output range, not the targets'"
     done = convert_full(path)
     scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
     model = mujoco.MjModel.from_xml_path(str(scene))
