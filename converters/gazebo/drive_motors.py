@@ -95,7 +95,7 @@ def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
         return [(j, record.mode, record.force_range, record.pid) for j in record.joints]
     if isinstance(record, TrajectoryDrive):
         rows = zip(record.joints, record.force_ranges, record.pids, strict=True)
-        return [(j, "position", force, pid) for j, force, pid in rows]
+        return [(j, "position" if pid else "effort", force, pid) for j, force, pid in rows]
     return []
 
 

@@ -12,8 +12,9 @@ twin runs the joints as position servos with the plugin's gains: kp = position_p
 kv = position_d_gain + velocity_p_gain (both terms act on the joint's speed), within the sum of
 the two PIDs' output limits, with the sum of their `cmd_offset` forces as the servo's constant
 force; `twin trajectory ENTITY FILE` sends a trajectory. The joints start at
-their initial positions (the spawn posture) rather than being driven there from 0. Gains that are
-all 0 make gz-sim apply no force; twin's servo then uses its own gains, and says so.
+their initial positions (the spawn posture) rather than being driven there from 0. A joint whose
+gains are all 0 gets no force from gz-sim but a trajectory's effort: twin leaves it limp, on a
+torque motor that takes effort commands, where it stays in the model's own posture.
 """
 
 from __future__ import annotations
@@ -70,7 +71,10 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
     pids = tuple(_pid(p, i) for i in range(count))
     limp = [j for j, pid in zip(joints, pids, strict=True) if pid is None]
     topic = p.text(f"/model/{ctx.model}/joint_trajectory", "topic")
-    limp_note = f"{', '.join(limp)}: gains all 0 (gz-sim applies no force); twin's servo gains"
+    limp_note = (
+        f"{', '.join(limp)}: gains all 0, so gz-sim pushes only a trajectory's efforts: limp, "
+        "on a torque motor (effort commands; twin trajectory files carry no efforts)"
+    )
     return TrajectoryDrive(
         name=blob.name or "JointTrajectoryController",
         where=blob.where,
@@ -143,9 +147,10 @@ def start_at_initial_positions(spec: mujoco.MjSpec, record: TrajectoryDrive) -> 
         return
     model = spec.copy().compile()
     qpos = np.array(key.qpos, dtype=float)
-    for joint, value in zip(record.joints, record.initial_positions, strict=True):
+    rows = zip(record.joints, record.initial_positions, record.pids, strict=True)
+    for joint, value, pid in rows:
         j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
-        if j < 0:
+        if j < 0 or pid is None:  # a limp joint: gz-sim never drives it to its initial position
             continue
         if model.jnt_limited[j]:
             value = float(np.clip(value, *model.jnt_range[j]))

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import drive_models as dm
 import pytest
+from pid_law import gz_held_bar
 
 from converters.pipeline import convert_full
 from converters.report import Outcome
@@ -121,6 +122,39 @@ def test_its_cmd_offsets_shift_where_each_joint_settles_before_and_after_a_traje
     end = {s.name: s.position for s in world.joint_states("arm")}
     expected = {"shoulder": 0.8 + shifts[0], "elbow": -1.0 + shifts[1]}
     assert end == pytest.approx(expected, abs=2e-4), f"after a trajectory [rad]: {end}"
+
+
+LIMP_BAR = """<robot name="bar"><link name="world"/>
+  <link name="bar"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-4"
+    iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="world"/><child link="bar"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
+  <gazebo><plugin filename="gz-sim-joint-trajectory-controller-system"
+    name="gz::sim::systems::JointTrajectoryController"><joint_name>hinge</joint_name>
+    <initial_position>0.4</initial_position></plugin></gazebo></robot>"""
+
+
+def test_a_joint_without_gains_is_limp_as_in_gz_sim_and_takes_efforts(tmp_path: Path) -> None:
+    """With every gain 0 gz-sim's PIDs push nothing: the joint gets only a trajectory's effort.
+    The level bar (1 kg, 0.5 m out) stays where the model puts it, not at initial_position,
+    falls as a free pendulum (gz-math's PID with gains 0, `gz_held_bar`), and an effort
+    command of its weight's moment holds it level."""
+    path = tmp_path / "bar.urdf"
+    path.write_text(LIMP_BAR)
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bar")
+    assert world.joint_commands("bar")["hinge"]["modes"] == ["effort"], "a torque motor only"
+    fall = gz_held_bar((0.0, 0.0, 0.0), None, 0.5, inertia=0.2501, load=4.905, every=0.1)
+    angles = []
+    for _ in fall:
+        world.step(round(0.1 / world.model.opt.timestep))
+        angles.append(world.joint_states("bar")[0].position)
+    assert angles == pytest.approx(fall, abs=1e-5), f"limp fall {angles}, pendulum {fall}"
+    world.reset()
+    world.command_joints("bar", {"hinge": -4.905}, mode="effort")
+    world.step(round(1.0 / world.model.opt.timestep))
+    level = world.joint_states("bar")[0].position
+    assert abs(level) < 1e-6, f"held by its weight's moment: {level:.2e} rad"
 
 
 def test_a_joint_it_names_that_the_model_lacks_is_refused_naming_the_joints(
