@@ -49,7 +49,7 @@ from converters.gazebo.drive_records import (
     TricycleDrive,
 )
 from converters.gazebo.multicopter import Rotor, add_rotors
-from converters.gazebo.trajectory_controller import start_at_initial_positions
+from converters.gazebo.trajectory_controller import HOME_KEY, start_at_initial_positions
 from converters.gazebo.wheel_contact import centre_wheel_contacts
 from converters.report import Report
 
@@ -64,6 +64,19 @@ PLANAR_SITE = "planar:{name}"
 def planar_actuator(plugin: str, axis: str) -> str:
     """The name of a holonomic drive's servo along `axis` ("vx", "vy" or "wz")."""
     return f"planar:{plugin}:{axis}"
+
+
+def planar_ctrl(
+    drive: HolonomicDrive, twist: Sequence[float], centre: Sequence[float]
+) -> tuple[float, float, float]:
+    """The planar servos' ctrl for `twist` (vx, vy, ωz): the servos move the robot's centre of
+    mass (`centre`, from the root link's origin in its frame). gz-sim's VelocityControl sets
+    the velocity of its canonical link's origin, which differs from the centre's by ω × r;
+    planar move and MecanumDrive set the centre's."""
+    vx, vy, wz = (float(v) for v in twist)
+    if drive.family != "gz_velocity_control":
+        return vx, vy, wz
+    return vx - wz * float(centre[1]), vy + wz * float(centre[0]), wz
 
 
 JointMode = tuple[str, str, "tuple[float, float]", "tuple[float, float, float] | None"]
@@ -233,12 +246,27 @@ def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
     mass, yaw_inertia, centre = _planar_inertia(spec)
     site = root.add_site(name=PLANAR_SITE.format(name=drive.name))
     site.pos = centre
+    before = len(spec.actuators)
     for axis, gear in PLANAR_AXES:
         servo = spec.add_actuator(name=planar_actuator(drive.name, axis), target=site.name)
         servo.trntype = mujoco.mjtTrn.mjTRN_SITE
         servo.gear = np.array(gear, dtype=float)
         kv = (yaw_inertia if axis == "wz" else mass) / PLANAR_TAU
         servo.set_to_velocity(kv=kv)
+    _start_twist(spec, before, planar_ctrl(drive, drive.initial_twist, centre))
+
+
+def _start_twist(spec: mujoco.MjSpec, before: int, twist: tuple[float, float, float]) -> None:
+    """The home key's ctrl for the `before`..+3 planar servos: the twist the plugin drives from
+    load (gz-sim VelocityControl's initial one; 0 for the others), so the exported file's home
+    starts it as the world does (`twin_cli.world.plugin_holds`)."""
+    key = next((k for k in spec.keys if k.name == HOME_KEY), None)
+    if key is None or not any(twist):
+        return
+    ctrl = np.array(key.ctrl, dtype=float)
+    if len(ctrl) not in (0, before):
+        return  # a key written for other actuators: left as it is
+    key.ctrl = np.concatenate([ctrl if len(ctrl) else np.zeros(before), twist])
 
 
 def _planar_inertia(spec: mujoco.MjSpec) -> tuple[float, float, np.ndarray]:

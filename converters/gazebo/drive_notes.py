@@ -139,6 +139,7 @@ USED: dict[str, set[str]] = {
         "frame_id",
         "child_frame_id",
     },
+    "gz-sim-velocity-control-system": {"topic", "initial_linear", "initial_angular"},
     "gz-sim-joint-controller-system": {
         "joint_name",
         "use_force_commands",

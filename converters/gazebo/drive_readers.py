@@ -296,6 +296,33 @@ def read_gz_mecanum(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
     )
 
 
+def read_gz_velocity_control(p: Params, blob: Blob, ctx: ReadContext) -> HolonomicDrive:
+    """gz-sim VelocityControl: the model's twist in its own frame, set at every step, from
+    `initial_linear`/`initial_angular` until a first command on `<topic>` (default
+    `/model/<model>/cmd_vel`). twin runs its planar part (x, y, yaw) as planar move's."""
+    linear, angular = p.vector3("initial_linear"), p.vector3("initial_angular")
+    ignored = [n for n, v in (("linear z", linear[2]), ("angular x", angular[0])) if v]
+    ignored += ["angular y"] if angular[1] else []
+    notes = [
+        "the planar twist (x, y, yaw) of its canonical link's origin, through three velocity "
+        "servos at the centre of mass; gz-sim sets all six velocities (z, roll and pitch are "
+        "left to the physics here) and publishes no odometry (twin's is the world pose)"
+    ]
+    if ignored:
+        notes.append(f"initial {', '.join(ignored)}: not run (twin drives the planar twist)")
+    return HolonomicDrive(
+        name=blob.name or "VelocityControl",
+        where=blob.where,
+        family="gz_velocity_control",
+        update_rate=EVERY_STEP,
+        initial_twist=(linear[0], linear[1], angular[2]),
+        odometry_frame=f"{ctx.model}/odom",
+        robot_base_frame=f"{ctx.model}/{ctx.base_link}",
+        gz=gz_names(p, ctx.base_link),
+        notes=tuple(notes),
+    )
+
+
 POSITION_PID_NOTE = (
     "its PID as MuJoCo's pid actuator: kp = p_gain, kd = d_gain on the joint's speed, ki = "
     "i_gain (0.1 unless given) with the integral term within ±i_max, the force within "
@@ -394,6 +421,7 @@ READERS: dict[str, Reader] = {
     "gz-sim-diff-drive-system": read_gz_diff_drive,
     "gz-sim-ackermann-steering-system": read_gz_ackermann,
     "gz-sim-mecanum-drive-system": read_gz_mecanum,
+    "gz-sim-velocity-control-system": read_gz_velocity_control,
     "gz-sim-joint-controller-system": read_joint_controller,
     "gz-sim-joint-position-controller-system": read_joint_position_controller,
     "gz-sim-joint-trajectory-controller-system": read_joint_trajectory_controller,

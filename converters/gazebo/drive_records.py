@@ -216,10 +216,13 @@ class HolonomicDrive(_Record):
     """A base driven by its planar twist (vx, vy, ωz in its own frame).
 
     Attributes:
-        family: `gazebo_ros_planar_move` or `gz_mecanum_drive`; update_rate [Hz];
-        wheel_joints_named: the mecanum wheels (spun at their kinematic speeds), else ();
-        wheel_radius, wheel_separation, wheelbase [m] (mecanum); max_linear_velocity [m/s],
-        max_angular_velocity [rad/s]; odometry_frame, robot_base_frame, notes.
+        family: `gazebo_ros_planar_move`, `gz_mecanum_drive` or `gz_velocity_control`;
+        update_rate [Hz]; wheel_joints_named: the mecanum wheels (spun at their kinematic
+        speeds), else (); wheel_radius, wheel_separation, wheelbase [m] (mecanum);
+        max_linear_velocity [m/s], max_angular_velocity [rad/s]; initial_twist: (vx [m/s],
+        vy [m/s], ωz [rad/s]) it drives from load until a first command (gz-sim
+        VelocityControl's `initial_linear`/`initial_angular`); odometry_frame,
+        robot_base_frame, notes.
     """
 
     name: str
@@ -232,6 +235,7 @@ class HolonomicDrive(_Record):
     wheelbase: float = 0.0
     max_linear_velocity: float = math.inf
     max_angular_velocity: float = math.inf
+    initial_twist: tuple[float, float, float] = (0.0, 0.0, 0.0)
     odometry_source: str = "world"
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"

@@ -82,6 +82,22 @@ class Params:
             self._number(tag, (el.text or "").strip(), signed) for el in self.root.findall(tag)
         )
 
+    def vector3(self, tag: str) -> tuple[float, float, float]:
+        """`tag`'s three numbers (gz-sim's `math::Vector3d`, e.g. "0.3 0 0"), else zeros.
+
+        Raises:
+            GazeboTagError: the value is not three finite numbers.
+        """
+        el = self.root.find(tag)
+        if el is None:
+            return (0.0, 0.0, 0.0)
+        text = (el.text or "").strip()
+        parts = text.split()
+        if len(parts) != 3:
+            raise GazeboTagError(self.source, "", f"plugin/{tag}", text, "three numbers: x y z")
+        x, y, z = (self._number(tag, part, signed=True) for part in parts)
+        return (x, y, z)
+
     def flag(self, default: bool, *tags: str) -> bool:
         """The first given value of `tags` as a boolean (true/false/1/0).
 

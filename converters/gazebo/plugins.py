@@ -51,6 +51,7 @@ SYSTEM_NAMES = {
     "DiffDrive": "gz-sim-diff-drive-system",
     "AckermannSteering": "gz-sim-ackermann-steering-system",
     "MecanumDrive": "gz-sim-mecanum-drive-system",
+    "VelocityControl": "gz-sim-velocity-control-system",
     "JointController": "gz-sim-joint-controller-system",
     "JointPositionController": "gz-sim-joint-position-controller-system",
     "JointTrajectoryController": "gz-sim-joint-trajectory-controller-system",

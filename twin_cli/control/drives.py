@@ -3,9 +3,9 @@
 A world's controllers are created on the first command to an entity and kept beside the world
 (keyed weakly, so a replaced world takes its controllers with it). The entity's first drive
 record decides the controller: a differential drive, a steered base (Ackermann, tricycle) or a
-holonomic one (planar move, mecanum). Every request is checked before anything changes: an
-unknown entity, an entity without a drive, an option its drive does not take, or a non-finite
-value raises one TwinError and leaves the world as it was.
+holonomic one (planar move, mecanum, VelocityControl). Every request is checked before anything
+changes: an unknown entity, an entity without a drive, an option its drive does not take, or a
+non-finite value raises one TwinError and leaves the world as it was.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ CONTROLLERS: dict[str, type[DriveController]] = {
 }
 DRIVE_NAMES = (
     "gazebo_ros diff drive, skid steer, Ackermann, tricycle or planar move; gz-sim DiffDrive, "
-    "AckermannSteering or MecanumDrive; or a vendor diff drive"
+    "AckermannSteering, MecanumDrive or VelocityControl; or a vendor diff drive"
 )
 
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import mujoco
 
-from converters.gazebo.drive_motors import planar_actuator
+from converters.gazebo.drive_motors import PLANAR_SITE, planar_actuator, planar_ctrl
 from twin_cli.control.drive_base import DriveController
 from twin_cli.control.kinematics import ramp
 
@@ -61,7 +61,11 @@ class HolonomicController(DriveController):
         if any(a < 0 for a in ids):
             return  # a hand-written model without the servos: nothing to drive
         if force or now != self.current:
-            self.world.set_controls(ids, now)
+            site = mujoco.mj_name2id(
+                m, mujoco.mjtObj.mjOBJ_SITE, f"{self.entity}/{PLANAR_SITE.format(name=name)}"
+            )
+            centre = m.site_pos[site] if site >= 0 else (0.0, 0.0, 0.0)
+            self.world.set_controls(ids, planar_ctrl(self.plugin, now, centre))
             self.current = now  # type: ignore[assignment]
         self._written = dict(self.world.commands())
 

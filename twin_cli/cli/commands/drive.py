@@ -21,7 +21,10 @@ def drive(
     linear: Annotated[float, typer.Option("--linear", help="Forward speed, m/s.")] = 0.0,
     angular: Annotated[float, typer.Option("--angular", help="Yaw rate, rad/s.")] = 0.0,
     lateral: Annotated[
-        float, typer.Option("--lateral", help="Sideways speed, m/s (planar move, mecanum).")
+        float,
+        typer.Option(
+            "--lateral", help="Sideways speed, m/s (planar move, mecanum, VelocityControl)."
+        ),
     ] = 0.0,
     steering: Annotated[
         float | None,
