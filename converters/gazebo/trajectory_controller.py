@@ -45,16 +45,23 @@ USED = {
     "position_cmd_max",
     "position_cmd_offset",
     "velocity_p_gain",
+    "velocity_i_gain",  # unbounded: a spring on the reference (`_pid`)
     "velocity_cmd_min",
     "velocity_cmd_max",
     "velocity_cmd_offset",
     "topic",
 }
 APPROXIMATED = (
-    "joints as position servos with kp = position_p_gain and kv = position_d_gain + "
+    "joints as position servos with kp = position_p_gain (+ velocity_i_gain, an unbounded "
+    "velocity integral being a spring on the reference) and kv = position_d_gain + "
     "velocity_p_gain, following twin trajectory's spline instead of stepping its targets from "
     "point to point; they start at initial_position instead of being driven there from 0, and "
     "hold it once commanded (twin trajectory, twin command), not from the first step",
+)
+
+BOUNDED_NOTE = (
+    "velocity_i_gain within [velocity_i_min, velocity_i_max]: a bounded velocity integral is "
+    "no spring MuJoCo can hold; not run"
 )
 
 
@@ -70,6 +77,11 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
     count = len(joints)
     pids = tuple(_pid(p, i) for i in range(count))
     limp = [j for j, pid in zip(joints, pids, strict=True) if pid is None]
+    bounded = [
+        j
+        for i, j in enumerate(joints)
+        if _nth(p.numbers("velocity_i_gain"), i, 0.0) and not _unbounded_velocity_integral(p, i)
+    ]
     topic = p.text(f"/model/{ctx.model}/joint_trajectory", "topic")
     limp_note = (
         f"{', '.join(limp)}: gains all 0, so gz-sim pushes only a trajectory's efforts: limp, "
@@ -85,7 +97,8 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
         force_offsets=tuple(_offset(p, i) for i in range(count)),
         topic=topic,
         progress_topic=f"{topic}_progress",
-        notes=(limp_note,) if limp else (),
+        notes=((limp_note,) if limp else ())
+        + ((f"{', '.join(bounded)}: {BOUNDED_NOTE}",) if bounded else ()),
     )
 
 
@@ -108,10 +121,24 @@ def _nth_all(values: tuple[float, ...], count: int, default: float) -> tuple[flo
 
 
 def _pid(p: Params, i: int) -> tuple[float, float, float] | None:
-    """(kp, 0, kv) of joint `i`'s servo, or None when its gains are all 0."""
+    """(kp, 0, kv) of joint `i`'s servo, or None when its gains are all 0.
+
+    The velocity PID's integral, i·∫(q̇ − q̇*)dt, is i·(q − q_ref) with q_ref where the joint
+    started plus the trajectory's integrated speed: a spring on the position reference, as the
+    position PID's p is. Unbounded (gz-sim's default, `velocity_i_max` < `velocity_i_min`) it
+    adds to kp; a bounded one is left out and reported."""
     kp = _nth(p.numbers("position_p_gain"), i, 0.0)
+    if _unbounded_velocity_integral(p, i):
+        kp += _nth(p.numbers("velocity_i_gain"), i, 0.0)
     kv = _nth(p.numbers("position_d_gain"), i, 0.0) + _nth(p.numbers("velocity_p_gain"), i, 0.0)
     return (kp, 0.0, kv) if kp or kv else None
+
+
+def _unbounded_velocity_integral(p: Params, i: int) -> bool:
+    """Whether joint `i`'s velocity integral is unbounded: gz-math clamps it to [i_min, i_max]
+    only when i_max ≥ i_min (defaults 0 and -1: no clamp)."""
+    low = _nth(p.numbers("velocity_i_min", signed=True), i, 0.0)
+    return _nth(p.numbers("velocity_i_max", signed=True), i, -1.0) < low
 
 
 def _offset(p: Params, i: int) -> float:
