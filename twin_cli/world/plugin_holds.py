@@ -48,10 +48,12 @@ def _start_twists(state: WorldState, name: str) -> None:
     model = state.model
     for plugin in state.entities[name].plugins:
         twist = getattr(plugin, "initial_twist", None)
+        if not twist or not any(twist):
+            continue
         site = mujoco.mj_name2id(
             model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/{PLANAR_SITE.format(name=plugin.name)}"
         )
-        if not twist or not any(twist) or site < 0:
+        if site < 0:
             continue
         ctrl = planar_ctrl(plugin, twist, model.site_pos[site])
         for axis, value in zip(("vx", "vy", "wz"), ctrl, strict=True):
