@@ -59,6 +59,7 @@ if TYPE_CHECKING:
 PLANAR_TAU = 1e-5  # [s] time constant of the planar velocity servo (implicit: any value is stable)
 PLANAR_AXES = (("vx", (1, 0, 0, 0, 0, 0)), ("vy", (0, 1, 0, 0, 0, 0)), ("wz", (0, 0, 0, 0, 0, 1)))
 PLANAR_SITE = "planar:{name}"
+MODEL_SITE = "__model__"  # the builder's site at an SDF model's frame (on the root link)
 
 
 def planar_actuator(plugin: str, axis: str) -> str:
@@ -67,16 +68,22 @@ def planar_actuator(plugin: str, axis: str) -> str:
 
 
 def planar_ctrl(
-    drive: HolonomicDrive, twist: Sequence[float], centre: Sequence[float]
+    drive: HolonomicDrive, twist: Sequence[float], centre: Sequence[float], quat: Sequence[float]
 ) -> tuple[float, float, float]:
     """The planar servos' ctrl for `twist` (vx, vy, ωz): the servos move the robot's centre of
-    mass (`centre`, from the root link's origin in its frame). gz-sim's VelocityControl sets
-    the velocity of its canonical link's origin, which differs from the centre's by ω × r;
-    planar move and MecanumDrive set the centre's."""
+    mass (their site: `centre` from the root link's origin, turned by `quat`, both in the link's
+    frame). gz-sim's VelocityControl sets the velocity of its canonical link's origin, which
+    differs from the centre's by ω × r; planar move and MecanumDrive set the centre's."""
+    import mujoco
+
     vx, vy, wz = (float(v) for v in twist)
     if drive.family != "gz_velocity_control":
         return vx, vy, wz
-    return vx - wz * float(centre[1]), vy + wz * float(centre[0]), wz
+    back = np.zeros(4)
+    mujoco.mju_negQuat(back, np.asarray(quat, dtype=float))
+    r = np.zeros(3)
+    mujoco.mju_rotVecQuat(r, np.asarray(centre, dtype=float), back)  # r in the site's axes
+    return vx - wz * float(r[1]), vy + wz * float(r[0]), wz
 
 
 JointMode = tuple[str, str, "tuple[float, float]", "tuple[float, float, float] | None"]
@@ -246,6 +253,13 @@ def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
     mass, yaw_inertia, centre = _planar_inertia(spec)
     site = root.add_site(name=PLANAR_SITE.format(name=drive.name))
     site.pos = centre
+    frame = spec.site(MODEL_SITE)
+    if (
+        drive.family == "gz_velocity_control"
+        and frame is not None
+        and frame.parent.name == root.name
+    ):
+        site.quat = np.array(frame.quat, dtype=float)  # gz-sim turns the twist by the model's pose
     before = len(spec.actuators)
     for axis, gear in PLANAR_AXES:
         servo = spec.add_actuator(name=planar_actuator(drive.name, axis), target=site.name)
@@ -253,7 +267,7 @@ def _planar_servos(spec: mujoco.MjSpec, drive: HolonomicDrive) -> None:
         servo.gear = np.array(gear, dtype=float)
         kv = (yaw_inertia if axis == "wz" else mass) / PLANAR_TAU
         servo.set_to_velocity(kv=kv)
-    _start_twist(spec, before, planar_ctrl(drive, drive.initial_twist, centre))
+    _start_twist(spec, before, planar_ctrl(drive, drive.initial_twist, centre, site.quat))
 
 
 def _start_twist(spec: mujoco.MjSpec, before: int, twist: tuple[float, float, float]) -> None:

@@ -65,7 +65,7 @@ class DriveController:
     def __init__(self, world: World, entity: str, plugin: Any) -> None:
         self.world, self.entity, self.plugin = world, entity, plugin
         self.rate = update_rate(plugin.update_rate, float(world.model.opt.timestep))
-        self.twist = STOP
+        self.twist = self._rest()
         self.until = math.inf  # [s] sim time the command stops at
         self.updates = 0
         self.entity_record: Entity | None = None  # the entity this controller was made for
@@ -77,6 +77,10 @@ class DriveController:
         self.observed_rate = self.rate
 
     # ------------------------------------------------------------------ subclass hooks
+    def _rest(self) -> Twist:
+        """The twist the plugin drives before any command and after a world reset: none."""
+        return STOP
+
     def _reset_targets(self) -> None:
         """Forgets ramp state after a world reset (the world stopped the joints)."""
 
@@ -150,7 +154,7 @@ class DriveController:
             return
         now = float(self.world.data.time)
         if now < self.last_time:  # the world was reset: start over, wheels stopped
-            self.twist, self.until = STOP, math.inf
+            self.twist, self.until = self._rest(), math.inf
             self._reset_targets()
             self._start()
             return

@@ -1,11 +1,13 @@
-"""A holonomic base run as a twin controller: gazebo_ros planar move and gz-sim MecanumDrive.
+"""A holonomic base run as a twin controller: gazebo_ros planar move, gz-sim MecanumDrive and
+gz-sim VelocityControl.
 
-Gazebo's planar move sets the model's planar velocity itself. The converter gave the root link
-three velocity servos in its own frame (`converters.gazebo.drive_motors`: x, y and yaw, computed
-by MuJoCo at every step); this controller ramps the command (vx, vy, ωz) into their `ctrl`
-(LINEAR_RAMP, ANGULAR_RAMP), waking the robot if it sleeps, and reports the world pose as
-odometry. A held command costs no writes, and the servos hold a zero twist between commands, as
-the plugin does.
+These plugins set the model's planar velocity themselves. The converter gave the root link three
+velocity servos (`converters.gazebo.drive_motors`: x, y and yaw, computed by MuJoCo at every
+step); this controller ramps the command (vx, vy, ωz) into their `ctrl` (LINEAR_RAMP,
+ANGULAR_RAMP; `planar_ctrl` maps VelocityControl's twist of the link origin onto the centre of
+mass), waking the robot if it sleeps, and reports the world pose as odometry. A held command
+costs no writes, and between commands the servos hold the plugin's resting twist, as the plugin
+does: zero, or VelocityControl's initial one.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 
 from converters.gazebo.drive_motors import PLANAR_SITE, planar_actuator, planar_ctrl
-from twin_cli.control.drive_base import DriveController
+from twin_cli.control.drive_base import DriveController, Twist
 from twin_cli.control.kinematics import ramp
 
 if TYPE_CHECKING:
@@ -43,8 +45,19 @@ class HolonomicController(DriveController):
         top, spin = p.max_linear_velocity, p.max_angular_velocity
         return (_clip(t.linear, top), _clip(t.lateral, top), _clip(t.angular, spin))
 
+    def _rest(self) -> Twist:
+        """gz-sim VelocityControl's initial twist, which it drives until a command replaces it
+        (zero for the others): reading odometry or a first drive starts from it."""
+        vx, vy, wz = self.plugin.initial_twist
+        return Twist(linear=vx, angular=wz, lateral=vy)
+
+    def _start(self) -> None:
+        super()._start()
+        self._reset_targets()
+
     def _reset_targets(self) -> None:
-        self.current = (0.0, 0.0, 0.0)
+        vx, vy, wz = self.plugin.initial_twist
+        self.current = (float(vx), float(vy), float(wz))
 
     def _apply(self, dt: float, force: bool) -> None:
         goals = self.goals()
@@ -64,8 +77,10 @@ class HolonomicController(DriveController):
             site = mujoco.mj_name2id(
                 m, mujoco.mjtObj.mjOBJ_SITE, f"{self.entity}/{PLANAR_SITE.format(name=name)}"
             )
-            centre = m.site_pos[site] if site >= 0 else (0.0, 0.0, 0.0)
-            self.world.set_controls(ids, planar_ctrl(self.plugin, now, centre))
+            centre, quat = (
+                (m.site_pos[site], m.site_quat[site]) if site >= 0 else ((0, 0, 0), (1, 0, 0, 0))
+            )
+            self.world.set_controls(ids, planar_ctrl(self.plugin, now, centre, quat))
             self.current = now  # type: ignore[assignment]
         self._written = dict(self.world.commands())
 

@@ -55,7 +55,7 @@ def _start_twists(state: WorldState, name: str) -> None:
         )
         if site < 0:
             continue
-        ctrl = planar_ctrl(plugin, twist, model.site_pos[site])
+        ctrl = planar_ctrl(plugin, twist, model.site_pos[site], model.site_quat[site])
         for axis, value in zip(("vx", "vy", "wz"), ctrl, strict=True):
             full = f"{name}/{planar_actuator(plugin.name, axis)}"
             a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, full)

@@ -19,10 +19,11 @@ from pathlib import Path
 import pytest
 
 from twin_cli.control import drive
+from twin_cli.control.drives import odometry
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world import World
 
-SLAB = """<sdf version="1.9"><model name="slab"><link name="body">
+SLAB = """<sdf version="1.9"><model name="slab"><link name="body"><pose>{link_pose}</pose>
   <inertial><pose>0.15 0.05 0 0 0 0</pose><mass>5</mass><inertia><ixx>0.05</ixx><iyy>0.08</iyy>
     <izz>0.1</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial>
   <collision name="c"><geometry><box><size>1.0 0.8 0.1</size></box></geometry>
@@ -39,19 +40,29 @@ def _unicycle(twist: tuple[float, float, float], t: float) -> tuple[float, float
     return (vx * s - vy * c) / wz, (vx * c + vy * s) / wz, wz * t
 
 
-def _slab(tmp_path: Path, tags: str) -> World:
+def _slab(tmp_path: Path, tags: str, link_pose: str = "0 0 0 0 0 0") -> World:
     path = tmp_path / "slab.sdf"
-    path.write_text(SLAB.format(tags=tags))
+    path.write_text(SLAB.format(tags=tags, link_pose=link_pose))
     world = World()
     world.spawn(SpawnRequest(str(path), on_ground=True), name="slab")
     return world
 
 
-@pytest.mark.parametrize("twist", [(0.4, 0.0, 0.2), (0.3, -0.1, -0.5), (-0.2, 0.15, 1.0)])
+@pytest.mark.parametrize(
+    ("twist", "link_pose"),
+    [
+        ((0.4, 0.0, 0.2), "0 0 0 0 0 0"),
+        ((0.3, -0.1, -0.5), "0 0 0 0 0 0"),
+        ((-0.2, 0.15, 1.0), "0 0 0 0 0 0"),
+        ((0.4, 0.1, 0.3), "0 0 0 0 0 1.5708"),  # the link turned in its model: the model's axes
+    ],
+)
 def test_its_initial_twist_moves_the_links_origin_from_load(
-    tmp_path: Path, twist: tuple[float, float, float]
+    tmp_path: Path, twist: tuple[float, float, float], link_pose: str
 ) -> None:
-    """The world and the exported scene.xml (from its home key) alike, every 2 s for 6 s."""
+    """The world and the exported scene.xml (from its home key) alike, every 2 s for 6 s. gz-sim
+    turns the twist by the model's pose, so a link turned in its model still moves along the
+    model's axes."""
     import mujoco
 
     from converters.mjcf.writer import write_model
@@ -61,7 +72,7 @@ def test_its_initial_twist_moves_the_links_origin_from_load(
     tags = (
         f"<initial_linear>{vx} {vy} 0</initial_linear><initial_angular>0 0 {wz}</initial_angular>"
     )
-    world = _slab(tmp_path, tags)
+    world = _slab(tmp_path, tags, link_pose)
     start = world.get_pose("slab")
     done = convert_full(tmp_path / "slab.sdf")
     scene = write_model(done.spec, done.report, tmp_path / "out" / "slab").parent / "scene.xml"
@@ -98,3 +109,20 @@ def test_twin_drive_replaces_its_twist_as_a_cmd_vel_does(tmp_path: Path) -> None
     turn = math.remainder(b.yaw - a.yaw, math.tau) / 0.1
     assert speed == pytest.approx(math.hypot(0.3, 0.1), rel=0.01), f"{speed:.4f} m/s"
     assert turn == pytest.approx(0.4, rel=0.01), f"{turn:.4f} rad/s"
+
+
+def test_reading_its_odometry_leaves_its_initial_twist_running(tmp_path: Path) -> None:
+    """`twin odom` reads: the slab keeps the 0.3 m/s and 0.2 rad/s it drives from load."""
+    world = _slab(
+        tmp_path,
+        "<initial_linear>0.3 0 0</initial_linear><initial_angular>0 0 0.2</initial_angular>",
+    )
+    world.step(1000)
+    odometry(world, "slab")
+    world.step(500)
+    a = world.get_pose("slab")
+    world.step(100)
+    b = world.get_pose("slab")
+    speed = math.hypot(b.x - a.x, b.y - a.y) / 0.1
+    turn = math.remainder(b.yaw - a.yaw, math.tau) / 0.1
+    assert (speed, turn) == pytest.approx((0.3, 0.2), rel=0.01), f"{speed:.4f} m/s, {turn:.4f}"
