@@ -40,6 +40,7 @@ from converters.control_text import (
 )
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
+    UNBOUNDED,
     AckermannDrive,
     DiffDrive,
     DriveRecord,
@@ -115,7 +116,10 @@ def joint_modes(record: DriveRecord) -> Sequence[JointMode]:
         return [(j, record.mode, record.force_range, record.pid) for j in record.joints]
     if isinstance(record, TrajectoryDrive):
         rows = zip(record.joints, record.force_ranges, record.pids, strict=True)
-        return [(j, "position" if pid else "effort", force, pid) for j, force, pid in rows]
+        # a limp joint: gz-sim adds a trajectory's effort after its PIDs' clamps, so unbounded
+        return [
+            (j, "position", f, pid) if pid else (j, "effort", UNBOUNDED, None) for j, f, pid in rows
+        ]
     return []
 
 
@@ -226,7 +230,7 @@ def _record(drive: DriveRecord, joint: str, mode: str, pid: tuple | None) -> dic
         "plugin": None,
     }
     offset = _pid_offset(drive, joint)
-    if pid and offset:
+    if offset and (pid or mode == "effort"):  # a limp trajectory joint's PIDs still push it
         record[PID_OFFSET] = offset
     if pid and pid[1] and isinstance(drive, JointDrive) and mode == "position":
         record[PID_INTEGRAL] = drive.integral_limit  # gz-math's integral, bounded or not

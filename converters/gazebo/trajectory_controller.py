@@ -13,8 +13,11 @@ kv = position_d_gain + velocity_p_gain (both terms act on the joint's speed), wi
 the two PIDs' output limits, with the sum of their `cmd_offset` forces as the servo's constant
 force; `twin trajectory ENTITY FILE` sends a trajectory. The joints start at
 their initial positions (the spawn posture) rather than being driven there from 0. A joint whose
-gains are all 0 gets no force from gz-sim but a trajectory's effort: twin leaves it limp, on a
-torque motor that takes effort commands, where it stays in the model's own posture.
+gains are all 0 gets only its PIDs' `cmd_offset` and a trajectory's effort from gz-sim: twin
+leaves it limp, in the model's own posture, on a torque motor that takes effort commands, with
+the offset as a constant force beside it. The velocity PID's unbounded integral is a spring on
+where the joint started (`_pid`): twin anchors it at the spawn posture, gz-sim at the posture
+before its PIDs drove the joint to `initial_position`.
 """
 
 from __future__ import annotations
@@ -84,8 +87,9 @@ def read_joint_trajectory_controller(p: Params, blob: Blob, ctx: ReadContext) ->
     ]
     topic = p.text(f"/model/{ctx.model}/joint_trajectory", "topic")
     limp_note = (
-        f"{', '.join(limp)}: gains all 0, so gz-sim pushes only a trajectory's efforts: limp, "
-        "on a torque motor (effort commands; twin trajectory files carry no efforts)"
+        f"{', '.join(limp)}: gains all 0, so gz-sim pushes only cmd_offset and a trajectory's "
+        "efforts: limp, on a torque motor (effort commands; twin trajectory files carry no "
+        "efforts)"
     )
     return TrajectoryDrive(
         name=blob.name or "JointTrajectoryController",

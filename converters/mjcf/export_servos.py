@@ -87,7 +87,9 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
         (i, a, records[a.target]) for i, a in enumerate(spec.actuators) if _servoed(a, records)
     ]
     driven = [a for a in spec.actuators if _offers_velocity(spec, a, records)]
+    offsets = _effort_offsets(records)  # constant forces beside PID plugins join these below
     if not chosen and not driven:
+        _add_offsets(spec, offsets)
         return {}
     servoed: dict[str, str] = {}
     held: dict[str, tuple[float, float]] = {}  # each position servo's force range
@@ -97,7 +99,6 @@ def export_servos(spec: mujoco.MjSpec, timestep: float = TIMESTEP_S) -> dict[str
     if key is not None and len(ctrl) != len(spec.actuators):
         ctrl = np.zeros(len(spec.actuators))
     motors = _motors(driven, records, inertia)
-    offsets: dict[str, float] = {}  # the constant force beside each PID plugin (`_add_offsets`)
     for i, actuator, record in chosen:
         joint = actuator.target
         if not inertia.get(joint, (0.0, 0.0))[0] > 0.0 or (
@@ -291,14 +292,30 @@ def _to_pid_plugin(
     actuator.actdim = 1
 
 
+def _effort_offsets(records: Mapping[str, dict]) -> dict[str, float]:
+    """The constant force [N m or N] of each joint a Gazebo PID with no gains leaves on its
+    torque motor (a JointTrajectoryController joint whose gains are all 0 still pushes its
+    `cmd_offset`), by joint."""
+    return {
+        joint: float(record[PID_OFFSET])
+        for joint, record in records.items()
+        if isinstance(record, dict)
+        and record.get(PID_OFFSET)
+        and (record.get("modes") or [None])[0] == "effort"
+    }
+
+
 def _add_offsets(spec: mujoco.MjSpec, offsets: Mapping[str, float]) -> None:
-    """Each gz-sim PID plugin's `cmd_offset` (`offsets`, by joint [N m or N]): MuJoCo's pid
-    actuator has no constant force, so a second actuator pushes it, through a one-joint tendon
-    (the joint keeps one joint actuator, its servo). gz-math clamps offset and PID together to
-    [cmd_min, cmd_max]; the plugin's force range is that range less the offset (`_to_servo`), so
+    """Each gz-sim PID plugin's `cmd_offset` (`offsets`, by joint [N m or N]; also a limp
+    joint's, `_effort_offsets`): MuJoCo's pid actuator has no constant force, so a second
+    actuator pushes it, through a one-joint tendon (the joint keeps one joint actuator).
+    gz-math clamps offset and PID together to [cmd_min, cmd_max], which the joint's effort
+    limit may narrow; the plugin's force range is that range less the offset (`_to_servo`), so
     the sum is clamped alike. Keyframes get ctrl 0 for the new actuators (they read no ctrl)."""
     import mujoco
 
+    have = {t.name for t in spec.tendons}  # a spec exported before keeps its pushes
+    offsets = {j: v for j, v in offsets.items() if f"{j}{PID_OFFSET_SUFFIX}" not in have}
     before = len(spec.actuators)
     for joint, offset in offsets.items():
         tendon = spec.add_tendon(name=f"{joint}{PID_OFFSET_SUFFIX}")

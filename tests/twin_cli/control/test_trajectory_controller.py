@@ -158,6 +158,37 @@ def test_a_joint_without_gains_is_limp_as_in_gz_sim_and_takes_efforts(tmp_path: 
     assert abs(level) < 1e-6, f"held by its weight's moment: {level:.2e} rad"
 
 
+@pytest.mark.parametrize("offset", [-4.905, -3.0])
+def test_a_limp_joints_cmd_offset_still_pushes_as_gz_maths_pid_does(
+    tmp_path: Path, offset: float
+) -> None:
+    """gz-math's PID with every gain 0 still outputs its `cmd_offset`: the level bar is held by
+    an offset of its weight's moment, and with less falls as the pendulum under the rest
+    (`gz_held_bar` with that constant force), in the world and in the exported scene.xml."""
+    import mujoco
+
+    from converters.mjcf.writer import write_model
+
+    path = tmp_path / "bar.urdf"
+    tag = f"<position_cmd_offset>{offset}</position_cmd_offset>"
+    path.write_text(LIMP_BAR.replace("<initial_position>0.4</initial_position>", tag))
+    world = World()
+    world.spawn(SpawnRequest(str(path)), name="bar")
+    law = gz_held_bar((0, 0, 0), None, 0.5, inertia=0.2501, load=4.905, every=0.1, offset=offset)
+    angles = []
+    for _ in law:
+        world.step(round(0.1 / world.model.opt.timestep))
+        angles.append(world.joint_states("bar")[0].position)
+    assert angles == pytest.approx(law, abs=1e-5), f"bar {angles}, gz-math {law}"
+    done = convert_full(path)
+    scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_step(model, data, nstep=round(0.5 / model.opt.timestep))
+    assert float(data.qpos[0]) == pytest.approx(law[-1], abs=1e-5), "scene.xml"
+
+
 VELOCITY_BAR = LIMP_BAR.replace(
     "<initial_position>0.4</initial_position>", "<initial_position>0</initial_position>{gains}"
 )
