@@ -1,4 +1,4 @@
-"""World files saved before joints had velocity motors, loaded into a world that gives them one.
+"""World files saved before the model gained elements, loaded into a world that has them.
 
 A joint whose tags offer velocity commands now has a velocity motor: a rotor body with a joint,
 an actuator and a tendon (`converters.mjcf.velocity_motors`). A file saved before holds the same
@@ -6,10 +6,14 @@ model without them, so its state is shorter by one qpos, one dof, one actuator a
 motor, and nothing else moved: the rotors were added after every element of their kind, in the
 order each array keeps. Such a state gets the rotors' entries put back in: angle 0, speed that
 of the joint each one drives (the motor holds the joint at the rotor's speed), the rest 0.
+
+Later, actuators alone were added (`PUSH`: a Gazebo PID's `cmd_offset` beside its pid plugin,
+gz-sim VelocityControl's planar servos): their ctrl entries are put back in as 0 the same way.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import fields, replace
 
 import mujoco
@@ -76,29 +80,85 @@ def add_rotors(
         return layout, state
     if np.size(state) != mujoco.mj_stateSize(model, STATE) - _added(model, masks):
         return layout, state
+    new = _widen(model, state, masks, int(model.na))
+    _rotor_speeds(model, new[1 + model.nq : 1 + model.nq + model.nv])
+    return layout_of(model), new
+
+
+PUSH = re.compile(r"(:offset|^(.*/)?planar:.*VelocityControl:(vx|vy|wz))$")
+"""Actuators added after world files were first saved: a Gazebo PID's `cmd_offset` beside its
+pid plugin (`JOINT:offset`) and gz-sim VelocityControl's planar servos. Neither adds a joint,
+a dof or a body, and the offsets came with the pid plugin's integral activation."""
+
+
+def push_masks(model: mujoco.MjModel) -> dict[str, np.ndarray]:
+    """Per qpos entry, dof, actuator and body of `model`: whether it is a `PUSH` actuator."""
+    names = [model.actuator(a).name for a in range(model.nu)]
+    return {
+        "qpos": np.zeros(model.nq, bool),
+        "dof": np.zeros(model.nv, bool),
+        "actuator": np.array([PUSH.search(n) is not None for n in names], bool),
+        "body": np.zeros(model.nbody, bool),
+    }
+
+
+def add_pushes(
+    model: mujoco.MjModel, layout: dict[str, int], state: np.ndarray
+) -> tuple[dict[str, int], np.ndarray]:
+    """A world state saved before those actuators (`PUSH`), with their ctrl entries added (0:
+    they read none, or start from the drive's own hold) and its activations as saved (a pid
+    integral the save lacked is added next, `savefile._pid_integrals`); any other unchanged."""
+    masks = push_masks(model)
+    older = older_layout(model, masks)
+    saved_na = int(layout.get("na", -1))
+    if not masks["actuator"].any() or {**layout, "na": older["na"]} != older:
+        return layout, state
+    if not 0 <= saved_na <= model.na:
+        return layout, state
+    expected = mujoco.mj_stateSize(model, STATE) - _added(model, masks) - (model.na - saved_na)
+    if np.size(state) != expected:
+        return layout, state
+    return {**layout_of(model), "na": saved_na}, _widen(model, state, masks, saved_na)
+
+
+def _widen(
+    model: mujoco.MjModel, state: np.ndarray, masks: dict[str, np.ndarray], na: int
+) -> np.ndarray:
+    """A saved `state` (with `na` activations) with zeros where `masks` mark new entries."""
     pieces, at = [], 0
     for bit in (1 << k for k in range(int(_S.mjNSTATE))):
         if not int(STATE) & bit:
             continue
-        size = mujoco.mj_stateSize(model, bit)
+        size = na if bit == int(_S.mjSTATE_ACT) else mujoco.mj_stateSize(model, bit)
         kind = _PER.get(bit)
         if kind is None:
             pieces.append(state[at : at + size])
             at += size
             continue
-        width = size // len(masks[kind])
+        width = size // len(masks[kind]) if len(masks[kind]) else 0
         old = state[at : at + size - width * int(masks[kind].sum())]
         at += len(old)
-        pieces.append(_widened(old, masks[kind], width))
-    new = np.concatenate(pieces)
-    _rotor_speeds(model, new[1 + model.nq : 1 + model.nq + model.nv])
-    return layout_of(model), new
+        pieces.append(_widened(old, masks[kind], width) if width else old)
+    return np.concatenate(pieces)
 
 
 def add_entity_rotors(model: mujoco.MjModel, index: EntityIndex, saved: EntityState) -> EntityState:
     """An entity's saved spawn state with its velocity motors' entries added, if it is exactly
     the state of the entity without them; any other state unchanged (the restore checks it)."""
-    masks = rotor_masks(model)
+    return _entity_widened(rotor_masks(model), index, saved)
+
+
+def add_entity_pushes(model: mujoco.MjModel, index: EntityIndex, saved: EntityState) -> EntityState:
+    """An entity's saved spawn state with the `PUSH` actuators' ctrl added, if it is exactly
+    the entity's state without them; any other state unchanged (the restore checks it)."""
+    return _entity_widened(push_masks(model), index, saved)
+
+
+def _entity_widened(
+    masks: dict[str, np.ndarray], index: EntityIndex, saved: EntityState
+) -> EntityState:
+    """`saved` with zeros where `masks` mark new entries, if it is exactly the entity's state
+    without them; else unchanged."""
     changes = {}
     for f in fields(EntityState):
         if f.name not in _ENTITY_PARTS:
@@ -107,11 +167,12 @@ def add_entity_rotors(model: mujoco.MjModel, index: EntityIndex, saved: EntitySt
         mask = masks[kind][getattr(index, part)]
         width = 6 if f.name == "xfrc_applied" else 1
         values = np.asarray(getattr(saved, f.name), float).ravel()
-        if not mask.any() or values.size != width * int((~mask).sum()):
-            return saved
-        wide = _widened(values, mask, width)
-        changes[f.name] = wide.reshape(-1, 6) if width == 6 else wide
-    return replace(saved, **changes)
+        if values.size != width * int((~mask).sum()):
+            return saved  # not this entity's state without the new entries
+        if mask.any():
+            wide = _widened(values, mask, width)
+            changes[f.name] = wide.reshape(-1, 6) if width == 6 else wide
+    return replace(saved, **changes) if changes else saved
 
 
 def _added(model: mujoco.MjModel, masks: dict[str, np.ndarray]) -> int:

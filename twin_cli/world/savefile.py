@@ -146,6 +146,7 @@ def load(path: str | os.PathLike) -> World:
     layout, state = save_upgrades.add_rotors(
         world.model, dict(doc.layout), np.array(doc.state, dtype=float)
     )
+    layout, state = save_upgrades.add_pushes(world.model, layout, state)
     layout, state = _servo_references(world, layout, state)
     layout, state = _pid_integrals(world.model, layout, state)
     laws = _laws(world)
@@ -389,6 +390,7 @@ def _respawn(path: str | os.PathLike, world: World, item: dict[str, Any]) -> Ent
     entity = world.entity(item["name"])
     index = world.index_of(item["name"])
     spawn_state = save_upgrades.add_entity_rotors(world.model, index, spawn_state)
+    spawn_state = save_upgrades.add_entity_pushes(world.model, index, spawn_state)
     if spawn_state.act.size != entity.spawn_state.act.size:
         # saved before its motors carried servo references, or before its tagged position
         # joints ran their own servos (no activation): the spawn's activations as spawned now
