@@ -92,10 +92,12 @@ class Params:
         if el is None:
             return (0.0, 0.0, 0.0)
         text = (el.text or "").strip()
-        parts = text.split()
-        if len(parts) != 3:
-            raise GazeboTagError(self.source, "", f"plugin/{tag}", text, "three numbers: x y z")
-        x, y, z = (self._number(tag, part, signed=True) for part in parts)
+        try:
+            x, y, z = (float(part) for part in text.split())
+        except ValueError:  # not three parts, or one is not a number
+            x = y = z = math.nan
+        if not all(math.isfinite(v) for v in (x, y, z)):
+            raise GazeboTagError(self.source, "", f"plugin/{tag}", text, "three numbers")
         return (x, y, z)
 
     def flag(self, default: bool, *tags: str) -> bool:

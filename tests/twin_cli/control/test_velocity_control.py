@@ -126,3 +126,20 @@ def test_reading_its_odometry_leaves_its_initial_twist_running(tmp_path: Path) -
     speed = math.hypot(b.x - a.x, b.y - a.y) / 0.1
     turn = math.remainder(b.yaw - a.yaw, math.tau) / 0.1
     assert (speed, turn) == pytest.approx((0.3, 0.2), rel=0.01), f"{speed:.4f} m/s, {turn:.4f}"
+
+
+@pytest.mark.parametrize("value", ["0.3 0", "0.3 zero 0", "0.3 0 inf"])
+def test_a_twist_that_is_not_three_numbers_is_refused_naming_its_tag(
+    tmp_path: Path, value: str
+) -> None:
+    """gz-sim reads `initial_linear` as a 3-vector: anything else is refused, the tag named."""
+    from converters.errors import GazeboTagError
+    from converters.pipeline import convert
+
+    path = tmp_path / "slab.sdf"
+    tags = f"<initial_linear>{value}</initial_linear>"
+    path.write_text(SLAB.format(tags=tags, link_pose="0 0 0 0 0 0"))
+    with pytest.raises(GazeboTagError, match=r"<plugin/initial_linear>") as caught:
+        convert(path)
+    assert f"value '{value}' is not three numbers" in str(caught.value), str(caught.value)
+    assert "e.g. <plugin/initial_linear>1 0 0<" in str(caught.value), "the fix, as an example"
