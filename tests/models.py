@@ -113,6 +113,18 @@ def block_on_incline(mu: float) -> str:
     return block(mu)
 
 
+def hinged_bar(plugin: str, effort: float = 1000.0) -> str:
+    """A 1 kg bar, its mass 0.5 m out along x, on a y-axis hinge to the world within ±3 rad:
+    gravity loads it by 4.905·cos q N m, its inertia about the hinge is 0.2501 kg m². `plugin`
+    is the robot's one `<gazebo>` plugin (the controller under test)."""
+    return f"""<robot name="bar"><link name="world"/>
+  <link name="bar"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-4"
+    iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hinge" type="revolute"><parent link="world"/><child link="bar"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="{effort:g}" velocity="10"/></joint>
+  <gazebo>{plugin}</gazebo></robot>"""
+
+
 def pendulum_pair(gravity_off_link: str | None = "left", tag: str = "turnGravityOff") -> str:
     """Two sibling pendulums on a world-fixed base, both horizontal at rest (hinges about y).
 

@@ -12,6 +12,7 @@ import re
 from pathlib import Path
 
 import pytest
+from models import hinged_bar
 from pid_law import gz_held_bar, gz_position_pid, pid_law
 
 from converters.mjcf.velocity_motors import rotor_name
@@ -263,15 +264,11 @@ def test_a_joint_controllers_force_stays_within_the_joints_effort_limit_too(
 # 4.905·cos q N m, which a JointPositionController (p 100, d 2, i 0) holding 0 answers alone, as
 # in Gazebo (no gravity compensation helps a PID): it settles where p·q = 4.905·cos q if its
 # output range reaches that force, and falls otherwise.
-BAR = """<robot name="bar"><link name="world"/><link name="base">{inertial}</link>
-  <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>
-  <link name="bar"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-4"
-    iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="revolute"><parent link="base"/><child link="bar"/>
-    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1000" velocity="10"/></joint>
-  <gazebo><plugin filename="gz-sim-joint-position-controller-system"
-    name="gz::sim::systems::JointPositionController"><joint_name>hinge</joint_name>
-    <p_gain>100</p_gain><d_gain>2</d_gain><i_gain>0</i_gain>{bounds}</plugin></gazebo></robot>"""
+BAR = hinged_bar(
+    '<plugin filename="gz-sim-joint-position-controller-system" '
+    'name="gz::sim::systems::JointPositionController"><joint_name>hinge</joint_name>'
+    "<p_gain>100</p_gain><d_gain>2</d_gain><i_gain>0</i_gain>{bounds}</plugin>"
+)  # `.format(bounds=…)`: the PID's range and integral tags
 
 
 @pytest.mark.parametrize(
@@ -291,7 +288,7 @@ def test_a_held_arm_gets_only_the_force_its_pids_range_allows(
     4.9 N m it needs, and falls past 0.3 rad when it does not (it then swings about where
     4.905·cos q = 2 N m)."""
     path = tmp_path / "bar.urdf"
-    path.write_text(BAR.format(inertial=INERTIAL, bounds=bounds))
+    path.write_text(BAR.format(bounds=bounds))
     world = World()
     world.spawn(SpawnRequest(str(path)), name="bar")
     world.command_joints("bar", {"hinge": 0.0}, mode="position")
@@ -351,7 +348,7 @@ def test_a_held_arms_pid_integral_takes_up_its_sag_as_gz_maths_does(
     from converters.pipeline import convert_full
 
     path = tmp_path / "bar.urdf"
-    path.write_text(BAR.format(inertial=INERTIAL, bounds=tags).replace("<i_gain>0</i_gain>", ""))
+    path.write_text(BAR.format(bounds=tags).replace("<i_gain>0</i_gain>", ""))
     i_gain = float(tags.split("<i_gain>")[1].split("<")[0]) if "<i_gain>" in tags else 0.1
     law = gz_held_bar(
         (100.0, i_gain, 2.0), bound, 8.0, inertia=0.2501, load=4.905, offset=offset, output=output
@@ -389,7 +386,7 @@ def test_a_files_own_pid_actuator_is_a_position_servo_and_takes_no_other_mode(
     from converters.pipeline import convert_full
 
     path = tmp_path / "bar.urdf"
-    path.write_text(BAR.format(inertial=INERTIAL, bounds="").replace("<i_gain>0</i_gain>", ""))
+    path.write_text(BAR.format(bounds="").replace("<i_gain>0</i_gain>", ""))
     done = convert_full(path)
     scene = write_model(done.spec, done.report, tmp_path / "out" / "bar").parent / "scene.xml"
     robot = scene.with_name("bar.xml")
@@ -435,7 +432,7 @@ def test_a_pid_integral_goes_on_while_island_sleeping_is_on(tmp_path: Path) -> N
     integral (0.1, within ±1) still rises as its integral grows, as gz-sim's does: a sleeping
     tree would stay where it fell asleep while the integral winds on."""
     path = tmp_path / "bar.urdf"
-    path.write_text(BAR.format(inertial=INERTIAL, bounds="").replace("<i_gain>0</i_gain>", ""))
+    path.write_text(BAR.format(bounds="").replace("<i_gain>0</i_gain>", ""))
     law = gz_held_bar((100.0, 0.1, 2.0), 1.0, 30.0, inertia=0.2501, load=4.905)
     world = World()
     world.spawn(SpawnRequest(str(path)), name="bar")

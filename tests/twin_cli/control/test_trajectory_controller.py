@@ -15,6 +15,7 @@ from pathlib import Path
 
 import drive_models as dm
 import pytest
+from models import hinged_bar
 from pid_law import gz_held_bar
 
 from converters.pipeline import convert_full
@@ -125,14 +126,12 @@ def test_its_cmd_offsets_shift_where_each_joint_settles_before_and_after_a_traje
     assert end == pytest.approx(expected, abs=2e-4), f"after a trajectory [rad]: {end}"
 
 
-LIMP_BAR = """<robot name="bar"><link name="world"/>
-  <link name="bar"><inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="1e-4"
-    iyy="1e-4" izz="1e-4" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="hinge" type="revolute"><parent link="world"/><child link="bar"/>
-    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="100" velocity="10"/></joint>
-  <gazebo><plugin filename="gz-sim-joint-trajectory-controller-system"
-    name="gz::sim::systems::JointTrajectoryController"><joint_name>hinge</joint_name>
-    <initial_position>0.4</initial_position></plugin></gazebo></robot>"""
+LIMP_BAR = hinged_bar(
+    '<plugin filename="gz-sim-joint-trajectory-controller-system" '
+    'name="gz::sim::systems::JointTrajectoryController"><joint_name>hinge</joint_name>'
+    "<initial_position>0.4</initial_position></plugin>",
+    effort=100.0,
+)
 
 
 def test_a_joint_without_gains_is_limp_as_in_gz_sim_and_takes_efforts(tmp_path: Path) -> None:
