@@ -69,7 +69,10 @@ def planar_actuator(plugin: str, axis: str) -> str:
 
 
 def planar_ctrl(
-    drive: HolonomicDrive, twist: Sequence[float], centre: Sequence[float], quat: Sequence[float]
+    drive: HolonomicDrive,
+    twist: Sequence[float],
+    centre: Sequence[float] | np.ndarray,
+    quat: Sequence[float] | np.ndarray,
 ) -> tuple[float, float, float]:
     """The planar servos' ctrl for `twist` (vx, vy, ωz): the servos move the robot's centre of
     mass (their site: `centre` from the root link's origin, turned by `quat`, both in the link's
