@@ -135,6 +135,27 @@ def check_moon_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     )
 
 
+def _constant_pushes(run: ScenarioRun) -> str:
+    """The entity's constant actuator forces, by joint ("hinge 3 N m, …"): a Gazebo PID's
+    `cmd_offset` (a servo's `biasprm[0]`, or the `JOINT:offset` push beside a pid plugin),
+    which moves a joint nothing else loads, in Gazebo as here."""
+    import mujoco
+
+    model, prefix = run.world.model, f"{run.entity}/"
+    found = []
+    for a in range(model.nu):
+        name = model.actuator(a).name
+        force = float(model.actuator_biasprm[a, 0])
+        affine = int(model.actuator_biastype[a]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
+        if not name.startswith(prefix) or not force or not affine:
+            continue  # only an affine bias's biasprm[0] is a constant force
+        joint = name.removesuffix(":offset")
+        j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        slide = j >= 0 and int(model.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_SLIDE)
+        found.append(f"'{joint.removeprefix(prefix)}' {force:g} {'N' if slide else 'N m'}")
+    return ", ".join(found)
+
+
 def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, float]):
     """Zero gravity: the robot floats; its COM and links stay where they started."""
     run = ScenarioRun(robot, scenario)
@@ -148,9 +169,12 @@ def check_zero_gravity(robot: RobotUnderTest, scenario: Scenario, th: dict[str, 
     worst = int(np.argmax(moved))
     hints = []
     if drift > th["max_com_drift_m"]:
+        pushes = _constant_pushes(run)
+        by = f"; its controllers push constant forces ({pushes})" if pushes else ""
         hints.append(
             f"the centre of mass drifts {fmt_len(drift)} without gravity: something pushes the "
-            "robot (springs against the world, a non-zero gravity tag, or a diverging contact)"
+            f"robot (springs against the world, a non-zero gravity tag, or a diverging contact)"
+            f"{by}"
         )
     if moved[worst] > th["max_link_motion_m"]:
         name = run.world.model.body(run.bodies[worst]).name.removeprefix(f"{run.entity}/")
