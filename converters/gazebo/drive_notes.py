@@ -140,6 +140,7 @@ USED: dict[str, set[str]] = {
         "child_frame_id",
     },
     "gz-sim-velocity-control-system": {"topic", "initial_linear", "initial_angular"},
+    "gz-sim-apply-joint-force-system": {"joint_name"},
     "gz-sim-joint-controller-system": {
         "joint_name",
         "use_force_commands",

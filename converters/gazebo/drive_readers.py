@@ -378,6 +378,20 @@ def read_joint_position_controller(p: Params, blob: Blob, ctx: ReadContext) -> J
     )
 
 
+def read_apply_joint_force(p: Params, blob: Blob, ctx: ReadContext) -> JointDrive:
+    """gz-sim ApplyJointForce: the force its `/model/<model>/joint/<joint>/cmd_force` carries,
+    on `joint_name`, held until the next one (none before): an effort command's torque."""
+    return JointDrive(
+        name=blob.name or "ApplyJointForce",
+        where=blob.where,
+        joints=_required(p, ("joint_name",)),
+        mode="effort",
+        pid=None,
+        force_range=UNBOUNDED,
+        family="gz_apply_joint_force",
+    )
+
+
 def _integral_limit(p: Params) -> tuple[float | None, tuple[str, ...]]:
     """The bound [N m or N] on gz-math's integral term: it clamps the term to [i_min, i_max]
     (defaults ∓1), or not at all when i_max < i_min. MuJoCo's pid actuator bounds it by one
@@ -425,4 +439,5 @@ READERS: dict[str, Reader] = {
     "gz-sim-joint-controller-system": read_joint_controller,
     "gz-sim-joint-position-controller-system": read_joint_position_controller,
     "gz-sim-joint-trajectory-controller-system": read_joint_trajectory_controller,
+    "gz-sim-apply-joint-force-system": read_apply_joint_force,
 }

@@ -250,11 +250,13 @@ class HolonomicDrive(_Record):
 
 @dataclass(frozen=True)
 class JointDrive(_Record):
-    """gz-sim's JointController (velocity) or JointPositionController (position) on joints.
+    """gz-sim's JointController (velocity), JointPositionController (position) or
+    ApplyJointForce (effort) on joints.
 
     Attributes:
-        joints: the joints it commands; mode: "velocity" or "position"; pid: (p, i, d) when the
-        system runs its own PID on the joint's force, else None (it sets the joint's velocity);
+        joints: the joints it commands; mode: "velocity", "position" or "effort"; pid: (p, i,
+        d) when the system runs its own PID on the joint's force, else None (it sets the joint's
+        velocity, or its force as commanded);
         force_range: (low, high) [N m or N] its force stays in; force_offset [N m or N] its PID
         adds (`cmd_offset`); integral_limit: [N m or N] the bound on its PID's integral term
         (None: unbounded); initial: the system's initial command, notes.

@@ -55,6 +55,7 @@ SYSTEM_NAMES = {
     "JointController": "gz-sim-joint-controller-system",
     "JointPositionController": "gz-sim-joint-position-controller-system",
     "JointTrajectoryController": "gz-sim-joint-trajectory-controller-system",
+    "ApplyJointForce": "gz-sim-apply-joint-force-system",
 }
 TRAJECTORY_KEY = "gz-sim-joint-trajectory-controller-system"
 # Systems twin does not run, with what running them would need (one report line each).
@@ -202,7 +203,9 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         elif kind == "vendor_drive":
             report.approximated("model", f"<plugin> {label}: {RUN[kind]}", tag="plugin")
         else:
-            mode = "position" if "position" in (drive_key(blob) or "") else "velocity"
+            key = drive_key(blob) or ""
+            mode = next((m for m in ("position", "force") if m in key), "velocity")
+            mode = "effort" if mode == "force" else mode
             report.mapped("model", f"<plugin> {label}: {RUN[kind].format(mode=mode)}", tag="plugin")
 
 
