@@ -20,6 +20,9 @@ from converters.description.gazebo import GazeboExtensions
 # A link of this name is the world itself: a joint to it fixes (or moves) the model against the
 # world instead of letting the base float (sdformat's URDF reader, Gazebo's spawn).
 WORLD_LINK = "world"
+# The site a converted model carries at its frame where that is not its root link's (SDF's
+# `__model__`): poses, gz-sim's model-frame commands and tf are given in it.
+MODEL_SITE = "__model__"
 
 # Shapes a geometry can have; `size` below gives each one's numbers.
 SHAPES = ("box", "cylinder", "sphere", "capsule", "ellipsoid", "plane", "mesh")

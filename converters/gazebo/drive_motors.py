@@ -38,6 +38,7 @@ from converters.control_text import (
     control_records,
     set_control_record,
 )
+from converters.description.robot import MODEL_SITE
 from converters.errors import PluginJointError
 from converters.gazebo.drive_records import (
     UNBOUNDED,
@@ -60,7 +61,6 @@ if TYPE_CHECKING:
 PLANAR_TAU = 1e-5  # [s] time constant of the planar velocity servo (implicit: any value is stable)
 PLANAR_AXES = (("vx", (1, 0, 0, 0, 0, 0)), ("vy", (0, 1, 0, 0, 0, 0)), ("wz", (0, 0, 0, 0, 0, 1)))
 PLANAR_SITE = "planar:{name}"
-MODEL_SITE = "__model__"  # the builder's site at an SDF model's frame (on the root link)
 
 
 def planar_actuator(plugin: str, axis: str) -> str:

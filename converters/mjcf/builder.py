@@ -13,6 +13,7 @@ import numpy as np
 from converters.collision.plan import CollisionRequest, CollisionSettings
 from converters.collision.prepare import prepare_collision_meshes
 from converters.description import RobotDescription
+from converters.description.robot import MODEL_SITE
 from converters.isolated.budget import XacroBudget
 from converters.mjcf import inertia as inr
 from converters.mjcf.actuators import actuated_joints, add_mimics, add_motors
@@ -37,8 +38,6 @@ COLLISION_CLASS = "collision"
 VISUAL_GROUP = 2
 COLLISION_GROUP = 3
 HOME_KEY = "home"
-# Site marking the model frame where it is not the root body's frame (SDF `__model__`).
-MODEL_SITE = "__model__"
 
 
 @dataclass(frozen=True)

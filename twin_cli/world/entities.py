@@ -12,15 +12,13 @@ from dataclasses import dataclass, field, fields, replace
 import mujoco
 import numpy as np
 
+from converters.description.robot import MODEL_SITE
 from twin_cli.spawn_request import SpawnRequest
 from twin_cli.world.pose import Pose
 
 _QPOS_WIDTH = np.array([7, 4, 1, 1])  # by mjtJoint: free, ball, slide, hinge
 _DOF_WIDTH = np.array([6, 3, 1, 1])
 _INT = np.int64
-
-# Site that marks a model frame apart from the root body (written by the converter for SDF).
-MODEL_SITE = "__model__"
 
 
 @dataclass(frozen=True)

@@ -19,6 +19,7 @@ from dataclasses import fields, replace
 import mujoco
 import numpy as np
 
+from converters.mjcf.export_servos import PID_OFFSET_SUFFIX
 from twin_cli.world.entities import EntityIndex, EntityState
 from twin_cli.world.snapshot import layout_of
 from twin_cli.world.state import STATE
@@ -85,7 +86,7 @@ def add_rotors(
     return layout_of(model), new
 
 
-PUSH = re.compile(r"(:offset|^(.*/)?planar:.*VelocityControl:(vx|vy|wz))$")
+PUSH = re.compile(rf"({re.escape(PID_OFFSET_SUFFIX)}|^(.*/)?planar:.*VelocityControl:(vx|vy|wz))$")
 """Actuators added after world files were first saved: a Gazebo PID's `cmd_offset` beside its
 pid plugin (`JOINT:offset`) and gz-sim VelocityControl's planar servos. Neither adds a joint,
 a dof or a body, and the offsets came with the pid plugin's integral activation."""

@@ -141,6 +141,8 @@ def _constant_pushes(run: ScenarioRun) -> str:
     which moves a joint nothing else loads, in Gazebo as here."""
     import mujoco
 
+    from converters.mjcf.export_servos import PID_OFFSET_SUFFIX
+
     model, prefix = run.world.model, f"{run.entity}/"
     found = []
     for a in range(model.nu):
@@ -149,7 +151,7 @@ def _constant_pushes(run: ScenarioRun) -> str:
         affine = int(model.actuator_biastype[a]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
         if not name.startswith(prefix) or not force or not affine:
             continue  # only an affine bias's biasprm[0] is a constant force
-        joint = name.removesuffix(":offset")
+        joint = name.removesuffix(PID_OFFSET_SUFFIX)
         j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
         slide = j >= 0 and int(model.jnt_type[j]) == int(mujoco.mjtJoint.mjJNT_SLIDE)
         found.append(f"'{joint.removeprefix(prefix)}' {force:g} {'N' if slide else 'N m'}")
