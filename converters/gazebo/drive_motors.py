@@ -90,6 +90,25 @@ def planar_ctrl(
     return vx - wz * float(r[1]), vy + wz * float(r[0]), wz
 
 
+def planar_controls(
+    model: mujoco.MjModel, entity: str, drive: HolonomicDrive, twist: Sequence[float]
+) -> tuple[list[int], tuple[float, float, float]] | None:
+    """The ids of `entity`'s planar servos for `drive` in a compiled world `model`, and their
+    ctrl for `twist` (`planar_ctrl`, from their site); None when the model has none (a
+    hand-written file)."""
+    import mujoco
+
+    actuator, site = mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SITE
+    ids = [
+        mujoco.mj_name2id(model, actuator, f"{entity}/{planar_actuator(drive.name, a)}")
+        for a, _ in PLANAR_AXES
+    ]
+    s = mujoco.mj_name2id(model, site, f"{entity}/{PLANAR_SITE.format(name=drive.name)}")
+    if min(ids) < 0 or s < 0:
+        return None
+    return ids, planar_ctrl(drive, twist, model.site_pos[s], model.site_quat[s])
+
+
 JointMode = tuple[str, str, "tuple[float, float]", "tuple[float, float, float] | None"]
 
 

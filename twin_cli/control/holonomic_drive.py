@@ -15,14 +15,13 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-import mujoco
-
-from converters.gazebo.drive_motors import PLANAR_SITE, planar_actuator, planar_ctrl
+from converters.gazebo.drive_motors import planar_controls
 from twin_cli.control.drive_base import DriveController, Twist
 from twin_cli.control.kinematics import ramp
 
 if TYPE_CHECKING:
     from converters.gazebo.drive_records import HolonomicDrive
+    from twin_cli.world import World
 
 
 LINEAR_RAMP = 3.0  # [m/s²] twin's ramp of a new command (the plugin sets it at once)
@@ -51,9 +50,9 @@ class HolonomicController(DriveController):
         vx, vy, wz = self.plugin.initial_twist
         return Twist(linear=vx, angular=wz, lateral=vy)
 
-    def _start(self) -> None:
-        super()._start()
-        self._reset_targets()
+    def __init__(self, world: World, entity: str, plugin: HolonomicDrive) -> None:
+        super().__init__(world, entity, plugin)  # made under the world's lock: no update yet
+        self._reset_targets()  # the ramp starts from the twist the servos hold from load
 
     def _reset_targets(self) -> None:
         vx, vy, wz = self.plugin.initial_twist
@@ -63,24 +62,11 @@ class HolonomicController(DriveController):
         goals = self.goals()
         limits = (LINEAR_RAMP, LINEAR_RAMP, ANGULAR_RAMP)
         now = tuple(ramp(c, g, a, dt) for c, g, a in zip(self.current, goals, limits, strict=True))
-        m = self.world.model
-        name = self.plugin.name
-        ids = [
-            mujoco.mj_name2id(
-                m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{self.entity}/{planar_actuator(name, a)}"
-            )
-            for a in ("vx", "vy", "wz")
-        ]
-        if any(a < 0 for a in ids):
-            return  # a hand-written model without the servos: nothing to drive
         if force or now != self.current:
-            site = mujoco.mj_name2id(
-                m, mujoco.mjtObj.mjOBJ_SITE, f"{self.entity}/{PLANAR_SITE.format(name=name)}"
-            )
-            centre, quat = (
-                (m.site_pos[site], m.site_quat[site]) if site >= 0 else ((0, 0, 0), (1, 0, 0, 0))
-            )
-            self.world.set_controls(ids, planar_ctrl(self.plugin, now, centre, quat))
+            servos = planar_controls(self.world.model, self.entity, self.plugin, now)
+            if servos is None:
+                return  # a hand-written model without the servos: nothing to drive
+            self.world.set_controls(*servos)
             self.current = now  # type: ignore[assignment]
         self._written = dict(self.world.commands())
 

@@ -41,23 +41,11 @@ def hold_from_load(state: WorldState, names: Iterable[str]) -> None:
 def _start_twists(state: WorldState, name: str) -> None:
     """A holonomic drive's twist from load (gz-sim VelocityControl's `initial_linear` and
     `initial_angular`) into its planar servos' ctrl, as the exported home key has it."""
-    import mujoco
+    from converters.gazebo.drive_motors import planar_controls
 
-    from converters.gazebo.drive_motors import PLANAR_SITE, planar_actuator, planar_ctrl
-
-    model = state.model
     for plugin in state.entities[name].plugins:
         twist = getattr(plugin, "initial_twist", None)
-        if not twist or not any(twist):
-            continue
-        site = mujoco.mj_name2id(
-            model, mujoco.mjtObj.mjOBJ_SITE, f"{name}/{PLANAR_SITE.format(name=plugin.name)}"
-        )
-        if site < 0:
-            continue
-        ctrl = planar_ctrl(plugin, twist, model.site_pos[site], model.site_quat[site])
-        for axis, value in zip(("vx", "vy", "wz"), ctrl, strict=True):
-            full = f"{name}/{planar_actuator(plugin.name, axis)}"
-            a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, full)
-            if a >= 0:
-                state.data.ctrl[a] = value
+        servos = planar_controls(state.model, name, plugin, twist) if twist and any(twist) else None
+        if servos is not None:
+            ids, ctrl = servos
+            state.data.ctrl[ids] = ctrl
