@@ -58,6 +58,10 @@ SYSTEM_NAMES = {
     "ApplyJointForce": "gz-sim-apply-joint-force-system",
 }
 TRAJECTORY_KEY = "gz-sim-joint-trajectory-controller-system"
+JOINT_DRIVE_MODES = {  # the mode a joint system's report names (JointController's: velocity)
+    "gz-sim-joint-position-controller-system": "position",
+    "gz-sim-apply-joint-force-system": "effort",
+}
 # Systems twin does not run, with what running them would need (one report line each).
 NEEDS = {
     "gz-sim-lift-drag-system": "LiftDrag: not run; needs lift and drag along the blade's "
@@ -203,9 +207,7 @@ def report_plugins(blobs: tuple[Blob, ...], report: Report) -> None:
         elif kind == "vendor_drive":
             report.approximated("model", f"<plugin> {label}: {RUN[kind]}", tag="plugin")
         else:
-            key = drive_key(blob) or ""
-            mode = next((m for m in ("position", "force") if m in key), "velocity")
-            mode = "effort" if mode == "force" else mode
+            mode = JOINT_DRIVE_MODES.get(drive_key(blob) or "", "velocity")
             report.mapped("model", f"<plugin> {label}: {RUN[kind].format(mode=mode)}", tag="plugin")
 
 
